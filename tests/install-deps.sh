@@ -1,0 +1,11 @@
+#!/bin/sh
+# Install the Debian 12 packages Franja needs to build, test and cross-build.
+# Idempotent; run as root (make deps).  Edit only the package list.
+set -e
+export DEBIAN_FRONTEND=noninteractive
+apt-get update
+apt-get install -y --no-install-recommends \
+    build-essential pkg-config \
+    libcjson-dev \
+    docker.io debootstrap qemu-user-static \
+    gcc-aarch64-linux-gnu libc6-dev-arm64-cross
