@@ -7,5 +7,7 @@ apt-get update
 apt-get install -y --no-install-recommends \
     build-essential pkg-config \
     libcjson-dev \
+    libssh-dev libopenimageio-dev openimageio-tools \
+    openssh-server openssh-client iproute2 procps doxygen \
     docker.io debootstrap qemu-user-static \
     gcc-aarch64-linux-gnu libc6-dev-arm64-cross
