@@ -1,0 +1,85 @@
+# Franja -- one entry point: build, test, bench, docs, dist.
+#
+#   make            bin/franja-worker and bin/franja
+#   make deps       install the Debian packages the project needs (root)
+#   make check      build and run every test
+#   make bench      benchmarks (see tests/bench/)
+#   make render     render scenes/cornell.json to cornell.png on this machine
+
+CC      ?= cc
+CXX     ?= c++
+PKG     ?= pkg-config
+# The render path must give the same bits on every host: no contraction into
+# fused multiply-adds, no fast-math.  -fno-math-errno only lets sqrtf be the
+# (exactly rounded) machine instruction.
+FPFLAGS  = -ffp-contract=off -fno-math-errno
+OPT     ?= -O2
+CFLAGS  ?= $(OPT) -g
+CSTD     = -std=c17 -D_GNU_SOURCE -Wall -Wextra -Werror -Wno-format-truncation $(FPFLAGS) -Icommon
+CXXSTD   = -std=c++17 -Wall -Wextra -Werror $(FPFLAGS) -Icommon
+
+CJSON_CFLAGS := $(shell $(PKG) --cflags libcjson 2>/dev/null)
+CJSON_LIBS   := $(shell $(PKG) --libs libcjson 2>/dev/null || echo -lcjson)
+SSH_LIBS     := $(shell $(PKG) --libs libssh 2>/dev/null || echo -lssh)
+OIIO_CFLAGS  := $(shell $(PKG) --cflags OpenImageIO 2>/dev/null)
+OIIO_LIBS    := $(shell $(PKG) --libs OpenImageIO 2>/dev/null)
+ASSIMP_LIBS  := $(shell $(PKG) --libs assimp 2>/dev/null || echo -lassimp)
+
+B = build
+COMMON_SRC  = $(wildcard common/*.c)
+COMMON_OBJ  = $(COMMON_SRC:%.c=$(B)/%.o)
+WORKER_SRC  = $(wildcard worker/*.c)
+WORKER_OBJ  = $(WORKER_SRC:%.c=$(B)/%.o)
+COORD_SRC   = $(wildcard coordinator/*.c)
+COORD_CXX   = $(wildcard coordinator/*.cpp)
+COORD_OBJ   = $(COORD_SRC:%.c=$(B)/%.o) $(COORD_CXX:%.cpp=$(B)/%.o)
+TEST_SRC    = $(wildcard tests/test_*.c)
+TEST_BIN    = $(TEST_SRC:tests/%.c=bin/tests/%)
+LIB         = $(B)/libfranja.a
+
+WORKER_LIBS = $(CJSON_LIBS) -lm
+COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm
+
+.PHONY: all deps check bench render clean docs fuzz static dist check-cross
+all: bin/franja-worker bin/franja
+
+$(B)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -MMD -MP -c $< -o $@
+
+$(B)/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXSTD) $(CFLAGS) $(OIIO_CFLAGS) -MMD -MP -c $< -o $@
+
+$(LIB): $(COMMON_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && $(AR) rcs $@ $^
+
+bin/franja-worker: $(WORKER_OBJ) $(LIB)
+	@mkdir -p bin
+	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(LIB) $(WORKER_LIBS)
+
+bin/franja: $(COORD_OBJ) $(LIB)
+	@mkdir -p bin
+	$(CC) $(CFLAGS) -o $@ $(COORD_OBJ) $(LIB) $(COORD_LIBS)
+
+bin/tests/%: tests/%.c $(LIB)
+	@mkdir -p bin/tests
+	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -Itests -o $@ $< $(LIB) $(WORKER_LIBS)
+
+deps:
+	sh tests/install-deps.sh
+
+check: all $(TEST_BIN)
+	sh tests/run.sh
+
+bench: all
+	sh tests/bench/run.sh
+
+render: all
+	bin/franja render scenes/cornell.json -o cornell.png
+
+clean:
+	rm -rf $(B) bin
+
+-include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d)

@@ -1,0 +1,218 @@
+#include "builder.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "bvh.h"
+#include "fbin.h"
+#include "fmath.h"
+
+static void array_init(fr_array *a, uint32_t elem) { memset(a, 0, sizeof *a); a->elem = elem; }
+
+void bld_init(fr_builder *b)
+{
+    memset(b, 0, sizeof *b);
+    array_init(&b->materials, sizeof(fr_material));
+    array_init(&b->prims, sizeof(fr_prim));
+    array_init(&b->spheres, sizeof(fr_sphere));
+    array_init(&b->rects, sizeof(fr_rect));
+    array_init(&b->triangles, sizeof(fr_triangle));
+    array_init(&b->positions, sizeof(vec3));
+    array_init(&b->normals, sizeof(vec3));
+    array_init(&b->uvs, sizeof(vec2));
+    array_init(&b->planes, sizeof(fr_plane));
+    array_init(&b->lights, sizeof(fr_light));
+}
+
+void bld_free(fr_builder *b)
+{
+    fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
+                       &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        free(all[i]->data);
+    memset(b, 0, sizeof *b);
+}
+
+uint32_t bld_push(fr_array *a, const void *elem)
+{
+    if (a->count == a->cap) {
+        uint32_t cap = a->cap ? a->cap * 2 : 16;
+        if (cap <= a->cap || cap >= FR_NONE / 2)
+            return FR_NONE;
+        void *p = realloc(a->data, (size_t)cap * a->elem);
+        if (!p)
+            return FR_NONE;
+        a->data = p;
+        a->cap = cap;
+    }
+    memcpy((char *)a->data + (size_t)a->count * a->elem, elem, a->elem);
+    return a->count++;
+}
+
+static uint32_t push_prim(fr_builder *b, uint32_t kind, uint32_t index, uint32_t material)
+{
+    if (index == FR_NONE)
+        return FR_NONE;
+    fr_prim p = {kind, index, material, FR_NONE};
+    return bld_push(&b->prims, &p);
+}
+
+uint32_t bld_sphere(fr_builder *b, vec3 center, float radius, uint32_t material)
+{
+    fr_sphere s = {center, radius};
+    return push_prim(b, FR_PRIM_SPHERE, bld_push(&b->spheres, &s), material);
+}
+
+uint32_t bld_rect(fr_builder *b, vec3 origin, vec3 edge_u, vec3 edge_v, uint32_t material)
+{
+    fr_rect r = {origin, edge_u, edge_v};
+    return push_prim(b, FR_PRIM_RECT, bld_push(&b->rects, &r), material);
+}
+
+uint32_t bld_triangle(fr_builder *b, vec3 p0, vec3 p1, vec3 p2, uint32_t material)
+{
+    uint32_t i0 = bld_push(&b->positions, &p0);
+    uint32_t i1 = bld_push(&b->positions, &p1);
+    uint32_t i2 = bld_push(&b->positions, &p2);
+    if (i0 == FR_NONE || i1 == FR_NONE || i2 == FR_NONE)
+        return FR_NONE;
+    fr_triangle t = {{i0, i1, i2}, 0};
+    return push_prim(b, FR_PRIM_TRIANGLE, bld_push(&b->triangles, &t), material);
+}
+
+void bld_material_finish(fr_material *m)
+{
+    /* Lobes are picked in proportion to their brightest channel, so a lobe
+     * that reflects little is rarely followed. */
+    float w[4] = {v3_max(m->diffuse), v3_max(m->glossy), v3_max(m->specular), v3_max(m->transmit)};
+    float sum = w[0] + w[1] + w[2] + w[3], acc = 0.0f;
+    for (int i = 0; i < 4; i++) {
+        acc += sum > 0.0f ? w[i] / sum : 0.0f;
+        m->p_lobe[i] = acc;
+    }
+    if (sum > 0.0f)
+        m->p_lobe[3] = 1.0f;
+}
+
+int bld_camera_finish(fr_camera *c, fr_error *err)
+{
+    vec3 f = v3_sub(c->target, c->position);
+    if (!(v3_len2(f) > 0.0f))
+        return fr_fail(err, "camera: target equals position");
+    f = v3_norm(f);
+    vec3 r = v3_cross(f, c->up);
+    if (!(v3_len2(r) > 1e-12f * v3_len2(c->up)))
+        return fr_fail(err, "camera: up is parallel to the viewing direction (or zero)");
+    r = v3_norm(r);
+    /* Image +x is right = forward x up seen from behind the camera; with
+     * +y up and view along +z that is world -x, as the Cornell convention says. */
+    c->forward = f;
+    c->right = r;
+    c->upv = v3_cross(r, f);
+    if (!(c->vfov > 0.0f && c->vfov < FM_PI))
+        return fr_fail(err, "camera: fov must be in (0, 180) degrees");
+    c->tan_half = fm_tanf(0.5f * c->vfov);
+    return 0;
+}
+
+static float prim_area(const fr_builder *b, const fr_prim *p)
+{
+    if (p->kind == FR_PRIM_SPHERE) {
+        float r = ((const fr_sphere *)b->spheres.data)[p->index].radius;
+        return 4.0f * FM_PI * r * r;
+    }
+    if (p->kind == FR_PRIM_RECT) {
+        const fr_rect *q = &((const fr_rect *)b->rects.data)[p->index];
+        return v3_len(v3_cross(q->edge_u, q->edge_v));
+    }
+    const fr_triangle *t = &((const fr_triangle *)b->triangles.data)[p->index];
+    const vec3 *pos = b->positions.data;
+    return 0.5f * v3_len(v3_cross(v3_sub(pos[t->v[1]], pos[t->v[0]]), v3_sub(pos[t->v[2]], pos[t->v[0]])));
+}
+
+/* Turn every prim with an emissive material into an area light and set the
+ * probability of picking each light proportional to its power. */
+static int make_lights(fr_builder *b, fr_error *err)
+{
+    const fr_material *mats = b->materials.data;
+    fr_prim *prims = b->prims.data;
+    for (uint32_t i = 0; i < b->prims.count; i++) {
+        const fr_material *m = &mats[prims[i].material];
+        prims[i].light = FR_NONE;
+        if (v3_is_zero(m->emission))
+            continue;
+        fr_light l;
+        memset(&l, 0, sizeof l);
+        l.kind = FR_LIGHT_PRIM;
+        l.prim = i;
+        l.area = prim_area(b, &prims[i]);
+        uint32_t li = bld_push(&b->lights, &l);
+        if (li == FR_NONE)
+            return fr_fail(err, "out of memory for lights");
+        prims[i].light = li;
+    }
+    fr_light *lights = b->lights.data;
+    double total = 0.0;
+    for (uint32_t i = 0; i < b->lights.count; i++) {
+        double power;
+        if (lights[i].kind == FR_LIGHT_POINT) {
+            power = 4.0 * FM_PI * v3_luma(lights[i].intensity);
+        } else {
+            const fr_material *m = &mats[prims[lights[i].prim].material];
+            power = FM_PI * v3_luma(m->emission) * lights[i].area * (m->two_sided ? 2.0 : 1.0);
+        }
+        lights[i].pick = (float)power;
+        total += power;
+    }
+    double acc = 0.0;
+    for (uint32_t i = 0; i < b->lights.count; i++) {
+        double p = total > 0.0 ? lights[i].pick / total : 1.0 / b->lights.count;
+        acc += p;
+        lights[i].pick = (float)p;
+        lights[i].cdf = i + 1 == b->lights.count ? 1.0f : (float)acc;
+    }
+    return 0;
+}
+
+int bld_finish(fr_builder *b, fr_scene *out, fr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (bld_camera_finish(&b->camera, err) < 0)
+        return -1;
+    fr_array nodes;
+    array_init(&nodes, sizeof(fr_bvh_node));
+    /* The BVH reorders prims, so lights (which point at prims) come after. */
+    if (bvh_build(b, &nodes, err) < 0)
+        return -1;
+    /* Point lights were pushed by the parser; area lights are derived here. */
+    fr_array points = b->lights;
+    array_init(&b->lights, sizeof(fr_light));
+    int rc = 0;
+    for (uint32_t i = 0; i < points.count && rc == 0; i++)
+        if (bld_push(&b->lights, (fr_light *)points.data + i) == FR_NONE)
+            rc = fr_fail(err, "out of memory for lights");
+    free(points.data);
+    if (rc == 0)
+        rc = make_lights(b, err);
+
+    fr_scene view;
+    memset(&view, 0, sizeof view);
+    view.settings = b->settings;
+    view.camera = b->camera;
+#define VIEW(field, arr) view.field = arr.data, view.n_##field = arr.count
+    VIEW(materials, b->materials); VIEW(prims, b->prims); VIEW(spheres, b->spheres);
+    VIEW(rects, b->rects); VIEW(triangles, b->triangles); VIEW(positions, b->positions);
+    VIEW(normals, b->normals); VIEW(uvs, b->uvs); VIEW(planes, b->planes);
+    VIEW(lights, b->lights); VIEW(nodes, nodes);
+#undef VIEW
+    void *blob = NULL;
+    size_t size = 0;
+    if (rc == 0)
+        rc = fbin_serialize(&view, &blob, &size, err);
+    free(nodes.data);
+    if (rc == 0)
+        rc = fbin_open_mem(blob, size, 0, out, err);
+    if (rc < 0)
+        free(blob);
+    return rc;
+}

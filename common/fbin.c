@@ -1,0 +1,281 @@
+#include "fbin.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
+static const unsigned char fbin_magic[8] = {0x89, 'F', 'R', 'J', 'S', 'C', 'N', '\n'};
+enum { HEADER_SIZE = 64, ENTRY_SIZE = 32, ALIGN = 64 };
+
+enum {
+    SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
+    SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES,
+    SEC_COUNT = SEC_NODES
+};
+
+/* Where each section lives in an fr_scene, so serialize and open share one
+ * table instead of thirteen copies of the same lines. */
+typedef struct {
+    const char *name;
+    uint32_t elem;
+    size_t data_off, count_off; /* offsetof into fr_scene; count_off 0 = exactly one element */
+} section_desc;
+
+#define ARR(id, name, field, type) \
+    [id] = {name, sizeof(type), offsetof(fr_scene, field), offsetof(fr_scene, n_##field)}
+static const section_desc sections[SEC_COUNT + 1] = {
+    [SEC_SETTINGS] = {"settings", sizeof(fr_settings), offsetof(fr_scene, settings), 0},
+    [SEC_CAMERA] = {"camera", sizeof(fr_camera), offsetof(fr_scene, camera), 0},
+    ARR(SEC_MATERIALS, "materials", materials, fr_material),
+    ARR(SEC_PRIMS, "prims", prims, fr_prim),
+    ARR(SEC_SPHERES, "spheres", spheres, fr_sphere),
+    ARR(SEC_RECTS, "rects", rects, fr_rect),
+    ARR(SEC_TRIANGLES, "triangles", triangles, fr_triangle),
+    ARR(SEC_POSITIONS, "positions", positions, vec3),
+    ARR(SEC_NORMALS, "normals", normals, vec3),
+    ARR(SEC_UVS, "uvs", uvs, vec2),
+    ARR(SEC_PLANES, "planes", planes, fr_plane),
+    ARR(SEC_LIGHTS, "lights", lights, fr_light),
+    ARR(SEC_NODES, "nodes", nodes, fr_bvh_node),
+};
+#undef ARR
+
+static void put32(unsigned char *p, uint32_t v) { for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i)); }
+static void put64(unsigned char *p, uint64_t v) { for (int i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i)); }
+static uint32_t get32(const unsigned char *p) { uint32_t v = 0; for (int i = 3; i >= 0; i--) v = v << 8 | p[i]; return v; }
+static uint64_t get64(const unsigned char *p) { uint64_t v = 0; for (int i = 7; i >= 0; i--) v = v << 8 | p[i]; return v; }
+
+static size_t align_up(size_t x) { return (x + ALIGN - 1) & ~(size_t)(ALIGN - 1); }
+
+static const void *sec_data(const fr_scene *s, int id, uint64_t *count)
+{
+    const section_desc *d = &sections[id];
+    if (!d->count_off) {
+        *count = 1;
+        return (const char *)s + d->data_off;
+    }
+    *count = *(const uint32_t *)((const char *)s + d->count_off);
+    return *(const void *const *)((const char *)s + d->data_off);
+}
+
+void fbin_hash_hex(uint64_t hash, char buf[17]) { snprintf(buf, 17, "%016llx", (unsigned long long)hash); }
+
+int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err)
+{
+    if (*(const uint32_t *)"\1\0\0\0" != 1)
+        return fr_fail(err, "binary scenes are little-endian; this host is not");
+    size_t off = align_up(HEADER_SIZE + (size_t)ENTRY_SIZE * SEC_COUNT);
+    size_t offsets[SEC_COUNT + 1];
+    for (int id = 1; id <= SEC_COUNT; id++) {
+        uint64_t count;
+        sec_data(view, id, &count);
+        offsets[id] = off;
+        off = align_up(off + count * sections[id].elem);
+    }
+    unsigned char *p = calloc(1, off);
+    if (!p)
+        return fr_fail(err, "out of memory serializing the scene (%zu bytes)", off);
+    memcpy(p, fbin_magic, 8);
+    put32(p + 8, FBIN_VERSION);
+    put32(p + 12, 0x01020304u);
+    put32(p + 16, HEADER_SIZE);
+    put32(p + 20, SEC_COUNT);
+    put64(p + 24, off);
+    for (int id = 1; id <= SEC_COUNT; id++) {
+        uint64_t count;
+        const void *data = sec_data(view, id, &count);
+        unsigned char *e = p + HEADER_SIZE + (size_t)ENTRY_SIZE * (id - 1);
+        put32(e, (uint32_t)id);
+        put32(e + 4, sections[id].elem);
+        put64(e + 8, offsets[id]);
+        put64(e + 16, count);
+        put64(e + 24, count * sections[id].elem);
+        if (count)
+            memcpy(p + offsets[id], data, count * sections[id].elem);
+    }
+    put64(p + 32, XXH3_64bits(p + HEADER_SIZE, off - HEADER_SIZE));
+    *blob = p;
+    *size = off;
+    return 0;
+}
+
+static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+/* Check every cross-reference so that rendering can index without checks. */
+static int validate(const fr_scene *s, fr_error *err)
+{
+    const fr_settings *st = &s->settings;
+    if (st->width == 0 || st->height == 0 || st->width > 65536 || st->height > 65536 || st->spp == 0)
+        return fr_fail(err, "section settings: bad image size or sample count");
+    const fr_camera *c = &s->camera;
+    if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
+        !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !(c->focus > 0.0f || c->aperture == 0.0f))
+        return fr_fail(err, "section camera: degenerate or non-finite camera");
+    for (uint32_t i = 0; i < s->n_materials; i++) {
+        const fr_material *m = &s->materials[i];
+        if (m->tex_diffuse != FR_NONE || m->tex_bump != FR_NONE)
+            return fr_fail(err, "section materials: element %u: texture index out of range", i);
+        if (!(m->p_lobe[3] >= 0.0f && m->p_lobe[3] <= 1.0f) || !(m->ior > 0.0f) || !(m->exponent >= 0.0f))
+            return fr_fail(err, "section materials: element %u: bad lobe probabilities, ior or exponent", i);
+    }
+    uint32_t kind_count[FR_PRIM_KINDS] = {s->n_triangles, s->n_spheres, s->n_rects};
+    for (uint32_t i = 0; i < s->n_prims; i++) {
+        const fr_prim *p = &s->prims[i];
+        if (p->kind >= FR_PRIM_KINDS || p->index >= kind_count[p->kind])
+            return fr_fail(err, "section prims: element %u: bad kind or index", i);
+        if (p->material >= s->n_materials)
+            return fr_fail(err, "section prims: element %u: material %u out of range", i, p->material);
+        if (p->light != FR_NONE && (p->light >= s->n_lights || s->lights[p->light].kind != FR_LIGHT_PRIM ||
+                                    s->lights[p->light].prim != i))
+            return fr_fail(err, "section prims: element %u: light %u does not point back", i, p->light);
+    }
+    for (uint32_t i = 0; i < s->n_triangles; i++) {
+        const fr_triangle *t = &s->triangles[i];
+        for (int k = 0; k < 3; k++) {
+            if (t->v[k] >= s->n_positions ||
+                ((t->flags & FR_TRI_NORMALS) && t->v[k] >= s->n_normals) ||
+                ((t->flags & FR_TRI_UVS) && t->v[k] >= s->n_uvs))
+                return fr_fail(err, "section triangles: element %u: vertex index %u out of range", i, t->v[k]);
+        }
+    }
+    for (uint32_t i = 0; i < s->n_planes; i++)
+        if (s->planes[i].material >= s->n_materials)
+            return fr_fail(err, "section planes: element %u: material out of range", i);
+    for (uint32_t i = 0; i < s->n_lights; i++) {
+        const fr_light *l = &s->lights[i];
+        if (l->kind > FR_LIGHT_PRIM || (l->kind == FR_LIGHT_PRIM && (l->prim >= s->n_prims || s->prims[l->prim].light != i)))
+            return fr_fail(err, "section lights: element %u: bad kind or primitive", i);
+        if (!(l->pick > 0.0f && l->pick <= 1.0f))
+            return fr_fail(err, "section lights: element %u: bad pick probability", i);
+    }
+    if (s->n_prims > 0 && s->n_nodes == 0)
+        return fr_fail(err, "section nodes: scene has primitives but no BVH");
+    for (uint32_t i = 0; i < s->n_nodes; i++) {
+        const fr_bvh_node *n = &s->nodes[i];
+        uint32_t count = n->count & 0xffffffu;
+        if (count == 0) {
+            /* Children must lie after their parent: no cycles, bounded depth is checked in traversal. */
+            if (i + 1 >= s->n_nodes || n->offset <= i + 1 || n->offset >= s->n_nodes || (n->count >> 24) > 2)
+                return fr_fail(err, "section nodes: element %u: child index out of range", i);
+        } else if (n->offset > s->n_prims || count > s->n_prims - n->offset) {
+            return fr_fail(err, "section nodes: element %u: primitive range out of bounds", i);
+        }
+    }
+    return 0;
+}
+
+int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *err)
+{
+    const unsigned char *p = blob;
+    memset(out, 0, sizeof *out);
+    if (size < HEADER_SIZE)
+        return fr_fail(err, "header: file is %zu bytes, shorter than the %d-byte header", size, HEADER_SIZE);
+    if (memcmp(p, fbin_magic, 8) != 0)
+        return fr_fail(err, "byte 0: not a Franja binary scene (bad magic)");
+    if (get32(p + 8) != FBIN_VERSION)
+        return fr_fail(err, "byte 8: scene format version %u, this program reads version %d", get32(p + 8), FBIN_VERSION);
+    if (get32(p + 12) != 0x01020304u || *(const uint32_t *)"\1\0\0\0" != 1)
+        return fr_fail(err, "byte 12: byte order mismatch (binary scenes are little-endian)");
+    uint32_t nsec = get32(p + 20);
+    if (get32(p + 16) != HEADER_SIZE || nsec != SEC_COUNT)
+        return fr_fail(err, "byte 16: header size %u / section count %u, expected %d / %d", get32(p + 16), nsec, HEADER_SIZE, SEC_COUNT);
+    if (get64(p + 24) != size)
+        return fr_fail(err, "byte 24: header says %llu bytes, file has %zu (truncated?)", (unsigned long long)get64(p + 24), size);
+    if ((size_t)HEADER_SIZE + (size_t)ENTRY_SIZE * nsec > size)
+        return fr_fail(err, "byte %d: section table runs past the end of the file", HEADER_SIZE);
+    uint64_t hash = XXH3_64bits(p + HEADER_SIZE, size - HEADER_SIZE);
+    if (hash != get64(p + 32))
+        return fr_fail(err, "byte 32: content hash mismatch (file is corrupt)");
+    for (uint32_t k = 0; k < nsec; k++) {
+        const unsigned char *e = p + HEADER_SIZE + (size_t)ENTRY_SIZE * k;
+        size_t at = HEADER_SIZE + (size_t)ENTRY_SIZE * k;
+        uint32_t id = get32(e), elem = get32(e + 4);
+        uint64_t off = get64(e + 8), count = get64(e + 16), bytes = get64(e + 24);
+        if (id != k + 1)
+            return fr_fail(err, "byte %zu: section %u has id %u, expected %u", at, k, id, k + 1);
+        const section_desc *d = &sections[id];
+        if (elem != d->elem)
+            return fr_fail(err, "byte %zu: section %s: element size %u, expected %u", at, d->name, elem, d->elem);
+        if (off % ALIGN || off > size || count > 0xffffffffu || bytes != count * elem || bytes > size - off)
+            return fr_fail(err, "byte %zu: section %s: offset %llu / count %llu out of bounds", at, d->name,
+                           (unsigned long long)off, (unsigned long long)count);
+        if (!d->count_off) {
+            if (count != 1)
+                return fr_fail(err, "byte %zu: section %s: count %llu, expected 1", at, d->name, (unsigned long long)count);
+            memcpy((char *)out + d->data_off, p + off, elem);
+        } else {
+            *(const void **)((char *)out + d->data_off) = p + off;
+            *(uint32_t *)((char *)out + d->count_off) = (uint32_t)count;
+        }
+    }
+    if (validate(out, err) < 0) {
+        memset(out, 0, sizeof *out);
+        return -1;
+    }
+    out->hash = hash;
+    out->blob = blob;
+    out->blob_size = size;
+    out->mapped = mapped;
+    return 0;
+}
+
+int fbin_load(const char *path, fr_scene *out, fr_error *err)
+{
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return fr_fail(err, "%s: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) < 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return fr_fail(err, "%s: not a regular file", path);
+    }
+    size_t size = (size_t)st.st_size;
+    void *m = size ? mmap(NULL, size, PROT_READ, MAP_PRIVATE, fd, 0) : MAP_FAILED;
+    close(fd);
+    if (m == MAP_FAILED)
+        return fr_fail(err, "%s: %s", path, size ? strerror(errno) : "empty file");
+    fr_error e;
+    if (fbin_open_mem(m, size, 1, out, &e) < 0) {
+        munmap(m, size);
+        return fr_fail(err, "%s: %s", path, e.msg);
+    }
+    return 0;
+}
+
+int fbin_write(const fr_scene *s, const char *path, fr_error *err)
+{
+    char tmp[4096];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof tmp)
+        return fr_fail(err, "%s: path too long", path);
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return fr_fail(err, "%s: %s", tmp, strerror(errno));
+    int ok = fwrite(s->blob, 1, s->blob_size, f) == s->blob_size;
+    ok = (fclose(f) == 0) && ok;
+    if (!ok || rename(tmp, path) < 0) {
+        int e = errno;
+        unlink(tmp);
+        return fr_fail(err, "%s: %s", path, strerror(e));
+    }
+    return 0;
+}
+
+void scn_free(fr_scene *s)
+{
+    if (s->blob) {
+        if (s->mapped)
+            munmap(s->blob, s->blob_size);
+        else
+            free(s->blob);
+    }
+    memset(s, 0, sizeof *s);
+}

@@ -1,0 +1,39 @@
+/* fbin.h -- the binary scene: one file a worker maps and renders from.
+ *
+ * Layout (little-endian, specified in common/FORMAT.md): a 64-byte header
+ * with magic, version and content hash, a table of sections, then each
+ * section's array of fixed-size elements, 64-byte aligned.  The content
+ * hash (XXH3-64 of everything after the header) names the scene in partial
+ * images and host caches.
+ *
+ * Every open checks the header, every section's bounds and size, the hash
+ * and every index inside (vertex, material, light, BVH child and range)
+ * before the scene is used, so a truncated or corrupt file is refused with
+ * the section and byte offset at fault, never a crash. */
+#ifndef FRANJA_FBIN_H
+#define FRANJA_FBIN_H
+
+#include "error.h"
+#include "scene.h"
+
+#define FBIN_VERSION 1
+
+/* Serialize the arrays `view` points at into a new malloc'd blob (owned by
+ * the caller) and compute its hash. */
+int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err);
+
+/* Validate `blob` and point *out into it.  On success *out owns the blob
+ * (freed or unmapped by scn_free according to `mapped`); on failure the
+ * caller still owns it. */
+int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *err);
+
+/* Map and validate a binary scene file.  Errors name the file. */
+int fbin_load(const char *path, fr_scene *out, fr_error *err);
+
+/* Write a scene's blob to `path` atomically (temporary name, then rename). */
+int fbin_write(const fr_scene *s, const char *path, fr_error *err);
+
+/* The 16 lowercase hex digits of a hash, NUL-terminated, into buf[17]. */
+void fbin_hash_hex(uint64_t hash, char buf[17]);
+
+#endif

@@ -1,0 +1,124 @@
+#include "image.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmath.h"
+
+float img_srgb_encode(float v)
+{
+    if (!(v > 0.0f))
+        return 0.0f;
+    if (v >= 1.0f)
+        return 1.0f;
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * fm_powf(v, 1.0f / 2.4f) - 0.055f;
+}
+
+int img_format_parse(const char *name, img_format *fmt)
+{
+    if (!strcmp(name, "pf")) *fmt = IMG_PF;
+    else if (!strcmp(name, "ppm16")) *fmt = IMG_PPM16;
+    else if (!strcmp(name, "ppm8")) *fmt = IMG_PPM8;
+    else return -1;
+    return 0;
+}
+
+int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, fr_error *err)
+{
+    uint32_t w = info->width, rows = info->y1 - info->y0;
+    fprintf(f, "%s\n# franja scene=%016" PRIx64 " rows=%u:%u spp=%u size=%ux%u\n%u %u\n%s\n",
+            fmt == IMG_PF ? "PF" : "P6", info->scene, info->y0, info->y1, info->spp, info->width,
+            info->height, w, rows, fmt == IMG_PF ? "-1.0" : fmt == IMG_PPM16 ? "65535" : "255");
+    size_t rowbytes = (size_t)w * 3 * (fmt == IMG_PF ? 4 : fmt == IMG_PPM16 ? 2 : 1);
+    unsigned char *line = malloc(rowbytes ? rowbytes : 1);
+    if (!line)
+        return fr_fail(err, "out of memory writing the image");
+    for (uint32_t r = 0; r < rows; r++) {
+        /* PFM stores the bottom row first. */
+        const float *src = rgb + (size_t)(fmt == IMG_PF ? rows - 1 - r : r) * w * 3;
+        for (size_t i = 0; i < (size_t)w * 3; i++) {
+            if (fmt == IMG_PF) {
+                uint32_t bits;
+                memcpy(&bits, &src[i], 4);
+                for (int k = 0; k < 4; k++)
+                    line[i * 4 + k] = (unsigned char)(bits >> (8 * k));
+            } else if (fmt == IMG_PPM16) {
+                unsigned v = (unsigned)(img_srgb_encode(src[i]) * 65535.0f + 0.5f);
+                line[i * 2] = (unsigned char)(v >> 8);
+                line[i * 2 + 1] = (unsigned char)v;
+            } else {
+                line[i] = (unsigned char)(img_srgb_encode(src[i]) * 255.0f + 0.5f);
+            }
+        }
+        if (fwrite(line, 1, rowbytes, f) != rowbytes) {
+            free(line);
+            return fr_fail(err, "write failed: %s", strerror(errno));
+        }
+    }
+    free(line);
+    if (fflush(f) != 0)
+        return fr_fail(err, "write failed: %s", strerror(errno));
+    return 0;
+}
+
+/* Read one header line (without the newline) starting at *pos. */
+static int header_line(const unsigned char *buf, size_t len, size_t *pos, char *out, size_t cap)
+{
+    size_t i = 0;
+    while (*pos < len && buf[*pos] != '\n') {
+        if (i + 1 >= cap)
+            return -1;
+        out[i++] = (char)buf[(*pos)++];
+    }
+    if (*pos >= len)
+        return -1;
+    (*pos)++;
+    out[i] = 0;
+    return 0;
+}
+
+int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *info, float **rgb, fr_error *err)
+{
+    char line[256];
+    size_t pos = 0, at;
+    if (header_line(buf, len, &pos, line, sizeof line) < 0 || strcmp(line, "PF") != 0)
+        return fr_fail(err, "byte 0: not a PF (float RGB) partial image");
+    at = pos;
+    unsigned long long scene;
+    unsigned y0, y1, spp, fw, fh;
+    char tail;
+    if (header_line(buf, len, &pos, line, sizeof line) < 0 ||
+        sscanf(line, "# franja scene=%16llx rows=%u:%u spp=%u size=%ux%u%c", &scene, &y0, &y1, &spp, &fw, &fh,
+               &tail) != 6)
+        return fr_fail(err, "byte %zu: missing or malformed franja header comment", at);
+    at = pos;
+    unsigned w, h;
+    if (header_line(buf, len, &pos, line, sizeof line) < 0 || sscanf(line, "%u %u%c", &w, &h, &tail) != 2)
+        return fr_fail(err, "byte %zu: expected '<width> <height>'", at);
+    at = pos;
+    if (header_line(buf, len, &pos, line, sizeof line) < 0 || strcmp(line, "-1.0") != 0)
+        return fr_fail(err, "byte %zu: expected scale -1.0 (little-endian)", at);
+    if (y0 >= y1 || y1 > fh || w != fw || h != y1 - y0 || w == 0 || fw > 65536 || fh > 65536)
+        return fr_fail(err, "byte %zu: size %ux%u does not match rows %u:%u of a %ux%u image", at, w, h, y0, y1,
+                       fw, fh);
+    size_t n = (size_t)w * h * 3;
+    if (len - pos != n * 4)
+        return fr_fail(err, "byte %zu: %zu bytes of pixels, expected %zu", pos, len - pos, n * 4);
+    float *out = malloc(n * sizeof *out);
+    if (!out)
+        return fr_fail(err, "out of memory reading a partial image");
+    for (size_t r = 0; r < h; r++) {
+        const unsigned char *src = buf + pos + (h - 1 - r) * (size_t)w * 12;
+        for (size_t i = 0; i < (size_t)w * 3; i++) {
+            uint32_t bits = (uint32_t)src[i * 4] | (uint32_t)src[i * 4 + 1] << 8 | (uint32_t)src[i * 4 + 2] << 16 |
+                            (uint32_t)src[i * 4 + 3] << 24;
+            memcpy(&out[r * w * 3 + i], &bits, 4);
+        }
+    }
+    info->scene = scene;
+    info->y0 = y0; info->y1 = y1; info->spp = spp; info->width = fw; info->height = fh;
+    *rgb = out;
+    return 0;
+}

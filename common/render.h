@@ -1,0 +1,29 @@
+/* render.h -- the integrator: unidirectional path tracing with next-event
+ * estimation and multiple importance sampling, and the camera.
+ *
+ * Radiance estimates are linear RGB.  A pixel's value is the mean of its
+ * samples; each sample's random numbers come from sampler.h, so any rows
+ * rendered anywhere give the same bits. */
+#ifndef FRANJA_RENDER_H
+#define FRANJA_RENDER_H
+
+#include "error.h"
+#include "scene.h"
+#include "trace.h"
+
+/* How direct light is estimated.  Only PT_MIS is used for images; the other
+ * two exist so tests can show all three agree (MIS is unbiased). */
+typedef enum { PT_MIS = 0, PT_LIGHT_ONLY, PT_BSDF_ONLY } pt_strategy;
+
+/* The primary ray of pixel (x, y) for lens/pixel numbers in [0,1)^2:
+ * box filter of one pixel, thin lens when the camera has an aperture. */
+fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly);
+
+/* Radiance of sample `index` of pixel (x, y). */
+vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index);
+
+/* Render rows [y0, y1) with s->settings' size and spp into rgb
+ * (3 floats per pixel, row y0 first, caller-owned, width*(y1-y0)*3). */
+void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb);
+
+#endif

@@ -1,0 +1,133 @@
+/* scene.h -- the scene as the renderer sees it.
+ *
+ * A scene is a set of flat arrays of plain structs.  The same bytes are the
+ * sections of the binary scene file (see fbin.h and docs in
+ * common/FORMAT.md): a worker maps the file and points these arrays into
+ * it, with no per-element parsing.  So every struct here is fixed-size,
+ * made of 4-byte fields, and little-endian on disk.
+ *
+ * Units are the scene's own (the Cornell box is in millimetres); radiance is
+ * linear RGB; angles in the scene file are degrees, radians here.
+ *
+ * Ownership: an fr_scene owns `blob` (malloc'd or mmap'd, per `mapped`);
+ * every array points into it.  scn_free() releases it. */
+#ifndef FRANJA_SCENE_H
+#define FRANJA_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "vec.h"
+
+#define FR_NONE 0xffffffffu /* "no index" for optional uint32 references */
+
+typedef struct {
+    uint32_t width, height;    /* pixels */
+    uint32_t spp;              /* samples per pixel */
+    uint32_t max_depth;        /* bounces; a path has at most max_depth+1 vertices after the camera */
+    uint32_t seed;             /* decorrelates renders of the same scene */
+    uint32_t pad[3];
+} fr_settings;
+
+typedef struct {
+    vec3 position, target, up;
+    float vfov;                /* vertical field of view, radians */
+    float aperture;            /* lens radius, scene units; 0 = pinhole */
+    float focus;               /* focus distance along the view axis */
+    /* derived by scn_finalize_camera: */
+    vec3 forward, right, upv;  /* orthonormal: right = image +x, upv = image -y */
+    float tan_half;            /* tan(vfov/2) */
+    float pad;
+} fr_camera;
+
+/* A material is a weighted set of lobes, one of which is picked per
+ * scattering event by Russian roulette with probability proportional to
+ * its weight.  A plain Lambert material has only `diffuse`; a Phong
+ * material `diffuse` and `glossy`; a mirror `specular`; glass `transmit`.
+ * Lobe colours are the albedos the lobe contributes: energy is conserved
+ * when the per-channel sum of the four is at most 1. */
+typedef struct {
+    vec3 diffuse;              /* Lambert albedo */
+    vec3 glossy;               /* normalized Phong albedo */
+    vec3 specular;             /* perfect mirror reflectance */
+    vec3 transmit;             /* smooth dielectric tint (Fresnel picks reflect/refract) */
+    vec3 emission;             /* emitted radiance, front side only (unless two_sided) */
+    float exponent;            /* Phong exponent, >= 0 */
+    float ior;                 /* dielectric index of refraction (inside / outside) */
+    float p_lobe[4];           /* cumulative lobe-selection probabilities: diffuse, glossy, specular, transmit */
+    uint32_t two_sided;        /* emission on both sides */
+    uint32_t tex_diffuse;      /* texture index or FR_NONE (reserved for textures) */
+    uint32_t tex_bump;         /* texture index or FR_NONE (reserved for bump maps) */
+    float bump_strength;
+    uint32_t pad[2];
+} fr_material;
+
+enum { FR_PRIM_TRIANGLE = 0, FR_PRIM_SPHERE = 1, FR_PRIM_RECT = 2, FR_PRIM_KINDS };
+
+/* One entry per bounded primitive; the BVH's leaves hold ranges of this
+ * array.  `index` points into the array of the primitive's kind. */
+typedef struct {
+    uint32_t kind;             /* FR_PRIM_* */
+    uint32_t index;            /* into spheres, rects or triangles */
+    uint32_t material;
+    uint32_t light;            /* index into lights if emissive, else FR_NONE */
+} fr_prim;
+
+typedef struct { vec3 center; float radius; } fr_sphere;
+
+/* Parallelogram origin + s*edge_u + t*edge_v, s,t in [0,1]; its front side
+ * faces cross(edge_u, edge_v). */
+typedef struct { vec3 origin, edge_u, edge_v; } fr_rect;
+
+/* Vertex indices into positions (and normals/uvs when the mesh has them;
+ * one index per vertex for all three).  The front side faces
+ * cross(p1-p0, p2-p0). */
+typedef struct { uint32_t v[3]; uint32_t flags; } fr_triangle;
+enum { FR_TRI_NORMALS = 1, FR_TRI_UVS = 2 };
+
+/* Infinite plane through `point` facing `normal` (unit).  Never a light. */
+typedef struct { vec3 point, normal; uint32_t material; uint32_t pad; } fr_plane;
+
+enum { FR_LIGHT_POINT = 0, FR_LIGHT_PRIM = 1 };
+typedef struct {
+    uint32_t kind;             /* FR_LIGHT_* */
+    uint32_t prim;             /* FR_LIGHT_PRIM: index into prims */
+    vec3 position;             /* FR_LIGHT_POINT */
+    vec3 intensity;            /* FR_LIGHT_POINT: W/sr, i.e. radiance*area units */
+    float area;                /* FR_LIGHT_PRIM: surface area */
+    float pick;                /* probability of picking this light (sums to 1) */
+    float cdf;                 /* sum of pick over lights[0..this], for binary search */
+    float pad;
+} fr_light;
+
+/* Flattened BVH node (32 bytes).  Interior: count == 0, children are
+ * this+1 and `offset`.  Leaf: prims[offset .. offset+count). */
+typedef struct {
+    vec3 lo; uint32_t offset;
+    vec3 hi; uint32_t count;   /* high byte of count holds the split axis for interior nodes */
+} fr_bvh_node;
+
+typedef struct {
+    fr_settings settings;
+    fr_camera camera;
+
+    const fr_material *materials; uint32_t n_materials;
+    const fr_prim *prims;         uint32_t n_prims;
+    const fr_sphere *spheres;     uint32_t n_spheres;
+    const fr_rect *rects;         uint32_t n_rects;
+    const fr_triangle *triangles; uint32_t n_triangles;
+    const vec3 *positions;        uint32_t n_positions;
+    const vec3 *normals;          uint32_t n_normals;
+    const vec2 *uvs;              uint32_t n_uvs;
+    const fr_plane *planes;       uint32_t n_planes;
+    const fr_light *lights;       uint32_t n_lights;
+    const fr_bvh_node *nodes;     uint32_t n_nodes;
+
+    uint64_t hash;                /* content hash of the binary scene */
+    void *blob; size_t blob_size; int mapped;
+} fr_scene;
+
+/* Releases the scene's blob (free or munmap) and zeroes *s. */
+void scn_free(fr_scene *s);
+
+#endif

@@ -1,0 +1,466 @@
+#include "scene_json.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmath.h"
+
+#define PATHLEN 160
+
+typedef struct {
+    const char *file;
+    const char *dir;
+    const scn_hooks *hooks;
+    fr_builder *b;
+    const cJSON *materials;    /* the "materials" object, for name lookup */
+    fr_error *err;
+} ctx;
+
+int scn_json_number(const cJSON *obj, const char *key, const char *where, int required, float def, float *out,
+                    fr_error *err)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) {
+        if (required)
+            return fr_fail(err, "%s.%s: missing (expected a number)", where, key);
+        *out = def;
+        return 0;
+    }
+    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || fabs(v->valuedouble) > 3.0e38)
+        return fr_fail(err, "%s.%s: expected a finite number", where, key);
+    *out = (float)v->valuedouble;
+    return 0;
+}
+
+/* Read value v (at JSON path `path`) as [x, y, z]. */
+static int read_vec3(const cJSON *v, const char *path, vec3 *out, fr_error *err)
+{
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
+        return fr_fail(err, "%s: expected an array of 3 numbers", path);
+    float c[3];
+    for (int i = 0; i < 3; i++) {
+        const cJSON *e = cJSON_GetArrayItem(v, i);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 3.0e38)
+            return fr_fail(err, "%s[%d]: expected a finite number", path, i);
+        c[i] = (float)e->valuedouble;
+    }
+    *out = v3(c[0], c[1], c[2]);
+    return 0;
+}
+
+int scn_json_vec3(const cJSON *obj, const char *key, const char *where, int required, vec3 def, vec3 *out,
+                  fr_error *err)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) {
+        if (required)
+            return fr_fail(err, "%s.%s: missing (expected [x, y, z])", where, key);
+        *out = def;
+        return 0;
+    }
+    char path[PATHLEN];
+    snprintf(path, sizeof path, "%s.%s", where, key);
+    return read_vec3(v, path, out, err);
+}
+
+/* Refuse members not in `allowed` (NULL-terminated): a typo must not be
+ * silently ignored. */
+static int only_fields(const cJSON *obj, const char *where, const char *const *allowed, fr_error *err)
+{
+    for (const cJSON *m = obj->child; m; m = m->next) {
+        int ok = 0;
+        for (int i = 0; allowed[i] && !ok; i++)
+            ok = !strcmp(m->string, allowed[i]);
+        if (!ok)
+            return fr_fail(err, "%s.%s: unknown field", where, m->string);
+    }
+    return 0;
+}
+
+static int get_uint(const cJSON *obj, const char *key, const char *where, int required, uint32_t def,
+                    uint32_t lo, uint32_t hi, uint32_t *out, fr_error *err)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) {
+        if (required)
+            return fr_fail(err, "%s.%s: missing (expected an integer in [%u, %u])", where, key, lo, hi);
+        *out = def;
+        return 0;
+    }
+    double d = v->valuedouble;
+    if (!cJSON_IsNumber(v) || !(d >= lo && d <= hi) || d != floor(d))
+        return fr_fail(err, "%s.%s: expected an integer in [%u, %u]", where, key, lo, hi);
+    *out = (uint32_t)d;
+    return 0;
+}
+
+static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
+
+static int parse_image(ctx *c, const cJSON *o)
+{
+    static const char *const fields[] = {"width", "height", "spp", "max_depth", "seed", NULL};
+    fr_settings *s = &c->b->settings;
+    if (!cJSON_IsObject(o))
+        return fr_fail(c->err, "image: missing or not an object");
+    if (only_fields(o, "image", fields, c->err) < 0 ||
+        get_uint(o, "width", "image", 1, 0, 1, 65536, &s->width, c->err) < 0 ||
+        get_uint(o, "height", "image", 1, 0, 1, 65536, &s->height, c->err) < 0 ||
+        get_uint(o, "spp", "image", 0, 16, 1, 1u << 20, &s->spp, c->err) < 0 ||
+        get_uint(o, "max_depth", "image", 0, 8, 0, 4096, &s->max_depth, c->err) < 0 ||
+        get_uint(o, "seed", "image", 0, 0, 0, 0xffffffffu, &s->seed, c->err) < 0)
+        return -1;
+    return 0;
+}
+
+static int parse_camera(ctx *c, const cJSON *o)
+{
+    static const char *const fields[] = {"position", "target", "up", "fov", "aperture", "focus", NULL};
+    fr_camera *cam = &c->b->camera;
+    float fov;
+    if (!cJSON_IsObject(o))
+        return fr_fail(c->err, "camera: missing or not an object");
+    if (only_fields(o, "camera", fields, c->err) < 0 ||
+        scn_json_vec3(o, "position", "camera", 1, v3s(0), &cam->position, c->err) < 0 ||
+        scn_json_vec3(o, "target", "camera", 1, v3s(0), &cam->target, c->err) < 0 ||
+        scn_json_vec3(o, "up", "camera", 0, v3(0, 1, 0), &cam->up, c->err) < 0 ||
+        scn_json_number(o, "fov", "camera", 1, 0, &fov, c->err) < 0 ||
+        scn_json_number(o, "aperture", "camera", 0, 0, &cam->aperture, c->err) < 0)
+        return -1;
+    if (!(fov > 0.0f && fov < 180.0f))
+        return fr_fail(c->err, "camera.fov: expected degrees in (0, 180)");
+    if (cam->aperture < 0.0f)
+        return fr_fail(c->err, "camera.aperture: expected a lens radius >= 0");
+    float dist = v3_len(v3_sub(cam->target, cam->position));
+    if (scn_json_number(o, "focus", "camera", 0, dist, &cam->focus, c->err) < 0)
+        return -1;
+    if (!(cam->focus > 0.0f))
+        return fr_fail(c->err, "camera.focus: expected a positive distance");
+    cam->vfov = fov * (FM_PI / 180.0f);
+    fr_error e;
+    if (bld_camera_finish(cam, &e) < 0)
+        return fr_fail(c->err, "%s", e.msg);
+    return 0;
+}
+
+static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material *m)
+{
+    static const char *const fields[] = {"type", "albedo", "diffuse", "glossy", "specular", "exponent",
+                                         "reflectance", "transmit", "tint", "ior", "emission", "two_sided", NULL};
+    memset(m, 0, sizeof *m);
+    m->tex_diffuse = m->tex_bump = FR_NONE;
+    m->ior = 1.5f;
+    if (!cJSON_IsObject(o))
+        return fr_fail(c->err, "%s: expected an object", where);
+    if (only_fields(o, where, fields, c->err) < 0)
+        return -1;
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
+    if (!cJSON_IsString(t))
+        return fr_fail(c->err, "%s.type: missing (expected lambert, phong, mirror, glass, mix or emitter)", where);
+    const char *type = t->valuestring;
+    int rc = 0;
+    if (!strcmp(type, "lambert")) {
+        rc = scn_json_vec3(o, "albedo", where, 1, v3s(0), &m->diffuse, c->err);
+    } else if (!strcmp(type, "phong")) {
+        rc = scn_json_vec3(o, "diffuse", where, 0, v3s(0), &m->diffuse, c->err) |
+             scn_json_vec3(o, "glossy", where, 1, v3s(0), &m->glossy, c->err) |
+             scn_json_number(o, "exponent", where, 1, 0, &m->exponent, c->err);
+    } else if (!strcmp(type, "mirror")) {
+        rc = scn_json_vec3(o, "reflectance", where, 0, v3s(1), &m->specular, c->err);
+    } else if (!strcmp(type, "glass")) {
+        rc = scn_json_vec3(o, "tint", where, 0, v3s(1), &m->transmit, c->err) |
+             scn_json_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
+    } else if (!strcmp(type, "mix")) {
+        rc = scn_json_vec3(o, "diffuse", where, 0, v3s(0), &m->diffuse, c->err) |
+             scn_json_vec3(o, "glossy", where, 0, v3s(0), &m->glossy, c->err) |
+             scn_json_number(o, "exponent", where, 0, 0, &m->exponent, c->err) |
+             scn_json_vec3(o, "specular", where, 0, v3s(0), &m->specular, c->err) |
+             scn_json_vec3(o, "transmit", where, 0, v3s(0), &m->transmit, c->err) |
+             scn_json_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
+    } else if (strcmp(type, "emitter") != 0) {
+        return fr_fail(c->err, "%s.type: '%s' is not lambert, phong, mirror, glass, mix or emitter", where, type);
+    }
+    if (rc < 0 || scn_json_vec3(o, "emission", where, 0, v3s(0), &m->emission, c->err) < 0)
+        return -1;
+    const cJSON *ts = cJSON_GetObjectItemCaseSensitive(o, "two_sided");
+    if (ts && !cJSON_IsBool(ts))
+        return fr_fail(c->err, "%s.two_sided: expected true or false", where);
+    m->two_sided = ts && cJSON_IsTrue(ts);
+    if (!nonneg3(m->diffuse) || !nonneg3(m->glossy) || !nonneg3(m->specular) || !nonneg3(m->transmit) ||
+        !nonneg3(m->emission))
+        return fr_fail(c->err, "%s: colours must be >= 0", where);
+    vec3 sum = v3_add(v3_add(m->diffuse, m->glossy), v3_add(m->specular, m->transmit));
+    if (v3_max(sum) > 1.0f)
+        return fr_fail(c->err, "%s: lobe albedos sum to %g > 1 in some channel (the material would create energy)",
+                       where, (double)v3_max(sum));
+    if (!(m->exponent >= 0.0f && m->exponent <= 1.0e6f))
+        return fr_fail(c->err, "%s.exponent: expected a number in [0, 1e6]", where);
+    if (!(m->ior >= 1.0f / 16.0f && m->ior <= 16.0f) || m->ior == 1.0f)
+        return fr_fail(c->err, "%s.ior: expected an index of refraction in [1/16, 16], not 1", where);
+    bld_material_finish(m);
+    return 0;
+}
+
+static int parse_materials(ctx *c, const cJSON *o)
+{
+    if (!cJSON_IsObject(o))
+        return fr_fail(c->err, "materials: missing or not an object (name -> material)");
+    for (const cJSON *m = o->child; m; m = m->next) {
+        char where[PATHLEN];
+        snprintf(where, sizeof where, "materials.%s", m->string);
+        fr_material mat;
+        if (parse_material(c, m, where, &mat) < 0)
+            return -1;
+        if (bld_push(&c->b->materials, &mat) == FR_NONE)
+            return fr_fail(c->err, "%s: out of memory", where);
+    }
+    c->materials = o;
+    return 0;
+}
+
+static int material_ref(ctx *c, const cJSON *shape, const char *where, uint32_t *out)
+{
+    const cJSON *n = cJSON_GetObjectItemCaseSensitive(shape, "material");
+    if (!cJSON_IsString(n))
+        return fr_fail(c->err, "%s.material: missing (expected a material name)", where);
+    uint32_t i = 0;
+    for (const cJSON *m = c->materials->child; m; m = m->next, i++) {
+        if (!strcmp(m->string, n->valuestring)) {
+            *out = i;
+            return 0;
+        }
+    }
+    return fr_fail(c->err, "%s.material: no material named '%s'", where, n->valuestring);
+}
+
+static int vertices(ctx *c, const cJSON *o, const char *where, int n, vec3 *v)
+{
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, "vertices");
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n)
+        return fr_fail(c->err, "%s.vertices: expected an array of %d points", where, n);
+    for (int i = 0; i < n; i++) {
+        char path[PATHLEN];
+        snprintf(path, sizeof path, "%s.vertices[%d]", where, i);
+        if (read_vec3(cJSON_GetArrayItem(a, i), path, &v[i], c->err) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int add_triangle(ctx *c, const char *where, vec3 a, vec3 b, vec3 d, uint32_t mat)
+{
+    if (!(v3_len2(v3_cross(v3_sub(b, a), v3_sub(d, a))) > 0.0f))
+        return fr_fail(c->err, "%s: zero-area triangle", where);
+    return bld_triangle(c->b, a, b, d, mat) == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
+}
+
+static int parse_shape(ctx *c, const cJSON *o, const char *where)
+{
+    if (!cJSON_IsObject(o))
+        return fr_fail(c->err, "%s: expected an object", where);
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
+    if (!cJSON_IsString(t))
+        return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle or mesh)", where);
+    const char *type = t->valuestring;
+    /* Meshes may take their materials from their own files. */
+    uint32_t mat = FR_NONE;
+    if (strcmp(type, "mesh") != 0 || cJSON_GetObjectItemCaseSensitive(o, "material"))
+        if (material_ref(c, o, where, &mat) < 0)
+            return -1;
+    const fr_material *m = mat == FR_NONE ? NULL : (const fr_material *)c->b->materials.data + mat;
+    uint32_t r = 0;
+    if (!strcmp(type, "sphere")) {
+        static const char *const f[] = {"type", "material", "center", "radius", NULL};
+        vec3 center;
+        float radius;
+        if (only_fields(o, where, f, c->err) < 0 || scn_json_vec3(o, "center", where, 1, v3s(0), &center, c->err) < 0 ||
+            scn_json_number(o, "radius", where, 1, 0, &radius, c->err) < 0)
+            return -1;
+        if (!(radius > 0.0f))
+            return fr_fail(c->err, "%s.radius: expected a positive number", where);
+        r = bld_sphere(c->b, center, radius, mat);
+    } else if (!strcmp(type, "plane")) {
+        static const char *const f[] = {"type", "material", "point", "normal", NULL};
+        fr_plane p;
+        memset(&p, 0, sizeof p);
+        if (only_fields(o, where, f, c->err) < 0 || scn_json_vec3(o, "point", where, 1, v3s(0), &p.point, c->err) < 0 ||
+            scn_json_vec3(o, "normal", where, 1, v3s(0), &p.normal, c->err) < 0)
+            return -1;
+        if (!(v3_len2(p.normal) > 0.0f))
+            return fr_fail(c->err, "%s.normal: expected a non-zero vector", where);
+        if (m && !v3_is_zero(m->emission))
+            return fr_fail(c->err, "%s.material: an infinite plane cannot emit light", where);
+        p.normal = v3_norm(p.normal);
+        p.material = mat;
+        r = bld_push(&c->b->planes, &p);
+    } else if (!strcmp(type, "rect")) {
+        static const char *const f[] = {"type", "material", "origin", "edge_u", "edge_v", NULL};
+        vec3 org, eu, ev;
+        if (only_fields(o, where, f, c->err) < 0 || scn_json_vec3(o, "origin", where, 1, v3s(0), &org, c->err) < 0 ||
+            scn_json_vec3(o, "edge_u", where, 1, v3s(0), &eu, c->err) < 0 ||
+            scn_json_vec3(o, "edge_v", where, 1, v3s(0), &ev, c->err) < 0)
+            return -1;
+        if (!(v3_len2(v3_cross(eu, ev)) > 0.0f))
+            return fr_fail(c->err, "%s: zero-area rectangle (edges parallel or zero)", where);
+        r = bld_rect(c->b, org, eu, ev, mat);
+    } else if (!strcmp(type, "quad")) {
+        static const char *const f[] = {"type", "material", "vertices", NULL};
+        vec3 v[4];
+        if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 4, v) < 0)
+            return -1;
+        vec3 d = v3_sub(v3_add(v[0], v[2]), v3_add(v[1], v[3]));
+        if (v3_is_zero(d)) {
+            /* An exact parallelogram: one rectangle, one light if emissive. */
+            vec3 eu = v3_sub(v[1], v[0]), ev = v3_sub(v[3], v[0]);
+            if (!(v3_len2(v3_cross(eu, ev)) > 0.0f))
+                return fr_fail(c->err, "%s: zero-area quad", where);
+            r = bld_rect(c->b, v[0], eu, ev, mat);
+        } else if (add_triangle(c, where, v[0], v[1], v[2], mat) < 0 || add_triangle(c, where, v[0], v[2], v[3], mat) < 0) {
+            return -1;
+        }
+    } else if (!strcmp(type, "triangle")) {
+        static const char *const f[] = {"type", "material", "vertices", NULL};
+        vec3 v[3];
+        if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 3, v) < 0 ||
+            add_triangle(c, where, v[0], v[1], v[2], mat) < 0)
+            return -1;
+    } else if (!strcmp(type, "mesh")) {
+        if (!c->hooks || !c->hooks->mesh)
+            return fr_fail(c->err, "%s: meshes need the scene compiler: run `franja compile` and render the .fbin", where);
+        fr_error e;
+        if (c->hooks->mesh(c->b, o, where, c->dir, mat, &e) < 0)
+            return fr_fail(c->err, "%s", e.msg);
+    } else {
+        return fr_fail(c->err, "%s.type: '%s' is not sphere, plane, rect, quad, triangle or mesh", where, type);
+    }
+    return r == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
+}
+
+static int parse_lights(ctx *c, const cJSON *a)
+{
+    if (!a)
+        return 0;
+    if (!cJSON_IsArray(a))
+        return fr_fail(c->err, "lights: expected an array");
+    int i = 0;
+    for (const cJSON *o = a->child; o; o = o->next, i++) {
+        static const char *const f[] = {"type", "position", "intensity", NULL};
+        char where[PATHLEN];
+        snprintf(where, sizeof where, "lights[%d]", i);
+        if (!cJSON_IsObject(o))
+            return fr_fail(c->err, "%s: expected an object", where);
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
+        if (!cJSON_IsString(t) || strcmp(t->valuestring, "point") != 0)
+            return fr_fail(c->err, "%s.type: expected \"point\" (area lights are shapes with emission)", where);
+        fr_light l;
+        memset(&l, 0, sizeof l);
+        l.kind = FR_LIGHT_POINT;
+        l.prim = FR_NONE;
+        if (only_fields(o, where, f, c->err) < 0 ||
+            scn_json_vec3(o, "position", where, 1, v3s(0), &l.position, c->err) < 0 ||
+            scn_json_vec3(o, "intensity", where, 1, v3s(0), &l.intensity, c->err) < 0)
+            return -1;
+        if (!nonneg3(l.intensity) || v3_is_zero(l.intensity))
+            return fr_fail(c->err, "%s.intensity: expected a non-negative, non-zero colour", where);
+        if (bld_push(&c->b->lights, &l) == FR_NONE)
+            return fr_fail(c->err, "%s: out of memory", where);
+    }
+    return 0;
+}
+
+int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, fr_builder *b, fr_error *err)
+{
+    fr_error e;
+    cJSON *root = cJSON_Parse(text);
+    if (!root) {
+        /* cJSON tells where it stopped; turn that into a line number. */
+        const char *at = cJSON_GetErrorPtr();
+        int line = 1;
+        for (const char *p = text; at && p < at && *p; p++)
+            line += *p == '\n';
+        return fr_fail(err, "%s:%d: invalid JSON", file, line);
+    }
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", file);
+    char *slash = strrchr(dir, '/');
+    if (slash)
+        *slash = 0;
+    else
+        snprintf(dir, sizeof dir, ".");
+    ctx c = {file, dir, hooks, b, NULL, &e};
+    static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description", NULL};
+    int rc = -1;
+    if (!cJSON_IsObject(root)) {
+        fr_fail(&e, "(top level): expected an object");
+    } else if (only_fields(root, "(top level)", top, &e) == 0 &&
+               parse_image(&c, cJSON_GetObjectItemCaseSensitive(root, "image")) == 0 &&
+               parse_camera(&c, cJSON_GetObjectItemCaseSensitive(root, "camera")) == 0 &&
+               parse_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials")) == 0 &&
+               parse_lights(&c, cJSON_GetObjectItemCaseSensitive(root, "lights")) == 0) {
+        const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
+        if (!cJSON_IsArray(shapes)) {
+            fr_fail(&e, "shapes: missing or not an array");
+        } else {
+            rc = 0;
+            int i = 0;
+            for (const cJSON *s = shapes->child; s && rc == 0; s = s->next, i++) {
+                char where[PATHLEN];
+                snprintf(where, sizeof where, "shapes[%d]", i);
+                rc = parse_shape(&c, s, where);
+            }
+            if (rc == 0 && b->prims.count == 0 && b->planes.count == 0)
+                rc = fr_fail(&e, "shapes: the scene has no shapes");
+            if (rc == 0 && b->lights.count == 0) {
+                int emissive = 0;
+                for (uint32_t k = 0; k < b->prims.count; k++) {
+                    const fr_prim *p = (const fr_prim *)b->prims.data + k;
+                    emissive |= !v3_is_zero(((const fr_material *)b->materials.data)[p->material].emission);
+                }
+                if (!emissive)
+                    rc = fr_fail(&e, "lights: the scene has no light (no point light, no emissive shape)");
+            }
+        }
+    }
+    cJSON_Delete(root);
+    return rc < 0 ? fr_fail(err, "%s: %s", file, e.msg) : 0;
+}
+
+int scn_load_json(const char *path, const scn_hooks *hooks, fr_scene *out, fr_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return fr_fail(err, "%s: %s", path, strerror(errno));
+    size_t cap = 1 << 16, len = 0;
+    char *text = malloc(cap);
+    size_t n;
+    while (text && (n = fread(text + len, 1, cap - len - 1, f)) > 0) {
+        len += n;
+        if (len + 1 == cap) {
+            char *t = realloc(text, cap * 2);
+            if (!t) { free(text); text = NULL; break; }
+            text = t;
+            cap *= 2;
+        }
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (!text || bad) {
+        free(text);
+        return fr_fail(err, "%s: cannot read the file", path);
+    }
+    text[len] = 0;
+    fr_builder b;
+    bld_init(&b);
+    int rc = scn_parse_json(text, path, hooks, &b, err);
+    free(text);
+    if (rc == 0) {
+        fr_error e;
+        rc = bld_finish(&b, out, &e);
+        if (rc < 0)
+            fr_fail(err, "%s: %s", path, e.msg);
+    }
+    bld_free(&b);
+    return rc;
+}
