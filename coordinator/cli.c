@@ -1,0 +1,81 @@
+/* cli.c -- option parsing shared by the subcommands. */
+#include "cli.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+const char cli_transport_help[] =
+    "  --known-hosts FILE   SSH known_hosts file (default ~/.ssh/known_hosts)\n"
+    "  --accept-new-hosts   add the keys of hosts not yet known (never changed ones)\n"
+    "  --no-ssh-config      do not read ~/.ssh/config\n"
+    "  --timeout S          connect time-out and longest silence of a host (default 10)\n";
+
+int cli_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    char *end;
+    errno = 0;
+    if (!s || !*s || *s == '-' || *s == '+')
+        return -1;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno || *end || v < lo || v > hi)
+        return -1;
+    *out = (uint32_t)v;
+    return 0;
+}
+
+const char *cli_local_worker(void)
+{
+    static char path[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", path, sizeof path - 32);
+    if (n <= 0)
+        return NULL;
+    path[n] = 0;
+    char *slash = strrchr(path, '/');
+    if (!slash)
+        return NULL;
+    strcpy(slash + 1, "franja-worker");
+    return path;
+}
+
+void cli_transport_defaults(tr_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->read_ssh_config = 1;
+    o->timeout_s = 10;
+    o->local_worker = cli_local_worker();
+}
+
+int cli_transport_option(int argc, char **argv, int *i, tr_options *o)
+{
+    const char *a = argv[*i];
+    if (!strcmp(a, "--accept-new-hosts")) {
+        o->accept_new = 1;
+        return 1;
+    }
+    if (!strcmp(a, "--no-ssh-config")) {
+        o->read_ssh_config = 0;
+        return 1;
+    }
+    if (strcmp(a, "--known-hosts") && strcmp(a, "--timeout"))
+        return 0;
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "franja: %s needs a value\n", a);
+        return -1;
+    }
+    const char *v = argv[++*i];
+    if (!strcmp(a, "--known-hosts")) {
+        o->known_hosts = v;
+        return 1;
+    }
+    uint32_t t;
+    if (cli_uint(v, 1, 3600, &t)) {
+        fprintf(stderr, "franja: --timeout: expected seconds in 1..3600, got '%s'\n", v);
+        return -1;
+    }
+    o->timeout_s = (int)t;
+    return 1;
+}

@@ -1,0 +1,131 @@
+/* hostcmd.c -- `franja hosts check` (connect to every host and say what is
+ * wrong) and `franja hosts list` (parse the table only). */
+#include "hostcmd.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "cluster.h"
+
+static const char usage[] =
+    "usage: franja hosts check --hosts FILE [options]\n"
+    "       franja hosts list --hosts FILE\n"
+    "\n"
+    "check: connects to every host of the table, verifies its key against\n"
+    "known_hosts, and reports its architecture, OS, cores, worker version and\n"
+    "scene cache, or exactly what is wrong with it.  Exit status 0 only if every\n"
+    "host is usable.\n"
+    "list:  parses the table and prints it with the defaults filled in.\n"
+    "\n"
+    "  --hosts FILE         host table (franja-hosts(5))\n";
+
+static void list(const hosts_table *t)
+{
+    printf("%-16s %-24s %-10s %5s  %s\n", "name", "address", "user", "cores", "workdir / worker");
+    for (int i = 0; i < t->n; i++) {
+        const hosts_entry *e = &t->v[i];
+        char addr[300], cores[16];
+        if (e->port)
+            snprintf(addr, sizeof addr, strchr(e->address, ':') ? "[%s]:%d" : "%s:%d", e->address, e->port);
+        else
+            snprintf(addr, sizeof addr, "%s", e->address);
+        snprintf(cores, sizeof cores, e->cores ? "%d" : "auto", e->cores);
+        printf("%-16s %-24s %-10s %5s  %s %s%s%s%s%s\n", e->name, addr, e->user[0] ? e->user : "-", cores,
+               hosts_is_local(e) ? "-" : hosts_workdir(e), e->worker[0] ? e->worker : "(default worker)",
+               e->arch[0] ? " arch=" : "", e->arch, e->os[0] ? " os=" : "", e->os);
+    }
+}
+
+static int check(const hosts_table *t, const tr_options *o)
+{
+    cl_host *cl = calloc((size_t)t->n, sizeof *cl);
+    if (!cl)
+        return 1;
+    for (int i = 0; i < t->n; i++)
+        cl[i].entry = &t->v[i];
+    cl_open(cl, t->n, o, NULL, 0);
+    int bad = 0;
+    printf("%-16s %-6s %-8s %-7s %5s  %-36s %s\n", "host", "state", "arch", "os", "cores", "worker", "scene cache");
+    for (int i = 0; i < t->n; i++) {
+        cl_host *h = &cl[i];
+        if (!h->tr) {
+            bad++;
+            printf("%-16s %-6s %s\n", h->entry->name, "FAIL", h->err.msg);
+            continue;
+        }
+        const char *warn = "";
+        if (h->entry->arch[0] && strcmp(h->entry->arch, h->info.arch))
+            warn = "  (table says arch=";
+        int files;
+        uint64_t bytes;
+        char cache[64];
+        fr_error e2;
+        if (hosts_is_local(h->entry))
+            snprintf(cache, sizeof cache, "local, none needed");
+        else if (tr_cache(h->tr, &files, &bytes, &e2))
+            snprintf(cache, sizeof cache, "unreadable");
+        else
+            snprintf(cache, sizeof cache, "%d scene%s, %.1f MB", files, files == 1 ? "" : "s", bytes / 1e6);
+        int cores = h->entry->cores ? h->entry->cores : h->info.cores;
+        printf("%-16s %-6s %-8s %-7s %5d  %-36s %s%s%s%s\n", h->entry->name, "ok", h->info.arch, h->info.os, cores,
+               h->info.version, cache, warn, *warn ? h->entry->arch : "", *warn ? ")" : "");
+    }
+    fr_error err;
+    if (cl_check_versions(cl, t->n, &err)) {
+        printf("problem: %s\n", err.msg);
+        bad++;
+    }
+    cl_close(cl, t->n);
+    free(cl);
+    if (bad)
+        printf("%d problem%s found\n", bad, bad == 1 ? "" : "s");
+    else
+        printf("all %d host%s usable\n", t->n, t->n == 1 ? "" : "s");
+    return bad ? 1 : 0;
+}
+
+int cmd_hosts(int argc, char **argv)
+{
+    tr_options o;
+    cli_transport_defaults(&o);
+    const char *path = NULL, *what = NULL;
+    for (int i = 1; i < argc; i++) {
+        int t = cli_transport_option(argc, argv, &i, &o);
+        if (t < 0)
+            return 2;
+        if (t)
+            continue;
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            fputs(usage, stdout);
+            fputs(cli_transport_help, stdout);
+            return 0;
+        }
+        if (!strcmp(argv[i], "--hosts") && i + 1 < argc)
+            path = argv[++i];
+        else if (!what && (!strcmp(argv[i], "check") || !strcmp(argv[i], "list")))
+            what = argv[i];
+        else {
+            fprintf(stderr, "franja hosts: unexpected '%s' (see franja hosts --help)\n", argv[i]);
+            return 2;
+        }
+    }
+    if (!what || !path) {
+        fprintf(stderr, "franja hosts: expected 'check' or 'list' and --hosts FILE (see franja hosts --help)\n");
+        return 2;
+    }
+    hosts_table t;
+    fr_error err;
+    if (hosts_load(path, &t, &err)) {
+        fprintf(stderr, "franja hosts: %s\n", err.msg);
+        return 2;
+    }
+    int rc = 0;
+    if (!strcmp(what, "list"))
+        list(&t);
+    else
+        rc = check(&t, &o);
+    hosts_free(&t);
+    return rc;
+}

@@ -1,0 +1,272 @@
+/* hosts.c -- the host table parser (format in hosts.h and franja-hosts(5)). */
+#include "hosts.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define HOSTS_MAX_LINE 4096
+
+/* Copies src into a fixed field, refusing what would not fit rather than
+ * silently cutting a path or a name. */
+static int copy_field(char *dst, size_t cap, const char *src, const char *path, int line,
+                      const char *what, fr_error *err)
+{
+    size_t n = strlen(src);
+    if (n == 0)
+        return fr_fail(err, "%s:%d: empty %s", path, line, what);
+    if (n >= cap)
+        return fr_fail(err, "%s:%d: %s is longer than %zu characters", path, line, what, cap - 1);
+    memcpy(dst, src, n + 1);
+    return 0;
+}
+
+/* Parses a decimal integer in [lo, hi]; returns -1 if it is anything else. */
+static long parse_range(const char *s, long lo, long hi)
+{
+    if (!*s)
+        return -1;
+    for (const char *p = s; *p; p++)
+        if (!isdigit((unsigned char)*p))
+            return -1;
+    errno = 0;
+    long v = strtol(s, NULL, 10);
+    if (errno || v < lo || v > hi)
+        return -1;
+    return v;
+}
+
+static int valid_name(const char *s)
+{
+    for (; *s; s++)
+        if (!isalnum((unsigned char)*s) && !strchr("-_.", *s))
+            return 0;
+    return 1;
+}
+
+/* address[:port], [ipv6]:port or a bare IPv6 address (more than one colon). */
+static int parse_address(hosts_entry *h, const char *s, const char *path, int line, fr_error *err)
+{
+    char host[256];
+    const char *port = NULL;
+    if (s[0] == '[') {
+        const char *close = strchr(s, ']');
+        if (!close)
+            return fr_fail(err, "%s:%d: address '%s': '[' without ']'", path, line, s);
+        size_t n = (size_t)(close - s - 1);
+        if (n == 0 || n >= sizeof host)
+            return fr_fail(err, "%s:%d: address '%s': bad bracketed address", path, line, s);
+        memcpy(host, s + 1, n);
+        host[n] = 0;
+        if (close[1] == ':')
+            port = close + 2;
+        else if (close[1])
+            return fr_fail(err, "%s:%d: address '%s': expected ':PORT' after ']'", path, line, s);
+    } else {
+        const char *colon = strchr(s, ':');
+        if (colon && strchr(colon + 1, ':'))
+            colon = NULL; /* a bare IPv6 address */
+        size_t n = colon ? (size_t)(colon - s) : strlen(s);
+        if (n == 0 || n >= sizeof host)
+            return fr_fail(err, "%s:%d: address '%s': expected HOST[:PORT]", path, line, s);
+        memcpy(host, s, n);
+        host[n] = 0;
+        if (colon)
+            port = colon + 1;
+    }
+    if (port) {
+        long p = parse_range(port, 1, 65535);
+        if (p < 0)
+            return fr_fail(err, "%s:%d: bad port '%s' in address '%s': expected 1..65535", path, line,
+                           port, s);
+        h->port = (int)p;
+    }
+    if (!strcmp(host, "local") && port)
+        return fr_fail(err, "%s:%d: address 'local' takes no port", path, line);
+    return copy_field(h->address, sizeof h->address, host, path, line, "address", err);
+}
+
+static int parse_option(hosts_entry *h, char *kv, const char *path, int line, fr_error *err)
+{
+    char *eq = strchr(kv, '=');
+    if (!eq || eq == kv)
+        return fr_fail(err, "%s:%d: '%s': expected key=value (identity, worker, workdir, arch, os)",
+                       path, line, kv);
+    *eq = 0;
+    const char *key = kv, *val = eq + 1;
+    struct { const char *key; char *dst; size_t cap; } keys[] = {
+        {"identity", h->identity, sizeof h->identity},
+        {"worker", h->worker, sizeof h->worker},
+        {"workdir", h->workdir, sizeof h->workdir},
+        {"arch", h->arch, sizeof h->arch},
+        {"os", h->os, sizeof h->os},
+    };
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+        if (strcmp(key, keys[i].key))
+            continue;
+        if (keys[i].dst[0])
+            return fr_fail(err, "%s:%d: %s= given twice", path, line, key);
+        return copy_field(keys[i].dst, keys[i].cap, val, path, line, key, err);
+    }
+    return fr_fail(err, "%s:%d: unknown key '%s': expected identity, worker, workdir, arch or os",
+                   path, line, key);
+}
+
+/* Splits a line into whitespace-separated words in place; a '#' starts a
+ * comment.  Returns the number of words. */
+static int split(char *s, char **w, int max)
+{
+    int n = 0;
+    for (;;) {
+        while (*s == ' ' || *s == '\t' || *s == '\r')
+            s++;
+        if (!*s || *s == '#')
+            return n;
+        if (n == max)
+            return max + 1;
+        w[n++] = s;
+        while (*s && *s != ' ' && *s != '\t' && *s != '\r' && *s != '#')
+            s++;
+        if (*s == '#') {
+            *s = 0;
+            return n;
+        }
+        if (*s)
+            *s++ = 0;
+    }
+}
+
+static int parse_line(hosts_entry *h, char **w, int nw, const char *path, int line, fr_error *err)
+{
+    memset(h, 0, sizeof *h);
+    h->line = line;
+    static const char *fields[] = {"name", "address[:port]", "user", "cores"};
+    if (nw < 4)
+        return fr_fail(err, "%s:%d: missing %s: expected NAME ADDRESS[:PORT] USER CORES [key=value ...]",
+                       path, line, fields[nw]);
+    if (!valid_name(w[0]))
+        return fr_fail(err, "%s:%d: host name '%s': expected letters, digits, '-', '_' or '.'", path,
+                       line, w[0]);
+    if (copy_field(h->name, sizeof h->name, w[0], path, line, "host name", err) ||
+        parse_address(h, w[1], path, line, err))
+        return -1;
+    if (strcmp(w[2], "-") && copy_field(h->user, sizeof h->user, w[2], path, line, "user", err))
+        return -1;
+    if (strcmp(w[3], "auto")) {
+        long c = parse_range(w[3], 1, 4096);
+        if (c < 0)
+            return fr_fail(err, "%s:%d: cores '%s': expected 1..4096 or 'auto'", path, line, w[3]);
+        h->cores = (int)c;
+    }
+    for (int i = 4; i < nw; i++)
+        if (parse_option(h, w[i], path, line, err))
+            return -1;
+    return 0;
+}
+
+int hosts_parse(const char *text, const char *path, hosts_table *t, fr_error *err)
+{
+    memset(t, 0, sizeof *t);
+    snprintf(t->path, sizeof t->path, "%s", path);
+    int cap = 0, line = 0;
+    const char *p = text;
+    char buf[HOSTS_MAX_LINE];
+    while (*p) {
+        line++;
+        const char *nl = strchr(p, '\n');
+        size_t len = nl ? (size_t)(nl - p) : strlen(p);
+        if (len >= sizeof buf) {
+            hosts_free(t);
+            return fr_fail(err, "%s:%d: line longer than %d characters", path, line, HOSTS_MAX_LINE - 1);
+        }
+        memcpy(buf, p, len);
+        buf[len] = 0;
+        p = nl ? nl + 1 : p + len;
+        char *w[32];
+        int nw = split(buf, w, 32);
+        if (nw == 0)
+            continue;
+        if (nw > 32) {
+            hosts_free(t);
+            return fr_fail(err, "%s:%d: too many fields", path, line);
+        }
+        if (t->n == cap) {
+            cap = cap ? cap * 2 : 8;
+            hosts_entry *v = realloc(t->v, (size_t)cap * sizeof *v);
+            if (!v) {
+                hosts_free(t);
+                return fr_fail(err, "%s:%d: out of memory", path, line);
+            }
+            t->v = v;
+        }
+        hosts_entry *h = &t->v[t->n];
+        if (parse_line(h, w, nw, path, line, err)) {
+            hosts_free(t);
+            return -1;
+        }
+        for (int i = 0; i < t->n; i++)
+            if (!strcmp(t->v[i].name, h->name)) {
+                int first = t->v[i].line;
+                hosts_free(t);
+                return fr_fail(err, "%s:%d: duplicate host name '%s' (first defined on line %d)", path,
+                               line, w[0], first);
+            }
+        t->n++;
+    }
+    if (t->n == 0) {
+        hosts_free(t);
+        return fr_fail(err, "%s: no hosts: expected lines NAME ADDRESS[:PORT] USER CORES", path);
+    }
+    return 0;
+}
+
+int hosts_load(const char *path, hosts_table *t, fr_error *err)
+{
+    memset(t, 0, sizeof *t);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return fr_fail(err, "%s: cannot open host table: %s", path, strerror(errno));
+    size_t cap = 4096, n = 0;
+    char *text = malloc(cap);
+    for (;;) {
+        if (!text) {
+            fclose(f);
+            return fr_fail(err, "%s: out of memory", path);
+        }
+        n += fread(text + n, 1, cap - n - 1, f);
+        if (n < cap - 1)
+            break;
+        cap *= 2;
+        char *bigger = realloc(text, cap);
+        if (!bigger)
+            free(text);
+        text = bigger;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(text);
+        return fr_fail(err, "%s: read error", path);
+    }
+    text[n] = 0;
+    if (memchr(text, 0, n)) {
+        free(text);
+        return fr_fail(err, "%s: binary data in host table", path);
+    }
+    int rc = hosts_parse(text, path, t, err);
+    free(text);
+    return rc;
+}
+
+int hosts_is_local(const hosts_entry *h) { return !strcmp(h->address, "local"); }
+
+const char *hosts_workdir(const hosts_entry *h) { return h->workdir[0] ? h->workdir : ".cache/franja"; }
+
+void hosts_free(hosts_table *t)
+{
+    free(t->v);
+    t->v = NULL;
+    t->n = 0;
+}

@@ -1,0 +1,58 @@
+/** @file hosts.h
+ * The host table: which machines render, how to reach them, how many
+ * worker processes each runs.  The format is described in franja-hosts(5):
+ *
+ *     # name   address[:port]   user   cores   [key=value ...]
+ *     alpha    10.0.0.5         anna   8       workdir=/scratch/franja
+ *     beta     beta.lab:2222    -      auto    identity=~/.ssh/lab_ed25519
+ *     here     local            -      auto
+ *
+ * `local` as the address runs workers on this machine without SSH; `-` as
+ * the user means "the SSH default" (~/.ssh/config, else the login name);
+ * `auto` cores means "as many as the host reports".
+ */
+#ifndef FRANJA_HOSTS_H
+#define FRANJA_HOSTS_H
+
+#include "error.h"
+
+/** One line of the host table.  Empty strings mean "not given". */
+typedef struct {
+    char name[64];       /**< unique label used in messages and logs */
+    char address[256];   /**< DNS name, IPv4, IPv6 (no brackets), or "local" */
+    int port;            /**< TCP port, 0 = SSH default */
+    char user[64];       /**< login name, "" = SSH default */
+    int cores;           /**< worker processes, 0 = ask the host */
+    char identity[512];  /**< private key file, "" = agent / default keys */
+    char worker[512];    /**< worker path on the host, "" = WORKDIR/franja-worker */
+    char workdir[512];   /**< work directory on the host, "" = .cache/franja (home-relative) */
+    char arch[32];       /**< declared architecture (uname -m), "" = unknown */
+    char os[64];         /**< declared operating system, "" = unknown */
+    int line;            /**< line number in the file, for messages */
+} hosts_entry;
+
+/** A parsed host table.  Owns `v` (hosts_free releases it). */
+typedef struct {
+    hosts_entry *v;
+    int n;
+    char path[512];      /**< the file it came from, for messages */
+} hosts_table;
+
+/** Parses `text` (NUL-terminated) as a host table named `path` in messages.
+ * Fails with "path:line: what was expected" on the first bad line, on a
+ * duplicate name and on a table without hosts.  On failure *t is empty. */
+int hosts_parse(const char *text, const char *path, hosts_table *t, fr_error *err);
+
+/** Reads and parses the file at `path` (see hosts_parse). */
+int hosts_load(const char *path, hosts_table *t, fr_error *err);
+
+/** Returns 1 if the entry runs workers on this machine without SSH. */
+int hosts_is_local(const hosts_entry *h);
+
+/** The work directory with its default applied. */
+const char *hosts_workdir(const hosts_entry *h);
+
+/** Frees the table's entries and zeroes *t. */
+void hosts_free(hosts_table *t);
+
+#endif

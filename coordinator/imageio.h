@@ -1,0 +1,24 @@
+/** @file imageio.h
+ * The coordinator's bridge to OpenImageIO (imageio.cpp, the one C++ file):
+ * writes a finished image in the format its file name's extension names.
+ */
+#ifndef FRANJA_IMAGEIO_H
+#define FRANJA_IMAGEIO_H
+
+#include <stdint.h>
+
+#include "error.h"
+
+/** Pixel types iio_write accepts. */
+typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32 } iio_type;
+
+/** Writes width x height RGB pixels (top row first, 3 values of `type` per
+ * pixel) to `path`; OpenImageIO picks the format from the extension (png,
+ * exr, tif, jpg, hdr, bmp, ppm ...).  Fails with OpenImageIO's message. */
+int iio_write(const char *path, const void *pixels, iio_type type, uint32_t width, uint32_t height,
+              fr_error *err);
+
+/** Returns 1 if OpenImageIO has a writer for the file name's extension. */
+int iio_can_write(const char *path);
+
+#endif

@@ -1,0 +1,251 @@
+/* jobdir.c -- finished slabs on disk (see jobdir.h). */
+#include "jobdir.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
+                      uint32_t y1, fr_error *err)
+{
+    img_partial_info info;
+    float *rgb = NULL;
+    if (img_read_partial(buf, len, &info, &rgb, err))
+        return -1;
+    free(rgb);
+    if (info.scene != spec->hash)
+        return fr_fail(err, "scene hash %016llx, expected %016llx", (unsigned long long)info.scene,
+                       (unsigned long long)spec->hash);
+    if (info.width != spec->width || info.height != spec->height)
+        return fr_fail(err, "image size %ux%u, expected %ux%u", info.width, info.height, spec->width,
+                       spec->height);
+    if (info.y0 != y0 || info.y1 != y1)
+        return fr_fail(err, "rows %u:%u, expected %u:%u", info.y0, info.y1, y0, y1);
+    if (info.spp != spec->spp)
+        return fr_fail(err, "%u samples per pixel, expected %u", info.spp, spec->spp);
+    return 0;
+}
+
+static int write_file(const char *path, const void *data, size_t len, fr_error *err)
+{
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0)
+        return fr_fail(err, "%s: %s", tmp, strerror(errno));
+    const char *p = data;
+    size_t left = len;
+    while (left) {
+        ssize_t n = write(fd, p, left);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0) {
+            int e = errno;
+            close(fd);
+            unlink(tmp);
+            return fr_fail(err, "%s: write failed: %s", tmp, strerror(e));
+        }
+        p += n;
+        left -= (size_t)n;
+    }
+    if (close(fd) || rename(tmp, path)) {
+        int e = errno;
+        unlink(tmp);
+        return fr_fail(err, "%s: %s", path, strerror(e));
+    }
+    return 0;
+}
+
+static int read_file(const char *path, unsigned char **buf, size_t *len, fr_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return fr_fail(err, "%s: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) || !(*buf = malloc((size_t)st.st_size + 1))) {
+        fclose(f);
+        return fr_fail(err, "%s: cannot read", path);
+    }
+    *len = fread(*buf, 1, (size_t)st.st_size, f);
+    fclose(f);
+    if (*len != (size_t)st.st_size) {
+        free(*buf);
+        return fr_fail(err, "%s: short read", path);
+    }
+    return 0;
+}
+
+static void spec_text(const job_spec *s, char *out, size_t cap)
+{
+    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n", (unsigned long long)s->hash,
+             s->width, s->height, s->spp);
+}
+
+/* Calls fn for every slab file name in dir ("rows-Y0-Y1.pf"). */
+static int each_slab(const char *dir, int (*fn)(const char *dir, const char *name, uint32_t y0,
+                                                uint32_t y1, void *ctx),
+                     void *ctx, fr_error *err)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return fr_fail(err, "%s: %s", dir, strerror(errno));
+    struct dirent *e;
+    int rc = 0;
+    while (rc == 0 && (e = readdir(d))) {
+        unsigned y0, y1;
+        char tail;
+        if (sscanf(e->d_name, "rows-%u-%u.p%c", &y0, &y1, &tail) == 3 && tail == 'f' &&
+            strlen(e->d_name) > 4 && !strcmp(e->d_name + strlen(e->d_name) - 3, ".pf"))
+            rc = fn(dir, e->d_name, y0, y1, ctx);
+    }
+    closedir(d);
+    return rc;
+}
+
+static int remove_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *ctx)
+{
+    (void)y0, (void)y1, (void)ctx;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    unlink(path);
+    return 0;
+}
+
+int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
+{
+    char want[256], path[4200];
+    spec_text(spec, want, sizeof want);
+    snprintf(path, sizeof path, "%s/job", dir);
+    if (mkdir(dir, 0755) && errno != EEXIST)
+        return fr_fail(err, "%s: cannot create job directory: %s", dir, strerror(errno));
+    if (resume) {
+        unsigned char *have = NULL;
+        size_t len = 0;
+        fr_error e2;
+        if (read_file(path, &have, &len, &e2) == 0) {
+            int same = len == strlen(want) && !memcmp(have, want, len);
+            free(have);
+            if (!same)
+                return fr_fail(err, "%s: this job directory belongs to another render (different scene, "
+                               "size or samples); remove it or render without --resume", dir);
+            return 0;
+        }
+    } else {
+        fr_error ignore;
+        each_slab(dir, remove_one, NULL, &ignore);
+    }
+    return write_file(path, want, strlen(want), err);
+}
+
+typedef struct {
+    const job_spec *spec;
+    unsigned char *have;
+    float *rgb;                /* job_stitch only */
+    int rows;
+} scan_ctx;
+
+static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
+{
+    scan_ctx *c = vctx;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    unsigned char *buf;
+    size_t len;
+    fr_error e;
+    int bad = read_file(path, &buf, &len, &e);
+    if (!bad) {
+        bad = job_check_partial(buf, len, c->spec, y0, y1, &e);
+        if (!bad && c->rgb) {
+            img_partial_info info;
+            float *rows;
+            if ((bad = img_read_partial(buf, len, &info, &rows, &e)) == 0) {
+                memcpy(c->rgb + (size_t)y0 * c->spec->width * 3, rows,
+                       (size_t)(y1 - y0) * c->spec->width * 3 * sizeof(float));
+                free(rows);
+            }
+        }
+        free(buf);
+    }
+    if (bad) {
+        fprintf(stderr, "franja: %s: discarded (%s)\n", path, e.msg);
+        unlink(path);
+        return 0;
+    }
+    for (uint32_t y = y0; y < y1; y++) {
+        c->rows += !c->have[y];
+        c->have[y] = 1;
+    }
+    return 0;
+}
+
+int job_scan(const char *dir, const job_spec *spec, unsigned char *have, fr_error *err)
+{
+    scan_ctx c = {spec, have, NULL, 0};
+    memset(have, 0, spec->height);
+    if (each_slab(dir, scan_one, &c, err))
+        return -1;
+    return c.rows;
+}
+
+int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf, size_t len, fr_error *err)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/rows-%05u-%05u.pf", dir, y0, y1);
+    return write_file(path, buf, len, err);
+}
+
+void job_missing_rows(const unsigned char *have, uint32_t height, char *out, size_t cap)
+{
+    size_t n = 0;
+    out[0] = 0;
+    for (uint32_t y = 0; y < height;) {
+        if (have[y]) {
+            y++;
+            continue;
+        }
+        uint32_t a = y;
+        while (y < height && !have[y])
+            y++;
+        int k = snprintf(out + n, cap - n, "%s%u:%u", n ? ", " : "", a, y);
+        if (k < 0 || (size_t)k >= cap - n) {
+            if (cap > 4)
+                strcpy(out + cap - 4, "...");
+            return;
+        }
+        n += (size_t)k;
+    }
+}
+
+int job_stitch(const char *dir, const job_spec *spec, float *rgb, fr_error *err)
+{
+    unsigned char *have = calloc(spec->height, 1);
+    if (!have)
+        return fr_fail(err, "out of memory");
+    scan_ctx c = {spec, have, rgb, 0};
+    int rc = each_slab(dir, scan_one, &c, err);
+    if (rc == 0 && (uint32_t)c.rows != spec->height) {
+        char missing[300];
+        job_missing_rows(have, spec->height, missing, sizeof missing);
+        rc = fr_fail(err, "rows %s are missing from %s; the image was not written", missing, dir);
+    }
+    free(have);
+    return rc;
+}
+
+void job_remove(const char *dir)
+{
+    fr_error ignore;
+    char path[4200];
+    each_slab(dir, remove_one, NULL, &ignore);
+    const char *names[] = {"job", "scene.fbin"};
+    for (size_t i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        unlink(path);
+    }
+    rmdir(dir);
+}

@@ -1,0 +1,58 @@
+/** @file jobdir.h
+ * The job directory: where a render keeps its finished slabs as they
+ * arrive, so that nothing done is lost and `--resume` renders only what is
+ * missing.  Layout:
+ *
+ *     DIR/job                  what render this is (scene hash, size, spp)
+ *     DIR/scene.fbin           the compiled scene, for JSON inputs
+ *     DIR/rows-Y0-Y1.pf        one checked partial image per finished slab
+ *
+ * Every slab file is written to a temporary name and renamed, so a crash
+ * leaves either the whole slab or nothing.
+ */
+#ifndef FRANJA_JOBDIR_H
+#define FRANJA_JOBDIR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "error.h"
+#include "image.h"
+
+/** What a render produces: every partial must match it exactly. */
+typedef struct {
+    uint64_t hash;             /**< scene content hash */
+    uint32_t width, height;    /**< full image, pixels */
+    uint32_t spp;              /**< samples per pixel */
+} job_spec;
+
+/** Checks a partial image (PF bytes) against the spec and the rows asked
+ * for.  Returns 0 if it is exactly that slab; otherwise err says what is
+ * wrong (size, header, scene hash, rows, spp). */
+int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
+                      uint32_t y1, fr_error *err);
+
+/** Creates the directory for a new render (removing the slabs of an old
+ * one), or, with resume, keeps it if it belongs to the same render and
+ * refuses it if not. */
+int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err);
+
+/** Marks in have[0..height) the rows that finished slab files in dir
+ * cover.  Files that do not check out are deleted, with a message on
+ * stderr.  Returns the number of rows covered, or -1. */
+int job_scan(const char *dir, const job_spec *spec, unsigned char *have, fr_error *err);
+
+/** Stores a checked slab (the worker's bytes as they came). */
+int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf, size_t len, fr_error *err);
+
+/** Reads every slab into rgb (width*height*3 floats, top row first).
+ * Fails, naming the missing rows, unless every row is covered. */
+int job_stitch(const char *dir, const job_spec *spec, float *rgb, fr_error *err);
+
+/** Deletes the job directory and what franja put in it. */
+void job_remove(const char *dir);
+
+/** Formats the rows not set in have[0..height) as "a:b, c:d" into out. */
+void job_missing_rows(const unsigned char *have, uint32_t height, char *out, size_t cap);
+
+#endif

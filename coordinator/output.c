@@ -1,0 +1,86 @@
+/* output.c -- tone mapping and the atomic write of the final image. */
+#include "output.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "image.h"
+#include "imageio.h"
+
+static const char *extension(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash : path, '.');
+    return dot ? dot + 1 : "";
+}
+
+static int is_ext(const char *path, const char *ext) { return !strcasecmp(extension(path), ext); }
+
+int out_check(const char *path, fr_error *err)
+{
+    if (is_ext(path, "pfm") || (*extension(path) && iio_can_write(path)))
+        return 0;
+    return fr_fail(err, "%s: unknown image type '%s': expected .png, .exr, .tif, .jpg, .hdr, .ppm, .bmp "
+                   "or .pfm", path, extension(path));
+}
+
+/* dir/.name.tmp-PID.ext: same directory (rename stays atomic), same
+ * extension (OpenImageIO picks the format by it). */
+static void temp_name(const char *path, char *out, size_t cap)
+{
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash - path + 1) : 0;
+    const char *base = path + dirlen;
+    snprintf(out, cap, "%.*s.%s.tmp-%ld.%s", dirlen, path, base, (long)getpid(), extension(path));
+}
+
+static int write_pfm(const char *tmp, const float *rgb, const job_spec *spec, fr_error *err)
+{
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return fr_fail(err, "%s: %s", tmp, strerror(errno));
+    img_partial_info info = {spec->hash, 0, spec->height, spec->spp, spec->width, spec->height};
+    int rc = img_write(f, IMG_PF, &info, rgb, err);
+    if (fclose(f) && rc == 0)
+        rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
+    return rc;
+}
+
+int out_write(const char *path, const float *rgb, const job_spec *spec, float exposure, fr_error *err)
+{
+    char tmp[4200];
+    temp_name(path, tmp, sizeof tmp);
+    size_t n = (size_t)spec->width * spec->height * 3;
+    int rc;
+    if (is_ext(path, "pfm")) {
+        rc = write_pfm(tmp, rgb, spec, err);
+    } else if (is_ext(path, "exr") || is_ext(path, "hdr")) {
+        rc = iio_write(tmp, rgb, IIO_F32, spec->width, spec->height, err);
+    } else {
+        int wide = is_ext(path, "tif") || is_ext(path, "tiff");
+        float scale = exp2f(exposure);
+        void *px = malloc(n * (wide ? 2 : 1));
+        if (!px)
+            return fr_fail(err, "out of memory for the final image");
+        for (size_t i = 0; i < n; i++) {
+            float v = img_srgb_encode(rgb[i] * scale);
+            if (wide)
+                ((uint16_t *)px)[i] = (uint16_t)(v * 65535.0f + 0.5f);
+            else
+                ((uint8_t *)px)[i] = (uint8_t)(v * 255.0f + 0.5f);
+        }
+        rc = iio_write(tmp, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, err);
+        free(px);
+    }
+    if (rc == 0 && rename(tmp, path))
+        rc = fr_fail(err, "%s: %s", path, strerror(errno));
+    if (rc)
+        unlink(tmp);
+    return rc;
+}

@@ -1,0 +1,26 @@
+/** @file output.h
+ * The final image: tone mapping (once, after stitching) and an atomic write
+ * in the format the file name's extension names.
+ *
+ * HDR outputs (.exr, .hdr, .pfm) keep linear radiance and ignore the
+ * exposure; LDR outputs (.png, .jpg, .bmp, .ppm 8-bit; .tif 16-bit) are
+ * scaled by 2^exposure, then sRGB-encoded and clamped.  A .pfm is written
+ * by Franja itself (OpenImageIO has no PFM writer) with the same header a
+ * one-process worker render of the whole image has, so the two files can
+ * be compared byte for byte.
+ */
+#ifndef FRANJA_OUTPUT_H
+#define FRANJA_OUTPUT_H
+
+#include "error.h"
+#include "jobdir.h"
+
+/** Fails, before any rendering, if no writer handles the path's extension. */
+int out_check(const char *path, fr_error *err);
+
+/** Writes rgb (width*height*3 linear floats, top row first) to path via a
+ * temporary file in the same directory and a rename, so path is either the
+ * old file or the complete new one. */
+int out_write(const char *path, const float *rgb, const job_spec *spec, float exposure, fr_error *err);
+
+#endif

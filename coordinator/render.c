@@ -1,0 +1,347 @@
+/* render.c -- `franja render`: compile if needed, get the hosts ready,
+ * schedule the slabs, stitch, tone-map once and write the image. */
+#include "rendercmd.h"
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "cluster.h"
+#include "compile.h"
+#include "fbin.h"
+#include "jobdir.h"
+#include "output.h"
+#include "sched.h"
+
+static const char usage[] =
+    "usage: franja render SCENE(.json|.fbin) -o OUT [options]\n"
+    "\n"
+    "Renders SCENE on this machine's cores, or on the hosts of a host table over\n"
+    "SSH, and writes OUT (.png .exr .tif .jpg .hdr .ppm .bmp .pfm, by extension).\n"
+    "\n"
+    "  -o OUT               output image (written atomically, only when complete)\n"
+    "  --hosts FILE         host table (franja-hosts(5)); default: this machine\n"
+    "  -j N                 worker processes (local: default one per core;\n"
+    "                       with --hosts: at most N per host)\n"
+    "  --spp N              samples per pixel (default: the scene's)\n"
+    "  --size WxH           image size (default: the scene's)\n"
+    "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
+    "                       (HDR outputs .exr .hdr .pfm keep linear radiance)\n"
+    "  --resume             keep the finished slabs of an interrupted render\n"
+    "  --job DIR            job directory (default OUT.franja-job)\n"
+    "  --keep-job           keep the job directory after success\n"
+    "  --slab-rows N        rows per slab (default: about 4 slabs per slot)\n"
+    "  --retries N          attempts per slab before giving up (default 5)\n";
+
+static volatile sig_atomic_t stop_flag;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_flag = 1;
+}
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && !strcasecmp(s + a - b, suffix);
+}
+
+typedef struct {
+    const char *scene, *out, *hosts, *jobdir;
+    uint32_t jobs, spp, width, height, slab_rows, retries;
+    float exposure;
+    int resume, keep_job;
+    tr_options tr;
+} render_args;
+
+/* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
+static int parse(int argc, char **argv, render_args *a)
+{
+    memset(a, 0, sizeof *a);
+    a->retries = 5;
+    cli_transport_defaults(&a->tr);
+    for (int i = 1; i < argc; i++) {
+        const char *s = argv[i];
+        int t = cli_transport_option(argc, argv, &i, &a->tr);
+        if (t < 0)
+            return 2;
+        if (t)
+            continue;
+        if (!strcmp(s, "--help") || !strcmp(s, "-h")) {
+            fputs(usage, stdout);
+            fputs(cli_transport_help, stdout);
+            return 1;
+        }
+        if (!strcmp(s, "--resume")) {
+            a->resume = 1;
+            continue;
+        }
+        if (!strcmp(s, "--keep-job")) {
+            a->keep_job = 1;
+            continue;
+        }
+        if (s[0] != '-') {
+            if (a->scene) {
+                fprintf(stderr, "franja render: more than one scene ('%s' and '%s')\n", a->scene, s);
+                return 2;
+            }
+            a->scene = s;
+            continue;
+        }
+        static const char *valued[] = {"-o", "--hosts", "-j", "--spp", "--size", "--exposure",
+                                       "--job", "--slab-rows", "--retries"};
+        int known = 0;
+        for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
+            known |= !strcmp(s, valued[k]);
+        if (!known) {
+            fprintf(stderr, "franja render: unknown option '%s' (see franja render --help)\n", s);
+            return 2;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "franja render: %s needs a value\n", s);
+            return 2;
+        }
+        const char *v = argv[++i];
+        int bad = 0;
+        if (!strcmp(s, "-o"))
+            a->out = v;
+        else if (!strcmp(s, "--hosts"))
+            a->hosts = v;
+        else if (!strcmp(s, "--job"))
+            a->jobdir = v;
+        else if (!strcmp(s, "-j"))
+            bad = cli_uint(v, 1, 4096, &a->jobs);
+        else if (!strcmp(s, "--spp"))
+            bad = cli_uint(v, 1, 1u << 20, &a->spp);
+        else if (!strcmp(s, "--slab-rows"))
+            bad = cli_uint(v, 1, 65536, &a->slab_rows);
+        else if (!strcmp(s, "--retries"))
+            bad = cli_uint(v, 1, 1000, &a->retries);
+        else if (!strcmp(s, "--size")) {
+            char w[16];
+            const char *x = strchr(v, 'x');
+            bad = !x || x - v >= (long)sizeof w;
+            if (!bad) {
+                memcpy(w, v, (size_t)(x - v));
+                w[x - v] = 0;
+                bad = cli_uint(w, 1, 65536, &a->width) || cli_uint(x + 1, 1, 65536, &a->height);
+            }
+        } else {
+            char *end;
+            errno = 0;
+            a->exposure = strtof(v, &end);
+            bad = errno || *end || end == v || a->exposure < -64 || a->exposure > 64;
+        }
+        if (bad) {
+            fprintf(stderr, "franja render: %s: bad value '%s' (see franja render --help)\n", s, v);
+            return 2;
+        }
+    }
+    if (!a->scene || !a->out) {
+        fprintf(stderr, "franja render: %s is required (see franja render --help)\n",
+                a->scene ? "-o OUT" : "a SCENE");
+        return 2;
+    }
+    return 0;
+}
+
+/* Gets the binary scene: loads an .fbin, or compiles a JSON scene into the
+ * job directory.  *path receives the .fbin to ship. */
+static int scene_binary(const render_args *a, const char *jobdir, char *path, size_t cap, fr_scene *sc,
+                        fr_error *err)
+{
+    if (!ends_with(a->scene, ".json")) {
+        snprintf(path, cap, "%s", a->scene);
+        return fbin_load(path, sc, err);
+    }
+    if (mkdir(jobdir, 0755) && errno != EEXIST)
+        return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
+    snprintf(path, cap, "%s/scene.fbin", jobdir);
+    fr_scene compiled;
+    if (compile_json(a->scene, &compiled, err))
+        return -1;
+    int rc = fbin_write(&compiled, path, err);
+    scn_free(&compiled);
+    return rc ? -1 : fbin_load(path, sc, err);
+}
+
+static void summary(const sched_host *hs, int n, const job_spec *spec, const sched_stats *st, int rows_run,
+                    double wall)
+{
+    double samples = (double)rows_run * spec->width * spec->spp;
+    fprintf(stderr, "franja: %ux%u at %u spp in %.2f s: %.2f Msamples/s; %d slabs, %d retries, %d duplicates\n",
+            spec->width, spec->height, spec->spp, wall, wall > 0 ? samples / wall / 1e6 : 0.0, st->slabs,
+            st->retries, st->duplicates);
+    if (n == 0)
+        return;
+    fprintf(stderr, "  %-16s %5s %6s %6s %8s %6s %8s  %s\n", "host", "slots", "slabs", "rows", "failures", "dups",
+            "busy s", "state");
+    for (int i = 0; i < n; i++) {
+        const sched_host *h = &hs[i];
+        fprintf(stderr, "  %-16s %5d %6d %6d %8d %6d %8.2f  %s%s\n", h->name, h->slots, h->slabs, h->rows,
+                h->failures, h->duplicates, h->busy_s, h->dropped ? "dropped: " : "ok",
+                h->dropped ? h->drop_reason : "");
+    }
+}
+
+/* Connects the hosts and runs the slabs not yet in the job directory. */
+static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
+                     const char *jobdir, const unsigned char *have, int rows_missing, fr_error *err)
+{
+    int n = table->n;
+    cl_host *cl = calloc((size_t)n, sizeof *cl);
+    sched_host *sh = calloc((size_t)n, sizeof *sh);
+    if (!cl || !sh) {
+        free(cl);
+        free(sh);
+        return fr_fail(err, "out of memory");
+    }
+    for (int i = 0; i < n; i++)
+        cl[i].entry = &table->v[i];
+    cl_open(cl, n, &a->tr, fbin, spec->hash);
+    int ready = 0, ns = 0;
+    for (int i = 0; i < n; i++) {
+        if (!cl[i].tr) {
+            fprintf(stderr, "franja: host %s is not used: %s\n", cl[i].entry->name, cl[i].err.msg);
+            continue;
+        }
+        ready++;
+        int slots = cl[i].entry->cores ? cl[i].entry->cores : cl[i].info.cores;
+        if (a->jobs && (!a->hosts || slots > (int)a->jobs))
+            slots = (int)a->jobs;
+        sched_host *h = &sh[ns++];
+        h->tr = cl[i].tr;
+        h->name = cl[i].entry->name;
+        h->slots = slots > 0 ? slots : 1;
+        snprintf(h->scene, sizeof h->scene, "%s", cl[i].scene);
+        if (a->hosts || !isatty(2))
+            fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", h->name, cl[i].info.os,
+                    cl[i].info.arch, h->slots, cl[i].info.version,
+                    hosts_is_local(cl[i].entry) ? "local" : cl[i].uploaded ? "uploaded" : "already there",
+                    cl[i].ready_s);
+    }
+    int rc;
+    if (!ready)
+        rc = fr_fail(err, "no host could be used (see the messages above)");
+    else
+        rc = cl_check_versions(cl, n, err);
+    if (rc == 0) {
+        sched_params p = {*spec, jobdir, have, (int)a->slab_rows, (int)a->retries, 3, isatty(2), &stop_flag};
+        sched_stats st;
+        double t0 = now_s();
+        rc = sched_run(&p, sh, ns, &st, err);
+        summary(sh, ns, spec, &st, rows_missing, now_s() - t0);
+    }
+    cl_close(cl, n);
+    free(cl);
+    free(sh);
+    return rc;
+}
+
+int cmd_render(int argc, char **argv)
+{
+    render_args a;
+    int pr = parse(argc, argv, &a);
+    if (pr)
+        return pr == 1 ? 0 : 2;
+    fr_error err;
+    if (out_check(a.out, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return 2;
+    }
+    char jobdir[4096], fbin[4200];
+    if (a.jobdir)
+        snprintf(jobdir, sizeof jobdir, "%s", a.jobdir);
+    else
+        snprintf(jobdir, sizeof jobdir, "%s.franja-job", a.out);
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+
+    double t0 = now_s();
+    fr_scene sc;
+    if (scene_binary(&a, jobdir, fbin, sizeof fbin, &sc, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return 1;
+    }
+    job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
+                     a.spp ? a.spp : sc.settings.spp};
+    scn_free(&sc);
+
+    hosts_table table;
+    if (a.hosts) {
+        if (hosts_load(a.hosts, &table, &err)) {
+            fprintf(stderr, "franja render: %s\n", err.msg);
+            return 2;
+        }
+    } else {
+        table.n = 1;
+        table.v = calloc(1, sizeof *table.v);
+        if (!table.v)
+            return 1;
+        snprintf(table.path, sizeof table.path, "(this machine)");
+        strcpy(table.v[0].name, "local");
+        strcpy(table.v[0].address, "local");
+    }
+
+    unsigned char *have = calloc(spec.height, 1);
+    float *rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *rgb);
+    int rc = 1;
+    if (!have || !rgb) {
+        fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
+        goto done;
+    }
+    if (job_open(jobdir, &spec, a.resume, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        goto done;
+    }
+    int rows_have = 0;
+    if (a.resume) {
+        rows_have = job_scan(jobdir, &spec, have, &err);
+        if (rows_have < 0) {
+            fprintf(stderr, "franja render: %s\n", err.msg);
+            goto done;
+        }
+        fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", rows_have, spec.height, jobdir);
+    }
+    if ((uint32_t)rows_have < spec.height &&
+        run_slabs(&a, &table, fbin, &spec, jobdir, have, (int)spec.height - rows_have, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        goto done;
+    }
+    if (job_stitch(jobdir, &spec, rgb, &err) || out_write(a.out, rgb, &spec, a.exposure, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        goto done;
+    }
+    if (!a.keep_job)
+        job_remove(jobdir);
+    fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, spec.width, spec.height, spec.spp,
+            now_s() - t0);
+    rc = 0;
+done:
+    if (rc && stop_flag)
+        rc = 130;
+    free(have);
+    free(rgb);
+    hosts_free(&table);
+    return rc;
+}
