@@ -65,12 +65,14 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
         out->pdf = l->pick;
         out->p = l->position;
         out->n = v3_neg(out->wi);
+        out->prim = FR_NONE;
         out->delta = 1;
         return 1;
     }
     const fr_prim *pr = &s->prims[l->prim];
     const fr_material *m = &s->materials[pr->material];
     out->delta = 0;
+    out->prim = l->prim;
     if (pr->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[pr->index];
         vec3 dc = v3_sub(sp->center, from);

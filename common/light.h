@@ -14,7 +14,8 @@ typedef struct {
     float dist;                /* distance to the sampled point */
     vec3 radiance;             /* incident radiance (area) or intensity/dist^2 (point) */
     float pdf;                 /* solid-angle pdf including the pick; for a point light the pick alone */
-    vec3 p, n;                 /* sampled point and its light's normal (for the shadow ray) */
+    vec3 p, n;                 /* sampled point and its light's normal */
+    uint32_t prim;             /* the emitting prim, FR_NONE for a point light */
     int delta;                 /* 1 for point lights: no MIS */
 } fr_light_sample;
 

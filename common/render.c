@@ -96,12 +96,8 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
             vec3 f = bsdf_eval(m, &sf, wo, ls.wi, &bpdf);
             if (!v3_is_zero(f)) {
                 fr_ray shadow = {geo_offset(sf.p, sf.ng, ls.wi), ls.wi};
-                /* Stop short of the light's own surface: its point is offset
-                 * the same way, toward the shading point. */
-                vec3 target = ls.delta ? ls.p : geo_offset(ls.p, ls.n, v3_neg(ls.wi));
-                vec3 to = v3_sub(target, shadow.o);
-                float tmax = v3_dot(to, ls.wi);
-                if (tmax > 0.0f && !trace_occluded(s, &shadow, tmax)) {
+                float tmax = v3_dot(v3_sub(ls.p, shadow.o), ls.wi);
+                if (tmax > 0.0f && !trace_occluded(s, &shadow, tmax, ls.prim)) {
                     float w = (ls.delta || strategy == PT_LIGHT_ONLY) ? 1.0f : power_heuristic(ls.pdf, bpdf);
                     float cosi = fabsf(v3_dot(ls.wi, sf.ns));
                     L = v3_add(L, v3_scale(v3_mul(beta, v3_mul(f, ls.radiance)), w * cosi / ls.pdf));

@@ -32,7 +32,7 @@ static float box_entry(const fr_bvh_node *n, vec3 o, vec3 inv, float tmax)
 }
 
 /* Walk the BVH; with `any` set, return at the first hit. */
-static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int any)
+static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int any, uint32_t skip)
 {
     int found = 0;
     for (uint32_t i = 0; i < s->n_planes; i++) {
@@ -59,6 +59,8 @@ static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int
         if (count) {
             for (uint32_t i = n->offset; i < n->offset + count; i++) {
                 float a, b;
+                if (i == skip)
+                    continue;
                 float t = trace_prim(s, i, r, tmax, &a, &b);
                 if (t > 0.0f) {
                     if (any) return 1;
@@ -89,13 +91,13 @@ static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int
 
 int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 {
-    return walk(s, r, tmax, hit, 0);
+    return walk(s, r, tmax, hit, 0, FR_NONE);
 }
 
-int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax)
+int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
     fr_hit h;
-    return walk(s, r, tmax, &h, 1);
+    return walk(s, r, tmax, &h, 1, skip);
 }
 
 void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out)

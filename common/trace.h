@@ -29,8 +29,11 @@ typedef struct {
 
 /* Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0. */
 int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit);
-/* 1 if anything is hit in (0, tmax). */
-int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax);
+/* 1 if anything but prim `skip` (FR_NONE: nothing skipped) is hit in
+ * (0, tmax).  Shadow rays skip the light they aim at: a convex emitter
+ * cannot hide its own sampled point, and near its silhouette rounding would
+ * make it seem to. */
+int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip);
 /* Nearest hit on one primitive, for tests and the BVH: t or 0. */
 float trace_prim(const fr_scene *s, uint32_t prim, const fr_ray *r, float tmax, float *a, float *b);
 /* Rebuild the surface at a hit. */
