@@ -133,15 +133,15 @@ static int parse_camera(ctx *c, const cJSON *o)
         return fr_fail(c->err, "camera.fov: expected degrees in (0, 180)");
     if (cam->aperture < 0.0f)
         return fr_fail(c->err, "camera.aperture: expected a lens radius >= 0");
+    cam->vfov = fov * (FM_PI / 180.0f);
+    fr_error e;
+    if (bld_camera_finish(cam, &e) < 0)
+        return fr_fail(c->err, "%s", e.msg);
     float dist = v3_len(v3_sub(cam->target, cam->position));
     if (scn_json_number(o, "focus", "camera", 0, dist, &cam->focus, c->err) < 0)
         return -1;
     if (!(cam->focus > 0.0f))
         return fr_fail(c->err, "camera.focus: expected a positive distance");
-    cam->vfov = fov * (FM_PI / 180.0f);
-    fr_error e;
-    if (bld_camera_finish(cam, &e) < 0)
-        return fr_fail(c->err, "%s", e.msg);
     return 0;
 }
 
