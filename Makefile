@@ -35,6 +35,8 @@ COORD_CXX   = $(wildcard coordinator/*.cpp)
 COORD_OBJ   = $(COORD_SRC:%.c=$(B)/%.o) $(COORD_CXX:%.cpp=$(B)/%.o)
 TEST_SRC    = $(wildcard tests/test_*.c)
 TEST_BIN    = $(TEST_SRC:tests/%.c=bin/tests/%)
+TOOL_SRC    = $(wildcard tests/tools/*.c)
+TOOL_BIN    = $(TOOL_SRC:tests/tools/%.c=bin/tools/%)
 LIB         = $(B)/libfranja.a
 
 WORKER_LIBS = $(CJSON_LIBS) -lm
@@ -67,17 +69,49 @@ bin/tests/%: tests/%.c $(LIB)
 	@mkdir -p bin/tests
 	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -Itests -o $@ $< $(LIB) $(WORKER_LIBS)
 
+bin/tools/%: tests/tools/%.c $(LIB)
+	@mkdir -p bin/tools
+	$(CC) $(CSTD) $(CFLAGS) -o $@ $< $(LIB) -lm
+
 deps:
 	sh tests/install-deps.sh
 
-check: all $(TEST_BIN)
+check: all $(TEST_BIN) $(TOOL_BIN)
 	sh tests/run.sh
 
-bench: all
+bench: all $(TOOL_BIN)
 	sh tests/bench/run.sh
 
 render: all
 	bin/franja render scenes/cornell.json -o cornell.png
+
+# Fully static workers, bin/static/<arch>/franja-worker: they run on any Linux
+# of their architecture.  Debian ships no static cJSON, so they are built with
+# -DFRANJA_NO_JSON and read binary scenes only.  Each arch has its own objects.
+STATIC_ARCHS = amd64 arm64
+STATIC_CC_amd64 = x86_64-linux-gnu-gcc
+STATIC_CC_arm64 = aarch64-linux-gnu-gcc
+static: $(STATIC_ARCHS:%=bin/static/%/franja-worker)
+
+bin/static/%/franja-worker: $(COMMON_SRC) $(WORKER_SRC) $(wildcard common/*.h worker/*.h)
+	$(MAKE) --no-print-directory B=$(B)/static-$* CC=$(STATIC_CC_$*) \
+	    AR=$(STATIC_CC_$*:-gcc=-ar) CJSON_CFLAGS= CFLAGS='$(CFLAGS) -DFRANJA_NO_JSON' \
+	    $(B)/static-$*/libfranja.a $(WORKER_SRC:%.c=$(B)/static-$*/%.o)
+	@mkdir -p $(dir $@)
+	$(STATIC_CC_$*) $(CFLAGS) -static -o $@ $(WORKER_SRC:%.c=$(B)/static-$*/%.o) \
+	    $(B)/static-$*/libfranja.a -lm
+
+# dist/<os>-<arch>/ from the docker/Dockerfile.* images (docker/build.sh; see
+# docker/README.md), plus dist/static-<arch>/.  DIST_TARGETS: bullseye bookworm
+# trixie (default all); DIST_FLAGS e.g. --own-engine where no Docker runs.
+dist: static
+	sh docker/build.sh $(DIST_FLAGS) -o dist $(DIST_TARGETS)
+	for a in $(STATIC_ARCHS); do mkdir -p dist/static-$$a && \
+	    cp bin/static/$$a/franja-worker dist/static-$$a/; done
+
+# Cross-architecture and cross-distribution tests (qemu, Docker; root).
+check-cross: all static
+	sh tests/cross/run.sh
 
 clean:
 	rm -rf $(B) bin

@@ -1,0 +1,100 @@
+/* imgcmp -- compare a rendered PFM against a reference PFM.
+ *
+ *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
+ *
+ * IMAGE is box-downsampled to the reference's size when it is an integer
+ * multiple of it.  Prints each channel's mean (image and reference) and the
+ * RMSE over all channels of the pixels off the light (reference pixels with
+ * a channel >= 10 are the light).  With limits, prints the closing
+ * "N passed, N failed" line and exits non-zero when one is exceeded. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct { int w, h; float *px; } image;
+
+static int read_pfm(const char *path, image *im)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) { perror(path); return -1; }
+    char magic[3] = {0};
+    double scale;
+    int c;
+    if (fscanf(f, "%2s", magic) != 1 || strcmp(magic, "PF") != 0) goto bad;
+    /* Skip comment lines between the header fields. */
+    while ((c = fgetc(f)) == '\n' || c == ' ' || c == '#')
+        if (c == '#') while ((c = fgetc(f)) != '\n' && c != EOF) {}
+    ungetc(c, f);
+    if (fscanf(f, "%d %d %lf", &im->w, &im->h, &scale) != 3 || fgetc(f) != '\n' || im->w <= 0 || im->h <= 0 ||
+        scale >= 0 || im->w > 65536 || im->h > 65536)
+        goto bad;
+    size_t n = (size_t)im->w * im->h * 3;
+    im->px = malloc(n * sizeof(float));
+    float *raw = malloc(n * sizeof(float));
+    if (!im->px || !raw || fread(raw, sizeof(float), n, f) != n) { free(raw); goto bad; }
+    for (int y = 0; y < im->h; y++) /* PFM rows are bottom to top */
+        memcpy(im->px + (size_t)y * im->w * 3, raw + (size_t)(im->h - 1 - y) * im->w * 3, (size_t)im->w * 12);
+    free(raw);
+    fclose(f);
+    return 0;
+bad:
+    fprintf(stderr, "%s: not a little-endian RGB PFM\n", path);
+    fclose(f);
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    double max_rmse = -1, max_rel = -1;
+    if (argc < 3) { fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]\n"); return 2; }
+    for (int i = 3; i + 1 < argc; i += 2) {
+        if (!strcmp(argv[i], "--max-rmse")) max_rmse = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--max-mean-rel")) max_rel = atof(argv[i + 1]);
+        else { fprintf(stderr, "imgcmp: unknown option %s\n", argv[i]); return 2; }
+    }
+    image a, r;
+    if (read_pfm(argv[1], &a) < 0 || read_pfm(argv[2], &r) < 0) return 2;
+    if (a.w % r.w || a.h % r.h || a.w / r.w != a.h / r.h) {
+        fprintf(stderr, "imgcmp: %dx%d is not a multiple of %dx%d\n", a.w, a.h, r.w, r.h);
+        return 2;
+    }
+    int k = a.w / r.w;
+    double mean[3] = {0}, rmean[3] = {0}, se = 0;
+    long off = 0;
+    for (int y = 0; y < r.h; y++)
+        for (int x = 0; x < r.w; x++) {
+            const float *q = r.px + ((size_t)y * r.w + x) * 3;
+            int light = q[0] >= 10 || q[1] >= 10 || q[2] >= 10;
+            for (int ch = 0; ch < 3; ch++) {
+                double v = 0;
+                for (int j = 0; j < k; j++)
+                    for (int i = 0; i < k; i++)
+                        v += a.px[((size_t)(y * k + j) * a.w + x * k + i) * 3 + ch];
+                v /= k * k;
+                mean[ch] += v;
+                rmean[ch] += q[ch];
+                if (!light) se += (v - q[ch]) * (v - q[ch]);
+            }
+            off += !light;
+        }
+    int npx = r.w * r.h, pass = 0, fail = 0;
+    double rmse = sqrt(se / (3.0 * off));
+    for (int ch = 0; ch < 3; ch++) {
+        mean[ch] /= npx;
+        rmean[ch] /= npx;
+        double rel = fabs(mean[ch] - rmean[ch]) / rmean[ch];
+        printf("channel %c: mean %.5f, reference %.5f (%.2f %%)\n", "RGB"[ch], mean[ch], rmean[ch], 100 * rel);
+        if (max_rel >= 0) {
+            if (rel <= max_rel) pass++;
+            else { fail++; printf("FAIL: channel %c mean off by %.2f %% (limit %.2f %%)\n", "RGB"[ch], 100 * rel, 100 * max_rel); }
+        }
+    }
+    printf("rmse %.5f over %ld pixels off the light\n", rmse, off);
+    if (max_rmse >= 0) {
+        if (rmse <= max_rmse) pass++;
+        else { fail++; printf("FAIL: rmse %.5f above %.5f\n", rmse, max_rmse); }
+    }
+    if (max_rmse >= 0 || max_rel >= 0) printf("%d passed, %d failed\n", pass, fail);
+    return fail ? 1 : 0;
+}
