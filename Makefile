@@ -113,34 +113,6 @@ dist: static
 check-cross: all static
 	sh tests/cross/run.sh
 
-# Fully static workers, bin/static/<arch>/franja-worker: they run on any Linux
-# of their architecture.  Debian ships no static cJSON, so they are built with
-# -DFRANJA_NO_JSON and read binary scenes only.  Each arch has its own objects.
-STATIC_ARCHS = amd64 arm64
-STATIC_CC_amd64 = x86_64-linux-gnu-gcc
-STATIC_CC_arm64 = aarch64-linux-gnu-gcc
-static: $(STATIC_ARCHS:%=bin/static/%/franja-worker)
-
-bin/static/%/franja-worker: $(COMMON_SRC) $(WORKER_SRC) $(wildcard common/*.h worker/*.h)
-	$(MAKE) --no-print-directory B=$(B)/static-$* CC=$(STATIC_CC_$*) \
-	    AR=$(STATIC_CC_$*:-gcc=-ar) CJSON_CFLAGS= CFLAGS='$(CFLAGS) -DFRANJA_NO_JSON' \
-	    $(B)/static-$*/libfranja.a $(WORKER_SRC:%.c=$(B)/static-$*/%.o)
-	@mkdir -p $(dir $@)
-	$(STATIC_CC_$*) $(CFLAGS) -static -o $@ $(WORKER_SRC:%.c=$(B)/static-$*/%.o) \
-	    $(B)/static-$*/libfranja.a -lm
-
-# dist/<os>-<arch>/ from the docker/Dockerfile.* images (docker/build.sh; see
-# docker/README.md), plus dist/static-<arch>/.  DIST_TARGETS: bullseye bookworm
-# trixie (default all); DIST_FLAGS e.g. --own-engine where no Docker runs.
-dist: static
-	sh docker/build.sh $(DIST_FLAGS) -o dist $(DIST_TARGETS)
-	for a in $(STATIC_ARCHS); do mkdir -p dist/static-$$a && \
-	    cp bin/static/$$a/franja-worker dist/static-$$a/; done
-
-# Cross-architecture and cross-distribution tests (qemu, Docker; root).
-check-cross: all static
-	sh tests/cross/run.sh
-
 clean:
 	rm -rf $(B) bin
 
