@@ -85,6 +85,12 @@ bench: all $(TOOL_BIN)
 render: all
 	bin/franja render scenes/cornell.json -o cornell.png
 
+# HTML API documentation of the headers, in build/docs/html (Doxygen).
+docs:
+	@mkdir -p $(B)/docs
+	doxygen coordinator/Doxyfile
+	@echo "API documentation: $(B)/docs/html/index.html"
+
 # Fully static workers, bin/static/<arch>/franja-worker: they run on any Linux
 # of their architecture.  Debian ships no static cJSON, so they are built with
 # -DFRANJA_NO_JSON and read binary scenes only.  Each arch has its own objects.

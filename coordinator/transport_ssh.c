@@ -245,11 +245,11 @@ static int run_remote(ssh_host *h, const char *cmd, tr_proc *p, int *status, fr_
         int m;
         while ((m = ssh_channel_read_nonblocking(ch, buf, sizeof buf, 1)) > 0)
             tr_proc_add_err(p, buf, (size_t)m);
-        if (n < 0 || m < 0) {
+        if ((n < 0 && n != SSH_EOF) || (m < 0 && m != SSH_EOF)) {
             rc = fr_fail(err, "%s: connection lost: %s", h->label, ssh_get_error(h->s));
             break;
         }
-        if (n == 0 && (ssh_channel_is_eof(ch) || ssh_channel_is_closed(ch)))
+        if ((n == 0 || n == SSH_EOF) && (ssh_channel_is_eof(ch) || ssh_channel_is_closed(ch)))
             break;
         if (now_s() > end) {
             rc = fr_fail(err, "%s: command did not finish in time: %s", h->label, cmd);
@@ -525,7 +525,7 @@ static int ssh_service(void *impl, tr_proc *procs, fr_error *err)
                 tr_proc_fail(p, "out of memory for the worker's output");
         while (n >= 0 && (m = ssh_channel_read_nonblocking(sp->ch, buf, sizeof buf, 1)) > 0)
             tr_proc_add_err(p, buf, (size_t)m);
-        if (n < 0 || m < 0) {
+        if ((n < 0 && n != SSH_EOF) || (m < 0 && m != SSH_EOF)) {
             char why[1024];
             snprintf(why, sizeof why, "%s: connection lost: %s", h->label, ssh_get_error(h->s));
             lose(h, procs, why);

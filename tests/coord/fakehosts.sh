@@ -1,0 +1,156 @@
+# fakehosts.sh -- sourced by the coordinator's integration tests (it_coord_*.sh).
+#
+# Fake cluster hosts: real OpenSSH servers on loopback addresses 127.0.0.N,
+# each with its own throwaway host key, port and work directory; one
+# throwaway client key; a private known_hosts file.  Everything lives under
+# $FH (a temporary directory) and every process started here is stopped by
+# fh_cleanup, by PID.
+#
+#   fh_init                   create $FH, the client key, the known_hosts file
+#   fh_start NAME N [CORES] [WORKER]
+#                             start sshd for host NAME on 127.0.0.N and append
+#                             its line to $FH/hosts (WORKER: worker path)
+#   fh_pids NAME              PIDs of the host: sshd, its sessions, its workers
+#   fh_kill NAME / fh_stop NAME / fh_cont NAME
+#   fh_wrapper NAME MODE      a worker wrapper that misbehaves once (MODE:
+#                             kill, truncate, extra, slow, hang) and prints its path
+#   check DESC CMD...         counts a passed/failed check
+#   fh_summary                prints "N passed, N failed" and returns the status
+
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+FRANJA="$ROOT/bin/franja"
+WORKER="$ROOT/bin/franja-worker"
+PASSED=0
+FAILED=0
+
+check() {
+    desc=$1
+    shift
+    if "$@"; then
+        PASSED=$((PASSED + 1))
+    else
+        FAILED=$((FAILED + 1))
+        echo "FAIL: $desc"
+    fi
+}
+
+fh_summary() {
+    echo "$PASSED passed, $FAILED failed"
+    [ "$FAILED" -eq 0 ]
+}
+
+fh_init() {
+    for tool in /usr/sbin/sshd ssh-keygen ps; do
+        if ! command -v "$tool" >/dev/null 2>&1; then
+            echo "FAIL: $tool is missing (run tests/install-deps.sh)"
+            echo "0 passed, 1 failed"
+            exit 1
+        fi
+    done
+    FH=$(mktemp -d /tmp/franja-fh.XXXXXX)
+    chmod 755 "$FH"
+    mkdir -p -m0755 /run/sshd 2>/dev/null || true
+    ssh-keygen -q -t ed25519 -N '' -f "$FH/client_key" -C franja-test
+    cp "$FH/client_key.pub" "$FH/authorized_keys"
+    : >"$FH/known_hosts"
+    : >"$FH/hosts"
+    FH_USER=$(id -un)
+    # A port range of our own, so parallel runs on one machine do not collide.
+    FH_PORT=$((20000 + ($$ % 2000) * 10))
+    FH_HOSTS=""
+    trap fh_cleanup EXIT
+    trap 'exit 130' INT TERM
+}
+
+fh_start() {
+    name=$1 n=$2 cores=${3:-2} worker=${4:-$WORKER}
+    d="$FH/$name"
+    mkdir -p "$d/work"
+    ssh-keygen -q -t ed25519 -N '' -f "$d/host_key" -C "$name"
+    port=$((FH_PORT + n))
+    cat >"$d/sshd_config" <<CFG
+ListenAddress 127.0.0.$n:$port
+HostKey $d/host_key
+PidFile $d/sshd.pid
+AuthorizedKeysFile $FH/authorized_keys
+PasswordAuthentication no
+KbdInteractiveAuthentication no
+UsePAM no
+StrictModes no
+PermitRootLogin prohibit-password
+Subsystem sftp /usr/lib/openssh/sftp-server
+MaxStartups 100:30:200
+MaxSessions 64
+UseDNS no
+PrintMotd no
+LogLevel ERROR
+CFG
+    /usr/sbin/sshd -f "$d/sshd_config" -E "$d/sshd.log" || {
+        echo "FAIL: sshd for $name did not start:"
+        cat "$d/sshd.log"
+        return 1
+    }
+    echo "[127.0.0.$n]:$port $(cut -d' ' -f1,2 "$d/host_key.pub")" >>"$FH/known_hosts"
+    echo "$name 127.0.0.$n:$port $FH_USER $cores identity=$FH/client_key workdir=$d/work worker=$worker" >>"$FH/hosts"
+    FH_HOSTS="$FH_HOSTS $name"
+}
+
+# The PID and every descendant of a process.
+fh_tree() {
+    echo "$1"
+    for c in $(ps -o pid= --ppid "$1" 2>/dev/null); do
+        fh_tree "$c"
+    done
+}
+
+fh_pids() {
+    pidfile="$FH/$1/sshd.pid"
+    [ -s "$pidfile" ] && fh_tree "$(cat "$pidfile")"
+}
+
+fh_kill() { for p in $(fh_pids "$1"); do kill -KILL "$p" 2>/dev/null; done; }
+fh_stop() { for p in $(fh_pids "$1"); do kill -STOP "$p" 2>/dev/null; done; }
+fh_cont() { for p in $(fh_pids "$1"); do kill -CONT "$p" 2>/dev/null; done; }
+
+fh_cleanup() {
+    for h in $FH_HOSTS; do
+        pids=$(fh_pids "$h")
+        for p in $pids; do kill -CONT "$p" 2>/dev/null; done
+        for p in $pids; do kill -TERM "$p" 2>/dev/null; done
+    done
+    [ -n "${FH_BG:-}" ] && kill -KILL "$FH_BG" 2>/dev/null
+    [ -n "$FH" ] && [ -d "$FH" ] && [ -z "${KEEP:-}" ] && rm -rf "$FH"
+}
+
+# A wrapper around the worker for host NAME that misbehaves on the first
+# slab it is asked for (later calls, --version and --check behave):
+#   kill      dies by SIGKILL after writing part of the image
+#   truncate  writes only part of the image and exits 0
+#   extra     writes the image plus stray bytes (wrong size) and exits 0
+#   slow      every slab waits 0.4 s first (for faults injected from outside)
+#   hang      never finishes (a stuck process)
+fh_wrapper() {
+    name=$1 mode=$2 w="$FH/$1/worker-$2.sh"
+    cat >"$w" <<SH
+#!/bin/sh
+case " \$* " in *" --rows "*) ;; *) exec "$WORKER" "\$@" ;; esac
+if [ "$mode" = slow ]; then sleep 0.4; exec "$WORKER" "\$@"; fi
+if mkdir "$FH/$name/faulted" 2>/dev/null; then
+    case "$mode" in
+    kill) "$WORKER" "\$@" | head -c 100; kill -KILL \$\$ ;;
+    truncate) "$WORKER" "\$@" | head -c 200; exit 0 ;;
+    extra) "$WORKER" "\$@"; printf 'stray'; exit 0 ;;
+    hang) exec sleep 600 ;;
+    esac
+fi
+exec "$WORKER" "\$@"
+SH
+    chmod +x "$w"
+    echo "$w"
+}
+
+# franja with the test's SSH settings: private known_hosts, no ~/.ssh/config,
+# no agent, a short time-out.
+fr() {
+    env -u SSH_AUTH_SOCK "$FRANJA" "$@" --known-hosts "$FH/known_hosts" --no-ssh-config --timeout 3
+}

@@ -1,0 +1,89 @@
+#!/bin/sh
+# Faults on fake SSH hosts, each render still ending byte-identical to the
+# one-process render: a worker killed mid-slab, truncated and wrong-size
+# partial images, a host unreachable from the start, a whole host killed
+# mid-render, a host that goes silent (all its processes stopped), and the
+# coordinator killed and resumed.
+. "$(dirname "$0")/coord/fakehosts.sh"
+fh_init
+cd "$FH" || exit 1
+SIZE="--size 32x32 --spp 4"
+"$FRANJA" render "$ROOT/scenes/cornell.json" -o local.pfm $SIZE --job job0 --keep-job 2>/dev/null
+cp job0/scene.fbin scene.fbin
+"$WORKER" --scene scene.fbin --rows 0:32 $SIZE -o ref.pfm
+
+# Hosts whose workers misbehave once, and a healthy one.
+fh_start kill 2 2 "$(mkdir -p "$FH/kill" && fh_wrapper kill kill)"
+fh_start trunc 3 2 "$(mkdir -p "$FH/trunc" && fh_wrapper trunc truncate)"
+fh_start extra 4 2 "$(mkdir -p "$FH/extra" && fh_wrapper extra extra)"
+fh_start good 5 2
+# A host nobody listens on.
+echo "gone 127.0.0.9:$((FH_PORT + 9)) $FH_USER 2 identity=$FH/client_key workdir=$FH/gone" >>hosts
+fr render scene.fbin -o bad.pfm --hosts hosts $SIZE 2>logb
+check "render with faulty workers is byte-identical" cmp -s bad.pfm ref.pfm
+check "worker killed mid-slab: retried" grep -q "failed on kill (attempt 1 of 5)" logb
+check "truncated image: rejected" grep -q "failed on trunc .*bad partial image" logb
+check "wrong-size image: rejected" grep -q "failed on extra .*bad partial image.*bytes of pixels" logb
+check "unreachable host: reported" grep -q "host gone is not used: .*cannot connect" logb
+check "unreachable host: not in the summary" sh -c "! grep -q '^  gone ' logb"
+
+# Whole host killed mid-render, and a host that goes silent.  Slow workers
+# (0.4 s a slab) leave time to do it while slabs are in flight.
+: >hosts
+FH_HOSTS_OLD=$FH_HOSTS
+for h in s1 s2 s3; do mkdir -p "$FH/$h"; done
+fh_start s1 6 2 "$(fh_wrapper s1 slow)"
+fh_start s2 7 2 "$(fh_wrapper s2 slow)"
+fh_start s3 8 2 "$(fh_wrapper s3 slow)"
+wait_running() { # wait until host $1 runs a worker
+    i=0
+    while ! fh_pids "$1" | xargs -r ps -o args= -p 2>/dev/null | grep -q "franja-worker.*--rows" && [ $i -lt 100 ]; do
+        sleep 0.1
+        i=$((i + 1))
+    done
+}
+fr render scene.fbin -o killed.pfm --hosts hosts $SIZE --slab-rows 2 2>logk &
+FH_BG=$!
+wait_running s2
+fh_kill s2
+wait $FH_BG
+rc=$?
+FH_BG=
+check "host killed mid-render: render succeeds" test $rc -eq 0
+check "host killed mid-render: byte-identical" cmp -s killed.pfm ref.pfm
+check "host killed mid-render: dropped with a message" grep -q "dropping host s2: .*connection" logk
+
+fr render scene.fbin -o silent.pfm --hosts hosts $SIZE --slab-rows 2 2>logs &
+FH_BG=$!
+wait_running s3
+fh_stop s3
+t0=$(date +%s)
+wait $FH_BG
+rc=$?
+FH_BG=
+fh_cont s3
+check "silent host: render succeeds" test $rc -eq 0
+check "silent host: byte-identical" cmp -s silent.pfm ref.pfm
+check "silent host: dropped after the time-out" grep -q "dropping host s3: .*no answer for" logs
+check "silent host: noticed within a few time-outs" test $(($(date +%s) - t0)) -lt 20
+
+# The coordinator killed (SIGKILL, no chance to clean up), then --resume.
+fr render scene.fbin -o resumed.pfm --hosts hosts $SIZE --slab-rows 2 2>logc1 &
+FH_BG=$!
+i=0
+while [ "$(ls resumed.pfm.franja-job 2>/dev/null | grep -c '^rows-')" -lt 3 ] && [ $i -lt 100 ]; do
+    sleep 0.1
+    i=$((i + 1))
+done
+kill -KILL $FH_BG
+wait $FH_BG 2>/dev/null
+FH_BG=
+kept=$(ls resumed.pfm.franja-job | grep -c '^rows-')
+check "killed coordinator leaves no image" test ! -e resumed.pfm
+check "killed coordinator leaves its finished slabs" test "$kept" -ge 3
+fr render scene.fbin -o resumed.pfm --hosts hosts $SIZE --slab-rows 2 --resume 2>logc2
+check "resumed render is byte-identical" cmp -s resumed.pfm ref.pfm
+check "resume kept the finished rows" grep -q "resuming: $((kept * 2)) of 32 rows" logc2
+check "resume rendered only the rest" grep -q "; $((16 - kept)) slabs" logc2
+
+fh_summary
