@@ -21,35 +21,34 @@ static uint32_t reverse_bits(uint32_t x)
     return x;
 }
 
-/* Owen scrambling of a 32-bit fraction: each bit is flipped by a hash of
- * the bits above it.  Working on the reversed value, "bits above" become
- * "bits below", which adding a seed and xor-ing with multiples by even
- * constants affect only upward (Laine and Karras 2011; constants from
- * Burley 2020). */
-static uint32_t owen_scramble(uint32_t x, uint32_t seed)
+/* Laine-Karras permutation of a bit-reversed 32-bit fraction: each bit is
+ * flipped by a hash of the bits below it (the more significant bits of the
+ * fraction), which adding a seed and xor-ing with multiples by even
+ * constants affect only upward.  reverse(lk(reverse(x))) is Owen
+ * scrambling of x (Laine and Karras 2011; constants from Burley 2020). */
+static uint32_t lk_permute(uint32_t x, uint32_t seed)
 {
-    x = reverse_bits(x);
     x += seed;
     x ^= x * 0x6c50b47cu;
     x ^= x * 0xb82f1e52u;
     x ^= x * 0xc7afe638u;
     x ^= x * 0x8d22f6e6u;
-    return reverse_bits(x);
+    return x;
 }
 
-/* The first two dimensions of the Sobol sequence as 32-bit fractions: the
- * van der Corput radical inverse, and the sequence whose direction numbers
- * follow v[k] = v[k-1] ^ (v[k-1] >> 1) (primitive polynomial x + 1). */
-static void sobol2(uint32_t i, uint32_t *a, uint32_t *b)
+/* The second Sobol dimension, bit-reversed, as a function of the index.
+ * Its generator matrix (primitive polynomial x + 1) is Pascal's triangle
+ * mod 2: digit r of the value is the xor of the index bits k with
+ * k & r == r (Lucas' theorem).  That superset sum over GF(2) takes five
+ * shift-and-xor steps, one per bit of the digit position. */
+static uint32_t sobol1_rev(uint32_t i)
 {
-    uint32_t v = 0x80000000u, y = 0;
-    *a = reverse_bits(i);
-    for (; i; i >>= 1) {
-        if (i & 1)
-            y ^= v;
-        v ^= v >> 1;
-    }
-    *b = y;
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return i;
 }
 
 static float to_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
@@ -63,12 +62,14 @@ void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t s
 
 void smp_2d(fr_sampler *s, float *u, float *v)
 {
+    /* Owen-scramble the index to shuffle the order per dimension pair, take
+     * the point of the 2D Sobol sequence, Owen-scramble both coordinates.
+     * The first Sobol dimension is the bit reversal of the index, so its
+     * scrambling needs one reversal, not three. */
     uint32_t seed = smp_hash(s->pixel ^ smp_hash(s->dim++));
-    uint32_t i = owen_scramble(s->index, seed);
-    uint32_t a, b;
-    sobol2(i, &a, &b);
-    *u = to_unit(owen_scramble(a, smp_hash(seed + 1)));
-    *v = to_unit(owen_scramble(b, smp_hash(seed + 2)));
+    uint32_t i = reverse_bits(lk_permute(reverse_bits(s->index), seed));
+    *u = to_unit(reverse_bits(lk_permute(i, smp_hash(seed + 1))));
+    *v = to_unit(reverse_bits(lk_permute(sobol1_rev(i), smp_hash(seed + 2))));
 }
 
 float smp_1d(fr_sampler *s)
