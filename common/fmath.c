@@ -350,20 +350,41 @@ float fm_atan2f(float y, float x)
     return (float)atan2_core(y, x);
 }
 
-/* asin and acos as the angles of (sqrt(1-x^2), x); (1-x)(1+x) is exact up to
- * one rounding for any float x, unlike 1 - x*x near |x| = 1. */
+/* asin(w) for |w| <= 1/2: w * (1 + z*P(z)), z = w^2, relative error
+ * 2^-43.9.  Beyond 1/2, asin(w) = pi/2 - 2 asin(sqrt((1-w)/2)) brings the
+ * argument back, with (1-w)/2 exact for a float w. */
+static inline double asin_kernel(double w)
+{
+    double z = w * w, z2 = z * z, z4 = z2 * z2;
+    double p = ((0x1.555555565a9bdp-3 + z * 0x1.333331f267ad2p-4)
+             + z2 * (0x1.6db762b5088a4p-5 + z * 0x1.f1ab4339193bbp-6))
+             + z4 * (((0x1.7027ec1aff965p-6 + z * 0x1.0e11622a1ad57p-6)
+             + z2 * (0x1.30da3dcc249cbp-6 + z * -0x1.6ff281390acbcp-9))
+             + z4 * 0x1.056f908d69f34p-5);
+    return w * (1.0 + z * p);
+}
+
 float fm_asinf(float x)
 {
     if (x != x)
         return x + x;
-    double d = x > 1.0f ? 1.0 : x < -1.0f ? -1.0 : (double)x;
-    return (float)atan2_core(d, sqrt((1.0 - d) * (1.0 + d)));
+    double ax = fabs((double)x);
+    ax = ax > 1.0 ? 1.0 : ax;
+    int big = ax > 0.5;
+    double a = asin_kernel(pick(big, sqrt((1.0 - ax) * 0.5), ax));
+    double r = pick(big, PIO2_D - 2.0 * a, a);
+    return (float)u2d(d2u(r) | (d2u((double)x) & ((uint64_t)1 << 63)));   /* r >= 0 */
 }
 
+/* acos(x) = pi/2 - asin(x) for |x| <= 1/2, else 2 asin(sqrt((1-|x|)/2)),
+ * taken from pi for negative x. */
 float fm_acosf(float x)
 {
     if (x != x)
         return x + x;
     double d = x > 1.0f ? 1.0 : x < -1.0f ? -1.0 : (double)x;
-    return (float)atan2_core(sqrt((1.0 - d) * (1.0 + d)), d);
+    int big = fabs(d) > 0.5;
+    double a = asin_kernel(pick(big, sqrt((1.0 - fabs(d)) * 0.5), d));
+    double far = pick(signbit(d), PI_D - 2.0 * a, 2.0 * a);
+    return (float)pick(big, far, PIO2_D - a);
 }
