@@ -22,12 +22,16 @@ void bld_init(fr_builder *b)
     array_init(&b->uvs, sizeof(vec2));
     array_init(&b->planes, sizeof(fr_plane));
     array_init(&b->lights, sizeof(fr_light));
+    array_init(&b->textures, sizeof(fr_texture));
+    array_init(&b->texels, sizeof(float));
+    array_init(&b->media, sizeof(fr_medium));
 }
 
 void bld_free(fr_builder *b)
 {
     fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
-                       &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights};
+                       &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
+                       &b->textures, &b->texels, &b->media};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->data);
     memset(b, 0, sizeof *b);
@@ -78,6 +82,15 @@ uint32_t bld_triangle(fr_builder *b, vec3 p0, vec3 p1, vec3 p2, uint32_t materia
         return FR_NONE;
     fr_triangle t = {{i0, i1, i2}, 0};
     return push_prim(b, FR_PRIM_TRIANGLE, bld_push(&b->triangles, &t), material);
+}
+
+void bld_material_init(fr_material *m)
+{
+    memset(m, 0, sizeof *m);
+    m->tex_diffuse = m->tex_glossy = m->tex_specular = m->tex_transmit = m->tex_emission = FR_NONE;
+    m->tex_bump = m->tex_normal = FR_NONE;
+    m->ior = 1.5f;
+    m->normal_strength = 1.0f;
 }
 
 void bld_material_finish(fr_material *m)
@@ -204,6 +217,9 @@ int bld_finish(fr_builder *b, fr_scene *out, fr_error *err)
     VIEW(rects, b->rects); VIEW(triangles, b->triangles); VIEW(positions, b->positions);
     VIEW(normals, b->normals); VIEW(uvs, b->uvs); VIEW(planes, b->planes);
     VIEW(lights, b->lights); VIEW(nodes, nodes);
+    VIEW(textures, b->textures); VIEW(texels, b->texels); VIEW(media, b->media);
+    view.volume = b->volume;
+    view.tonemap = b->tonemap;
 #undef VIEW
     void *blob = NULL;
     size_t size = 0;

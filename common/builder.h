@@ -22,6 +22,9 @@ typedef struct {
     fr_camera camera;
     fr_array materials, prims, spheres, rects, triangles;
     fr_array positions, normals, uvs, planes, lights;
+    fr_array textures, texels, media;   /* fr_texture, float, fr_medium */
+    fr_volume volume;
+    fr_tonemap tonemap;
 } fr_builder;
 
 void bld_init(fr_builder *b);
@@ -36,6 +39,10 @@ uint32_t bld_push(fr_array *a, const void *elem);
 uint32_t bld_sphere(fr_builder *b, vec3 center, float radius, uint32_t material);
 uint32_t bld_rect(fr_builder *b, vec3 origin, vec3 edge_u, vec3 edge_v, uint32_t material);
 uint32_t bld_triangle(fr_builder *b, vec3 p0, vec3 p1, vec3 p2, uint32_t material);
+
+/* A material with no lobe, no emission and no texture (every texture index
+ * FR_NONE, ior 1.5, normal-map strength 1): start every material here. */
+void bld_material_init(fr_material *m);
 
 /* Fill p_lobe of a material from its lobe colours.  Returns -1 if the
  * material has no lobe at all and no emission (it would be black). */

@@ -19,7 +19,8 @@ enum { HEADER_SIZE = 64, ENTRY_SIZE = 32, ALIGN = 64 };
 enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES,
-    SEC_COUNT = SEC_NODES
+    SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP,
+    SEC_COUNT = SEC_TONEMAP
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -46,6 +47,11 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_PLANES, "planes", planes, fr_plane),
     ARR(SEC_LIGHTS, "lights", lights, fr_light),
     ARR(SEC_NODES, "nodes", nodes, fr_bvh_node),
+    ARR(SEC_TEXTURES, "textures", textures, fr_texture),
+    ARR(SEC_TEXELS, "texels", texels, float),
+    ARR(SEC_MEDIA, "media", media, fr_medium),
+    [SEC_VOLUME] = {"volume", sizeof(fr_volume), offsetof(fr_scene, volume), 0},
+    [SEC_TONEMAP] = {"tonemap", sizeof(fr_tonemap), offsetof(fr_scene, tonemap), 0},
 };
 #undef ARR
 
@@ -110,6 +116,48 @@ int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *er
 
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
+static int tex_ref_ok(const fr_scene *s, uint32_t t) { return t == FR_NONE || t < s->n_textures; }
+
+/* Textures, texels, media and the material fields that refer to them. */
+static int validate_appearance(const fr_scene *s, fr_error *err)
+{
+    for (uint32_t i = 0; i < s->n_textures; i++) {
+        const fr_texture *t = &s->textures[i];
+        if (t->kind > FR_TEX_CHECKER || t->wrap > FR_WRAP_CLAMP || t->filter > FR_FILTER_NEAREST ||
+            !isfinite(t->scale.u) || !isfinite(t->scale.v) || !isfinite(t->offset.u) || !isfinite(t->offset.v) ||
+            !finite3(t->color0) || !finite3(t->color1))
+            return fr_fail(err, "section textures: element %u: bad kind, wrap, filter or non-finite parameter", i);
+        if (t->kind == FR_TEX_IMAGE &&
+            (t->width == 0 || t->height == 0 || (t->channels != 1 && t->channels != 3) ||
+             (uint64_t)t->width * t->height * t->channels > (uint64_t)s->n_texels - t->first || t->first > s->n_texels))
+            return fr_fail(err, "section textures: element %u: image size or texel range out of bounds", i);
+    }
+    for (uint32_t i = 0; i < s->n_texels; i++)
+        if (!isfinite(s->texels[i]))
+            return fr_fail(err, "section texels: element %u: not a finite number", i);
+    for (uint32_t i = 0; i < s->n_media; i++) {
+        const fr_medium *m = &s->media[i];
+        if (!finite3(m->sigma_a) || !finite3(m->sigma_s) || v3_min(m->sigma_a) < 0.0f || v3_min(m->sigma_s) < 0.0f ||
+            !(m->g > -1.0f && m->g < 1.0f))
+            return fr_fail(err, "section media: element %u: negative or non-finite coefficient, or |g| >= 1", i);
+    }
+    if (s->volume.fog > s->n_media || s->volume.camera_medium > s->n_media)
+        return fr_fail(err, "section volume: medium index out of range");
+    if (!(s->tonemap.exposure >= -64.0f && s->tonemap.exposure <= 64.0f) || s->tonemap.curve > FR_CURVE_FILMIC)
+        return fr_fail(err, "section tonemap: exposure outside [-64, 64] or unknown curve");
+    for (uint32_t i = 0; i < s->n_materials; i++) {
+        const fr_material *m = &s->materials[i];
+        if (!tex_ref_ok(s, m->tex_diffuse) || !tex_ref_ok(s, m->tex_glossy) || !tex_ref_ok(s, m->tex_specular) ||
+            !tex_ref_ok(s, m->tex_transmit) || !tex_ref_ok(s, m->tex_emission) || !tex_ref_ok(s, m->tex_bump) ||
+            !tex_ref_ok(s, m->tex_normal))
+            return fr_fail(err, "section materials: element %u: texture index out of range", i);
+        if (!isfinite(m->bump_strength) || !isfinite(m->normal_strength) || m->medium > s->n_media ||
+            m->interface > 1 || (m->interface && m->medium == 0))
+            return fr_fail(err, "section materials: element %u: bad bump or normal strength, medium or interface", i);
+    }
+    return 0;
+}
+
 /* Check every cross-reference so that rendering can index without checks. */
 static int validate(const fr_scene *s, fr_error *err)
 {
@@ -120,10 +168,10 @@ static int validate(const fr_scene *s, fr_error *err)
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
         !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !(c->focus > 0.0f || c->aperture == 0.0f))
         return fr_fail(err, "section camera: degenerate or non-finite camera");
+    if (validate_appearance(s, err) < 0)
+        return -1;
     for (uint32_t i = 0; i < s->n_materials; i++) {
         const fr_material *m = &s->materials[i];
-        if (m->tex_diffuse != FR_NONE || m->tex_bump != FR_NONE)
-            return fr_fail(err, "section materials: element %u: texture index out of range", i);
         if (!(m->p_lobe[3] >= 0.0f && m->p_lobe[3] <= 1.0f) || !(m->ior > 0.0f) || !(m->exponent >= 0.0f))
             return fr_fail(err, "section materials: element %u: bad lobe probabilities, ior or exponent", i);
     }

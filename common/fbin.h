@@ -16,7 +16,7 @@
 #include "error.h"
 #include "scene.h"
 
-#define FBIN_VERSION 1
+#define FBIN_VERSION 2
 
 /* Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */

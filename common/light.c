@@ -1,12 +1,27 @@
 #include "light.h"
 
 #include "fmath.h"
+#include "texture.h"
 
 vec3 lgt_emitted(const fr_material *m, vec3 ng, vec3 w)
 {
     if (m->two_sided || v3_dot(ng, w) > 0.0f)
         return m->emission;
     return v3s(0.0f);
+}
+
+/* Emitted radiance le of light primitive `prim` at its point p, times the
+ * material's emission texture there (a, b: the rect's edge coordinates or
+ * the triangle's barycentrics of p1, p2, as trace_surface takes them). */
+static vec3 textured(const fr_scene *s, const fr_material *m, uint32_t prim, vec3 p, float a, float b, vec3 le)
+{
+    if (m->tex_emission == FR_NONE || v3_is_zero(le))
+        return le;
+    fr_hit h = {0.0f, prim, FR_NONE, a, b};
+    fr_ray r = {p, v3s(0.0f)};
+    fr_surface sf;
+    trace_surface(s, &r, &h, &sf);
+    return tex_emission(s, m, sf.uv);
 }
 
 static uint32_t pick_light(const fr_scene *s, float u)
@@ -73,6 +88,7 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
     const fr_material *m = &s->materials[pr->material];
     out->delta = 0;
     out->prim = l->prim;
+    float ua, ub;              /* the sampled point's coordinates on its primitive */
     if (pr->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[pr->index];
         vec3 dc = v3_sub(sp->center, from);
@@ -95,7 +111,7 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
             out->p = v3_madd(from, out->wi, out->dist);
             out->n = v3_norm(v3_sub(out->p, sp->center));
             out->pdf = l->pick / (2.0f * FM_PI * omc);
-            out->radiance = lgt_emitted(m, out->n, v3_neg(out->wi));
+            out->radiance = textured(s, m, l->prim, out->p, 0.0f, 0.0f, lgt_emitted(m, out->n, v3_neg(out->wi)));
             return out->pdf > 0.0f && !v3_is_zero(out->radiance);
         }
         /* Inside the sphere: uniform on its surface. */
@@ -103,16 +119,21 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
         fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
         out->n = v3(r * cs, r * sn, z);
         out->p = v3_madd(sp->center, out->n, sp->radius);
+        ua = ub = 0.0f;
     } else if (pr->kind == FR_PRIM_RECT) {
         const fr_rect *q = &s->rects[pr->index];
         out->p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, u1), v3_scale(q->edge_v, u2)));
         out->n = v3_norm(v3_cross(q->edge_u, q->edge_v));
+        ua = u1;
+        ub = u2;
     } else {
         const fr_triangle *t = &s->triangles[pr->index];
         vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
         float su = sqrtf(u1), b1 = u2 * su, b0 = 1.0f - su;
         out->p = v3_add(v3_add(v3_scale(p0, b0), v3_scale(p1, b1)), v3_scale(p2, 1.0f - b0 - b1));
         out->n = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+        ua = b1;
+        ub = 1.0f - b0 - b1;
     }
     vec3 d = v3_sub(out->p, from);
     float d2 = v3_len2(d);
@@ -124,6 +145,6 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
     if (cosl <= 0.0f)
         return 0;
     out->pdf = l->pick * d2 / (cosl * l->area);
-    out->radiance = lgt_emitted(m, out->n, v3_neg(out->wi));
+    out->radiance = textured(s, m, l->prim, out->p, ua, ub, lgt_emitted(m, out->n, v3_neg(out->wi)));
     return !v3_is_zero(out->radiance);
 }

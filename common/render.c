@@ -4,6 +4,7 @@
 #include "fmath.h"
 #include "light.h"
 #include "sampler.h"
+#include "texture.h"
 
 /* Power heuristic with beta = 2 (Veach 1997). */
 static float power_heuristic(float a, float b)
@@ -63,7 +64,8 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
             break;
         fr_surface sf;
         trace_surface(s, &ray, &hit, &sf);
-        const fr_material *m = &s->materials[sf.material];
+        fr_material textured;
+        const fr_material *m = tex_material(s, &s->materials[sf.material], &sf, &textured);
         vec3 wo = v3_neg(ray.d);
 
         /* Light reached by the BSDF sample (or seen directly). */

@@ -56,11 +56,68 @@ typedef struct {
     float ior;                 /* dielectric index of refraction (inside / outside) */
     float p_lobe[4];           /* cumulative lobe-selection probabilities: diffuse, glossy, specular, transmit */
     uint32_t two_sided;        /* emission on both sides */
-    uint32_t tex_diffuse;      /* texture index or FR_NONE (reserved for textures) */
-    uint32_t tex_bump;         /* texture index or FR_NONE (reserved for bump maps) */
+    /* Textures (indices into textures, or FR_NONE).  A textured colour is
+     * the colour above times the texture's value at the hit's UV, so the
+     * colour above is a tint (white when the scene file gives a bare
+     * texture); reflectance textures are clamped to [0, 1] when looked up,
+     * which keeps the energy bound checked on the tints. */
+    uint32_t tex_diffuse;
+    uint32_t tex_bump;         /* grey height map: displacement = bump_strength * value, scene units */
     float bump_strength;
-    uint32_t pad[2];
+    uint32_t tex_glossy, tex_specular, tex_transmit, tex_emission;
+    uint32_t tex_normal;       /* tangent-space normal map (linear RGB, 0.5 = 0) */
+    float normal_strength;     /* scales the map's tangential components */
+    uint32_t medium;           /* medium inside the shape: 1 + index into media, 0 = none */
+    uint32_t interface;        /* 1: no surface at all, only a boundary between media */
 } fr_material;
+
+/* A texture: an image of decoded linear texels stored in the scene, or a
+ * procedural checkerboard.  Lookups map the surface's UV through
+ * uv * scale + offset; v grows upward, so v = 0 is the image's bottom row
+ * (the OBJ convention). */
+enum { FR_TEX_IMAGE = 0, FR_TEX_CHECKER = 1 };
+enum { FR_WRAP_REPEAT = 0, FR_WRAP_CLAMP = 1 };
+enum { FR_FILTER_BILINEAR = 0, FR_FILTER_NEAREST = 1 };
+typedef struct {
+    uint32_t kind;             /* FR_TEX_* */
+    uint32_t width, height;    /* image: pixels */
+    uint32_t channels;         /* image: 1 (grey) or 3 (RGB) floats per texel */
+    uint32_t first;            /* image: index of its first float in texels */
+    uint32_t wrap;             /* FR_WRAP_* */
+    uint32_t filter;           /* FR_FILTER_* */
+    uint32_t pad;
+    vec2 scale, offset;        /* UV transform */
+    vec3 color0, color1;       /* checker: the square at the UV origin, the other one */
+} fr_texture;
+
+/* A homogeneous participating medium: coefficients per colour channel in
+ * inverse scene units, Henyey-Greenstein phase function (g = 0 is
+ * isotropic; g > 0 scatters forward). */
+typedef struct {
+    vec3 sigma_a, sigma_s;
+    float g;
+    uint32_t pad;
+} fr_medium;
+
+/* Which medium fills space outside every shape with an interior medium
+ * (fog), and which one the camera sits in: 1 + index into media, 0 = none.
+ * Shapes with interior media must be closed, outward-facing and must not
+ * overlap or nest. */
+typedef struct {
+    uint32_t fog;
+    uint32_t camera_medium;
+    uint32_t pad[2];
+} fr_volume;
+
+/* Tone mapping defaults for the final image (the coordinator applies them
+ * once, after stitching; the linear radiance in partial images and HDR
+ * outputs is never tone-mapped). */
+enum { FR_CURVE_NONE = 0, FR_CURVE_FILMIC = 1 };
+typedef struct {
+    float exposure;            /* stops: LDR values are scaled by 2^exposure */
+    uint32_t curve;            /* FR_CURVE_* */
+    uint32_t pad[2];
+} fr_tonemap;
 
 enum { FR_PRIM_TRIANGLE = 0, FR_PRIM_SPHERE = 1, FR_PRIM_RECT = 2, FR_PRIM_KINDS };
 
@@ -119,6 +176,11 @@ typedef struct {
     const vec3 *positions;        uint32_t n_positions;
     const vec3 *normals;          uint32_t n_normals;
     const vec2 *uvs;              uint32_t n_uvs;
+    const fr_texture *textures;   uint32_t n_textures;
+    const float *texels;          uint32_t n_texels;
+    const fr_medium *media;       uint32_t n_media;
+    fr_volume volume;
+    fr_tonemap tonemap;
     const fr_plane *planes;       uint32_t n_planes;
     const fr_light *lights;       uint32_t n_lights;
     const fr_bvh_node *nodes;     uint32_t n_nodes;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "scene_appear.h"
 
 #define PATHLEN 160
 
@@ -17,6 +18,7 @@ typedef struct {
     fr_builder *b;
     const cJSON *materials;    /* the "materials" object, for name lookup */
     fr_error *err;
+    scn_appear *look;          /* textures, media (scene_appear.h) */
 } ctx;
 
 int scn_json_number(const cJSON *obj, const char *key, const char *where, int required, float def, float *out,
@@ -80,6 +82,11 @@ static int only_fields(const cJSON *obj, const char *where, const char *const *a
     return 0;
 }
 
+int scn_json_only_fields(const cJSON *obj, const char *where, const char *const *allowed, fr_error *err)
+{
+    return only_fields(obj, where, allowed, err);
+}
+
 static int get_uint(const cJSON *obj, const char *key, const char *where, int required, uint32_t def,
                     uint32_t lo, uint32_t hi, uint32_t *out, fr_error *err)
 {
@@ -117,7 +124,8 @@ static int parse_image(ctx *c, const cJSON *o)
 
 static int parse_camera(ctx *c, const cJSON *o)
 {
-    static const char *const fields[] = {"position", "target", "up", "fov", "aperture", "focus", NULL};
+    static const char *const fields[] = {"position", "target", "up", "fov", "aperture", "focus", "fstop",
+                                         "focal_length", NULL};
     fr_camera *cam = &c->b->camera;
     float fov;
     if (!cJSON_IsObject(o))
@@ -127,7 +135,8 @@ static int parse_camera(ctx *c, const cJSON *o)
         scn_json_vec3(o, "target", "camera", 1, v3s(0), &cam->target, c->err) < 0 ||
         scn_json_vec3(o, "up", "camera", 0, v3(0, 1, 0), &cam->up, c->err) < 0 ||
         scn_json_number(o, "fov", "camera", 1, 0, &fov, c->err) < 0 ||
-        scn_json_number(o, "aperture", "camera", 0, 0, &cam->aperture, c->err) < 0)
+        scn_json_number(o, "aperture", "camera", 0, 0, &cam->aperture, c->err) < 0 ||
+        scn_camera_lens(o, cam, c->err) < 0)
         return -1;
     if (!(fov > 0.0f && fov < 180.0f))
         return fr_fail(c->err, "camera.fov: expected degrees in (0, 180)");
@@ -148,41 +157,45 @@ static int parse_camera(ctx *c, const cJSON *o)
 static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material *m)
 {
     static const char *const fields[] = {"type", "albedo", "diffuse", "glossy", "specular", "exponent",
-                                         "reflectance", "transmit", "tint", "ior", "emission", "two_sided", NULL};
-    memset(m, 0, sizeof *m);
-    m->tex_diffuse = m->tex_bump = FR_NONE;
-    m->ior = 1.5f;
+                                         "reflectance", "transmit", "tint", "ior", "emission", "two_sided",
+                                         "bump", "normal_map", "medium", NULL};
+    bld_material_init(m);
+    scn_appear *a = c->look;
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "%s: expected an object", where);
     if (only_fields(o, where, fields, c->err) < 0)
         return -1;
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
-        return fr_fail(c->err, "%s.type: missing (expected lambert, phong, mirror, glass, mix or emitter)", where);
+        return fr_fail(c->err, "%s.type: missing (expected lambert, phong, mirror, glass, mix, emitter or interface)",
+                       where);
     const char *type = t->valuestring;
     int rc = 0;
+    /* Colours may be textures (scn_colour). */
     if (!strcmp(type, "lambert")) {
-        rc = scn_json_vec3(o, "albedo", where, 1, v3s(0), &m->diffuse, c->err);
+        rc = scn_colour(a, o, "albedo", where, 1, v3s(0), &m->diffuse, &m->tex_diffuse, c->err);
     } else if (!strcmp(type, "phong")) {
-        rc = scn_json_vec3(o, "diffuse", where, 0, v3s(0), &m->diffuse, c->err) |
-             scn_json_vec3(o, "glossy", where, 1, v3s(0), &m->glossy, c->err) |
+        rc = scn_colour(a, o, "diffuse", where, 0, v3s(0), &m->diffuse, &m->tex_diffuse, c->err) |
+             scn_colour(a, o, "glossy", where, 1, v3s(0), &m->glossy, &m->tex_glossy, c->err) |
              scn_json_number(o, "exponent", where, 1, 0, &m->exponent, c->err);
     } else if (!strcmp(type, "mirror")) {
-        rc = scn_json_vec3(o, "reflectance", where, 0, v3s(1), &m->specular, c->err);
+        rc = scn_colour(a, o, "reflectance", where, 0, v3s(1), &m->specular, &m->tex_specular, c->err);
     } else if (!strcmp(type, "glass")) {
-        rc = scn_json_vec3(o, "tint", where, 0, v3s(1), &m->transmit, c->err) |
+        rc = scn_colour(a, o, "tint", where, 0, v3s(1), &m->transmit, &m->tex_transmit, c->err) |
              scn_json_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
     } else if (!strcmp(type, "mix")) {
-        rc = scn_json_vec3(o, "diffuse", where, 0, v3s(0), &m->diffuse, c->err) |
-             scn_json_vec3(o, "glossy", where, 0, v3s(0), &m->glossy, c->err) |
+        rc = scn_colour(a, o, "diffuse", where, 0, v3s(0), &m->diffuse, &m->tex_diffuse, c->err) |
+             scn_colour(a, o, "glossy", where, 0, v3s(0), &m->glossy, &m->tex_glossy, c->err) |
              scn_json_number(o, "exponent", where, 0, 0, &m->exponent, c->err) |
-             scn_json_vec3(o, "specular", where, 0, v3s(0), &m->specular, c->err) |
-             scn_json_vec3(o, "transmit", where, 0, v3s(0), &m->transmit, c->err) |
+             scn_colour(a, o, "specular", where, 0, v3s(0), &m->specular, &m->tex_specular, c->err) |
+             scn_colour(a, o, "transmit", where, 0, v3s(0), &m->transmit, &m->tex_transmit, c->err) |
              scn_json_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
-    } else if (strcmp(type, "emitter") != 0) {
-        return fr_fail(c->err, "%s.type: '%s' is not lambert, phong, mirror, glass, mix or emitter", where, type);
+    } else if (strcmp(type, "emitter") != 0 && strcmp(type, "interface") != 0) {
+        return fr_fail(c->err, "%s.type: '%s' is not lambert, phong, mirror, glass, mix, emitter or interface", where,
+                       type);
     }
-    if (rc < 0 || scn_json_vec3(o, "emission", where, 0, v3s(0), &m->emission, c->err) < 0)
+    if (rc < 0 || scn_colour(a, o, "emission", where, 0, v3s(0), &m->emission, &m->tex_emission, c->err) < 0 ||
+        scn_material_appearance(a, o, where, !strcmp(type, "interface"), m, c->err) < 0)
         return -1;
     const cJSON *ts = cJSON_GetObjectItemCaseSensitive(o, "two_sided");
     if (ts && !cJSON_IsBool(ts))
@@ -262,7 +275,7 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         return fr_fail(c->err, "%s: expected an object", where);
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
-        return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle or mesh)", where);
+        return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle, box or mesh)", where);
     const char *type = t->valuestring;
     /* Meshes may take their materials from their own files. */
     uint32_t mat = FR_NONE;
@@ -326,6 +339,9 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 3, v) < 0 ||
             add_triangle(c, where, v[0], v[1], v[2], mat) < 0)
             return -1;
+    } else if (!strcmp(type, "box")) {
+        if (scn_box(c->b, o, where, mat, c->err) < 0)
+            return -1;
     } else if (!strcmp(type, "mesh")) {
         if (!c->hooks || !c->hooks->mesh)
             return fr_fail(c->err, "%s: meshes need the scene compiler: run `franja compile` and render the .fbin", where);
@@ -333,7 +349,7 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         if (c->hooks->mesh(c->b, o, where, c->dir, mat, &e) < 0)
             return fr_fail(c->err, "%s", e.msg);
     } else {
-        return fr_fail(c->err, "%s.type: '%s' is not sphere, plane, rect, quad, triangle or mesh", where, type);
+        return fr_fail(c->err, "%s.type: '%s' is not sphere, plane, rect, quad, triangle, box or mesh", where, type);
     }
     return r == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
 }
@@ -389,14 +405,18 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
         *slash = 0;
     else
         snprintf(dir, sizeof dir, ".");
-    ctx c = {file, dir, hooks, b, NULL, &e};
-    static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description", NULL};
+    scn_appear look;
+    memset(&look, 0, sizeof look);
+    ctx c = {file, dir, hooks, b, NULL, &e, &look};
+    static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
+                                      "textures", "media", "medium", "tonemap", NULL};
     int rc = -1;
     if (!cJSON_IsObject(root)) {
         fr_fail(&e, "(top level): expected an object");
     } else if (only_fields(root, "(top level)", top, &e) == 0 &&
                parse_image(&c, cJSON_GetObjectItemCaseSensitive(root, "image")) == 0 &&
                parse_camera(&c, cJSON_GetObjectItemCaseSensitive(root, "camera")) == 0 &&
+               scn_appear_begin(&look, root, dir, hooks, b, &e) == 0 &&
                parse_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials")) == 0 &&
                parse_lights(&c, cJSON_GetObjectItemCaseSensitive(root, "lights")) == 0) {
         const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
@@ -421,8 +441,11 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
                 if (!emissive)
                     rc = fr_fail(&e, "lights: the scene has no light (no point light, no emissive shape)");
             }
+            if (rc == 0)
+                rc = scn_appear_finish(&look, root, &e);
         }
     }
+    scn_appear_free(&look);
     cJSON_Delete(root);
     return rc < 0 ? fr_fail(err, "%s: %s", file, e.msg) : 0;
 }

@@ -16,12 +16,23 @@
 
 #include "builder.h"
 
+/* An image as a texture hook decodes it: width*height*channels floats,
+ * top row first, the values as stored (8- and 16-bit images scaled to
+ * [0, 1]; no colour conversion).  pixels is malloc'd; the parser frees it. */
+typedef struct {
+    float *pixels;
+    uint32_t width, height, channels;
+} scn_image;
+
 typedef struct {
     /* Add the mesh described by JSON object `node` (at JSON path `where`)
      * to the builder with material `material`; `dir` is the scene file's
      * directory, for relative file names. */
     int (*mesh)(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
                 fr_error *err);
+    /* Decode image file `path` (already joined to the scene's directory)
+     * into *img; on failure say why (unreadable, unsupported, corrupt). */
+    int (*texture)(const char *path, scn_image *img, fr_error *err);
 } scn_hooks;
 
 /* Parse the JSON text `text` (from file `file`, used in messages) into b. */
@@ -34,6 +45,9 @@ int scn_load_json(const char *path, const scn_hooks *hooks, fr_scene *out, fr_er
  * a 3-vector, with the same error style.  `where` is the object's path. */
 int scn_json_number(const cJSON *obj, const char *key, const char *where, int required, float def, float *out,
                     fr_error *err);
+/* Refuse members of obj not in `allowed` (NULL-terminated): a typo must
+ * not be silently ignored. */
+int scn_json_only_fields(const cJSON *obj, const char *where, const char *const *allowed, fr_error *err);
 int scn_json_vec3(const cJSON *obj, const char *key, const char *where, int required, vec3 def, vec3 *out,
                   fr_error *err);
 

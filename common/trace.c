@@ -110,6 +110,8 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
         v3_basis(pl->normal, &t, &b);
         vec3 rel = v3_sub(out->p, pl->point);
         out->uv = (vec2){v3_dot(rel, t), v3_dot(rel, b)};
+        out->dpdu = t;
+        out->dpdv = b;
         out->material = pl->material;
         out->light = FR_NONE;
         return;
@@ -123,13 +125,23 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
         out->ng = out->ns = v3_norm(n);
         /* Re-project onto the surface: removes most of the hit point's error. */
         out->p = v3_madd(sp->center, out->ng, sp->radius);
-        float phi = fm_atan2f(out->ng.z, out->ng.x);
-        out->uv = (vec2){(phi + FM_PI) * FM_INV_2PI, fm_acosf(out->ng.y) * FM_INV_PI};
+        /* Longitude and latitude, seen from outside as an image is seen:
+         * u grows eastward (+x toward -z), v from 0 at the -y pole to 1 at
+         * +y, so cross(dpdu, dpdv) faces out and an image is not mirrored. */
+        float phi = fm_atan2f(-out->ng.z, out->ng.x);
+        out->uv = (vec2){(phi + FM_PI) * FM_INV_2PI, 1.0f - fm_acosf(out->ng.y) * FM_INV_PI};
+        vec3 rel = v3_sub(out->p, sp->center);
+        float rxz = sqrtf(rel.x * rel.x + rel.z * rel.z);
+        out->dpdu = v3(2.0f * FM_PI * rel.z, 0.0f, -2.0f * FM_PI * rel.x);
+        out->dpdv = rxz > 0.0f ? v3_scale(v3(rel.x * rel.y / rxz, -rxz, rel.z * rel.y / rxz), -FM_PI)
+                               : v3(0.0f, 0.0f, 0.0f);
     } else if (p->kind == FR_PRIM_RECT) {
         const fr_rect *q = &s->rects[p->index];
         out->ng = out->ns = v3_norm(v3_cross(q->edge_u, q->edge_v));
         out->p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, hit->a), v3_scale(q->edge_v, hit->b)));
         out->uv = (vec2){hit->a, hit->b};
+        out->dpdu = q->edge_u;
+        out->dpdv = q->edge_v;
     } else {
         const fr_triangle *t = &s->triangles[p->index];
         vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
@@ -148,8 +160,21 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
         if (t->flags & FR_TRI_UVS) {
             vec2 u0 = s->uvs[t->v[0]], u1 = s->uvs[t->v[1]], u2 = s->uvs[t->v[2]];
             out->uv = (vec2){b0 * u0.u + hit->a * u1.u + hit->b * u2.u, b0 * u0.v + hit->a * u1.v + hit->b * u2.v};
+            /* Solve [dp1 dp2] = [dpdu dpdv] [duv1 duv2] for the tangents. */
+            float du1 = u1.u - u0.u, dv1 = u1.v - u0.v, du2 = u2.u - u0.u, dv2 = u2.v - u0.v;
+            float det = du1 * dv2 - dv1 * du2;
+            vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+            if (fabsf(det) > 1e-20f) {
+                float inv = 1.0f / det;
+                out->dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), inv);
+                out->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), inv);
+            } else {
+                v3_basis(out->ng, &out->dpdu, &out->dpdv);
+            }
         } else {
             out->uv = (vec2){hit->a, hit->b};
+            out->dpdu = v3_sub(p1, p0);
+            out->dpdv = v3_sub(p2, p0);
         }
     }
 }

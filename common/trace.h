@@ -23,6 +23,7 @@ typedef struct {
     vec3 ng;                   /* geometric normal (unit, front side) */
     vec3 ns;                   /* shading normal (unit, same hemisphere as ng) */
     vec2 uv;                   /* texture coordinates */
+    vec3 dpdu, dpdv;           /* how p moves with u and v (tangents for bump and normal maps) */
     uint32_t material;
     uint32_t light;            /* FR_NONE unless an area light */
 } fr_surface;

@@ -2,6 +2,7 @@
 // in the coordinator is C++, and no C++ exception crosses into C.
 #include <OpenImageIO/imageio.h>
 
+#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -33,6 +34,38 @@ extern "C" int iio_write(const char *path, const void *pixels, iio_type type, ui
             return fr_fail(err, "%s: %s", path, out->geterror().c_str());
         return 0;
     } catch (const std::exception &e) {
+        return fr_fail(err, "%s: %s", path, e.what());
+    }
+}
+
+extern "C" int iio_read(const char *path, float **pixels, uint32_t *width, uint32_t *height, uint32_t *channels,
+                        fr_error *err)
+{
+    *pixels = nullptr;
+    float *px = nullptr;
+    try {
+        std::unique_ptr<ImageInput> in = ImageInput::open(path);
+        if (!in)
+            return fr_fail(err, "%s: %s", path, OIIO::geterror().c_str());
+        const ImageSpec &spec = in->spec();
+        uint64_t n = (uint64_t)spec.width * (uint64_t)spec.height * (uint64_t)spec.nchannels;
+        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1 || n > (1u << 29))
+            return fr_fail(err, "%s: %d x %d x %d pixels, %d channels: not a 2D image of at most 2^29 values", path,
+                           spec.width, spec.height, spec.depth, spec.nchannels);
+        px = (float *)malloc(n * sizeof(float));
+        if (!px)
+            return fr_fail(err, "%s: out of memory for %llu values", path, (unsigned long long)n);
+        if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, px)) {
+            free(px);
+            return fr_fail(err, "%s: %s", path, in->geterror().c_str());
+        }
+        *pixels = px;
+        *width = (uint32_t)spec.width;
+        *height = (uint32_t)spec.height;
+        *channels = (uint32_t)spec.nchannels;
+        return 0;
+    } catch (const std::exception &e) {
+        free(px);
         return fr_fail(err, "%s: %s", path, e.what());
     }
 }

@@ -18,6 +18,14 @@ typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32 } iio_type;
 int iio_write(const char *path, const void *pixels, iio_type type, uint32_t width, uint32_t height,
               fr_error *err);
 
+/** Reads the first image of `path` as floats: *pixels (malloc'd, the
+ * caller frees) holds width*height*channels values, top row first, as
+ * stored (integer formats scaled to [0, 1], no colour conversion).  Fails
+ * with OpenImageIO's message for a missing, unreadable or unsupported file,
+ * and for images over 2^29 values. */
+int iio_read(const char *path, float **pixels, uint32_t *width, uint32_t *height, uint32_t *channels,
+             fr_error *err);
+
 /** Returns 1 if OpenImageIO has a writer for the file name's extension. */
 int iio_can_write(const char *path);
 
