@@ -192,11 +192,15 @@ int bld_finish(fr_builder *b, fr_scene *out, fr_error *err)
     memset(out, 0, sizeof *out);
     if (bld_camera_finish(&b->camera, err) < 0)
         return -1;
-    fr_array nodes;
+    fr_array nodes, leaves;
     array_init(&nodes, sizeof(fr_bvh_node));
+    array_init(&leaves, sizeof(fr_bvh_leaf));
     /* The BVH reorders prims, so lights (which point at prims) come after. */
-    if (bvh_build(b, &nodes, err) < 0)
+    if (bvh_build(b, &nodes, &leaves, err) < 0) {
+        free(nodes.data);
+        free(leaves.data);
         return -1;
+    }
     /* Point lights were pushed by the parser; area lights are derived here. */
     fr_array points = b->lights;
     array_init(&b->lights, sizeof(fr_light));
@@ -216,7 +220,7 @@ int bld_finish(fr_builder *b, fr_scene *out, fr_error *err)
     VIEW(materials, b->materials); VIEW(prims, b->prims); VIEW(spheres, b->spheres);
     VIEW(rects, b->rects); VIEW(triangles, b->triangles); VIEW(positions, b->positions);
     VIEW(normals, b->normals); VIEW(uvs, b->uvs); VIEW(planes, b->planes);
-    VIEW(lights, b->lights); VIEW(nodes, nodes);
+    VIEW(lights, b->lights); VIEW(nodes, nodes); VIEW(leaves, leaves);
     VIEW(textures, b->textures); VIEW(texels, b->texels); VIEW(media, b->media);
     view.volume = b->volume;
     view.tonemap = b->tonemap;
@@ -226,6 +230,7 @@ int bld_finish(fr_builder *b, fr_scene *out, fr_error *err)
     if (rc == 0)
         rc = fbin_serialize(&view, &blob, &size, err);
     free(nodes.data);
+    free(leaves.data);
     if (rc == 0)
         rc = fbin_open_mem(blob, size, 0, out, err);
     if (rc < 0)

@@ -1,7 +1,52 @@
 #include "bvh.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "simd4.h"
+
+/* Leaves hold up to LEAF_MAX primitives (four blocks) when the SAH finds
+ * that cheaper than splitting; LEAF_MIN or fewer always make a leaf (one
+ * block is tested as fast as one triangle).  Costs are in units of one
+ * block test; a node test (four boxes) costs about the same. */
+enum { BINS = 32, LEAF_MIN = 4, LEAF_MAX = 16 };
+#define TRAV_COST 1.0f
+
+typedef struct { f4 lo, hi; } box4;   /* lane 3 unused (kept 0) */
+
+/* A contiguous range of references with its bounds and the bounds of its
+ * centroids (stored doubled: lo + hi, which bins the same and saves a
+ * multiply). */
+typedef struct {
+    uint32_t begin, end;
+    box4 box, cent;
+    int leaf;                  /* decided: becomes a leaf */
+} span;
+
+typedef struct {
+    box4 *box;                 /* per reference: bounds of its primitive */
+    uint32_t *id;              /* per reference: index into the builder's prims */
+    const fr_builder *b;
+    fr_prim *out;              /* prims in leaf order */
+    uint32_t n_out;
+    fr_array *nodes, *leaves;
+    fr_error *err;
+} build;
+
+static box4 box_empty(void) { return (box4){f4_set1(INFINITY), f4_set1(-INFINITY)}; }
+static void box_grow(box4 *a, box4 b) { a->lo = f4_min_num(b.lo, a->lo); a->hi = f4_max_num(b.hi, a->hi); }
+static void box_add(box4 *a, f4 p) { a->lo = f4_min_num(p, a->lo); a->hi = f4_max_num(p, a->hi); }
+static f4 centroid(box4 b) { return b.lo + b.hi; }
+
+/* Half the surface area: the SAH only compares areas. */
+static float half_area(box4 b)
+{
+    f4 d = b.hi - b.lo;
+    return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+}
+
+static float blocks(uint32_t n) { return (float)((n + 3) / 4); }
 
 void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi)
 {
@@ -24,54 +69,404 @@ void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi)
     }
 }
 
-typedef struct { vec3 lo, hi, c; } item;
-
-static int build_rec(fr_builder *b, item *items, fr_prim *prims, uint32_t first, uint32_t count,
-                     fr_array *nodes, int depth, fr_error *err)
+/* Bounds of references [begin, end). */
+static void span_bounds(const build *B, span *s)
 {
-    fr_bvh_node node;
-    vec3 lo = items[first].lo, hi = items[first].hi, clo = items[first].c, chi = items[first].c;
-    for (uint32_t i = first + 1; i < first + count; i++) {
-        lo = v3_vmin(lo, items[i].lo); hi = v3_vmax(hi, items[i].hi);
-        clo = v3_vmin(clo, items[i].c); chi = v3_vmax(chi, items[i].c);
+    s->box = box_empty();
+    s->cent = box_empty();
+    for (uint32_t i = s->begin; i < s->end; i++) {
+        box_grow(&s->box, B->box[i]);
+        box_add(&s->cent, centroid(B->box[i]));
     }
-    node.lo = lo; node.hi = hi;
-    vec3 ext = v3_sub(chi, clo);
-    int axis = ext.x > ext.y ? (ext.x > ext.z ? 0 : 2) : (ext.y > ext.z ? 1 : 2);
-    if (count <= 4 || depth >= BVH_MAX_DEPTH - 2 || v3_get(ext, axis) <= 0.0f) {
-        node.offset = first; node.count = count;
-        return bld_push(nodes, &node) == FR_NONE ? fr_fail(err, "out of memory for the BVH") : 0;
-    }
-    /* Split at the centroid midpoint, partition in place. */
-    float mid = 0.5f * (v3_get(clo, axis) + v3_get(chi, axis));
-    uint32_t i = first, j = first + count;
-    while (i < j) {
-        if (v3_get(items[i].c, axis) < mid) { i++; continue; }
-        j--;
-        item ti = items[i]; items[i] = items[j]; items[j] = ti;
-        fr_prim tp = prims[i]; prims[i] = prims[j]; prims[j] = tp;
-    }
-    uint32_t left = i - first;
-    if (left == 0 || left == count) left = count / 2;
-    node.offset = 0; node.count = (uint32_t)axis << 24;
-    uint32_t me = bld_push(nodes, &node);
-    if (me == FR_NONE) return fr_fail(err, "out of memory for the BVH");
-    if (build_rec(b, items, prims, first, left, nodes, depth + 1, err) < 0) return -1;
-    ((fr_bvh_node *)nodes->data)[me].offset = nodes->count;
-    return build_rec(b, items, prims, first + left, count - left, nodes, depth + 1, err);
 }
 
-int bvh_build(fr_builder *b, fr_array *nodes, fr_error *err)
+static void swap_refs(build *B, uint32_t i, uint32_t j)
+{
+    box4 tb = B->box[i]; B->box[i] = B->box[j]; B->box[j] = tb;
+    uint32_t ti = B->id[i]; B->id[i] = B->id[j]; B->id[j] = ti;
+}
+
+/* Bin scale per axis: BINS slightly shrunk so the largest centroid lands in
+ * the last bin; 0 on an axis where every centroid is equal. */
+static f4 bin_scale(const span *s)
+{
+    f4 ext = s->cent.hi - s->cent.lo, k = f4_set1(0.0f);
+    for (int a = 0; a < 3; a++)
+        if (ext[a] > 0.0f)
+            k[a] = ((float)BINS * 0.9999f) / ext[a];
+    return k;
+}
+
+static i4 bin_of(f4 c, f4 lo, f4 scale)
+{
+    i4 k = __builtin_convertvector((c - lo) * scale, i4);
+    i4 top = i4_set1(BINS - 1), over = k > top;
+    return (k & ~over) | (top & over);
+}
+
+/* Split span s into *l and *r.  Returns 0 when s should rather be a leaf
+ * (allowed only if !force), 1 after partitioning.  `median` skips the SAH
+ * and halves the range (the depth guard: halving always terminates). */
+static int split_span(build *B, const span *s, span *l, span *r, int force, int median)
+{
+    uint32_t n = s->end - s->begin;
+    int best_axis = -1, best_bin = 0;
+    float best_cost = INFINITY;
+    f4 scale = bin_scale(s);
+    if (!median) {
+        box4 bins[3][BINS];
+        uint32_t count[3][BINS];
+        for (int a = 0; a < 3; a++)
+            for (int k = 0; k < BINS; k++) {
+                bins[a][k] = box_empty();
+                count[a][k] = 0;
+            }
+        for (uint32_t i = s->begin; i < s->end; i++) {
+            box4 bx = B->box[i];
+            i4 k = bin_of(centroid(bx), s->cent.lo, scale);
+            for (int a = 0; a < 3; a++) {
+                box_grow(&bins[a][k[a]], bx);
+                count[a][k[a]]++;
+            }
+        }
+        for (int a = 0; a < 3; a++) {
+            if (scale[a] == 0.0f)
+                continue;
+            float right_area[BINS];
+            uint32_t right_count[BINS];
+            box4 acc = box_empty();
+            uint32_t c = 0;
+            for (int k = BINS - 1; k > 0; k--) {
+                box_grow(&acc, bins[a][k]);
+                c += count[a][k];
+                right_count[k] = c;
+                right_area[k] = c ? half_area(acc) : 0.0f;
+            }
+            acc = box_empty();
+            c = 0;
+            for (int k = 1; k < BINS; k++) {
+                box_grow(&acc, bins[a][k - 1]);
+                c += count[a][k - 1];
+                if (c == 0 || right_count[k] == 0)
+                    continue;
+                float cost = half_area(acc) * blocks(c) + right_area[k] * blocks(right_count[k]);
+                if (cost < best_cost) {
+                    best_cost = cost;
+                    best_axis = a;
+                    best_bin = k;
+                }
+            }
+        }
+        if (!force) {
+            float area = half_area(s->box);
+            if (area * blocks(n) <= TRAV_COST * area + best_cost)
+                return 0;
+        }
+    }
+    uint32_t mid;
+    if (best_axis < 0) {
+        /* Every centroid in one bin (or the depth guard): halve the range. */
+        mid = s->begin + n / 2;
+    } else {
+        float lo = s->cent.lo[best_axis], sc = scale[best_axis];
+        uint32_t i = s->begin, j = s->end;
+        while (i < j) {
+            f4 c = centroid(B->box[i]);
+            int k = (int)((c[best_axis] - lo) * sc);
+            if (k > BINS - 1)
+                k = BINS - 1;
+            if (k < best_bin) {
+                i++;
+            } else {
+                j--;
+                swap_refs(B, i, j);
+            }
+        }
+        mid = i;
+    }
+    *l = (span){s->begin, mid, box_empty(), box_empty(), 0};
+    *r = (span){mid, s->end, box_empty(), box_empty(), 0};
+    span_bounds(B, l);
+    span_bounds(B, r);
+    return 1;
+}
+
+/* Fill the blocks of a leaf; *first and *meta become the parent's slot. */
+static int emit_leaf(build *B, const span *s, uint32_t *first, uint32_t *meta)
+{
+    const fr_prim *prims = B->b->prims.data;
+    const fr_triangle *tris = B->b->triangles.data;
+    const vec3 *pos = B->b->positions.data;
+    uint32_t n = s->end - s->begin, nblk = (n + 3) / 4, mixed = 0;
+    *first = B->leaves->count;
+    for (uint32_t k = 0; k < nblk; k++) {
+        fr_bvh_leaf L;
+        memset(&L, 0, sizeof L);
+        for (uint32_t lane = 0; lane < 4; lane++) {
+            uint32_t i = s->begin + 4 * k + lane;
+            if (i >= s->end) {
+                L.prim[lane] = FR_NONE;
+                continue;
+            }
+            const fr_prim *p = &prims[B->id[i]];
+            L.prim[lane] = B->n_out;
+            B->out[B->n_out++] = *p;
+            if (p->kind != FR_PRIM_TRIANGLE) {
+                mixed = FR_BVH_MIXED;
+                continue;
+            }
+            const fr_triangle *t = &tris[p->index];
+            for (int v = 0; v < 3; v++) {
+                vec3 q = pos[t->v[v]];
+                L.v[3 * v + 0][lane] = q.x;
+                L.v[3 * v + 1][lane] = q.y;
+                L.v[3 * v + 2][lane] = q.z;
+            }
+        }
+        if (bld_push(B->leaves, &L) == FR_NONE)
+            return fr_fail(B->err, "out of memory for the BVH leaves");
+    }
+    *meta = nblk | mixed;
+    return 0;
+}
+
+/* Levels a tree of halving splits needs below a node of n references. */
+static int median_levels(uint32_t n)
+{
+    int l = 0;
+    while (n > LEAF_MIN) {
+        n = (n + 3) / 4;
+        l++;
+    }
+    return l;
+}
+
+/* Make a node at `depth` whose children start as init[0..nc); split the
+ * widest child until there are four.  *index receives the node's index. */
+static int build_node(build *B, const span *init, int nc, int depth, int median, uint32_t *index)
+{
+    fr_bvh_node node;
+    memset(&node, 0, sizeof node);
+    uint32_t me = bld_push(B->nodes, &node);
+    if (me == FR_NONE)
+        return fr_fail(B->err, "out of memory for the BVH nodes");
+    span ch[4];
+    memcpy(ch, init, (size_t)nc * sizeof *ch);
+    if (!median)
+        median = depth + 2 + median_levels(init[nc - 1].end - init[0].begin) >= BVH_MAX_DEPTH;
+    while (nc < 4) {
+        /* The child with the largest area (or most references, when only
+         * halving) gains most from being split. */
+        int pick = -1;
+        float best = -1.0f;
+        for (int i = 0; i < nc; i++) {
+            float key = median ? (float)(ch[i].end - ch[i].begin) : half_area(ch[i].box);
+            if (!ch[i].leaf && key > best) {
+                best = key;
+                pick = i;
+            }
+        }
+        if (pick < 0)
+            break;
+        uint32_t n = ch[pick].end - ch[pick].begin;
+        span l, r;
+        if (n <= LEAF_MIN || !split_span(B, &ch[pick], &l, &r, n > LEAF_MAX, median)) {
+            ch[pick].leaf = 1;
+            continue;
+        }
+        ch[pick] = l;
+        ch[nc++] = r;
+    }
+    for (int i = 0; i < 4; i++) {
+        fr_bvh_node *nd = (fr_bvh_node *)B->nodes->data + me;
+        box4 bx = i < nc ? ch[i].box : box_empty();
+        for (int a = 0; a < 3; a++) {
+            nd->box[a][i] = bx.lo[a];
+            nd->box[3 + a][i] = bx.hi[a];
+        }
+        nd->child[i] = FR_NONE;
+        nd->leaf[i] = 0;
+        if (i >= nc)
+            continue;
+        uint32_t n = ch[i].end - ch[i].begin, child, meta = 0;
+        span pair[2];
+        if (!ch[i].leaf && n > LEAF_MIN && split_span(B, &ch[i], &pair[0], &pair[1], n > LEAF_MAX, median)) {
+            if (build_node(B, pair, 2, depth + 1, median, &child) < 0)
+                return -1;
+        } else if (emit_leaf(B, &ch[i], &child, &meta) < 0) {
+            return -1;
+        }
+        nd = (fr_bvh_node *)B->nodes->data + me;   /* the array may have moved */
+        nd->child[i] = child;
+        nd->leaf[i] = meta;
+    }
+    *index = me;
+    return 0;
+}
+
+int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err)
 {
     uint32_t n = b->prims.count;
-    if (n == 0) return 0;
-    item *items = malloc((size_t)n * sizeof *items);
-    if (!items) return fr_fail(err, "out of memory for the BVH");
-    for (uint32_t i = 0; i < n; i++) {
-        bvh_prim_bounds(b, i, &items[i].lo, &items[i].hi);
-        items[i].c = v3_scale(v3_add(items[i].lo, items[i].hi), 0.5f);
+    if (n == 0)
+        return 0;
+    if (n >= 0x80000000u)
+        return fr_fail(err, "%u primitives: the BVH holds at most 2^31 - 1", n);
+    build B = {0};
+    B.box = malloc((size_t)n * sizeof *B.box);
+    B.id = malloc((size_t)n * sizeof *B.id);
+    B.out = malloc((size_t)n * sizeof *B.out);
+    B.b = b;
+    B.nodes = nodes;
+    B.leaves = leaves;
+    B.err = err;
+    int rc = 0;
+    if (!B.box || !B.id || !B.out)
+        rc = fr_fail(err, "out of memory for the BVH (%u primitives)", n);
+    for (uint32_t i = 0; i < n && rc == 0; i++) {
+        vec3 lo, hi;
+        bvh_prim_bounds(b, i, &lo, &hi);
+        if (!isfinite(lo.x) || !isfinite(lo.y) || !isfinite(lo.z) || !isfinite(hi.x) || !isfinite(hi.y) ||
+            !isfinite(hi.z))
+            rc = fr_fail(err, "primitive %u has non-finite bounds", i);
+        B.box[i] = (box4){{lo.x, lo.y, lo.z, 0.0f}, {hi.x, hi.y, hi.z, 0.0f}};
+        B.id[i] = i;
     }
-    int rc = build_rec(b, items, b->prims.data, 0, n, nodes, 0, err);
-    free(items);
+    if (rc == 0) {
+        span all = {0, n, box_empty(), box_empty(), 0};
+        span_bounds(&B, &all);
+        uint32_t root;
+        rc = build_node(&B, &all, 1, 1, 0, &root);
+    }
+    free(B.box);
+    free(B.id);
+    if (rc < 0) {
+        free(B.out);
+        return -1;
+    }
+    free(b->prims.data);
+    b->prims.data = B.out;
+    b->prims.cap = n;
+    return 0;
+}
+
+/* ---- validation of a loaded BVH ---- */
+
+#define AT(p) ((size_t)((const char *)(p) - (const char *)base))
+
+int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
+{
+    if (s->n_prims == 0) {
+        if (s->n_nodes || s->n_leaves)
+            return fr_fail(err, "section nodes: a scene without primitives has no BVH");
+        return 0;
+    }
+    if (s->n_prims >= 0x80000000u)
+        return fr_fail(err, "section prims: %u primitives, at most 2^31 - 1", s->n_prims);
+    if (s->n_nodes == 0 || s->n_leaves == 0)
+        return fr_fail(err, "section nodes: the scene has primitives but no BVH");
+    unsigned char *depth = calloc(s->n_nodes, 1);
+    unsigned char *owner = calloc(s->n_leaves, 1);   /* 1: in a leaf, 2: in a mixed leaf */
+    unsigned char *seen = calloc(s->n_prims / 8 + 1, 1);
+    int rc = 0;
+    if (!depth || !owner || !seen) {
+        rc = fr_fail(err, "out of memory validating the BVH");
+        goto done;
+    }
+    depth[0] = 1;
+    for (uint32_t i = 0; i < s->n_nodes && rc == 0; i++) {
+        const fr_bvh_node *n = &s->nodes[i];
+        if (depth[i] == 0) {
+            rc = fr_fail(err, "section nodes, byte %zu: node %u is not reachable from the root", AT(n), i);
+            break;
+        }
+        for (int k = 0; k < 4 && rc == 0; k++) {
+            uint32_t c = n->child[k], meta = n->leaf[k];
+            if (c == FR_NONE) {
+                int empty = meta == 0;
+                for (int a = 0; a < 3; a++)
+                    empty &= n->box[a][k] == INFINITY && n->box[3 + a][k] == -INFINITY;
+                if (!empty)
+                    rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: an empty slot needs leaf 0 "
+                                 "and the empty box (+inf, -inf)", AT(n), i, k);
+                continue;
+            }
+            for (int a = 0; a < 3 && rc == 0; a++)
+                if (!(n->box[a][k] <= n->box[3 + a][k]) || !isfinite(n->box[a][k]) || !isfinite(n->box[3 + a][k]))
+                    rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: box not finite or inverted on axis %d",
+                                 AT(n->box[a] + k), i, k, a);
+            if (rc)
+                break;
+            if (meta == 0) {
+                if (c <= i || c >= s->n_nodes)
+                    rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: child %u not in (%u, %u)",
+                                 AT(n->child + k), i, k, c, i, s->n_nodes);
+                else if (depth[c])
+                    rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: node %u has two parents",
+                                 AT(n->child + k), i, k, c);
+                else if (depth[i] >= BVH_MAX_DEPTH)
+                    rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: deeper than %d levels",
+                                 AT(n->child + k), i, k, BVH_MAX_DEPTH);
+                else
+                    depth[c] = (unsigned char)(depth[i] + 1);
+                continue;
+            }
+            uint32_t nblk = meta & FR_BVH_LEAF_MAX;
+            if ((meta & ~(FR_BVH_LEAF_MAX | FR_BVH_MIXED)) || nblk == 0) {
+                rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: bad leaf word 0x%x",
+                             AT(n->leaf + k), i, k, meta);
+                break;
+            }
+            if (c >= s->n_leaves || nblk > s->n_leaves - c) {
+                rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: leaf blocks %u..%u past the %u blocks",
+                             AT(n->child + k), i, k, c, c + nblk - 1, s->n_leaves);
+                break;
+            }
+            for (uint32_t j = c; j < c + nblk && rc == 0; j++) {
+                if (owner[j])
+                    rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: leaf block %u is in two leaves",
+                                 AT(n->child + k), i, k, j);
+                owner[j] = (meta & FR_BVH_MIXED) ? 2 : 1;
+            }
+        }
+    }
+    for (uint32_t j = 0; j < s->n_leaves && rc == 0; j++) {
+        const fr_bvh_leaf *L = &s->leaves[j];
+        if (!owner[j]) {
+            rc = fr_fail(err, "section leaves, byte %zu: block %u belongs to no leaf", AT(L), j);
+            break;
+        }
+        for (int lane = 0; lane < 4 && rc == 0; lane++) {
+            uint32_t p = L->prim[lane];
+            if (p == FR_NONE) {
+                if (lane == 0)
+                    rc = fr_fail(err, "section leaves, byte %zu: block %u has no primitive in lane 0", AT(L->prim), j);
+                continue;
+            }
+            if (p >= s->n_prims) {
+                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u out of range (%u)",
+                             AT(L->prim + lane), j, lane, p, s->n_prims);
+            } else if (seen[p / 8] & (1u << (p % 8))) {
+                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u is in two lanes",
+                             AT(L->prim + lane), j, lane, p);
+            } else if (s->prims[p].kind != FR_PRIM_TRIANGLE && owner[j] != 2) {
+                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u is not a triangle but "
+                             "its leaf is not marked mixed", AT(L->prim + lane), j, lane, p);
+            } else {
+                seen[p / 8] |= (unsigned char)(1u << (p % 8));
+                if (s->prims[p].kind == FR_PRIM_TRIANGLE)
+                    for (int v = 0; v < 9 && rc == 0; v++)
+                        if (!isfinite(L->v[v][lane]))
+                            rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: non-finite vertex",
+                                         AT(L->v[v] + lane), j, lane);
+            }
+        }
+    }
+    for (uint32_t p = 0; p < s->n_prims && rc == 0; p++)
+        if (!(seen[p / 8] & (1u << (p % 8))))
+            rc = fr_fail(err, "section prims, byte %zu: primitive %u is in no BVH leaf", AT(s->prims + p), p);
+done:
+    free(depth);
+    free(owner);
+    free(seen);
     return rc;
 }

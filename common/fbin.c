@@ -1,6 +1,9 @@
 #include "fbin.h"
 
+#include "bvh.h"
+
 #include <errno.h>
+#include <stdint.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
@@ -18,7 +21,7 @@ enum { HEADER_SIZE = 64, ENTRY_SIZE = 32, ALIGN = 64 };
 
 enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
-    SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES,
+    SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP,
     SEC_COUNT = SEC_TONEMAP
 };
@@ -47,6 +50,7 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_PLANES, "planes", planes, fr_plane),
     ARR(SEC_LIGHTS, "lights", lights, fr_light),
     ARR(SEC_NODES, "nodes", nodes, fr_bvh_node),
+    ARR(SEC_LEAVES, "leaves", leaves, fr_bvh_leaf),
     ARR(SEC_TEXTURES, "textures", textures, fr_texture),
     ARR(SEC_TEXELS, "texels", texels, float),
     ARR(SEC_MEDIA, "media", media, fr_medium),
@@ -116,6 +120,9 @@ int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *er
 
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
+/* Byte offset of an element inside the blob, for messages. */
+#define AT(ptr) ((size_t)((const char *)(ptr) - (const char *)base))
+
 static int tex_ref_ok(const fr_scene *s, uint32_t t) { return t == FR_NONE || t < s->n_textures; }
 
 /* Textures, texels, media and the material fields that refer to them. */
@@ -159,72 +166,79 @@ static int validate_appearance(const fr_scene *s, fr_error *err)
 }
 
 /* Check every cross-reference so that rendering can index without checks. */
-static int validate(const fr_scene *s, fr_error *err)
+static int validate(const fr_scene *s, const void *base, fr_error *err)
 {
     const fr_settings *st = &s->settings;
-    if (st->width == 0 || st->height == 0 || st->width > 65536 || st->height > 65536 || st->spp == 0)
-        return fr_fail(err, "section settings: bad image size or sample count");
+    if (st->width == 0 || st->height == 0 || st->width > 65536 || st->height > 65536 || st->spp == 0 ||
+        st->spp > (1u << 20) || st->max_depth > 4096)
+        return fr_fail(err, "section settings, byte %zu: bad image size, sample count or depth", AT(st));
     const fr_camera *c = &s->camera;
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
-        !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !(c->focus > 0.0f || c->aperture == 0.0f))
-        return fr_fail(err, "section camera: degenerate or non-finite camera");
+        !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !isfinite(c->aperture) ||
+        !(c->focus > 0.0f || c->aperture == 0.0f))
+        return fr_fail(err, "section camera, byte %zu: degenerate or non-finite camera", AT(c));
     if (validate_appearance(s, err) < 0)
         return -1;
     for (uint32_t i = 0; i < s->n_materials; i++) {
         const fr_material *m = &s->materials[i];
-        if (!(m->p_lobe[3] >= 0.0f && m->p_lobe[3] <= 1.0f) || !(m->ior > 0.0f) || !(m->exponent >= 0.0f))
-            return fr_fail(err, "section materials: element %u: bad lobe probabilities, ior or exponent", i);
+        int ok = m->p_lobe[0] >= 0.0f && m->p_lobe[3] <= 1.0f;
+        for (int k = 1; k < 4; k++)
+            ok &= m->p_lobe[k] >= m->p_lobe[k - 1];
+        if (!ok || !(m->ior > 0.0f) || !(m->exponent >= 0.0f) || !finite3(m->emission))
+            return fr_fail(err, "section materials, byte %zu: material %u: bad lobe probabilities, ior, exponent "
+                           "or emission", AT(m), i);
     }
+    if (s->n_prims > 0 && s->n_materials == 0)
+        return fr_fail(err, "section materials: primitives but no material");
     uint32_t kind_count[FR_PRIM_KINDS] = {s->n_triangles, s->n_spheres, s->n_rects};
     for (uint32_t i = 0; i < s->n_prims; i++) {
         const fr_prim *p = &s->prims[i];
         if (p->kind >= FR_PRIM_KINDS || p->index >= kind_count[p->kind])
-            return fr_fail(err, "section prims: element %u: bad kind or index", i);
+            return fr_fail(err, "section prims, byte %zu: primitive %u: bad kind %u or index %u", AT(p), i, p->kind,
+                           p->index);
         if (p->material >= s->n_materials)
-            return fr_fail(err, "section prims: element %u: material %u out of range", i, p->material);
+            return fr_fail(err, "section prims, byte %zu: primitive %u: material %u out of range", AT(p), i,
+                           p->material);
         if (p->light != FR_NONE && (p->light >= s->n_lights || s->lights[p->light].kind != FR_LIGHT_PRIM ||
                                     s->lights[p->light].prim != i))
-            return fr_fail(err, "section prims: element %u: light %u does not point back", i, p->light);
+            return fr_fail(err, "section prims, byte %zu: primitive %u: light %u does not point back", AT(p), i,
+                           p->light);
     }
     for (uint32_t i = 0; i < s->n_triangles; i++) {
         const fr_triangle *t = &s->triangles[i];
+        if (t->flags & ~(uint32_t)(FR_TRI_NORMALS | FR_TRI_UVS))
+            return fr_fail(err, "section triangles, byte %zu: triangle %u: unknown flags 0x%x", AT(t), i, t->flags);
         for (int k = 0; k < 3; k++) {
             if (t->v[k] >= s->n_positions ||
                 ((t->flags & FR_TRI_NORMALS) && t->v[k] >= s->n_normals) ||
                 ((t->flags & FR_TRI_UVS) && t->v[k] >= s->n_uvs))
-                return fr_fail(err, "section triangles: element %u: vertex index %u out of range", i, t->v[k]);
+                return fr_fail(err, "section triangles, byte %zu: triangle %u: vertex index %u out of range",
+                               AT(t->v + k), i, t->v[k]);
         }
     }
     for (uint32_t i = 0; i < s->n_planes; i++)
-        if (s->planes[i].material >= s->n_materials)
-            return fr_fail(err, "section planes: element %u: material out of range", i);
+        if (s->planes[i].material >= s->n_materials || !finite3(s->planes[i].normal) ||
+            !finite3(s->planes[i].point))
+            return fr_fail(err, "section planes, byte %zu: plane %u: material out of range or non-finite geometry",
+                           AT(s->planes + i), i);
     for (uint32_t i = 0; i < s->n_lights; i++) {
         const fr_light *l = &s->lights[i];
         if (l->kind > FR_LIGHT_PRIM || (l->kind == FR_LIGHT_PRIM && (l->prim >= s->n_prims || s->prims[l->prim].light != i)))
-            return fr_fail(err, "section lights: element %u: bad kind or primitive", i);
-        if (!(l->pick > 0.0f && l->pick <= 1.0f))
-            return fr_fail(err, "section lights: element %u: bad pick probability", i);
+            return fr_fail(err, "section lights, byte %zu: light %u: bad kind or primitive", AT(l), i);
+        if (!(l->pick > 0.0f && l->pick <= 1.0f) || !(l->cdf >= 0.0f && l->cdf <= 1.0f))
+            return fr_fail(err, "section lights, byte %zu: light %u: bad pick probability", AT(l), i);
+        if (l->kind == FR_LIGHT_POINT && (!finite3(l->position) || !finite3(l->intensity)))
+            return fr_fail(err, "section lights, byte %zu: light %u: non-finite point light", AT(l), i);
     }
-    if (s->n_prims > 0 && s->n_nodes == 0)
-        return fr_fail(err, "section nodes: scene has primitives but no BVH");
-    for (uint32_t i = 0; i < s->n_nodes; i++) {
-        const fr_bvh_node *n = &s->nodes[i];
-        uint32_t count = n->count & 0xffffffu;
-        if (count == 0) {
-            /* Children must lie after their parent: no cycles, bounded depth is checked in traversal. */
-            if (i + 1 >= s->n_nodes || n->offset <= i + 1 || n->offset >= s->n_nodes || (n->count >> 24) > 2)
-                return fr_fail(err, "section nodes: element %u: child index out of range", i);
-        } else if (n->offset > s->n_prims || count > s->n_prims - n->offset) {
-            return fr_fail(err, "section nodes: element %u: primitive range out of bounds", i);
-        }
-    }
-    return 0;
+    return bvh_validate(s, base, err);
 }
 
 int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *err)
 {
     const unsigned char *p = blob;
     memset(out, 0, sizeof *out);
+    if ((uintptr_t)blob % 16)
+        return fr_fail(err, "scene bytes at %p are not 16-byte aligned", blob);
     if (size < HEADER_SIZE)
         return fr_fail(err, "header: file is %zu bytes, shorter than the %d-byte header", size, HEADER_SIZE);
     if (memcmp(p, fbin_magic, 8) != 0)
@@ -240,9 +254,14 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
         return fr_fail(err, "byte 24: header says %llu bytes, file has %zu (truncated?)", (unsigned long long)get64(p + 24), size);
     if ((size_t)HEADER_SIZE + (size_t)ENTRY_SIZE * nsec > size)
         return fr_fail(err, "byte %d: section table runs past the end of the file", HEADER_SIZE);
+    for (int k = 40; k < HEADER_SIZE; k++)
+        if (p[k])
+            return fr_fail(err, "byte %d: reserved header byte is not zero", k);
     uint64_t hash = XXH3_64bits(p + HEADER_SIZE, size - HEADER_SIZE);
     if (hash != get64(p + 32))
         return fr_fail(err, "byte 32: content hash mismatch (file is corrupt)");
+    /* Sections follow the table in id order without overlapping. */
+    uint64_t next = HEADER_SIZE + (uint64_t)ENTRY_SIZE * nsec;
     for (uint32_t k = 0; k < nsec; k++) {
         const unsigned char *e = p + HEADER_SIZE + (size_t)ENTRY_SIZE * k;
         size_t at = HEADER_SIZE + (size_t)ENTRY_SIZE * k;
@@ -253,9 +272,11 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
         const section_desc *d = &sections[id];
         if (elem != d->elem)
             return fr_fail(err, "byte %zu: section %s: element size %u, expected %u", at, d->name, elem, d->elem);
-        if (off % ALIGN || off > size || count > 0xffffffffu || bytes != count * elem || bytes > size - off)
-            return fr_fail(err, "byte %zu: section %s: offset %llu / count %llu out of bounds", at, d->name,
-                           (unsigned long long)off, (unsigned long long)count);
+        if (off % ALIGN || off < next || off > size || count > 0xffffffffu || bytes != count * elem ||
+            bytes > size - off)
+            return fr_fail(err, "byte %zu: section %s: offset %llu / count %llu out of bounds or overlapping", at,
+                           d->name, (unsigned long long)off, (unsigned long long)count);
+        next = off + bytes;
         if (!d->count_off) {
             if (count != 1)
                 return fr_fail(err, "byte %zu: section %s: count %llu, expected 1", at, d->name, (unsigned long long)count);
@@ -265,7 +286,7 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
             *(uint32_t *)((char *)out + d->count_off) = (uint32_t)count;
         }
     }
-    if (validate(out, err) < 0) {
+    if (validate(out, p, err) < 0) {
         memset(out, 0, sizeof *out);
         return -1;
     }

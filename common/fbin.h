@@ -7,24 +7,25 @@
  * images and host caches.
  *
  * Every open checks the header, every section's bounds and size, the hash
- * and every index inside (vertex, material, light, BVH child and range)
- * before the scene is used, so a truncated or corrupt file is refused with
- * the section and byte offset at fault, never a crash. */
+ * and every index inside (vertex, material, light, BVH child, leaf block
+ * and lane, tree shape and depth) before the scene is used, so a truncated
+ * or corrupt file is refused with the section and byte offset at fault,
+ * never a crash. */
 #ifndef FRANJA_FBIN_H
 #define FRANJA_FBIN_H
 
 #include "error.h"
 #include "scene.h"
 
-#define FBIN_VERSION 2
+#define FBIN_VERSION 3
 
 /* Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */
 int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err);
 
-/* Validate `blob` and point *out into it.  On success *out owns the blob
- * (freed or unmapped by scn_free according to `mapped`); on failure the
- * caller still owns it. */
+/* Validate `blob` (16-byte aligned, as malloc and mmap give) and point *out
+ * into it.  On success *out owns the blob (freed or unmapped by scn_free
+ * according to `mapped`); on failure the caller still owns it. */
 int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *err);
 
 /* Map and validate a binary scene file.  Errors name the file. */

@@ -157,12 +157,39 @@ typedef struct {
     float pad;
 } fr_light;
 
-/* Flattened BVH node (32 bytes).  Interior: count == 0, children are
- * this+1 and `offset`.  Leaf: prims[offset .. offset+count). */
+/* A 4-wide BVH node (128 bytes, two cache lines): the boxes of its four
+ * children side by side (structure of arrays), so one ray is tested against
+ * all four with one vector operation per plane.  box[0..2] are the lower
+ * x, y, z bounds, box[3..5] the upper ones, one lane per child.
+ *
+ * Child slot i is
+ *   - an inner node:  leaf[i] == 0, child[i] = index into nodes (> this node);
+ *   - a leaf:         leaf[i] = number of leaf blocks (1..FR_BVH_LEAF_MAX),
+ *                     plus FR_BVH_MIXED if some lane is not a triangle,
+ *                     child[i] = index of the first block in leaves;
+ *   - empty:          child[i] = FR_NONE, leaf[i] = 0, box lower = +inf,
+ *                     upper = -inf (a box no ray enters).
+ * Node 0 is the root; every other node is the child of exactly one node. */
 typedef struct {
-    vec3 lo; uint32_t offset;
-    vec3 hi; uint32_t count;   /* high byte of count holds the split axis for interior nodes */
+    float box[6][4];
+    uint32_t child[4];
+    uint32_t leaf[4];
 } fr_bvh_node;
+
+#define FR_BVH_LEAF_MAX 255u
+#define FR_BVH_MIXED 0x100u
+
+/* A leaf block: up to four primitives with their triangle vertices copied
+ * in leaf order (structure of arrays: v[3*k + axis][lane] is coordinate
+ * `axis` of vertex k of lane `lane`), so traversal reads one contiguous
+ * 160-byte block instead of following three indices per triangle.  prim[lane]
+ * is the index into prims, FR_NONE for an unused lane; lanes that are not
+ * triangles (spheres, rects; only in FR_BVH_MIXED leaves) have zero vertices
+ * and are intersected through prims. */
+typedef struct {
+    float v[9][4];
+    uint32_t prim[4];
+} fr_bvh_leaf;
 
 typedef struct {
     fr_settings settings;
@@ -184,6 +211,7 @@ typedef struct {
     const fr_plane *planes;       uint32_t n_planes;
     const fr_light *lights;       uint32_t n_lights;
     const fr_bvh_node *nodes;     uint32_t n_nodes;
+    const fr_bvh_leaf *leaves;    uint32_t n_leaves;
 
     uint64_t hash;                /* content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

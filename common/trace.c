@@ -1,7 +1,10 @@
 #include "trace.h"
 
+#include <string.h>
+
 #include "bvh.h"
 #include "fmath.h"
+#include "simd4.h"
 
 float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, float *a, float *b)
 {
@@ -17,75 +20,242 @@ float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, flo
     return geo_rect(&s->rects[p->index], r, tmax, a, b);
 }
 
-/* Slab test against a node's box with precomputed reciprocal direction;
- * returns the entry distance or -1 if missed within (0, tmax). */
-static float box_entry(const fr_bvh_node *n, vec3 o, vec3 inv, float tmax)
+/* ---- BVH traversal ----
+ *
+ * Hits are decided exactly as the per-primitive tests decide them (the
+ * triangle lanes below repeat geo_triangle's operations in the same order,
+ * four at a time), and among hits at the same t the lowest primitive index
+ * wins (planes, tested first, win over primitives).  So the result does not
+ * depend on the order nodes are visited in: it is the brute-force nearest
+ * hit, on every machine. */
+
+/* Box tests widen the far distance by 2*gamma(3) (Ize 2013, "Robust BVH
+ * ray traversal"), so rounding never drops a box the exact ray touches. */
+#define FAR_SCALE 1.00000036f
+
+typedef struct {
+    vec3 o, d;
+    f4 ox, oy, oz, ix, iy, iz;   /* origin and 1/direction, in every lane */
+    int near[3], far[3];         /* box row of the entry / exit plane per axis */
+    /* the watertight triangle test's ray frame (see geo_triangle) */
+    int kx, ky, kz;
+    f4 okx, oky, okz, sx, sy, sz;
+} ray4;
+
+/* Where the best hit so far is; `key` is the primitive that wins a tie at
+ * t == best (lower indices win; 0 while nothing or only a plane was hit,
+ * so nothing wins a tie with the ray's own tmax). */
+typedef struct {
+    float best;
+    uint32_t key;
+    fr_hit *hit;
+    int found;
+} hit_state;
+
+static int max_axis(vec3 v)
 {
-    float tx0 = (n->lo.x - o.x) * inv.x, tx1 = (n->hi.x - o.x) * inv.x;
-    float ty0 = (n->lo.y - o.y) * inv.y, ty1 = (n->hi.y - o.y) * inv.y;
-    float tz0 = (n->lo.z - o.z) * inv.z, tz1 = (n->hi.z - o.z) * inv.z;
-    float tmin = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), 0.0f));
-    float tfar = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)), fminf(fmaxf(tz0, tz1), tmax));
-    /* Widen the far bound by a few ulps so rounding never drops a box that
-     * the exact ray touches (robust traversal, Ize 2013). */
-    return tmin <= tfar * 1.00000024f ? tmin : -1.0f;
+    float x = fabsf(v.x), y = fabsf(v.y), z = fabsf(v.z);
+    return x > y ? (x > z ? 0 : 2) : (y > z ? 1 : 2);
 }
 
-/* Walk the BVH; with `any` set, return at the first hit. */
+static void ray_setup(ray4 *R, const fr_ray *r)
+{
+    R->o = r->o;
+    R->d = r->d;
+    R->ox = f4_set1(r->o.x); R->oy = f4_set1(r->o.y); R->oz = f4_set1(r->o.z);
+    R->ix = f4_set1(1.0f / r->d.x); R->iy = f4_set1(1.0f / r->d.y); R->iz = f4_set1(1.0f / r->d.z);
+    /* 1/-0 is -inf: the sign bit picks the planes, as it must. */
+    int neg[3] = {signbit(r->d.x) != 0, signbit(r->d.y) != 0, signbit(r->d.z) != 0};
+    for (int a = 0; a < 3; a++) {
+        R->near[a] = a + 3 * neg[a];
+        R->far[a] = a + 3 * !neg[a];
+    }
+    int kz = max_axis(r->d);
+    int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+    float dz = v3_get(r->d, kz);
+    if (dz < 0.0f) { int t = kx; kx = ky; ky = t; }
+    R->kx = kx; R->ky = ky; R->kz = kz;
+    R->okx = f4_set1(v3_get(r->o, kx)); R->oky = f4_set1(v3_get(r->o, ky)); R->okz = f4_set1(v3_get(r->o, kz));
+    R->sx = f4_set1(v3_get(r->d, kx) / dz);
+    R->sy = f4_set1(v3_get(r->d, ky) / dz);
+    R->sz = f4_set1(1.0f / dz);
+}
+
+/* Entry distances of the ray into the four boxes of node n, and which of
+ * them it enters before tmax (bit mask). */
+static inline unsigned node_hits(const fr_bvh_node *n, const ray4 *R, float tmax, f4 *tnear)
+{
+    f4 nx = (f4_load(n->box[R->near[0]]) - R->ox) * R->ix;
+    f4 ny = (f4_load(n->box[R->near[1]]) - R->oy) * R->iy;
+    f4 nz = (f4_load(n->box[R->near[2]]) - R->oz) * R->iz;
+    f4 fx = (f4_load(n->box[R->far[0]]) - R->ox) * R->ix;
+    f4 fy = (f4_load(n->box[R->far[1]]) - R->oy) * R->iy;
+    f4 fz = (f4_load(n->box[R->far[2]]) - R->oz) * R->iz;
+    f4 tn = f4_max_num(nx, f4_max_num(ny, f4_max_num(nz, f4_set1(0.0f))));
+    f4 tf = f4_min_num(fx, f4_min_num(fy, f4_min_num(fz, f4_set1(tmax))));
+    *tnear = tn;
+    return i4_bits(tn <= tf * f4_set1(FAR_SCALE));
+}
+
+/* The smallest float above x (x >= 0; infinity stays). */
+static float next_up(float x)
+{
+    if (x == INFINITY)
+        return x;
+    uint32_t u;
+    memcpy(&u, &x, 4);
+    u++;
+    memcpy(&x, &u, 4);
+    return x;
+}
+
+static int better(const hit_state *H, float t, uint32_t prim)
+{
+    return t < H->best || (t == H->best && prim < H->key);
+}
+
+static void record(hit_state *H, float t, uint32_t prim, float a, float b)
+{
+    H->best = t;
+    H->key = prim;
+    H->found = 1;
+    H->hit->t = t; H->hit->prim = prim; H->hit->plane = FR_NONE; H->hit->a = a; H->hit->b = b;
+}
+
+/* Test the lanes of one leaf block.  `lanes` says which lanes hold
+ * triangles to test.  With `any`, return 1 at the first hit. */
+static int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes, hit_state *H, int any)
+{
+    f4 az = f4_load(L->v[0 + R->kz]) - R->okz;
+    f4 bz = f4_load(L->v[3 + R->kz]) - R->okz;
+    f4 cz = f4_load(L->v[6 + R->kz]) - R->okz;
+    f4 ax = (f4_load(L->v[0 + R->kx]) - R->okx) - R->sx * az;
+    f4 ay = (f4_load(L->v[0 + R->ky]) - R->oky) - R->sy * az;
+    f4 bx = (f4_load(L->v[3 + R->kx]) - R->okx) - R->sx * bz;
+    f4 by = (f4_load(L->v[3 + R->ky]) - R->oky) - R->sy * bz;
+    f4 cx = (f4_load(L->v[6 + R->kx]) - R->okx) - R->sx * cz;
+    f4 cy = (f4_load(L->v[6 + R->ky]) - R->oky) - R->sy * cz;
+    f4 u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+    f4 zero = f4_set1(0.0f);
+    unsigned edge = i4_bits((u == zero) | (v == zero) | (w == zero)) & lanes;
+    for (int i = 0; edge; i++, edge >>= 1) {
+        if (!(edge & 1))
+            continue;
+        /* On an edge in single precision: decide in double, as geo_triangle. */
+        u[i] = (float)((double)cx[i] * by[i] - (double)cy[i] * bx[i]);
+        v[i] = (float)((double)ax[i] * cy[i] - (double)ay[i] * cx[i]);
+        w[i] = (float)((double)bx[i] * ay[i] - (double)by[i] * ax[i]);
+    }
+    i4 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+    f4 det = u + v + w;
+    unsigned m = i4_bits(~outside & (det != zero)) & lanes;
+    if (!m)
+        return 0;
+    f4 t = R->sz * (u * az + v * bz + w * cz) / det;
+    m &= i4_bits((t > zero) & (t <= f4_set1(H->best)));
+    for (int i = 0; m; i++, m >>= 1) {
+        if (!(m & 1) || !better(H, t[i], L->prim[i]))
+            continue;
+        if (any)
+            return 1;
+        record(H, t[i], L->prim[i], v[i] / det[i], w[i] / det[i]);
+    }
+    return 0;
+}
+
+/* Intersect a leaf of `meta` (count | flags) blocks starting at `first`. */
+static int leaf_test(const fr_scene *s, const fr_ray *r, const ray4 *R, uint32_t first, uint32_t meta, hit_state *H,
+                     int any, uint32_t skip)
+{
+    uint32_t end = first + (meta & FR_BVH_LEAF_MAX);
+    for (uint32_t j = first; j < end; j++) {
+        const fr_bvh_leaf *L = &s->leaves[j];
+        unsigned lanes = 0;
+        for (int i = 0; i < 4; i++)
+            lanes |= (unsigned)(L->prim[i] != FR_NONE && L->prim[i] != skip) << i;
+        if (meta & FR_BVH_MIXED) {
+            for (int i = 0; i < 4; i++) {
+                if (!(lanes & (1u << i)) || s->prims[L->prim[i]].kind == FR_PRIM_TRIANGLE)
+                    continue;
+                lanes &= ~(1u << i);
+                float a, b, t = trace_prim(s, L->prim[i], r, next_up(H->best), &a, &b);
+                if (t > 0.0f && better(H, t, L->prim[i])) {
+                    if (any)
+                        return 1;
+                    record(H, t, L->prim[i], a, b);
+                }
+            }
+        }
+        if (block_test(L, R, lanes, H, any))
+            return 1;
+    }
+    return 0;
+}
+
+typedef struct { uint32_t child, leaf; float t; } stack_entry;
+
+/* Walk the BVH; with `any` set, return at the first hit.  Prim `skip` is
+ * ignored (FR_NONE: none). */
 static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int any, uint32_t skip)
 {
-    int found = 0;
+    hit_state H = {tmax, 0, hit, 0};
     for (uint32_t i = 0; i < s->n_planes; i++) {
-        float t = geo_plane(&s->planes[i], r, tmax);
+        float t = geo_plane(&s->planes[i], r, H.best);
         if (t > 0.0f) {
-            if (any) return 1;
-            tmax = t;
+            if (any)
+                return 1;
+            H.best = t;
+            H.found = 1;
             hit->t = t; hit->prim = FR_NONE; hit->plane = i; hit->a = hit->b = 0.0f;
-            found = 1;
         }
     }
     if (s->n_nodes == 0)
-        return found;
-    vec3 inv = v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
-    int neg[3] = {r->d.x < 0.0f, r->d.y < 0.0f, r->d.z < 0.0f};
-    uint32_t stack[BVH_MAX_DEPTH * 2];
+        return H.found;
+    ray4 R;
+    ray_setup(&R, r);
+    stack_entry stack[BVH_STACK];
     int sp = 0;
     uint32_t node = 0;
-    if (box_entry(&s->nodes[0], r->o, inv, tmax) < 0.0f)
-        return found;
     for (;;) {
         const fr_bvh_node *n = &s->nodes[node];
-        uint32_t count = n->count & 0xffffffu;
-        if (count) {
-            for (uint32_t i = n->offset; i < n->offset + count; i++) {
-                float a, b;
-                if (i == skip)
-                    continue;
-                float t = trace_prim(s, i, r, tmax, &a, &b);
-                if (t > 0.0f) {
-                    if (any) return 1;
-                    tmax = t;
-                    hit->t = t; hit->prim = i; hit->plane = FR_NONE; hit->a = a; hit->b = b;
-                    found = 1;
-                }
-            }
-        } else {
-            /* Visit the near child first (by the split axis and ray sign). */
-            uint32_t first = node + 1, second = n->offset;
-            if (neg[n->count >> 24]) { uint32_t t = first; first = second; second = t; }
-            float t1 = box_entry(&s->nodes[first], r->o, inv, tmax);
-            float t2 = box_entry(&s->nodes[second], r->o, inv, tmax);
-            if (t1 >= 0.0f && t2 >= 0.0f) {
-                if (sp < (int)(sizeof stack / sizeof stack[0])) stack[sp++] = second;
-                node = first;
+        f4 tn;
+        unsigned m = node_hits(n, &R, H.best, &tn);
+        /* Order the children entered by entry distance (ties by slot), so
+         * the nearest is visited next and the others wait on the stack. */
+        stack_entry e[4];
+        int k = 0;
+        for (int i = 0; m; i++, m >>= 1) {
+            if (!(m & 1))
                 continue;
-            }
-            if (t1 >= 0.0f) { node = first; continue; }
-            if (t2 >= 0.0f) { node = second; continue; }
+            stack_entry x = {n->child[i], n->leaf[i], tn[i]};
+            int j = k++;
+            if (!any)
+                for (; j > 0 && e[j - 1].t > x.t; j--)
+                    e[j] = e[j - 1];
+            e[j] = x;
         }
-        if (sp == 0)
-            return found;
-        node = stack[--sp];
+        while (k > 1)
+            stack[sp++] = e[--k];
+        if (k == 1 && !e[0].leaf) {
+            node = e[0].child;
+            continue;
+        }
+        if (k == 1 && leaf_test(s, r, &R, e[0].child, e[0].leaf, &H, any, skip))
+            return 1;
+        /* Pop the next subtree the ray can still reach before the best hit. */
+        for (;;) {
+            if (sp == 0)
+                return H.found;
+            stack_entry x = stack[--sp];
+            if (x.t > H.best)
+                continue;
+            if (!x.leaf) {
+                node = x.child;
+                break;
+            }
+            if (leaf_test(s, r, &R, x.child, x.leaf, &H, any, skip))
+                return 1;
+        }
     }
 }
 
@@ -96,7 +266,7 @@ int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 
 int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
-    fr_hit h;
+    fr_hit h = {0};
     return walk(s, r, tmax, &h, 1, skip);
 }
 

@@ -1,0 +1,24 @@
+/** @file compile.h
+ * `franja compile`: a JSON scene with its meshes becomes a binary scene.
+ *
+ * The compiler is the JSON reader (common/scene_json.h) with the mesh hook
+ * of mesh.h: meshes are read (OBJ/MTL by our own reader; PLY, STL, glTF and
+ * other formats through Assimp), placed, given a level of detail and frozen
+ * with the rest into the binary layout of common/FORMAT.md.
+ */
+#ifndef FRANJA_COMPILE_H
+#define FRANJA_COMPILE_H
+
+#include "error.h"
+#include "scene.h"
+
+/** Reads the scene `json_path` and every mesh it names, builds the BVH and
+ * fills *out (which then owns its blob; release with scn_free).  Returns 0,
+ * or -1 with err naming the file and JSON path or line at fault. */
+int compile_json(const char *json_path, fr_scene *out, fr_error *err);
+
+/** `franja compile SCENE.json [-o SCENE.fbin]`: argv[0] is "compile".
+ * Returns the process exit status (0 ok, 1 failure, 2 usage error). */
+int cmd_compile(int argc, char **argv);
+
+#endif

@@ -1,0 +1,36 @@
+/** @file mesh.h
+ * Triangle meshes in a scene: the `mesh` shape of the JSON scene (fields in
+ * scenes/README.md), read from files, placed, given a level of detail and
+ * added to a builder.
+ *
+ * OBJ files go through our reader (obj.h, exact file:line errors); any
+ * other extension (ply, stl, gltf, glb, dae, fbx, 3ds ...) through Assimp.
+ * MTL (or Assimp) materials become Franja materials as scenes/README.md
+ * describes, unless the shape names a material that overrides them all.
+ */
+#ifndef FRANJA_MESH_H
+#define FRANJA_MESH_H
+
+#include <cjson/cJSON.h>
+
+#include "builder.h"
+#include "obj.h"
+
+/** The scn_hooks mesh hook: reads shape `node` (JSON path `where`), with
+ * file names relative to `dir`, and appends its triangles (and their
+ * materials, unless `material` is not FR_NONE) to b.  Errors start with
+ * `where` or the mesh file's name and line. */
+int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
+             fr_error *err);
+
+/** Reads a mesh file by its extension: OBJ by obj_read, others by Assimp
+ * into the same structure (free with obj_free). */
+int mesh_read(const char *path, obj_mesh *m, fr_error *err);
+
+/** The Franja material for an MTL material (see scenes/README.md, "mesh"):
+ * Kd diffuse, Ks with Ns Phong glossy (mirror for illum 3 and 5), Tf and Ni
+ * glass for illum 4, 6, 7 and 9, Ke emission; lobes scaled down together
+ * when they would reflect more than they receive. */
+void mesh_material(const obj_material *src, fr_material *out);
+
+#endif
