@@ -40,7 +40,7 @@ TOOL_BIN    = $(TOOL_SRC:tests/tools/%.c=bin/tools/%)
 LIB         = $(B)/libfranja.a
 
 WORKER_LIBS = $(CJSON_LIBS) -lm
-COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm
+COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm -pthread
 
 .PHONY: all deps check bench render clean docs fuzz static dist check-cross
 all: bin/franja-worker bin/franja
