@@ -1,0 +1,44 @@
+#!/bin/sh
+# The fully static workers (make static): they need no shared library, the
+# arm64 one runs under qemu-aarch64-static, and both render the test slab
+# byte-identical to this machine's bin/franja-worker.
+. "$(dirname "$0")/lib.sh"
+need readelf cmp "$QEMU"
+T=$(mktemp -d /tmp/franja-static.XXXXXX)
+trap 'rm -rf "$T"' EXIT
+S64="$ROOT/bin/static/amd64/franja-worker"
+SA64="$ROOT/bin/static/arm64/franja-worker"
+VERSION=$("$ROOT/bin/franja-worker" --version)
+
+cross_refs "$T"
+
+check "amd64 static worker built" test -x "$S64"
+check "amd64 static worker is x86-64" is_machine "$S64" "Advanced Micro Devices X86-64"
+check "amd64 static worker is static" is_static "$S64"
+check "amd64 static worker reports the same version" \
+    test "$("$S64" --version)" = "$VERSION"
+"$S64" --scene "$T/scene.fbin" $SLAB -o "$T/s64.pf"
+check "amd64 static slab is byte-identical" cmp "$T/s64.pf" "$T/ref-fbin.pf"
+"$S64" --scene "$T/scene.fbin" $SLAB -o - >"$T/s64-stdout.pf"
+check "amd64 static slab on stdout is byte-identical" cmp "$T/s64-stdout.pf" "$T/ref-fbin.pf"
+
+check "arm64 static worker built" test -x "$SA64"
+check "arm64 static worker is AArch64" is_machine "$SA64" AArch64
+check "arm64 static worker is static" is_static "$SA64"
+# No -L: a static binary needs no arm64 libraries on this machine.
+check "arm64 static worker reports the same version under qemu" \
+    test "$("$QEMU" "$SA64" --version)" = "$VERSION"
+"$QEMU" "$SA64" --scene "$T/scene.fbin" $SLAB -o "$T/sa64.pf"
+check "arm64 static slab under qemu is byte-identical" cmp "$T/sa64.pf" "$T/ref-fbin.pf"
+check "arm64 static worker validates the scene to the same hash" \
+    test "$("$QEMU" "$SA64" --scene "$T/scene.fbin" --check)" = \
+         "$("$ROOT/bin/franja-worker" --scene "$T/scene.fbin" --check)"
+
+# Built without cJSON, the static worker refuses a JSON scene with a message
+# instead of misreading it.
+"$S64" --scene "$ROOT/scenes/cornell.json" $SLAB -o "$T/json.pf" 2>"$T/json.err"
+check "static worker refuses a JSON scene" test $? -ne 0
+check "and says so on stderr" test -s "$T/json.err"
+check "and writes no image" test ! -s "$T/json.pf"
+
+cross_summary
