@@ -124,7 +124,7 @@ static void record(hit_state *H, float t, uint32_t prim, float a, float b)
 
 /* Test the lanes of one leaf block.  `lanes` says which lanes hold
  * triangles to test.  With `any`, return 1 at the first hit. */
-static int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes, hit_state *H, int any)
+static inline __attribute__((always_inline)) int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes, hit_state *H, int any)
 {
     f4 az = f4_load(L->v[0 + R->kz]) - R->okz;
     f4 bz = f4_load(L->v[3 + R->kz]) - R->okz;
@@ -164,15 +164,16 @@ static int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes, hit_s
 }
 
 /* Intersect a leaf of `meta` (count | flags) blocks starting at `first`. */
-static int leaf_test(const fr_scene *s, const fr_ray *r, const ray4 *R, uint32_t first, uint32_t meta, hit_state *H,
-                     int any, uint32_t skip)
+static inline __attribute__((always_inline)) int leaf_test(const fr_scene *s, const fr_ray *r, const ray4 *R,
+                                                           uint32_t first, uint32_t meta, hit_state *H, int any,
+                                                           uint32_t skip)
 {
     uint32_t end = first + (meta & FR_BVH_LEAF_MAX);
     for (uint32_t j = first; j < end; j++) {
         const fr_bvh_leaf *L = &s->leaves[j];
-        unsigned lanes = 0;
-        for (int i = 0; i < 4; i++)
-            lanes |= (unsigned)(L->prim[i] != FR_NONE && L->prim[i] != skip) << i;
+        i4 prim;
+        memcpy(&prim, L->prim, sizeof prim);
+        unsigned lanes = i4_bits((prim != i4_set1((int32_t)FR_NONE)) & (prim != i4_set1((int32_t)skip)));
         if (meta & FR_BVH_MIXED) {
             for (int i = 0; i < 4; i++) {
                 if (!(lanes & (1u << i)) || s->prims[L->prim[i]].kind == FR_PRIM_TRIANGLE)
@@ -195,8 +196,10 @@ static int leaf_test(const fr_scene *s, const fr_ray *r, const ray4 *R, uint32_t
 typedef struct { uint32_t child, leaf; float t; } stack_entry;
 
 /* Walk the BVH; with `any` set, return at the first hit.  Prim `skip` is
- * ignored (FR_NONE: none). */
-static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int any, uint32_t skip)
+ * ignored (FR_NONE: none).  Inlined into its two callers so each gets a
+ * loop without the other's tests. */
+static inline __attribute__((always_inline)) int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit,
+                                                      int any, uint32_t skip)
 {
     hit_state H = {tmax, 0, hit, 0};
     for (uint32_t i = 0; i < s->n_planes; i++) {
@@ -215,46 +218,66 @@ static int walk(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit, int
     ray_setup(&R, r);
     stack_entry stack[BVH_STACK];
     int sp = 0;
-    uint32_t node = 0;
+    uint32_t child = 0, leaf = 0;   /* what is visited now: the root node */
     for (;;) {
-        const fr_bvh_node *n = &s->nodes[node];
-        f4 tn;
-        unsigned m = node_hits(n, &R, H.best, &tn);
-        /* Order the children entered by entry distance (ties by slot), so
-         * the nearest is visited next and the others wait on the stack. */
-        stack_entry e[4];
-        int k = 0;
-        for (int i = 0; m; i++, m >>= 1) {
-            if (!(m & 1))
+        if (!leaf) {
+            const fr_bvh_node *n = &s->nodes[child];
+            f4 tnv;
+            unsigned m = node_hits(n, &R, H.best, &tnv);
+            if (m) {
+                /* Visit the nearest child entered next and stack the others,
+                 * farthest first (ties by slot; any-hit skips the order). */
+                float tn[4];
+                f4_store(tn, tnv);
+                unsigned a = (unsigned)__builtin_ctz(m);
+                m &= m - 1;
+                if (!m) {
+                    child = n->child[a];
+                    leaf = n->leaf[a];
+                    continue;
+                }
+                unsigned b = (unsigned)__builtin_ctz(m);
+                m &= m - 1;
+                if (!any && tn[b] < tn[a]) {
+                    unsigned t = a; a = b; b = t;
+                }
+                if (!m) {
+                    stack[sp++] = (stack_entry){n->child[b], n->leaf[b], tn[b]};
+                    child = n->child[a];
+                    leaf = n->leaf[a];
+                    continue;
+                }
+                unsigned e[4] = {a, b};
+                int k = 2;
+                for (; m; m &= m - 1) {
+                    unsigned c = (unsigned)__builtin_ctz(m);
+                    int j = k++;
+                    if (!any)
+                        for (; j > 0 && tn[e[j - 1]] > tn[c]; j--)
+                            e[j] = e[j - 1];
+                    e[j] = c;
+                }
+                while (k > 1) {
+                    unsigned c = e[--k];
+                    stack[sp++] = (stack_entry){n->child[c], n->leaf[c], tn[c]};
+                }
+                child = n->child[e[0]];
+                leaf = n->leaf[e[0]];
                 continue;
-            stack_entry x = {n->child[i], n->leaf[i], tn[i]};
-            int j = k++;
-            if (!any)
-                for (; j > 0 && e[j - 1].t > x.t; j--)
-                    e[j] = e[j - 1];
-            e[j] = x;
-        }
-        while (k > 1)
-            stack[sp++] = e[--k];
-        if (k == 1 && !e[0].leaf) {
-            node = e[0].child;
-            continue;
-        }
-        if (k == 1 && leaf_test(s, r, &R, e[0].child, e[0].leaf, &H, any, skip))
+            }
+        } else if (leaf_test(s, r, &R, child, leaf, &H, any, skip)) {
             return 1;
+        }
         /* Pop the next subtree the ray can still reach before the best hit. */
         for (;;) {
             if (sp == 0)
                 return H.found;
             stack_entry x = stack[--sp];
-            if (x.t > H.best)
+            if (!any && x.t > H.best)
                 continue;
-            if (!x.leaf) {
-                node = x.child;
-                break;
-            }
-            if (leaf_test(s, r, &R, x.child, x.leaf, &H, any, skip))
-                return 1;
+            child = x.child;
+            leaf = x.leaf;
+            break;
         }
     }
 }
