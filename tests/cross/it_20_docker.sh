@@ -58,6 +58,12 @@ qemu-aarch64-static \$d-arm64/franja-worker --version >\$1-arm64.version
 qemu-aarch64-static \$d-arm64/franja-worker --scene /scenes/cornell.json $SLAB -o \$1-arm64-json.pf
 qemu-aarch64-static \$d-arm64/franja-worker --scene /t/scene.fbin $SLAB -o \$1-arm64-fbin.pf
 \$d-amd64/franja compile /scenes/cornell.json -o \$1.fbin
+# The arm64 run-time libraries of this release, for qemu -L in the cluster test.
+mkdir -p sysroot-\$1/lib/aarch64-linux-gnu
+cp -L /lib/ld-linux-aarch64.so.1 sysroot-\$1/lib/
+for f in /lib/aarch64-linux-gnu/*.so* /usr/lib/aarch64-linux-gnu/*.so*; do
+    cp -L "\$f" sysroot-\$1/lib/aarch64-linux-gnu/
+done
 SH
 run_in() {
     image=$1
@@ -80,6 +86,8 @@ for t in $TARGETS; do
         check "$t-$a: binary-scene slab is byte-identical" cmp "$T/$t-$a-fbin.pf" "$T/ref-fbin.pf"
     done
     check "$t: coordinator compiles the same binary scene" cmp "$T/$t.fbin" "$T/scene.fbin"
+    rm -rf "$CROSS/sysroot-$t-arm64"
+    mv "$T/sysroot-$t" "$CROSS/sysroot-$t-arm64"
 done
 
 # The static workers in the bare base images: nothing there but the OS.

@@ -1,0 +1,72 @@
+#!/bin/sh
+# A mixed cluster of fake SSH hosts (tests/coord/fakehosts.sh): host "arm"
+# runs the static arm64 worker under qemu, "old" the Debian 11 amd64 build and
+# "armdeb" the Debian 12 arm64 build under qemu against that release's own
+# arm64 libraries.  The stitched image must be byte-identical to the
+# one-process amd64 render, every host must have rendered slabs, and a host
+# whose worker reports another version is refused by name.  The Docker builds
+# come from it_20_docker.sh (in $CROSS).
+. "$(dirname "$0")/../coord/fakehosts.sh"
+. "$(dirname "$0")/lib.sh"
+FRANJA="$ROOT/bin/franja"
+WORKER="$ROOT/bin/franja-worker"
+need "$QEMU" cmp
+fh_init
+cd "$FH" || exit 1
+SIZE="--size 64x64 --spp 4"
+
+OLD="$CROSS/dist/bullseye-amd64/franja-worker"
+ARMDEB="$CROSS/dist/bookworm-arm64/franja-worker"
+SYSROOT="$CROSS/sysroot-bookworm-arm64"
+for f in "$OLD" "$ARMDEB" "$SYSROOT/lib/ld-linux-aarch64.so.1"; do
+    check "Docker build output $f present (run by it_20_docker.sh)" test -e "$f"
+done
+
+# Worker commands for the fake hosts: qemu runs the arm64 binaries (this
+# machine has no binfmt_misc), with -L giving the dynamic one its OS's libs.
+cat >"$FH/worker-arm.sh" <<SH
+#!/bin/sh
+exec "$(command -v "$QEMU")" "$ROOT/bin/static/arm64/franja-worker" "\$@"
+SH
+cat >"$FH/worker-armdeb.sh" <<SH
+#!/bin/sh
+exec "$(command -v "$QEMU")" -L "$SYSROOT" "$ARMDEB" "\$@"
+SH
+chmod +x "$FH/worker-arm.sh" "$FH/worker-armdeb.sh"
+
+# The reference: the whole image by one amd64 worker process.
+"$FRANJA" compile "$ROOT/scenes/cornell.json" -o scene.fbin
+check "scene compiles" test -s scene.fbin
+"$WORKER" --scene scene.fbin --rows 0:64 $SIZE -o ref.pfm
+check "one-process reference renders" test -s ref.pfm
+
+fh_start arm 2 1 "$FH/worker-arm.sh"
+fh_start old 3 1 "$OLD"
+fh_start armdeb 4 1 "$FH/worker-armdeb.sh"
+
+fr hosts check --hosts hosts >check.out 2>&1
+check "hosts check passes for the mixed cluster" test $? -eq 0
+check "every host reports the same worker version" \
+    test "$(grep -c "$("$WORKER" --version)" check.out)" -eq 3
+
+# 16 slabs of 4 rows over 3 single-slot hosts: every host gets work.
+fr render scene.fbin -o out.pfm --hosts hosts $SIZE --slab-rows 4 2>log
+check "mixed-cluster render succeeds" test $? -eq 0
+check "mixed-cluster image is byte-identical to the one-process render" cmp out.pfm ref.pfm
+for h in arm old armdeb; do
+    check "$h rendered slabs" grep -Eq "^  $h +[0-9]+ +[1-9]" log
+done
+
+# A worker of another version joins: the coordinator refuses, naming it.
+cat >"$FH/worker-other.sh" <<SH
+#!/bin/sh
+case "\$1" in --version) echo "franja-worker 0.0.1 scene-format 1"; exit 0 ;; esac
+exec "$WORKER" "\$@"
+SH
+chmod +x "$FH/worker-other.sh"
+fh_start other 5 1 "$FH/worker-other.sh"
+fr render scene.fbin -o out2.pfm --hosts hosts $SIZE 2>log2
+check "render with a mismatched worker version is refused" test $? -ne 0
+check "and writes no image" test ! -e out2.pfm
+check "the refusal names the host" grep -q "host other runs .*refusing to mix" log2
+cross_summary
