@@ -6,6 +6,7 @@
 #include "bvh.h"
 #include "fbin.h"
 #include "fmath.h"
+#include "geom.h"
 
 static void array_init(fr_array *a, uint32_t elem) { memset(a, 0, sizeof *a); a->elem = elem; }
 
@@ -69,7 +70,7 @@ uint32_t bld_sphere(fr_builder *b, vec3 center, float radius, uint32_t material)
 
 uint32_t bld_rect(fr_builder *b, vec3 origin, vec3 edge_u, vec3 edge_v, uint32_t material)
 {
-    fr_rect r = {origin, edge_u, edge_v};
+    fr_rect r = geo_rect_make(origin, edge_u, edge_v);
     return push_prim(b, FR_PRIM_RECT, bld_push(&b->rects, &r), material);
 }
 

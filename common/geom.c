@@ -33,24 +33,30 @@ float geo_plane(const fr_plane *p, const fr_ray *r, float tmax)
     return t > 0.0f && t < tmax ? t : 0.0f;
 }
 
+fr_rect geo_rect_make(vec3 origin, vec3 edge_u, vec3 edge_v)
+{
+    fr_rect q = {origin, edge_u, edge_v, v3_cross(edge_u, edge_v), v3s(0), v3s(0)};
+    float uu = v3_dot(edge_u, edge_u), vv = v3_dot(edge_v, edge_v), uv = v3_dot(edge_u, edge_v);
+    float det = uu * vv - uv * uv;
+    if (det > 0.0f) {
+        q.dual_u = v3_scale(v3_sub(v3_scale(edge_u, vv), v3_scale(edge_v, uv)), 1.0f / det);
+        q.dual_v = v3_scale(v3_sub(v3_scale(edge_v, uu), v3_scale(edge_u, uv)), 1.0f / det);
+    }
+    return q;
+}
+
 float geo_rect(const fr_rect *q, const fr_ray *r, float tmax, float *s, float *t)
 {
-    vec3 n = v3_cross(q->edge_u, q->edge_v);
-    float dn = v3_dot(r->d, n);
+    float dn = v3_dot(r->d, q->normal);
     if (dn == 0.0f)
         return 0.0f;
-    vec3 op = v3_sub(q->origin, r->o);
-    float th = v3_dot(op, n) / dn;
+    float th = v3_dot(v3_sub(q->origin, r->o), q->normal) / dn;
     if (!(th > 0.0f && th < tmax))
         return 0.0f;
-    /* Coordinates of the hit in the (edge_u, edge_v) frame: project on the
-     * dual basis, which handles non-square parallelograms. */
+    /* Coordinates of the hit along the edges, by the dual basis (which
+     * handles non-square parallelograms). */
     vec3 rel = v3_sub(v3_madd(r->o, r->d, th), q->origin);
-    float uu = v3_dot(q->edge_u, q->edge_u), vv = v3_dot(q->edge_v, q->edge_v);
-    float uv = v3_dot(q->edge_u, q->edge_v);
-    float ru = v3_dot(rel, q->edge_u), rv = v3_dot(rel, q->edge_v);
-    float det = uu * vv - uv * uv;
-    float a = (ru * vv - rv * uv) / det, b = (rv * uu - ru * uv) / det;
+    float a = v3_dot(rel, q->dual_u), b = v3_dot(rel, q->dual_v);
     if (a < 0.0f || a > 1.0f || b < 0.0f || b > 1.0f)
         return 0.0f;
     *s = a;

@@ -12,6 +12,8 @@ typedef struct { vec3 o, d; } fr_ray;   /* d need not be unit length */
 
 float geo_sphere(const fr_sphere *s, const fr_ray *r, float tmax);
 float geo_plane(const fr_plane *p, const fr_ray *r, float tmax);
+/* The rectangle origin + s*edge_u + t*edge_v with its derived fields. */
+fr_rect geo_rect_make(vec3 origin, vec3 edge_u, vec3 edge_v);
 /* Parallelogram; *s,*t receive the hit's coordinates along edge_u, edge_v. */
 float geo_rect(const fr_rect *q, const fr_ray *r, float tmax, float *s, float *t);
 /* Triangle by the watertight test (Woop, Benthin, Wald 2013): rays through

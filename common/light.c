@@ -123,7 +123,7 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
     } else if (pr->kind == FR_PRIM_RECT) {
         const fr_rect *q = &s->rects[pr->index];
         out->p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, u1), v3_scale(q->edge_v, u2)));
-        out->n = v3_norm(v3_cross(q->edge_u, q->edge_v));
+        out->n = v3_norm(q->normal);
         ua = u1;
         ub = u2;
     } else {

@@ -134,7 +134,13 @@ typedef struct { vec3 center; float radius; } fr_sphere;
 
 /* Parallelogram origin + s*edge_u + t*edge_v, s,t in [0,1]; its front side
  * faces cross(edge_u, edge_v). */
-typedef struct { vec3 origin, edge_u, edge_v; } fr_rect;
+typedef struct {
+    vec3 origin, edge_u, edge_v;
+    /* Derived by geo_rect_make, so a ray test costs two dot products:
+     * normal = edge_u x edge_v (not unit), and the dual basis, with
+     * (p - origin) . dual_u = s and (p - origin) . dual_v = t in the plane. */
+    vec3 normal, dual_u, dual_v;
+} fr_rect;
 
 /* Vertex indices into positions (and normals/uvs when the mesh has them;
  * one index per vertex for all three).  The front side faces

@@ -49,7 +49,7 @@ static void test_plane_rect(void)
     r.d = v3(1, 0, 0);
     CHECK(geo_plane(&p, &r, INFINITY) == 0.0f, "parallel ray misses the plane");
 
-    fr_rect q = {v3(0, 0, 5), v3(2, 0, 0), v3(0, 1, 0)};
+    fr_rect q = geo_rect_make(v3(0, 0, 5), v3(2, 0, 0), v3(0, 1, 0));
     float s, t;
     r.o = v3(1.5f, 0.5f, 0);
     r.d = v3(0, 0, 1);
