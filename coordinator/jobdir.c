@@ -107,6 +107,22 @@ static int each_slab(const char *dir, int (*fn)(const char *dir, const char *nam
     return rc;
 }
 
+/* A slab file half-written when a coordinator died: never used, removed. */
+static void remove_temporaries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    struct dirent *e;
+    char path[4200];
+    while ((e = readdir(d)))
+        if (!strncmp(e->d_name, "rows-", 5) && strstr(e->d_name, ".pf.tmp-")) {
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            unlink(path);
+        }
+    closedir(d);
+}
+
 static int remove_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *ctx)
 {
     (void)y0, (void)y1, (void)ctx;
@@ -123,6 +139,7 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
     snprintf(path, sizeof path, "%s/job", dir);
     if (mkdir(dir, 0755) && errno != EEXIST)
         return fr_fail(err, "%s: cannot create job directory: %s", dir, strerror(errno));
+    remove_temporaries(dir);
     if (resume) {
         unsigned char *have = NULL;
         size_t len = 0;
@@ -242,6 +259,7 @@ void job_remove(const char *dir)
     fr_error ignore;
     char path[4200];
     each_slab(dir, remove_one, NULL, &ignore);
+    remove_temporaries(dir);
     const char *names[] = {"job", "scene.fbin"};
     for (size_t i = 0; i < 2; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);

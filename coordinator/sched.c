@@ -193,7 +193,8 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
 static void finish(sched *s, int r)
 {
     attempt *a = &s->run[r];
-    s->slabs[a->slab].copies--;
+    if (--s->slabs[a->slab].copies == 0 && !s->slabs[a->slab].done && a->slab < s->next)
+        s->next = a->slab; /* back in the queue */
     s->hosts[a->host].running--;
     tr_proc_free(a->proc);
     s->run[r] = s->run[--s->nrun];
@@ -237,8 +238,6 @@ static int fail_attempt(sched *s, int r, const char *why, fr_error *err)
         snprintf(msg, sizeof msg, "%d failures in a row", h->streak);
         drop_host(s, a.host, msg);
     }
-    if (a.slab < s->next)
-        s->next = a.slab;
     return 0;
 }
 

@@ -33,16 +33,16 @@ for ext in png exr tif jpg hdr bmp ppm; do
     fi
 done
 if command -v oiiotool >/dev/null; then
-    check "EXR holds the linear radiance of the PFM" oiiotool out.exr ref.pfm --diff --fail 0 --failpercent 0 -o /dev/null
+    check "EXR holds the linear radiance of the PFM" sh -c "oiiotool out.exr ref.pfm --diff --fail 0 | grep -q PASS"
 fi
 "$FRANJA" render scene.fbin -o bright.png $SIZE --exposure 1 2>/dev/null
 check "--exposure changes an LDR output" sh -c "! cmp -s bright.png out.png"
-"$FRANJA" render scene.fbin -o bright.exr $SIZE --exposure 1 2>/dev/null
-check "--exposure leaves an HDR output linear" cmp -s bright.exr out.exr
+"$FRANJA" render scene.fbin -o bright.pfm $SIZE --exposure 1 2>/dev/null
+check "--exposure leaves an HDR output linear" cmp -s bright.pfm ref.pfm
 
 # Faulty local workers.
-printf 'here local - 2 worker=%s\n' "$(fh_wrapper loc1 truncate)" >t_trunc
 mkdir -p loc1
+printf 'here local - 2 worker=%s\n' "$(fh_wrapper loc1 truncate)" >t_trunc
 "$FRANJA" render scene.fbin -o trunc.pfm $SIZE --hosts t_trunc 2>logt
 check "truncated partial is retried" cmp -s trunc.pfm ref.pfm
 check "truncated partial is reported" grep -q "bad partial image" logt
@@ -58,7 +58,7 @@ printf 'here local - 1 worker=%s\n' "$(fh_wrapper loc3 slow)" >t_slow
 "$FRANJA" render scene.fbin -o int.pfm $SIZE --hosts t_slow --slab-rows 4 2>logi &
 FH_BG=$!
 i=0
-while [ "$(ls int.pfm.franja-job 2>/dev/null | grep -c '^rows-')" -lt 2 ] && [ $i -lt 100 ]; do
+while [ "$(ls int.pfm.franja-job 2>/dev/null | grep -c '^rows-.*\.pf$')" -lt 2 ] && [ $i -lt 100 ]; do
     sleep 0.1
     i=$((i + 1))
 done
@@ -69,7 +69,7 @@ FH_BG=
 check "interrupted render exits 130" test $rc -eq 130
 check "interrupted render writes no image" test ! -e int.pfm
 check "interrupted render says how to resume" grep -q "rerun with --resume" logi
-kept=$(ls int.pfm.franja-job | grep -c '^rows-')
+kept=$(ls int.pfm.franja-job | grep -c '^rows-.*\.pf$')
 check "finished slabs are kept" test "$kept" -ge 2
 "$FRANJA" render scene.fbin -o int.pfm $SIZE --hosts t_slow --slab-rows 4 --resume 2>logr
 check "resumed render is byte-identical" cmp -s int.pfm ref.pfm
@@ -79,9 +79,9 @@ check "resume renders only the missing slabs" grep -q "; $((6 - kept)) slabs" lo
 check "resume refuses another render's job directory" grep -q "belongs to another render" logm
 
 # Bad command lines are refused before anything runs.
-"$FRANJA" render scene.fbin -o x.gif 2>e1
+"$FRANJA" render scene.fbin -o x.xyz 2>e1
 check "unknown output type refused (status 2)" test $? -eq 2
-check "unknown output type named" grep -q "unknown image type 'gif'" e1
+check "unknown output type named" grep -q "unknown image type 'xyz'" e1
 "$FRANJA" render scene.fbin 2>e2
 check "missing -o refused" test $? -eq 2
 "$FRANJA" render scene.fbin -o x.png --size 0x4 2>e3

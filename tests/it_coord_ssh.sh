@@ -40,7 +40,7 @@ touch -d '2000-01-01' a/work/scenes/$HASH.fbin
 fr render scene.fbin -o out3.pfm --hosts hosts $SIZE 2>log3
 check "second render is byte-identical" cmp -s out3.pfm ref.pfm
 check "second render uploads nothing" test "$(grep -c 'scene already there' log3)" -eq 3
-check "cached copy untouched" test "$(stat -c %Y a/work/scenes/$HASH.fbin)" = "$(stat -c %Y "$FH/b/work/scenes/$HASH.fbin" | sed 's/.*/946684800/')"
+check "cached copy untouched" test "$(stat -c %Y a/work/scenes/$HASH.fbin)" = 946684800
 
 # A damaged copy (same size, one byte changed) and a truncated one.
 printf 'X' | dd of=b/work/scenes/$HASH.fbin bs=1 seek=200 conv=notrunc 2>/dev/null

@@ -84,6 +84,10 @@ MaxSessions 64
 UseDNS no
 PrintMotd no
 LogLevel ERROR
+# bash sources ~/.bashrc for commands run by sshd unless it is a nested
+# shell; a heavy .bashrc (version managers, locks) would otherwise cost
+# every worker start up to seconds.  SHLVL=1 makes the login shell nested.
+SetEnv SHLVL=1
 CFG
     /usr/sbin/sshd -f "$d/sshd_config" -E "$d/sshd.log" || {
         echo "FAIL: sshd for $name did not start:"
@@ -150,7 +154,17 @@ SH
 }
 
 # franja with the test's SSH settings: private known_hosts, no ~/.ssh/config,
-# no agent, a short time-out.
+# no agent, a short time-out (options given later win).  fr_bg runs it in
+# the background with FH_BG set to the coordinator's own PID.
 fr() {
-    env -u SSH_AUTH_SOCK "$FRANJA" "$@" --known-hosts "$FH/known_hosts" --no-ssh-config --timeout 3
+    cmd=$1
+    shift
+    env -u SSH_AUTH_SOCK "$FRANJA" "$cmd" --known-hosts "$FH/known_hosts" --no-ssh-config --timeout 3 "$@"
+}
+
+fr_bg() {
+    cmd=$1
+    shift
+    env -u SSH_AUTH_SOCK "$FRANJA" "$cmd" --known-hosts "$FH/known_hosts" --no-ssh-config --timeout 3 "$@" &
+    FH_BG=$!
 }
