@@ -37,6 +37,8 @@ TEST_SRC    = $(wildcard tests/test_*.c)
 TEST_BIN    = $(TEST_SRC:tests/%.c=bin/tests/%)
 TOOL_SRC    = $(wildcard tests/tools/*.c)
 TOOL_BIN    = $(TOOL_SRC:tests/tools/%.c=bin/tools/%)
+BENCH_SRC   = $(wildcard tests/bench/*.c)
+BENCH_BIN   = $(BENCH_SRC:tests/bench/%.c=bin/bench/%)
 LIB         = $(B)/libfranja.a
 
 WORKER_LIBS = $(CJSON_LIBS) -lm
@@ -73,13 +75,18 @@ bin/tools/%: tests/tools/%.c $(LIB)
 	@mkdir -p bin/tools
 	$(CC) $(CSTD) $(CFLAGS) -o $@ $< $(LIB) -lm
 
+# Benchmark programs; only these link Embree (the reference they measure against).
+bin/bench/%: tests/bench/%.c $(LIB)
+	@mkdir -p bin/bench
+	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
+
 deps:
 	sh tests/install-deps.sh
 
 check: all $(TEST_BIN) $(TOOL_BIN)
 	sh tests/run.sh
 
-bench: all $(TOOL_BIN)
+bench: all $(TOOL_BIN) $(BENCH_BIN)
 	sh tests/bench/run.sh
 
 render: all

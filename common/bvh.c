@@ -242,7 +242,8 @@ static int median_levels(uint32_t n)
 }
 
 /* Make a node at `depth` whose children start as init[0..nc); split the
- * widest child until there are four.  *index receives the node's index. */
+ * widest child until there are FR_BVH_WIDTH.  *index receives the node's
+ * index. */
 static int build_node(build *B, const span *init, int nc, int depth, int median, uint32_t *index)
 {
     fr_bvh_node node;
@@ -250,11 +251,11 @@ static int build_node(build *B, const span *init, int nc, int depth, int median,
     uint32_t me = bld_push(B->nodes, &node);
     if (me == FR_NONE)
         return fr_fail(B->err, "out of memory for the BVH nodes");
-    span ch[4];
+    span ch[FR_BVH_WIDTH];
     memcpy(ch, init, (size_t)nc * sizeof *ch);
     if (!median)
         median = depth + 2 + median_levels(init[nc - 1].end - init[0].begin) >= BVH_MAX_DEPTH;
-    while (nc < 4) {
+    while (nc < FR_BVH_WIDTH) {
         /* The child with the largest area (or most references, when only
          * halving) gains most from being split. */
         int pick = -1;
@@ -277,7 +278,7 @@ static int build_node(build *B, const span *init, int nc, int depth, int median,
         ch[pick] = l;
         ch[nc++] = r;
     }
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < FR_BVH_WIDTH; i++) {
         fr_bvh_node *nd = (fr_bvh_node *)B->nodes->data + me;
         box4 bx = i < nc ? ch[i].box : box_empty();
         for (int a = 0; a < 3; a++) {
@@ -379,7 +380,7 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
             rc = fr_fail(err, "section nodes, byte %zu: node %u is not reachable from the root", AT(n), i);
             break;
         }
-        for (int k = 0; k < 4 && rc == 0; k++) {
+        for (int k = 0; k < FR_BVH_WIDTH && rc == 0; k++) {
             uint32_t c = n->child[k], meta = n->leaf[k];
             if (c == FR_NONE) {
                 int empty = meta == 0;

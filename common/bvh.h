@@ -1,6 +1,6 @@
 /* bvh.h -- the bounding volume hierarchy over a scene's bounded primitives.
  *
- * A 4-wide BVH (fr_bvh_node, scene.h) built once when a scene is compiled
+ * An 8-wide BVH (fr_bvh_node, scene.h) built once when a scene is compiled
  * and stored in the binary scene: nodes in depth-first order (children
  * after their parent), leaves as blocks of four primitives with their
  * triangle vertices copied in (fr_bvh_leaf), primitives reordered so each
@@ -9,7 +9,7 @@
  * The build is a binned surface-area-heuristic build (32 bins per axis on
  * primitive centroids, O(n log n)): a node takes the child range with the
  * largest surface area and splits it at the cheapest bin boundary until it
- * has four children or the SAH prefers leaves.  It is single-threaded and
+ * has eight children or the SAH prefers leaves.  It is single-threaded and
  * uses only exactly rounded float operations, so a scene gives the same
  * bytes on every machine. */
 #ifndef FRANJA_BVH_H
@@ -18,10 +18,10 @@
 #include "builder.h"
 
 /* Deepest node (the root is at depth 1).  Traversal's stack holds at most
- * three entries per level, so BVH_STACK entries always suffice for a tree
- * that bvh_validate() accepted. */
+ * FR_BVH_WIDTH - 1 entries per level, so BVH_STACK entries always suffice
+ * for a tree that bvh_validate() accepted. */
 #define BVH_MAX_DEPTH 64
-#define BVH_STACK (3 * BVH_MAX_DEPTH + 1)
+#define BVH_STACK ((FR_BVH_WIDTH - 1) * BVH_MAX_DEPTH + 1)
 
 /* Build the BVH over b->prims, reordering b->prims into leaf order, and
  * append its nodes to `nodes` (fr_array of fr_bvh_node) and its leaf blocks

@@ -163,10 +163,11 @@ typedef struct {
     float pad;
 } fr_light;
 
-/* A 4-wide BVH node (128 bytes, two cache lines): the boxes of its four
- * children side by side (structure of arrays), so one ray is tested against
- * all four with one vector operation per plane.  box[0..2] are the lower
- * x, y, z bounds, box[3..5] the upper ones, one lane per child.
+/* An 8-wide BVH node (256 bytes, four cache lines): the boxes of its
+ * eight children side by side (structure of arrays), so one ray is tested
+ * against all of them with a few vector operations per plane.  box[0..2]
+ * are the lower x, y, z bounds, box[3..5] the upper ones, one lane per
+ * child.
  *
  * Child slot i is
  *   - an inner node:  leaf[i] == 0, child[i] = index into nodes (> this node);
@@ -176,10 +177,11 @@ typedef struct {
  *   - empty:          child[i] = FR_NONE, leaf[i] = 0, box lower = +inf,
  *                     upper = -inf (a box no ray enters).
  * Node 0 is the root; every other node is the child of exactly one node. */
+#define FR_BVH_WIDTH 8
 typedef struct {
-    float box[6][4];
-    uint32_t child[4];
-    uint32_t leaf[4];
+    float box[6][FR_BVH_WIDTH];
+    uint32_t child[FR_BVH_WIDTH];
+    uint32_t leaf[FR_BVH_WIDTH];
 } fr_bvh_node;
 
 #define FR_BVH_LEAF_MAX 255u

@@ -29,9 +29,14 @@ float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, flo
  * depend on the order nodes are visited in: it is the brute-force nearest
  * hit, on every machine. */
 
-/* Box tests widen the far distance by 2*gamma(3) (Ize 2013, "Robust BVH
- * ray traversal"), so rounding never drops a box the exact ray touches. */
-#define FAR_SCALE 1.00000036f
+/* Box tests widen the far distance (and the best hit so far) by 2^-16.
+ * 2*gamma(3) would cover the box test's own rounding (Ize 2013, "Robust
+ * BVH ray traversal"); the rest covers the triangle test's rounded t, which
+ * for a triangle lying in a face of its box can come out a few ulps before
+ * the box's rounded entry distance.  Without it, of two coplanar triangles
+ * the one in a box entered "after" the best hit would be skipped and the
+ * result would depend on the visiting order. */
+#define FAR_SCALE 1.0000153f
 
 typedef struct {
     vec3 o, d;
@@ -81,20 +86,24 @@ static void ray_setup(ray4 *R, const fr_ray *r)
     R->sz = f4_set1(1.0f / dz);
 }
 
-/* Entry distances of the ray into the four boxes of node n, and which of
- * them it enters before tmax (bit mask). */
-static inline unsigned node_hits(const fr_bvh_node *n, const ray4 *R, float tmax, f4 *tnear)
+/* Entry distances tn[] of the ray into the boxes of node n, and which of
+ * them it enters before tmax (bit mask), four lanes at a time. */
+static inline unsigned node_hits(const fr_bvh_node *n, const ray4 *R, float tmax, float *tn)
 {
-    f4 nx = (f4_load(n->box[R->near[0]]) - R->ox) * R->ix;
-    f4 ny = (f4_load(n->box[R->near[1]]) - R->oy) * R->iy;
-    f4 nz = (f4_load(n->box[R->near[2]]) - R->oz) * R->iz;
-    f4 fx = (f4_load(n->box[R->far[0]]) - R->ox) * R->ix;
-    f4 fy = (f4_load(n->box[R->far[1]]) - R->oy) * R->iy;
-    f4 fz = (f4_load(n->box[R->far[2]]) - R->oz) * R->iz;
-    f4 tn = f4_max_num(nx, f4_max_num(ny, f4_max_num(nz, f4_set1(0.0f))));
-    f4 tf = f4_min_num(fx, f4_min_num(fy, f4_min_num(fz, f4_set1(tmax))));
-    *tnear = tn;
-    return i4_bits(tn <= tf * f4_set1(FAR_SCALE));
+    unsigned m = 0;
+    for (int h = 0; h < FR_BVH_WIDTH; h += 4) {
+        f4 nx = (f4_load(n->box[R->near[0]] + h) - R->ox) * R->ix;
+        f4 ny = (f4_load(n->box[R->near[1]] + h) - R->oy) * R->iy;
+        f4 nz = (f4_load(n->box[R->near[2]] + h) - R->oz) * R->iz;
+        f4 fx = (f4_load(n->box[R->far[0]] + h) - R->ox) * R->ix;
+        f4 fy = (f4_load(n->box[R->far[1]] + h) - R->oy) * R->iy;
+        f4 fz = (f4_load(n->box[R->far[2]] + h) - R->oz) * R->iz;
+        f4 t0 = f4_max_num(nx, f4_max_num(ny, f4_max_num(nz, f4_set1(0.0f))));
+        f4 t1 = f4_min_num(fx, f4_min_num(fy, f4_min_num(fz, f4_set1(tmax))));
+        f4_store(tn + h, t0);
+        m |= i4_bits(t0 <= t1 * f4_set1(FAR_SCALE)) << h;
+    }
+    return m;
 }
 
 /* The smallest float above x (x >= 0; infinity stays). */
@@ -137,18 +146,27 @@ static inline __attribute__((always_inline)) int block_test(const fr_bvh_leaf *L
     f4 cy = (f4_load(L->v[6 + R->ky]) - R->oky) - R->sy * cz;
     f4 u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
     f4 zero = f4_set1(0.0f);
-    unsigned edge = i4_bits((u == zero) | (v == zero) | (w == zero)) & lanes;
-    for (int i = 0; edge; i++, edge >>= 1) {
-        if (!(edge & 1))
-            continue;
-        /* On an edge in single precision: decide in double, as geo_triangle. */
-        u[i] = (float)((double)cx[i] * by[i] - (double)cy[i] * bx[i]);
-        v[i] = (float)((double)ax[i] * cy[i] - (double)ay[i] * cx[i]);
-        w[i] = (float)((double)bx[i] * ay[i] - (double)by[i] * ax[i]);
+    /* Inside or on the boundary when u, v and w share a sign: their min is
+     * >= 0 or their max <= 0.  (A NaN lane may pass; its t is NaN and fails
+     * the distance test below, as in geo_triangle.) */
+    unsigned m = i4_bits((f4_min_num(u, f4_min_num(v, w)) >= zero) | (f4_max_num(u, f4_max_num(v, w)) <= zero)) & lanes;
+    if (!m)
+        return 0;
+    unsigned edge = i4_bits((u == zero) | (v == zero) | (w == zero)) & m;
+    if (edge) {
+        for (int i = 0; edge; i++, edge >>= 1) {
+            if (!(edge & 1))
+                continue;
+            /* On an edge in single precision: decide in double, as geo_triangle. */
+            u[i] = (float)((double)cx[i] * by[i] - (double)cy[i] * bx[i]);
+            v[i] = (float)((double)ax[i] * cy[i] - (double)ay[i] * cx[i]);
+            w[i] = (float)((double)bx[i] * ay[i] - (double)by[i] * ax[i]);
+        }
+        i4 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+        m &= i4_bits(~outside);
     }
-    i4 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
     f4 det = u + v + w;
-    unsigned m = i4_bits(~outside & (det != zero)) & lanes;
+    m &= i4_bits(det != zero);
     if (!m)
         return 0;
     f4 t = R->sz * (u * az + v * bz + w * cz) / det;
@@ -222,13 +240,11 @@ static inline __attribute__((always_inline)) int walk(const fr_scene *s, const f
     for (;;) {
         if (!leaf) {
             const fr_bvh_node *n = &s->nodes[child];
-            f4 tnv;
-            unsigned m = node_hits(n, &R, H.best, &tnv);
+            float tn[FR_BVH_WIDTH];
+            unsigned m = node_hits(n, &R, H.best, tn);
             if (m) {
                 /* Visit the nearest child entered next and stack the others,
                  * farthest first (ties by slot; any-hit skips the order). */
-                float tn[4];
-                f4_store(tn, tnv);
                 unsigned a = (unsigned)__builtin_ctz(m);
                 m &= m - 1;
                 if (!m) {
@@ -247,7 +263,7 @@ static inline __attribute__((always_inline)) int walk(const fr_scene *s, const f
                     leaf = n->leaf[a];
                     continue;
                 }
-                unsigned e[4] = {a, b};
+                unsigned e[FR_BVH_WIDTH] = {a, b};
                 int k = 2;
                 for (; m; m &= m - 1) {
                     unsigned c = (unsigned)__builtin_ctz(m);
@@ -273,7 +289,7 @@ static inline __attribute__((always_inline)) int walk(const fr_scene *s, const f
             if (sp == 0)
                 return H.found;
             stack_entry x = stack[--sp];
-            if (!any && x.t > H.best)
+            if (!any && !(x.t <= H.best * FAR_SCALE))
                 continue;
             child = x.child;
             leaf = x.leaf;

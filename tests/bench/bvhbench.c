@@ -1,0 +1,339 @@
+/* bvhbench -- Franja's BVH against Embree 3 on the same triangles and rays.
+ *
+ *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH]
+ *
+ * Loads a compiled scene, takes its triangles, and measures single-threaded:
+ *   - BVH build time: bvh_build versus rtcCommitScene (Embree device with
+ *     threads=1, default build quality);
+ *   - closest-hit (trace_closest / rtcIntersect1) and any-hit
+ *     (trace_occluded / rtcOccluded1) throughput for primary rays (one per
+ *     pixel through the scene camera) and diffuse bounce rays (cosine
+ *     directions from the primary hits, incoherent);
+ *   - with --worker: worker start-up, from process start to its first pixel
+ *     written (a 1x1-pixel, 1-sample render of the scene);
+ *   - the binary scene's bytes per triangle.
+ * Every figure is the median of N runs; Embree's hits are checked against
+ * Franja's (same triangle, t within 1e-4 relative).  Linked with Embree only
+ * here: nothing else in Franja uses it. */
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bvh.h"
+#include "fbin.h"
+#include "geom.h"
+#include "render.h"
+#include "trace.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The scene's triangles as one Embree-style mesh: vertex array (padded by
+ * one float for Embree's 16-byte loads) and index triples. */
+typedef struct {
+    float *vert;               /* 3 floats per vertex, +1 padding */
+    uint32_t *idx;             /* 3 per triangle */
+    uint32_t n_vert, n_tri;
+    uint32_t *prim_of_tri;     /* Franja prim of each triangle, for checking */
+} tri_mesh;
+
+static int take_triangles(const fr_scene *s, tri_mesh *m)
+{
+    m->n_vert = s->n_positions;
+    m->n_tri = s->n_triangles;
+    m->vert = malloc(((size_t)m->n_vert * 3 + 1) * sizeof *m->vert);
+    m->idx = malloc((size_t)m->n_tri * 3 * sizeof *m->idx);
+    m->prim_of_tri = malloc((size_t)m->n_tri * sizeof *m->prim_of_tri);
+    if (!m->vert || !m->idx || !m->prim_of_tri)
+        return -1;
+    for (uint32_t i = 0; i < m->n_vert; i++) {
+        m->vert[3 * i] = s->positions[i].x;
+        m->vert[3 * i + 1] = s->positions[i].y;
+        m->vert[3 * i + 2] = s->positions[i].z;
+    }
+    m->vert[3 * m->n_vert] = 0.0f;
+    for (uint32_t i = 0; i < m->n_tri; i++)
+        for (int k = 0; k < 3; k++)
+            m->idx[3 * i + k] = s->triangles[i].v[k];
+    for (uint32_t p = 0; p < s->n_prims; p++)
+        if (s->prims[p].kind == FR_PRIM_TRIANGLE)
+            m->prim_of_tri[s->prims[p].index] = p;
+    return 0;
+}
+
+/* A builder holding just the triangles, for timing bvh_build. */
+static void fill_builder(fr_builder *b, const fr_scene *s)
+{
+    bld_init(b);
+    fr_material mat;
+    bld_material_init(&mat);
+    mat.diffuse = v3s(0.5f);
+    bld_push(&b->materials, &mat);
+    for (uint32_t i = 0; i < s->n_positions; i++)
+        bld_push(&b->positions, &s->positions[i]);
+    for (uint32_t i = 0; i < s->n_triangles; i++) {
+        bld_push(&b->triangles, &s->triangles[i]);
+        fr_prim p = {FR_PRIM_TRIANGLE, i, 0, FR_NONE};
+        bld_push(&b->prims, &p);
+    }
+}
+
+static RTCScene embree_scene(RTCDevice dev, const tri_mesh *m)
+{
+    RTCScene sc = rtcNewScene(dev);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m->vert, 0, 12, m->n_vert);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->idx, 0, 12, m->n_tri);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(sc, g);
+    rtcReleaseGeometry(g);
+    return sc;
+}
+
+/* A small counter-based generator for the bounce directions. */
+static float rnd(uint32_t *state)
+{
+    uint32_t h = (*state += 0x9E3779B9u);
+    h ^= h >> 16; h *= 0x7feb352du; h ^= h >> 15; h *= 0x846ca68bu; h ^= h >> 16;
+    return (float)(h >> 8) * (1.0f / 16777216.0f);
+}
+
+/* Primary rays, one per pixel; then for each primary hit a cosine-weighted
+ * bounce from the surface (rays[n_primary..)). */
+static fr_ray *make_rays(const fr_scene *s, uint32_t w, uint32_t h, uint32_t *n_primary, uint32_t *n_bounce)
+{
+    fr_ray *r = malloc((size_t)w * h * 2 * sizeof *r);
+    fr_scene cam = *s;
+    cam.settings.width = w;
+    cam.settings.height = h;
+    uint32_t n = 0;
+    for (uint32_t y = 0; y < h; y++)
+        for (uint32_t x = 0; x < w; x++)
+            r[n++] = pt_camera_ray(&cam, x, y, 0.5f, 0.5f, 0.5f, 0.5f);
+    *n_primary = n;
+    uint32_t state = 12345;
+    for (uint32_t i = 0; i < *n_primary; i++) {
+        fr_hit hit;
+        if (!trace_closest(s, &r[i], INFINITY, &hit))
+            continue;
+        fr_surface sf;
+        trace_surface(s, &r[i], &hit, &sf);
+        vec3 ng = v3_dot(sf.ng, r[i].d) < 0.0f ? sf.ng : v3_neg(sf.ng), t, b;
+        v3_basis(ng, &t, &b);
+        float u1 = rnd(&state), u2 = rnd(&state), rr = sqrtf(u1), phi = 2.0f * 3.14159265f * u2;
+        vec3 d = v3_from_local(v3(rr * cosf(phi), rr * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u1))), t, b, ng);
+        r[n].o = geo_offset(sf.p, ng, d);
+        r[n].d = v3_norm(d);
+        n++;
+    }
+    *n_bounce = n - *n_primary;
+    return r;
+}
+
+static void to_embree(const fr_ray *r, struct RTCRayHit *rh)
+{
+    memset(rh, 0, sizeof *rh);
+    rh->ray.org_x = r->o.x; rh->ray.org_y = r->o.y; rh->ray.org_z = r->o.z;
+    rh->ray.dir_x = r->d.x; rh->ray.dir_y = r->d.y; rh->ray.dir_z = r->d.z;
+    rh->ray.tnear = 0.0f;
+    rh->ray.tfar = INFINITY;
+    rh->ray.mask = 0xffffffffu;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+}
+
+typedef struct { double franja, embree; } pair;
+
+/* Mrays/s of closest-hit (any = 0) or any-hit queries on rays[0..n). */
+static pair throughput(const fr_scene *s, RTCScene es, const fr_ray *rays, uint32_t n, int any, int reps,
+                       volatile uint32_t *sink)
+{
+    double tf[64], te[64];
+    struct RTCIntersectContext ctx;
+    for (int k = 0; k < reps; k++) {
+        uint32_t acc = 0;
+        double t0 = now();
+        if (any) {
+            for (uint32_t i = 0; i < n; i++)
+                acc += (uint32_t)trace_occluded(s, &rays[i], INFINITY, FR_NONE);
+        } else {
+            for (uint32_t i = 0; i < n; i++) {
+                fr_hit h;
+                if (trace_closest(s, &rays[i], INFINITY, &h))
+                    acc += h.prim;
+            }
+        }
+        tf[k] = now() - t0;
+        *sink += acc;
+        acc = 0;
+        t0 = now();
+        for (uint32_t i = 0; i < n; i++) {
+            struct RTCRayHit rh;
+            to_embree(&rays[i], &rh);
+            rtcInitIntersectContext(&ctx);
+            if (any) {
+                rtcOccluded1(es, &ctx, &rh.ray);
+                acc += rh.ray.tfar < 0.0f;
+            } else {
+                rtcIntersect1(es, &ctx, &rh);
+                acc += rh.hit.primID;
+            }
+        }
+        te[k] = now() - t0;
+        *sink += acc;
+    }
+    return (pair){n / median(tf, reps) / 1e6, n / median(te, reps) / 1e6};
+}
+
+/* Rays where Embree and Franja disagree (hit/miss, triangle, or t). */
+static uint32_t disagreements(const fr_scene *s, RTCScene es, const tri_mesh *m, const fr_ray *rays, uint32_t n)
+{
+    uint32_t bad = 0;
+    struct RTCIntersectContext ctx;
+    for (uint32_t i = 0; i < n; i++) {
+        fr_hit h;
+        int f = trace_closest(s, &rays[i], INFINITY, &h);
+        struct RTCRayHit rh;
+        to_embree(&rays[i], &rh);
+        rtcInitIntersectContext(&ctx);
+        rtcIntersect1(es, &ctx, &rh);
+        int e = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        if (f != e || (f && m->prim_of_tri[rh.hit.primID] != h.prim && fabsf(rh.ray.tfar - h.t) > 1e-4f * h.t))
+            bad++;
+    }
+    return bad;
+}
+
+/* Process start to first pixel: a 1x1, 1-sample render of the scene. */
+static double startup_ms(const char *worker, const char *scene, int reps)
+{
+    double t[64];
+    for (int k = 0; k < reps; k++) {
+        double t0 = now();
+        pid_t pid = fork();
+        if (pid == 0) {
+            execl(worker, worker, "--scene", scene, "--rows", "0:1", "--size", "1x1", "--spp", "1", "-o", "/dev/null",
+                  (char *)NULL);
+            _exit(127);
+        }
+        int st;
+        waitpid(pid, &st, 0);
+        t[k] = (now() - t0) * 1e3;
+        if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+            fprintf(stderr, "bvhbench: %s failed on %s\n", worker, scene);
+            return -1.0;
+        }
+    }
+    return median(t, reps);
+}
+
+int main(int argc, char **argv)
+{
+    const char *path = NULL, *worker = NULL;
+    int reps = 5;
+    uint32_t w = 512, h = 512;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--reps") && i + 1 < argc) reps = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc) sscanf(argv[++i], "%ux%u", &w, &h);
+        else if (!strcmp(argv[i], "--worker") && i + 1 < argc) worker = argv[++i];
+        else if (argv[i][0] != '-') path = argv[i];
+        else { fprintf(stderr, "bvhbench: unknown argument %s\n", argv[i]); return 2; }
+    }
+    if (!path || reps < 1 || reps > 64 || w == 0 || h == 0) {
+        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH]\n");
+        return 2;
+    }
+    fr_scene s;
+    fr_error err;
+    if (fbin_load(path, &s, &err) < 0) {
+        fprintf(stderr, "bvhbench: %s\n", err.msg);
+        return 1;
+    }
+    tri_mesh m;
+    if (take_triangles(&s, &m) < 0 || m.n_tri == 0) {
+        fprintf(stderr, "bvhbench: %s: no triangles (or out of memory)\n", path);
+        return 1;
+    }
+    printf("scene %s: %u triangles, %zu bytes (%.1f bytes/triangle), %u nodes, %u leaf blocks\n", path, m.n_tri,
+           s.blob_size, (double)s.blob_size / m.n_tri, s.n_nodes, s.n_leaves);
+
+    /* Build times. */
+    double bf[64], be[64];
+    RTCDevice dev = rtcNewDevice("threads=1");
+    if (!dev) {
+        fprintf(stderr, "bvhbench: rtcNewDevice failed\n");
+        return 1;
+    }
+    for (int k = 0; k < reps; k++) {
+        fr_builder b;
+        fill_builder(&b, &s);
+        fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
+        double t0 = now();
+        if (bvh_build(&b, &nodes, &leaves, &err) < 0) {
+            fprintf(stderr, "bvhbench: %s\n", err.msg);
+            return 1;
+        }
+        bf[k] = now() - t0;
+        free(nodes.data);
+        free(leaves.data);
+        bld_free(&b);
+        RTCScene es = embree_scene(dev, &m);
+        t0 = now();
+        rtcCommitScene(es);
+        be[k] = now() - t0;
+        rtcReleaseScene(es);
+    }
+    double mbf = median(bf, reps), mbe = median(be, reps);
+    printf("build      franja %8.1f ms (%5.2f Mtri/s)   embree %8.1f ms (%5.2f Mtri/s)   ratio %.2f\n", mbf * 1e3,
+           m.n_tri / mbf / 1e6, mbe * 1e3, m.n_tri / mbe / 1e6, mbe / mbf);
+
+    RTCScene es = embree_scene(dev, &m);
+    rtcCommitScene(es);
+    uint32_t np, nb;
+    fr_ray *rays = make_rays(&s, w, h, &np, &nb);
+    uint32_t bad = disagreements(&s, es, &m, rays, np + nb);
+    printf("rays       %u primary (%ux%u), %u diffuse bounces; Embree disagrees on %u (%.3f %%)\n", np, w, h, nb, bad,
+           100.0 * bad / (np + nb));
+    volatile uint32_t sink = 0;
+    const char *names[4] = {"primary closest", "primary any    ", "bounce closest ", "bounce any     "};
+    for (int q = 0; q < 4; q++) {
+        const fr_ray *r = q < 2 ? rays : rays + np;
+        uint32_t n = q < 2 ? np : nb;
+        if (n == 0)
+            continue;
+        pair p = throughput(&s, es, r, n, q & 1, reps, &sink);
+        printf("%s franja %6.2f Mrays/s   embree %6.2f Mrays/s   ratio %.2f\n", names[q], p.franja, p.embree,
+               p.franja / p.embree);
+    }
+    if (worker) {
+        double ms = startup_ms(worker, path, reps);
+        if (ms < 0)
+            return 1;
+        printf("start-up   %s: %.1f ms from process start to first pixel\n", worker, ms);
+    }
+    rtcReleaseScene(es);
+    rtcReleaseDevice(dev);
+    free(rays);
+    scn_free(&s);
+    return 0;
+}

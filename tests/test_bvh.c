@@ -1,0 +1,276 @@
+/* test_bvh.c -- the BVH returns exactly the brute-force nearest hit.
+ *
+ * Random scenes (triangle soups, shared-edge grids, coplanar sheets,
+ * degenerate triangles, identical triangles, spheres and rectangles mixed
+ * in) are built through the builder; random rays (from outside and inside
+ * the boxes, axis-parallel ones with exact zero components, rays lying in
+ * box planes, rays with a finite tmax) are traced with trace_closest and
+ * compared with a loop over every primitive: same primitive, same t, same
+ * barycentrics, bit for bit.  trace_occluded must agree with the nearest
+ * hit, with and without a skipped primitive. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bvh.h"
+#include "check.h"
+#include "fbin.h"
+#include "trace.h"
+
+static uint64_t rng_state = 0x853c49e6748fea9bull;
+
+static uint32_t rnd_u32(void)
+{
+    rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;
+    uint32_t x = (uint32_t)(((rng_state >> 18) ^ rng_state) >> 27), r = (uint32_t)(rng_state >> 59);
+    return (x >> r) | (x << ((32 - r) & 31));
+}
+
+static float rnd(void) { return (float)(rnd_u32() >> 8) * (1.0f / 16777216.0f); }
+static float rnd_in(float a, float b) { return a + (b - a) * rnd(); }
+static vec3 rnd_vec(float a, float b) { return v3(rnd_in(a, b), rnd_in(a, b), rnd_in(a, b)); }
+
+static vec3 rnd_dir(void)
+{
+    for (;;) {
+        vec3 d = rnd_vec(-1.0f, 1.0f);
+        float l = v3_len2(d);
+        if (l > 1e-4f && l <= 1.0f)
+            return v3_scale(d, 1.0f / sqrtf(l));
+    }
+}
+
+static void start(fr_builder *b)
+{
+    bld_init(b);
+    fr_material m;
+    bld_material_init(&m);
+    m.diffuse = v3s(0.5f);
+    bld_material_finish(&m);
+    bld_push(&b->materials, &m);
+    b->settings = (fr_settings){64, 64, 1, 4, 0, {0, 0, 0}};
+    b->camera.position = v3(0, 0, -5);
+    b->camera.target = v3(0, 0, 0);
+    b->camera.up = v3(0, 1, 0);
+    b->camera.vfov = 1.0f;
+    b->camera.focus = 5.0f;
+}
+
+/* An indexed triangle without checks (degenerate ones welcome). */
+static void tri(fr_builder *b, uint32_t i0, uint32_t i1, uint32_t i2)
+{
+    fr_triangle t = {{i0, i1, i2}, 0};
+    uint32_t ti = bld_push(&b->triangles, &t);
+    fr_prim p = {FR_PRIM_TRIANGLE, ti, 0, FR_NONE};
+    bld_push(&b->prims, &p);
+}
+
+static uint32_t vert(fr_builder *b, vec3 p) { return bld_push(&b->positions, &p); }
+
+/* ---- the scenes ---- */
+
+static void soup(fr_builder *b, int n, float size)
+{
+    for (int i = 0; i < n; i++) {
+        vec3 c = rnd_vec(-1.0f, 1.0f);
+        tri(b, vert(b, v3_add(c, rnd_vec(-size, size))), vert(b, v3_add(c, rnd_vec(-size, size))),
+            vert(b, v3_add(c, rnd_vec(-size, size))));
+    }
+}
+
+/* A height grid: every inner edge shared by two triangles. */
+static void grid(fr_builder *b, int n)
+{
+    uint32_t base = b->positions.count;
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; j <= n; j++)
+            vert(b, v3(2.0f * i / n - 1.0f, 0.3f * rnd(), 2.0f * j / n - 1.0f));
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            uint32_t a = base + i * (n + 1) + j, c = a + n + 1;
+            tri(b, a, c, c + 1);
+            tri(b, a, c + 1, a + 1);
+        }
+}
+
+/* Triangles in the planes z = k/4 and x = 0.5: axis-parallel rays lie in
+ * them and in their boxes' faces. */
+static void sheets(fr_builder *b, int n)
+{
+    for (int i = 0; i < n; i++) {
+        float z = (float)(rnd_u32() % 5) * 0.25f - 0.5f;
+        float x0 = rnd_in(-1, 1), y0 = rnd_in(-1, 1);
+        tri(b, vert(b, v3(x0, y0, z)), vert(b, v3(x0 + rnd_in(0.05f, 0.4f), y0, z)),
+            vert(b, v3(x0, y0 + rnd_in(0.05f, 0.4f), z)));
+        tri(b, vert(b, v3(0.5f, y0, x0)), vert(b, v3(0.5f, y0 + 0.25f, x0)), vert(b, v3(0.5f, y0, x0 + 0.25f)));
+    }
+}
+
+static void degenerate(fr_builder *b, int n)
+{
+    for (int i = 0; i < n; i++) {
+        vec3 p = rnd_vec(-1, 1), q = rnd_vec(-1, 1);
+        switch (i % 3) {
+        case 0: tri(b, vert(b, p), vert(b, p), vert(b, q)); break;                         /* repeated vertex */
+        case 1: tri(b, vert(b, p), vert(b, v3_scale(v3_add(p, q), 0.5f)), vert(b, q)); break; /* collinear */
+        default: tri(b, vert(b, p), vert(b, p), vert(b, p)); break;                        /* a point */
+        }
+    }
+}
+
+/* Many copies of one triangle: every centroid equal, so the build must
+ * fall back to splitting by count. */
+static void copies(fr_builder *b, int n)
+{
+    uint32_t a = vert(b, v3(-0.3f, -0.2f, 0.1f)), c = vert(b, v3(0.4f, -0.1f, 0.1f)), d = vert(b, v3(0.0f, 0.5f, 0.2f));
+    for (int i = 0; i < n; i++)
+        tri(b, a, c, d);
+}
+
+static void others(fr_builder *b, int n)
+{
+    for (int i = 0; i < n; i++) {
+        if (i % 2)
+            bld_sphere(b, rnd_vec(-1, 1), rnd_in(0.01f, 0.3f), 0);
+        else
+            bld_rect(b, rnd_vec(-1, 1), rnd_vec(-0.3f, 0.3f), rnd_vec(-0.3f, 0.3f), 0);
+    }
+}
+
+/* ---- rays ---- */
+
+static fr_ray make_ray(const fr_scene *s, int kind)
+{
+    fr_ray r;
+    switch (kind) {
+    case 0: /* from outside, toward the middle */
+        r.o = v3_scale(rnd_dir(), 4.0f);
+        r.d = v3_norm(v3_sub(rnd_vec(-0.8f, 0.8f), r.o));
+        break;
+    case 1: /* from inside the boxes, anywhere */
+        r.o = rnd_vec(-1.2f, 1.2f);
+        r.d = rnd_dir();
+        break;
+    case 2: { /* axis-parallel, with exact zeros (and signed zeros) */
+        int a = (int)(rnd_u32() % 3);
+        float c[3] = {rnd() < 0.5f ? 0.0f : -0.0f, rnd() < 0.5f ? 0.0f : -0.0f, rnd() < 0.5f ? 0.0f : -0.0f};
+        c[a] = rnd() < 0.5f ? 1.0f : -1.0f;
+        r.o = rnd_vec(-1.5f, 1.5f);
+        r.d = v3(c[0], c[1], c[2]);
+        break;
+    }
+    default: { /* axis-parallel through a vertex's coordinates: in box planes */
+        if (s->n_positions == 0)
+            return make_ray(s, 2);
+        int a = (int)(rnd_u32() % 3);
+        vec3 p = s->positions[rnd_u32() % s->n_positions];
+        float c[3] = {0, 0, 0};
+        c[a] = rnd() < 0.5f ? 1.0f : -1.0f;
+        r.d = v3(c[0], c[1], c[2]);
+        r.o = p;
+        if (a == 0) r.o.x = rnd_in(-3, 3);
+        if (a == 1) r.o.y = rnd_in(-3, 3);
+        if (a == 2) r.o.z = rnd_in(-3, 3);
+        break;
+    }
+    }
+    return r;
+}
+
+/* Nearest hit by trying every primitive: lowest index wins a tie. */
+static int brute(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip, fr_hit *h)
+{
+    int found = 0;
+    float best = tmax;
+    for (uint32_t p = 0; p < s->n_prims; p++) {
+        float a, b;
+        if (p == skip)
+            continue;
+        float t = trace_prim(s, p, r, best, &a, &b);
+        if (t > 0.0f) {
+            best = t;
+            *h = (fr_hit){t, p, FR_NONE, a, b};
+            found = 1;
+        }
+    }
+    return found;
+}
+
+static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+static void compare(const char *name, fr_builder *b, fr_builder *again, int rays)
+{
+    fr_scene s;
+    fr_error err;
+    if (bld_finish(b, &s, &err) < 0) {
+        CHECK(0, "%s: build failed: %s", name, err.msg);
+        return;
+    }
+    CHECK(s.n_nodes > 0, "%s: has a BVH", name);
+    int bad = 0, badany = 0, hits = 0;
+    for (int i = 0; i < rays; i++) {
+        fr_ray r = make_ray(&s, i % 4);
+        float tmax = (i % 7 == 0) ? rnd_in(0.1f, 3.0f) : INFINITY;
+        fr_hit hb = {0}, ht = {0};
+        int fb = brute(&s, &r, tmax, FR_NONE, &hb);
+        int ft = trace_closest(&s, &r, tmax, &ht);
+        hits += fb;
+        if (fb != ft || (fb && (ht.prim != hb.prim || !same_bits(ht.t, hb.t) || !same_bits(ht.a, hb.a) ||
+                                !same_bits(ht.b, hb.b)))) {
+            if (bad++ < 5)
+                CHECK(0, "%s ray %d (kind %d): bvh %d prim %u t %.9g, brute %d prim %u t %.9g", name, i, i % 4, ft,
+                      ft ? ht.prim : 0, ft ? (double)ht.t : 0.0, fb, fb ? hb.prim : 0, fb ? (double)hb.t : 0.0);
+        }
+        if (trace_occluded(&s, &r, tmax, FR_NONE) != fb && badany++ < 5)
+            CHECK(0, "%s ray %d: any-hit %d, nearest hit %d", name, i, !fb, fb);
+        if (fb) {
+            /* Skipping the nearest primitive: occluded iff another one is hit. */
+            fr_hit h2;
+            int f2 = brute(&s, &r, tmax, hb.prim, &h2);
+            if (trace_occluded(&s, &r, tmax, hb.prim) != f2 && badany++ < 5)
+                CHECK(0, "%s ray %d: any-hit skipping %u disagrees", name, i, hb.prim);
+        }
+    }
+    CHECK(bad == 0, "%s: %d of %d rays differ from brute force", name, bad, rays);
+    CHECK(badany == 0, "%s: %d any-hit disagreements", name, badany);
+    CHECK(hits > rays / 20, "%s: only %d of %d rays hit anything (test too weak)", name, hits, rays);
+    /* The same input builds the same bytes. */
+    fr_scene s2;
+    if (bld_finish(again, &s2, &err) == 0) {
+        CHECK(s2.hash == s.hash, "%s: rebuilding gives another hash", name);
+        scn_free(&s2);
+    }
+    scn_free(&s);
+}
+
+int main(void)
+{
+    struct { const char *name; int n; int rays; } cases[] = {
+        {"small soup", 1, 2000},     {"soup", 3000, 4000},    {"large triangles", 400, 3000},
+        {"grid", 40, 4000},          {"sheets", 600, 4000},   {"degenerate", 300, 2000},
+        {"copies", 200, 1000},       {"mixed", 800, 3000},    {"mixed soup", 1500, 3000},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        fr_builder b[2];
+        uint64_t seed = rng_state;
+        for (int k = 0; k < 2; k++) {
+            rng_state = seed;
+            start(&b[k]);
+            switch (c) {
+            case 0: soup(&b[k], 1, 0.5f); break;
+            case 1: soup(&b[k], cases[c].n, 0.05f); break;
+            case 2: soup(&b[k], cases[c].n, 0.8f); break;
+            case 3: grid(&b[k], cases[c].n); break;
+            case 4: sheets(&b[k], cases[c].n); break;
+            case 5: degenerate(&b[k], cases[c].n); soup(&b[k], 200, 0.1f); break;
+            case 6: copies(&b[k], cases[c].n); soup(&b[k], 20, 0.1f); break;
+            case 7: others(&b[k], cases[c].n); break;
+            default: others(&b[k], 100); soup(&b[k], cases[c].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
+            }
+        }
+        compare(cases[c].name, &b[0], &b[1], cases[c].rays);
+        bld_free(&b[0]);
+        bld_free(&b[1]);
+    }
+    return check_done();
+}
