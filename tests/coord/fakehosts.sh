@@ -17,7 +17,7 @@
 #   check DESC CMD...         counts a passed/failed check
 #   fh_summary                prints "N passed, N failed" and returns the status
 
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
+ROOT=${ROOT:-$(cd "$(dirname "$0")/.." && pwd)}
 FRANJA="$ROOT/bin/franja"
 WORKER="$ROOT/bin/franja-worker"
 PASSED=0

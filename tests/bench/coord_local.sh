@@ -1,0 +1,16 @@
+#!/bin/sh
+# Parallel efficiency of local mode: the same render with -j 1 and with one
+# worker per core.  efficiency = T(1) / (N * T(N)); 1.0 is perfect.
+cd "$(dirname "$0")/../.." || exit 1
+. tests/bench/coord_common.sh
+N=$(nproc)
+SCENE=${SCENE:-scenes/cornell.json}
+ARGS="--size ${SIZE:-192x192} --spp ${SPP:-64}"
+T=$(mktemp -d /tmp/franja-bench.XXXXXX)
+trap 'rm -rf "$T"' EXIT
+machine
+bin/franja render "$SCENE" -o "$T/warm.pfm" $ARGS -j "$N" >/dev/null 2>&1
+median_time t1 bin/franja render "$SCENE" -o "$T/a.pfm" $ARGS -j 1 || exit 1
+median_time tn bin/franja render "$SCENE" -o "$T/b.pfm" $ARGS -j "$N" || exit 1
+cmp -s "$T/a.pfm" "$T/b.pfm" || { echo "-j 1 and -j $N images differ"; exit 1; }
+echo "local -j 1: $t1 s, -j $N: $tn s; speed-up $(calc "$t1 / $tn"), parallel efficiency $(calc "$t1 / ($N * $tn)")"

@@ -1,0 +1,28 @@
+#!/bin/sh
+# The cost of distribution: the same render on fake SSH hosts (sshd on
+# loopback, one worker slot each) against local worker processes with the
+# same total number of slots.  ratio = T(ssh) / T(local); the goal is a
+# ratio <= 1.03 for a render of about a minute.  Also checks that the scene
+# is uploaded once per host (the second run finds it cached).
+cd "$(dirname "$0")/../.." || exit 1
+ROOT=$(pwd)
+. tests/bench/coord_common.sh
+. tests/coord/fakehosts.sh
+N=$(nproc)
+ARGS="--size ${SIZE:-256x256} --spp ${SPP:-128}"
+fh_init
+machine
+bin/franja render scenes/cornell.json -o "$FH/warm.pfm" --size 16x16 --spp 1 --job "$FH/job" --keep-job >/dev/null 2>&1
+SCENE="$FH/job/scene.fbin"
+i=1
+while [ $i -le "$N" ]; do
+    fh_start "h$i" $((i + 1)) 1 >/dev/null
+    i=$((i + 1))
+done
+fr render "$SCENE" -o "$FH/first.pfm" --size 16x16 --spp 1 --hosts "$FH/hosts" 2>"$FH/first.log"
+fr render "$SCENE" -o "$FH/second.pfm" --size 16x16 --spp 1 --hosts "$FH/hosts" 2>"$FH/second.log"
+echo "scene uploads: first run $(grep -c 'scene uploaded' "$FH/first.log") of $N hosts, second run $(grep -c 'scene uploaded' "$FH/second.log")"
+median_time tl bin/franja render "$SCENE" -o "$FH/l.pfm" $ARGS -j "$N" || exit 1
+median_time ts fr render "$SCENE" -o "$FH/s.pfm" $ARGS --hosts "$FH/hosts" || exit 1
+cmp -s "$FH/l.pfm" "$FH/s.pfm" || { echo "SSH and local images differ"; exit 1; }
+echo "local $N slots: $tl s, $N fake SSH hosts x 1 slot: $ts s; ratio $(calc "$ts / $tl") (overhead $(calc "($ts - $tl) * 100 / $tl") %, $(calc "$ts - $tl") s)"
