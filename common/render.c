@@ -85,11 +85,10 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
         if (depth >= s->settings.max_depth)
             break;
 
-        float upick, ulobe, u1, u2, v1, v2, urr, unused;
+        float upick, ulobe, u1, u2, v1, v2;
         smp_2d(&smp, &upick, &ulobe);
         smp_2d(&smp, &u1, &u2);
         smp_2d(&smp, &v1, &v2);
-        smp_2d(&smp, &urr, &unused);
 
         /* Next-event estimation toward one light. */
         fr_light_sample ls;
@@ -122,7 +121,7 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
          * that follows the path's throughput, reweight survivors. */
         if (depth >= 3) {
             float q = fminf(0.95f, v3_max(beta));
-            if (!(urr < q))
+            if (!(smp_random(&smp) < q))
                 break;
             beta = v3_scale(beta, 1.0f / q);
         }

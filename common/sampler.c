@@ -11,10 +11,9 @@ uint32_t smp_hash(uint32_t x)
     return x;
 }
 
-static uint32_t reverse_bits(uint32_t x)
+static inline uint32_t reverse_bits(uint32_t x)
 {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = __builtin_bswap32(x);
     x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
     x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
@@ -70,6 +69,11 @@ void smp_2d(fr_sampler *s, float *u, float *v)
     uint32_t i = reverse_bits(lk_permute(reverse_bits(s->index), seed));
     *u = to_unit(reverse_bits(lk_permute(i, smp_hash(seed + 1))));
     *v = to_unit(reverse_bits(lk_permute(sobol1_rev(i), smp_hash(seed + 2))));
+}
+
+float smp_random(fr_sampler *s)
+{
+    return to_unit(smp_hash(s->pixel ^ smp_hash(s->index ^ smp_hash(s->dim++ + 0x85ebca6bu))));
 }
 
 float smp_1d(fr_sampler *s)

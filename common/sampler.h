@@ -25,6 +25,9 @@ typedef struct {
 void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t seed);
 /* Next two numbers in [0, 1), from one stratified 2D pattern. */
 void smp_2d(fr_sampler *s, float *u, float *v);
+/* Next number in [0, 1), not stratified: for decisions that gain nothing
+ * from stratification (Russian roulette); cheaper than smp_1d. */
+float smp_random(fr_sampler *s);
 /* Next number in [0, 1) (uses a whole dimension pair). */
 float smp_1d(fr_sampler *s);
 

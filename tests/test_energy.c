@@ -37,8 +37,9 @@ static void furnace_sphere(float rho, float le)
     const pt_strategy all[] = {PT_MIS, PT_LIGHT_ONLY, PT_BSDF_ONLY};
     const char *names[] = {"MIS", "light sampling", "BSDF sampling"};
     for (int k = 0; k < 3; k++) {
-        vec3 L = mean_radiance(&s, all[k], 2048);
+        vec3 L = mean_radiance(&s, all[k], 8192);
         float expect = le / (1.0f - rho);
+        printf("sphere furnace rho=%g (%s): %.5f, expected %.5f\n", rho, names[k], L.x, expect);
         CHECK(fabsf(L.x - expect) / expect < 0.005f, "sphere furnace rho=%g (%s): %g, expected %g", rho, names[k], L.x,
               expect);
     }
