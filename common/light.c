@@ -24,7 +24,7 @@ static vec3 textured(const fr_scene *s, const fr_material *m, uint32_t prim, vec
     return tex_emission(s, m, sf.uv);
 }
 
-static uint32_t pick_light(const fr_scene *s, float u)
+uint32_t lgt_pick(const fr_scene *s, float u)
 {
     uint32_t lo = 0, hi = s->n_lights - 1;
     while (lo < hi) {
@@ -67,7 +67,7 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
 {
     if (s->n_lights == 0)
         return 0;
-    uint32_t li = pick_light(s, upick);
+    uint32_t li = lgt_pick(s, upick);
     const fr_light *l = &s->lights[li];
     if (l->kind == FR_LIGHT_POINT) {
         vec3 d = v3_sub(l->position, from);

@@ -19,6 +19,9 @@ typedef struct {
     int delta;                 /* 1 for point lights: no MIS */
 } fr_light_sample;
 
+/* The light that lgt_sample picks with number u (the scene has lights). */
+uint32_t lgt_pick(const fr_scene *s, float u);
+
 /* Sample a light as seen from point `from`.  Returns 0 if the scene has no
  * lights or the sample carries no light (back side of a one-sided emitter). */
 int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out);

@@ -11,9 +11,11 @@
 #include "scene.h"
 #include "trace.h"
 
-/* How direct light is estimated.  Only PT_MIS is used for images; the other
- * two exist so tests can show all three agree (MIS is unbiased). */
-typedef enum { PT_MIS = 0, PT_LIGHT_ONLY, PT_BSDF_ONLY } pt_strategy;
+/* How direct light is estimated.  Only PT_MIS is used for images; the
+ * others exist so tests can show they agree (MIS is unbiased) and measure
+ * what each technique brings.  PT_MIS_DISTANCE is PT_MIS with media
+ * sampled by free-flight distance alone, without equiangular sampling. */
+typedef enum { PT_MIS = 0, PT_LIGHT_ONLY, PT_BSDF_ONLY, PT_MIS_DISTANCE } pt_strategy;
 
 /* The primary ray of pixel (x, y) for lens/pixel numbers in [0,1)^2:
  * box filter of one pixel, thin lens when the camera has an aperture. */
