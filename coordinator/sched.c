@@ -343,18 +343,38 @@ static int loop(sched *s, fr_error *err)
         }
         for (int i = 0; i < s->nhosts; i++) {
             sched_host *h = &s->hosts[i];
-            while (!h->dropped && h->running < h->slots) {
+            while (!h->dropped && h->running < h->slots && now_s() >= h->retry_at) {
                 int si = pick(s, i);
                 if (si < 0)
                     break;
                 fr_error e2;
-                if (start(s, i, si, &e2)) {
+                if (start(s, i, si, &e2) == 0) {
+                    h->start_streak = 0;
+                    continue;
+                }
+                if (h->running > 0) {
+                    /* The host takes fewer processes than it has cores (sshd's
+                     * MaxSessions, a process limit): use what it takes. */
+                    say(s, "host %s: cannot start more than %d workers (%s); using %d slots", h->name,
+                        h->running, e2.msg, h->running);
+                    h->slots = h->running;
+                } else if (++h->start_streak >= s->p->max_host_failures) {
                     h->failures++;
                     drop_host(s, i, e2.msg);
+                } else {
+                    /* The server may still be tearing down the channels of
+                     * the set-up (probe, SFTP): try again a little later. */
+                    h->failures++;
+                    h->retry_at = now_s() + 0.5 * h->start_streak;
+                    say(s, "host %s: %s; trying again", h->name, e2.msg);
                 }
+                break;
             }
         }
-        if (s->nrun == 0) {
+        int waiting = 0;
+        for (int i = 0; i < s->nhosts; i++)
+            waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > now_s();
+        if (s->nrun == 0 && !waiting) {
             rc = fr_fail(err, alive_hosts(s) ? "nothing left to run" : "no host left to render on");
             break;
         }

@@ -36,6 +36,8 @@ typedef struct {
     int duplicates;            /**< straggler copies started here */
     int streak;                /**< failures in a row */
     int dropped;
+    int start_streak;          /**< failed process starts in a row */
+    double retry_at;           /**< no new process before this time (after a failed start) */
     char drop_reason[300];
     double busy_s;             /**< sum of the run time of accepted slabs */
 } sched_host;

@@ -312,6 +312,15 @@ static int sftp_ready(ssh_host *h, fr_error *err)
     return 0;
 }
 
+/* The SFTP channel counts against the server's MaxSessions like a worker's
+ * channel, so it is closed as soon as the scene is in place. */
+static void sftp_done(ssh_host *h)
+{
+    if (h->sftp)
+        sftp_free(h->sftp);
+    h->sftp = NULL;
+}
+
 /* mkdir -p over SFTP. */
 static int sftp_mkdirs(ssh_host *h, const char *dir, fr_error *err)
 {
@@ -408,8 +417,10 @@ static int ssh_stage(void *impl, const char *local_path, uint64_t hash, char *re
     int ok = remote_copy_ok(h, path, (uint64_t)st.st_size, hex, err);
     if (ok < 0)
         return -1;
-    if (ok)
+    if (ok) {
+        sftp_done(h);
         return 0;
+    }
     sftp_attributes a = sftp_stat(h->sftp, path);
     if (a)
         fprintf(stderr, "franja: %s: cached scene %s is damaged; uploading it again\n", h->label, path);
@@ -436,6 +447,7 @@ static int ssh_stage(void *impl, const char *local_path, uint64_t hash, char *re
     if (!ok)
         return fr_fail(err, "%s: the uploaded scene %s does not check out (size or hash); "
                        "is the worker '%s' able to read this scene format?", h->label, path, h->worker);
+    sftp_done(h);
     return 0;
 }
 

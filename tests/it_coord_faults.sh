@@ -27,6 +27,14 @@ check "wrong-size image: rejected" grep -q "failed on extra .*bad partial image.
 check "unreachable host: reported" grep -q "host gone is not used: .*cannot connect" logb
 check "unreachable host: not in the summary" sh -c "! grep -q '^  gone ' logb"
 
+# A host that accepts fewer channels than it claims cores (sshd's
+# MaxSessions): it runs what it can take.
+: >hosts
+FH_SSHD_EXTRA="MaxSessions 2" fh_start narrow 10 4
+fr render scene.fbin -o narrow.pfm --hosts hosts $SIZE 2>logn
+check "narrow host: render succeeds" cmp -s narrow.pfm ref.pfm
+check "narrow host: slots reduced with a message" grep -q "host narrow: cannot start more than 2 workers" logn
+
 # Whole host killed mid-render, and a host that goes silent.  Slow workers
 # (0.4 s a slab) leave time to do it while slabs are in flight.
 : >hosts

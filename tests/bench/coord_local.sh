@@ -2,7 +2,7 @@
 # Parallel efficiency of local mode: the same render with -j 1 and with one
 # worker per core.  efficiency = T(1) / (N * T(N)); 1.0 is perfect.
 cd "$(dirname "$0")/../.." || exit 1
-. tests/bench/coord_common.sh
+. tests/coord/bench_common.sh
 N=$(nproc)
 SCENE=${SCENE:-scenes/cornell.json}
 ARGS="--size ${SIZE:-192x192} --spp ${SPP:-64}"

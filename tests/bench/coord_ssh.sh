@@ -6,7 +6,7 @@
 # is uploaded once per host (the second run finds it cached).
 cd "$(dirname "$0")/../.." || exit 1
 ROOT=$(pwd)
-. tests/bench/coord_common.sh
+. tests/coord/bench_common.sh
 . tests/coord/fakehosts.sh
 N=$(nproc)
 ARGS="--size ${SIZE:-256x256} --spp ${SPP:-128}"

@@ -1,4 +1,4 @@
-# coord_common.sh -- sourced by the coordinator benchmarks (not run alone).
+# bench_common.sh -- sourced by the coordinator benchmarks (tests/bench/coord_*.sh).
 # median_time VAR CMD...: runs CMD $RUNS times, sets VAR to the median wall
 # seconds.  machine: prints what the figures were measured on.
 RUNS=${RUNS:-3}

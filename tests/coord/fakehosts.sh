@@ -9,7 +9,8 @@
 #   fh_init                   create $FH, the client key, the known_hosts file
 #   fh_start NAME N [CORES] [WORKER]
 #                             start sshd for host NAME on 127.0.0.N and append
-#                             its line to $FH/hosts (WORKER: worker path)
+#                             its line to $FH/hosts (WORKER: worker path;
+#                             FH_SSHD_EXTRA: lines that override sshd_config)
 #   fh_pids NAME              PIDs of the host: sshd, its sessions, its workers
 #   fh_kill NAME / fh_stop NAME / fh_cont NAME
 #   fh_wrapper NAME MODE      a worker wrapper that misbehaves once (MODE:
@@ -68,7 +69,9 @@ fh_start() {
     mkdir -p "$d/work"
     ssh-keygen -q -t ed25519 -N '' -f "$d/host_key" -C "$name"
     port=$((FH_PORT + n))
+    # sshd keeps the first value of a keyword: FH_SSHD_EXTRA overrides.
     cat >"$d/sshd_config" <<CFG
+${FH_SSHD_EXTRA:-}
 ListenAddress 127.0.0.$n:$port
 HostKey $d/host_key
 PidFile $d/sshd.pid
