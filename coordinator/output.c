@@ -1,6 +1,8 @@
 /* output.c -- tone mapping and the atomic write of the final image. */
 #include "output.h"
 
+#include "tonemap.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdint.h>
@@ -52,7 +54,7 @@ static int write_pfm(const char *tmp, const float *rgb, const job_spec *spec, fr
     return rc;
 }
 
-int out_write(const char *path, const float *rgb, const job_spec *spec, float exposure, fr_error *err)
+int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err)
 {
     char tmp[4200];
     temp_name(path, tmp, sizeof tmp);
@@ -64,12 +66,11 @@ int out_write(const char *path, const float *rgb, const job_spec *spec, float ex
         rc = iio_write(tmp, rgb, IIO_F32, spec->width, spec->height, err);
     } else {
         int wide = is_ext(path, "tif") || is_ext(path, "tiff");
-        float scale = exp2f(exposure);
         void *px = malloc(n * (wide ? 2 : 1));
         if (!px)
             return fr_fail(err, "out of memory for the final image");
         for (size_t i = 0; i < n; i++) {
-            float v = img_srgb_encode(rgb[i] * scale);
+            float v = tm_display(tm, rgb[i]);
             if (wide)
                 ((uint16_t *)px)[i] = (uint16_t)(v * 65535.0f + 0.5f);
             else

@@ -2,9 +2,10 @@
  * The final image: tone mapping (once, after stitching) and an atomic write
  * in the format the file name's extension names.
  *
- * HDR outputs (.exr, .hdr, .pfm) keep linear radiance and ignore the
- * exposure; LDR outputs (.png, .jpg, .bmp, .ppm 8-bit; .tif 16-bit) are
- * scaled by 2^exposure, then sRGB-encoded and clamped.  A .pfm is written
+ * HDR outputs (.exr, .hdr, .pfm) keep linear radiance and ignore the tone
+ * mapping; LDR outputs (.png, .jpg, .bmp, .ppm 8-bit; .tif 16-bit) are
+ * tone-mapped by common/tonemap.h: scaled by 2^exposure, optionally
+ * through the filmic curve, then sRGB-encoded and clamped.  A .pfm is written
  * by Franja itself (OpenImageIO has no PFM writer) with the same header a
  * one-process worker render of the whole image has, so the two files can
  * be compared byte for byte.
@@ -14,6 +15,7 @@
 
 #include "error.h"
 #include "jobdir.h"
+#include "scene.h"
 
 /** Fails, before any rendering, if no writer handles the path's extension. */
 int out_check(const char *path, fr_error *err);
@@ -21,6 +23,6 @@ int out_check(const char *path, fr_error *err);
 /** Writes rgb (width*height*3 linear floats, top row first) to path via a
  * temporary file in the same directory and a rename, so path is either the
  * old file or the complete new one. */
-int out_write(const char *path, const float *rgb, const job_spec *spec, float exposure, fr_error *err);
+int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err);
 
 #endif

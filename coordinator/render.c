@@ -19,6 +19,7 @@
 #include "jobdir.h"
 #include "output.h"
 #include "sched.h"
+#include "tonemap.h"
 
 static const char usage[] =
     "usage: franja render SCENE(.json|.fbin) -o OUT [options]\n"
@@ -33,7 +34,9 @@ static const char usage[] =
     "  --spp N              samples per pixel (default: the scene's)\n"
     "  --size WxH           image size (default: the scene's)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
-    "                       (HDR outputs .exr .hdr .pfm keep linear radiance)\n"
+    "                       (default: the scene's tonemap; HDR outputs .exr\n"
+    "                       .hdr .pfm keep linear radiance)\n"
+    "  --tonemap CURVE      none or filmic (default: the scene's, else none)\n"
     "  --resume             keep the finished slabs of an interrupted render\n"
     "  --job DIR            job directory (default OUT.franja-job)\n"
     "  --keep-job           keep the job directory after success\n"
@@ -65,6 +68,8 @@ typedef struct {
     const char *scene, *out, *hosts, *jobdir;
     uint32_t jobs, spp, width, height, slab_rows, retries;
     float exposure;
+    int exposure_set;          /* --exposure given: overrides the scene's */
+    const char *curve;         /* --tonemap, or NULL for the scene's */
     int resume, keep_job;
     tr_options tr;
 } render_args;
@@ -104,7 +109,7 @@ static int parse(int argc, char **argv, render_args *a)
             continue;
         }
         static const char *valued[] = {"-o", "--hosts", "-j", "--spp", "--size", "--exposure",
-                                       "--job", "--slab-rows", "--retries"};
+                                       "--job", "--slab-rows", "--retries", "--tonemap"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(s, valued[k]);
@@ -124,6 +129,11 @@ static int parse(int argc, char **argv, render_args *a)
             a->hosts = v;
         else if (!strcmp(s, "--job"))
             a->jobdir = v;
+        else if (!strcmp(s, "--tonemap")) {
+            uint32_t c;
+            a->curve = v;
+            bad = tm_curve_parse(v, &c) < 0;
+        }
         else if (!strcmp(s, "-j"))
             bad = cli_uint(v, 1, 4096, &a->jobs);
         else if (!strcmp(s, "--spp"))
@@ -145,6 +155,7 @@ static int parse(int argc, char **argv, render_args *a)
             char *end;
             errno = 0;
             a->exposure = strtof(v, &end);
+            a->exposure_set = 1;
             bad = errno || *end || end == v || a->exposure < -64 || a->exposure > 64;
         }
         if (bad) {
@@ -285,6 +296,12 @@ int cmd_render(int argc, char **argv)
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
                      a.spp ? a.spp : sc.settings.spp};
+    /* Tone mapping: the scene's defaults, overridden by the command line. */
+    fr_tonemap tm = sc.tonemap;
+    if (a.exposure_set)
+        tm.exposure = a.exposure;
+    if (a.curve)
+        tm_curve_parse(a.curve, &tm.curve);
     scn_free(&sc);
 
     hosts_table table;
@@ -328,7 +345,7 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (job_stitch(jobdir, &spec, rgb, &err) || out_write(a.out, rgb, &spec, a.exposure, &err)) {
+    if (job_stitch(jobdir, &spec, rgb, &err) || out_write(a.out, rgb, &spec, &tm, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
