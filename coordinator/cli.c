@@ -11,7 +11,8 @@
 const char cli_transport_help[] =
     "  --known-hosts FILE   SSH known_hosts file (default ~/.ssh/known_hosts)\n"
     "  --accept-new-hosts   add the keys of hosts not yet known (never changed ones)\n"
-    "  --no-ssh-config      do not read ~/.ssh/config\n"
+    "  --ssh-config FILE    SSH client configuration (default ~/.ssh/config)\n"
+    "  --no-ssh-config      do not read any SSH client configuration\n"
     "  --timeout S          connect time-out and longest silence of a host (default 10)\n";
 
 int cli_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
@@ -60,7 +61,7 @@ int cli_transport_option(int argc, char **argv, int *i, tr_options *o)
         o->read_ssh_config = 0;
         return 1;
     }
-    if (strcmp(a, "--known-hosts") && strcmp(a, "--timeout"))
+    if (strcmp(a, "--known-hosts") && strcmp(a, "--timeout") && strcmp(a, "--ssh-config"))
         return 0;
     if (*i + 1 >= argc) {
         fprintf(stderr, "franja: %s needs a value\n", a);
@@ -69,6 +70,14 @@ int cli_transport_option(int argc, char **argv, int *i, tr_options *o)
     const char *v = argv[++*i];
     if (!strcmp(a, "--known-hosts")) {
         o->known_hosts = v;
+        return 1;
+    }
+    if (!strcmp(a, "--ssh-config")) {
+        if (access(v, R_OK)) {
+            fprintf(stderr, "franja: --ssh-config: cannot read '%s': %s\n", v, strerror(errno));
+            return -1;
+        }
+        o->ssh_config = v;
         return 1;
     }
     uint32_t t;

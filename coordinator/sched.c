@@ -79,7 +79,8 @@ static void draw(sched *s, int force)
         if (h->dropped)
             n += snprintf(line + n, sizeof line - (size_t)n, " %s:down", h->name);
         else
-            n += snprintf(line + n, sizeof line - (size_t)n, " %s:%d/%d", h->name, h->running, h->slots);
+            n += snprintf(line + n, sizeof line - (size_t)n, " %s:%d/%d,%dr", h->name, h->running, h->slots,
+                          h->rows);
     }
     fprintf(stderr, "\r\033[K%s", line);
     fflush(stderr);

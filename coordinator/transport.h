@@ -26,7 +26,8 @@
 typedef struct {
     const char *known_hosts;   /**< known_hosts file; NULL = ~/.ssh/known_hosts */
     int accept_new;            /**< add unknown host keys (never changed ones) */
-    int read_ssh_config;       /**< honour ~/.ssh/config */
+    int read_ssh_config;       /**< honour the SSH client configuration */
+    const char *ssh_config;    /**< that configuration file; NULL = ~/.ssh/config */
     int timeout_s;             /**< connect time-out and longest silence of a live host, seconds */
     const char *local_worker;  /**< worker binary for local hosts without worker= */
 } tr_options;

@@ -27,7 +27,8 @@
 typedef struct {
     hosts_entry entry;
     tr_options opt;
-    char label[400];           /* "name (user@address:port)" for messages */
+    char label[400];           /* "name (user@host:port)" for messages */
+    char host[256];            /* the address actually used (config's HostName applied) */
     char workdir[600];         /* home-relative unless absolute */
     char worker[1100];
     ssh_session s;
@@ -91,10 +92,14 @@ static int verify_host_key(ssh_host *h, fr_error *err)
     ssh_options_get_port(h->s, &port);
     char spec[300];
     if (port == 22)
-        snprintf(spec, sizeof spec, "%s", h->entry.address);
+        snprintf(spec, sizeof spec, "%s", h->host);
     else
-        snprintf(spec, sizeof spec, "[%s]:%u", h->entry.address, port);
-    const char *kh = h->opt.known_hosts ? h->opt.known_hosts : "~/.ssh/known_hosts";
+        snprintf(spec, sizeof spec, "[%s]:%u", h->host, port);
+    char *khs = NULL;
+    ssh_options_get(h->s, SSH_OPTIONS_KNOWNHOSTS, &khs); /* as ~/.ssh/config may have set it */
+    char kh[600];
+    snprintf(kh, sizeof kh, "%s", khs ? khs : h->opt.known_hosts ? h->opt.known_hosts : "~/.ssh/known_hosts");
+    ssh_string_free_char(khs);
     char *fp = fingerprint(h->s);
     const char *fps = fp ? fp : "(unknown fingerprint)";
     int rc = 0;
@@ -120,7 +125,7 @@ static int verify_host_key(ssh_host *h, fr_error *err)
             rc = fr_fail(err,
                          "%s: REFUSED: unknown host (key %s is not in %s). Check the fingerprint, then "
                          "add it with: ssh-keyscan -p %u %s >> %s (or run once with --accept-new-hosts)",
-                         h->label, fps, kh, port, h->entry.address, kh);
+                         h->label, fps, kh, port, h->host, kh);
         }
         break;
     default:
@@ -156,7 +161,7 @@ static int ssh_connect_host(const hosts_entry *e, const tr_options *o, void **im
     /* The host table wins over ~/.ssh/config, as the command line does for ssh(1). */
     int bad = ssh_options_set(s, SSH_OPTIONS_HOST, e->address) ||
               ssh_options_set(s, SSH_OPTIONS_PROCESS_CONFIG, &cfg) ||
-              (cfg && ssh_options_parse_config(s, NULL)) ||
+              (cfg && ssh_options_parse_config(s, o->ssh_config)) ||
               (e->port && ssh_options_set(s, SSH_OPTIONS_PORT, &(unsigned int){(unsigned)e->port})) ||
               (e->user[0] && ssh_options_set(s, SSH_OPTIONS_USER, e->user)) ||
               (o->known_hosts && ssh_options_set(s, SSH_OPTIONS_KNOWNHOSTS, o->known_hosts)) ||
@@ -168,12 +173,15 @@ static int ssh_connect_host(const hosts_entry *e, const tr_options *o, void **im
         else
             bad = ssh_options_set(s, SSH_OPTIONS_IDENTITY, ident);
     }
-    char *user = NULL;
+    char *user = NULL, *host = NULL;
     unsigned int port = 22;
     ssh_options_get(s, SSH_OPTIONS_USER, &user);
+    ssh_options_get(s, SSH_OPTIONS_HOST, &host); /* after ~/.ssh/config's HostName */
     ssh_options_get_port(s, &port);
-    snprintf(h->label, sizeof h->label, "%s (%s@%s:%u)", e->name, user ? user : "?", e->address, port);
+    snprintf(h->host, sizeof h->host, "%s", host ? host : e->address);
+    snprintf(h->label, sizeof h->label, "%s (%s@%s:%u)", e->name, user ? user : "?", h->host, port);
     ssh_string_free_char(user);
+    ssh_string_free_char(host);
     if (bad) {
         if (!strstr(err->msg, "identity"))
             fr_fail(err, "%s: bad SSH options: %s", h->label, ssh_get_error(s));

@@ -88,4 +88,29 @@ check "render with no usable host fails" test $? -ne 0
 check "and writes no image" test ! -e out8.pfm
 check "and says why" grep -q "no host could be used" log8
 
+# ~/.ssh/config is honoured (here a file given with --ssh-config): the table
+# names an alias, the configuration gives address, port, user, key and
+# known_hosts file.
+cat >ssh_config <<CFG
+Host viacfg
+    HostName 127.0.0.3
+    Port $((FH_PORT + 3))
+    User $FH_USER
+    IdentityFile $FH/client_key
+    UserKnownHostsFile $FH/known_full
+CFG
+echo "viacfg viacfg - 2 workdir=$FH/b/work worker=$WORKER" >t_cfg
+env -u SSH_AUTH_SOCK "$FRANJA" render scene.fbin -o cfg.pfm --hosts t_cfg --ssh-config ssh_config --timeout 3 $SIZE 2>logcfg
+check "SSH client configuration honoured" cmp -s cfg.pfm ref.pfm
+check "configuration's HostName and Port used" grep -q "viacfg: .*scene already there" logcfg
+
+# Remote arguments are quoted: a work directory full of shell syntax is
+# created and used literally.
+QDIR="$FH/q/it's\$HOME;*\`true\`"
+echo "q 127.0.0.4:$((FH_PORT + 4)) $FH_USER 2 identity=$FH/client_key workdir=$QDIR worker=$WORKER" >t_q
+cp known_full known_hosts
+fr render scene.fbin -o q.pfm --hosts t_q $SIZE 2>logq
+check "shell syntax in paths reaches the worker unharmed" cmp -s q.pfm ref.pfm
+check "scene stored under the literal path" cmp -s "$QDIR/scenes/$HASH.fbin" scene.fbin
+
 fh_summary
