@@ -367,9 +367,8 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
         return fr_fail(err, "section nodes: the scene has primitives but no BVH");
     unsigned char *depth = calloc(s->n_nodes, 1);
     unsigned char *owner = calloc(s->n_leaves, 1);   /* 1: in a leaf, 2: in a mixed leaf */
-    unsigned char *seen = calloc(s->n_prims / 8 + 1, 1);
     int rc = 0;
-    if (!depth || !owner || !seen) {
+    if (!depth || !owner) {
         rc = fr_fail(err, "out of memory validating the BVH");
         goto done;
     }
@@ -430,44 +429,40 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
             }
         }
     }
+    /* The blocks list the primitives in order, each once: lanes hold
+     * next, next+1, ... and unused lanes (FR_NONE) only end a block. */
+    uint32_t next = 0;
     for (uint32_t j = 0; j < s->n_leaves && rc == 0; j++) {
         const fr_bvh_leaf *L = &s->leaves[j];
         if (!owner[j]) {
             rc = fr_fail(err, "section leaves, byte %zu: block %u belongs to no leaf", AT(L), j);
             break;
         }
-        for (int lane = 0; lane < 4 && rc == 0; lane++) {
-            uint32_t p = L->prim[lane];
-            if (p == FR_NONE) {
-                if (lane == 0)
-                    rc = fr_fail(err, "section leaves, byte %zu: block %u has no primitive in lane 0", AT(L->prim), j);
-                continue;
-            }
-            if (p >= s->n_prims) {
-                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u out of range (%u)",
-                             AT(L->prim + lane), j, lane, p, s->n_prims);
-            } else if (seen[p / 8] & (1u << (p % 8))) {
-                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u is in two lanes",
-                             AT(L->prim + lane), j, lane, p);
-            } else if (s->prims[p].kind != FR_PRIM_TRIANGLE && owner[j] != 2) {
+        int used = 0;
+        while (used < 4 && L->prim[used] == next && next < s->n_prims) {
+            if (s->prims[next].kind != FR_PRIM_TRIANGLE && owner[j] != 2) {
                 rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u is not a triangle but "
-                             "its leaf is not marked mixed", AT(L->prim + lane), j, lane, p);
-            } else {
-                seen[p / 8] |= (unsigned char)(1u << (p % 8));
-                if (s->prims[p].kind == FR_PRIM_TRIANGLE)
-                    for (int v = 0; v < 9 && rc == 0; v++)
-                        if (!isfinite(L->v[v][lane]))
-                            rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: non-finite vertex",
-                                         AT(L->v[v] + lane), j, lane);
+                             "its leaf is not marked mixed", AT(L->prim + used), j, used, next);
+                break;
             }
+            used++;
+            next++;
         }
+        for (int lane = used; lane < 4 && rc == 0; lane++)
+            if (L->prim[lane] != FR_NONE || lane == 0)
+                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u, expected %s", AT(L->prim + lane),
+                             j, lane, L->prim[lane], lane == 0 ? "the next primitive in order" : "the next primitive or none");
+        /* Every coordinate finite: x * 0 is 0 for finite x, NaN otherwise. */
+        f4 acc = f4_set1(0.0f);
+        for (int v = 0; v < 9; v++)
+            acc = acc + f4_load(L->v[v]) * f4_set1(0.0f);
+        if (rc == 0 && i4_bits(acc != acc))
+            rc = fr_fail(err, "section leaves, byte %zu: block %u: non-finite vertex coordinate", AT(L), j);
     }
-    for (uint32_t p = 0; p < s->n_prims && rc == 0; p++)
-        if (!(seen[p / 8] & (1u << (p % 8))))
-            rc = fr_fail(err, "section prims, byte %zu: primitive %u is in no BVH leaf", AT(s->prims + p), p);
+    if (rc == 0 && next != s->n_prims)
+        rc = fr_fail(err, "section prims, byte %zu: primitive %u is in no BVH leaf", AT(s->prims + next), next);
 done:
     free(depth);
     free(owner);
-    free(seen);
     return rc;
 }
