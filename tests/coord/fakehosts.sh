@@ -10,7 +10,9 @@
 #   fh_start NAME N [CORES] [WORKER]
 #                             start sshd for host NAME on 127.0.0.N and append
 #                             its line to $FH/hosts (WORKER: worker path;
-#                             FH_SSHD_EXTRA: lines that override sshd_config)
+#                             FH_SSHD_EXTRA: lines that override sshd_config;
+#                             FH_ADDR: another address; FH_NETNS: run sshd
+#                             in that network namespace)
 #   fh_pids NAME              PIDs of the host: sshd, its sessions, its workers
 #   fh_kill NAME / fh_stop NAME / fh_cont NAME
 #   fh_wrapper NAME MODE      a worker wrapper that misbehaves once (MODE:
@@ -69,10 +71,11 @@ fh_start() {
     mkdir -p "$d/work"
     ssh-keygen -q -t ed25519 -N '' -f "$d/host_key" -C "$name"
     port=$((FH_PORT + n))
+    addr=${FH_ADDR:-127.0.0.$n}
     # sshd keeps the first value of a keyword: FH_SSHD_EXTRA overrides.
     cat >"$d/sshd_config" <<CFG
 ${FH_SSHD_EXTRA:-}
-ListenAddress 127.0.0.$n:$port
+ListenAddress $addr:$port
 HostKey $d/host_key
 PidFile $d/sshd.pid
 AuthorizedKeysFile $FH/authorized_keys
@@ -92,13 +95,13 @@ LogLevel ERROR
 # every worker start up to seconds.  SHLVL=1 makes the login shell nested.
 SetEnv SHLVL=1
 CFG
-    /usr/sbin/sshd -f "$d/sshd_config" -E "$d/sshd.log" || {
+    ${FH_NETNS:+ip netns exec "$FH_NETNS"} /usr/sbin/sshd -f "$d/sshd_config" -E "$d/sshd.log" || {
         echo "FAIL: sshd for $name did not start:"
         cat "$d/sshd.log"
         return 1
     }
-    echo "[127.0.0.$n]:$port $(cut -d' ' -f1,2 "$d/host_key.pub")" >>"$FH/known_hosts"
-    echo "$name 127.0.0.$n:$port $FH_USER $cores identity=$FH/client_key workdir=$d/work worker=$worker" >>"$FH/hosts"
+    echo "[$addr]:$port $(cut -d' ' -f1,2 "$d/host_key.pub")" >>"$FH/known_hosts"
+    echo "$name $addr:$port $FH_USER $cores identity=$FH/client_key workdir=$d/work worker=$worker" >>"$FH/hosts"
     FH_HOSTS="$FH_HOSTS $name"
 }
 
