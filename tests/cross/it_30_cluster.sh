@@ -57,16 +57,22 @@ for h in arm old armdeb; do
     check "$h rendered slabs" grep -Eq "^  $h +[0-9]+ +[1-9]" log
 done
 
-# A worker of another version joins: the coordinator refuses, naming it.
-cat >"$FH/worker-other.sh" <<SH
+# A worker of another version, then one of another scene format, joins: the
+# coordinator refuses to mix them, naming the host.
+REAL=$("$WORKER" --version)
+for bad in "$(echo "$REAL" | sed 's/^franja-worker [^ ]*/franja-worker 0.0.1/')" \
+           "$(echo "$REAL" | sed 's/scene-format .*/scene-format 999/')"; do
+    cat >"$FH/worker-other.sh" <<SH
 #!/bin/sh
-case "\$1" in --version) echo "franja-worker 0.0.1 scene-format 1"; exit 0 ;; esac
+case "\$1" in --version) echo "$bad"; exit 0 ;; esac
 exec "$WORKER" "\$@"
 SH
-chmod +x "$FH/worker-other.sh"
-fh_start other 5 1 "$FH/worker-other.sh"
-fr render scene.fbin -o out2.pfm --hosts hosts $SIZE 2>log2
-check "render with a mismatched worker version is refused" test $? -ne 0
-check "and writes no image" test ! -e out2.pfm
-check "the refusal names the host" grep -q "host other runs .*refusing to mix" log2
+    chmod +x "$FH/worker-other.sh"
+    case " $FH_HOSTS " in *" other "*) ;; *) fh_start other 5 1 "$FH/worker-other.sh" ;; esac
+    rm -f out2.pfm
+    fr render scene.fbin -o out2.pfm --hosts hosts $SIZE 2>log2
+    check "render with a worker reporting '$bad' is refused" test $? -ne 0
+    check "and writes no image" test ! -e out2.pfm
+    check "the refusal names the host" grep -q "host other.*$bad" log2
+done
 cross_summary
