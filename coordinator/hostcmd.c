@@ -56,8 +56,10 @@ static int check(const hosts_table *t, const tr_options *o)
             continue;
         }
         const char *warn = "";
-        if (h->entry->arch[0] && strcmp(h->entry->arch, h->info.arch))
-            warn = "  (table says arch=";
+        if (h->entry->arch[0] && strcmp(h->entry->arch, h->info.arch)) {
+            warn = "  PROBLEM: the table says arch=";
+            bad++;
+        }
         int files;
         uint64_t bytes;
         char cache[64];
@@ -70,7 +72,7 @@ static int check(const hosts_table *t, const tr_options *o)
             snprintf(cache, sizeof cache, "%d scene%s, %.1f MB", files, files == 1 ? "" : "s", bytes / 1e6);
         int cores = h->entry->cores ? h->entry->cores : h->info.cores;
         printf("%-16s %-6s %-8s %-7s %5d  %-36s %s%s%s%s\n", h->entry->name, "ok", h->info.arch, h->info.os, cores,
-               h->info.version, cache, warn, *warn ? h->entry->arch : "", *warn ? ")" : "");
+               h->info.version, cache, warn, *warn ? h->entry->arch : "", "");
     }
     fr_error err;
     if (cl_check_versions(cl, t->n, &err)) {
