@@ -387,7 +387,7 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
                     empty &= n->box[a][k] == INFINITY && n->box[3 + a][k] == -INFINITY;
                 if (!empty)
                     rc = fr_fail(err, "section nodes, byte %zu: node %u slot %d: an empty slot needs leaf 0 "
-                                 "and the empty box (+inf, -inf)", AT(n), i, k);
+                                 "and the empty box (+inf, -inf)", AT(n->child + k), i, k);
                 continue;
             }
             for (int a = 0; a < 3 && rc == 0; a++)
@@ -457,7 +457,10 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
         for (int v = 0; v < 9; v++)
             acc = acc + f4_load(L->v[v]) * f4_set1(0.0f);
         if (rc == 0 && i4_bits(acc != acc))
-            rc = fr_fail(err, "section leaves, byte %zu: block %u: non-finite vertex coordinate", AT(L), j);
+            for (int v = 0; v < 36 && rc == 0; v++)
+                if (!isfinite(L->v[v / 4][v % 4]))
+                    rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: non-finite vertex coordinate",
+                                 AT(&L->v[v / 4][v % 4]), j, v % 4);
     }
     if (rc == 0 && next != s->n_prims)
         rc = fr_fail(err, "section prims, byte %zu: primitive %u is in no BVH leaf", AT(s->prims + next), next);

@@ -120,64 +120,74 @@ int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *er
 
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
-/* Byte offset of an element inside the blob, for messages. */
+/* Byte offset of an element inside the blob, for messages; sections of a
+ * single element are copied out of the blob, so theirs come from the table
+ * (off[id]) plus the field's offset. */
 #define AT(ptr) ((size_t)((const char *)(ptr) - (const char *)base))
+#define AT1(id, type, field) ((size_t)(off[id] + offsetof(type, field)))
 
 static int tex_ref_ok(const fr_scene *s, uint32_t t) { return t == FR_NONE || t < s->n_textures; }
 
 /* Textures, texels, media and the material fields that refer to them. */
-static int validate_appearance(const fr_scene *s, fr_error *err)
+static int validate_appearance(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
     for (uint32_t i = 0; i < s->n_textures; i++) {
         const fr_texture *t = &s->textures[i];
         if (t->kind > FR_TEX_CHECKER || t->wrap > FR_WRAP_CLAMP || t->filter > FR_FILTER_NEAREST ||
             !isfinite(t->scale.u) || !isfinite(t->scale.v) || !isfinite(t->offset.u) || !isfinite(t->offset.v) ||
             !finite3(t->color0) || !finite3(t->color1))
-            return fr_fail(err, "section textures: element %u: bad kind, wrap, filter or non-finite parameter", i);
+            return fr_fail(err, "section textures, byte %zu: texture %u: bad kind, wrap, filter or non-finite parameter",
+                           AT(t), i);
         if (t->kind == FR_TEX_IMAGE &&
             (t->width == 0 || t->height == 0 || (t->channels != 1 && t->channels != 3) ||
              (uint64_t)t->width * t->height * t->channels > (uint64_t)s->n_texels - t->first || t->first > s->n_texels))
-            return fr_fail(err, "section textures: element %u: image size or texel range out of bounds", i);
+            return fr_fail(err, "section textures, byte %zu: texture %u: image size or texel range out of bounds", AT(t),
+                           i);
     }
     for (uint32_t i = 0; i < s->n_texels; i++)
         if (!isfinite(s->texels[i]))
-            return fr_fail(err, "section texels: element %u: not a finite number", i);
+            return fr_fail(err, "section texels, byte %zu: texel %u: not a finite number", AT(s->texels + i), i);
     for (uint32_t i = 0; i < s->n_media; i++) {
         const fr_medium *m = &s->media[i];
         if (!finite3(m->sigma_a) || !finite3(m->sigma_s) || v3_min(m->sigma_a) < 0.0f || v3_min(m->sigma_s) < 0.0f ||
             !(m->g > -1.0f && m->g < 1.0f))
-            return fr_fail(err, "section media: element %u: negative or non-finite coefficient, or |g| >= 1", i);
+            return fr_fail(err, "section media, byte %zu: medium %u: negative or non-finite coefficient, or |g| >= 1",
+                           AT(m), i);
     }
     if (s->volume.fog > s->n_media || s->volume.camera_medium > s->n_media)
-        return fr_fail(err, "section volume: medium index out of range");
+        return fr_fail(err, "section volume, byte %zu: medium index out of range", AT1(SEC_VOLUME, fr_volume, fog));
     if (!(s->tonemap.exposure >= -64.0f && s->tonemap.exposure <= 64.0f) || s->tonemap.curve > FR_CURVE_FILMIC)
-        return fr_fail(err, "section tonemap: exposure outside [-64, 64] or unknown curve");
+        return fr_fail(err, "section tonemap, byte %zu: exposure outside [-64, 64] or unknown curve",
+                       AT1(SEC_TONEMAP, fr_tonemap, exposure));
     for (uint32_t i = 0; i < s->n_materials; i++) {
         const fr_material *m = &s->materials[i];
         if (!tex_ref_ok(s, m->tex_diffuse) || !tex_ref_ok(s, m->tex_glossy) || !tex_ref_ok(s, m->tex_specular) ||
             !tex_ref_ok(s, m->tex_transmit) || !tex_ref_ok(s, m->tex_emission) || !tex_ref_ok(s, m->tex_bump) ||
             !tex_ref_ok(s, m->tex_normal))
-            return fr_fail(err, "section materials: element %u: texture index out of range", i);
+            return fr_fail(err, "section materials, byte %zu: material %u: texture index out of range",
+                           AT(&m->tex_diffuse), i);
         if (!isfinite(m->bump_strength) || !isfinite(m->normal_strength) || m->medium > s->n_media ||
             m->interface > 1 || (m->interface && m->medium == 0))
-            return fr_fail(err, "section materials: element %u: bad bump or normal strength, medium or interface", i);
+            return fr_fail(err, "section materials, byte %zu: material %u: bad bump or normal strength, medium or interface",
+                           AT(m), i);
     }
     return 0;
 }
 
 /* Check every cross-reference so that rendering can index without checks. */
-static int validate(const fr_scene *s, const void *base, fr_error *err)
+static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
     const fr_settings *st = &s->settings;
     if (st->width == 0 || st->height == 0 || st->width > 65536 || st->height > 65536 || st->spp == 0 ||
         st->spp > (1u << 20) || st->max_depth > 4096)
-        return fr_fail(err, "section settings, byte %zu: bad image size, sample count or depth", AT(st));
+        return fr_fail(err, "section settings, byte %zu: bad image size, sample count or depth",
+                       AT1(SEC_SETTINGS, fr_settings, width));
     const fr_camera *c = &s->camera;
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
         !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !isfinite(c->aperture) ||
         !(c->focus > 0.0f || c->aperture == 0.0f))
-        return fr_fail(err, "section camera, byte %zu: degenerate or non-finite camera", AT(c));
-    if (validate_appearance(s, err) < 0)
+        return fr_fail(err, "section camera, byte %zu: degenerate or non-finite camera", AT1(SEC_CAMERA, fr_camera, position));
+    if (validate_appearance(s, base, off, err) < 0)
         return -1;
     for (uint32_t i = 0; i < s->n_materials; i++) {
         const fr_material *m = &s->materials[i];
@@ -194,14 +204,15 @@ static int validate(const fr_scene *s, const void *base, fr_error *err)
     for (uint32_t i = 0; i < s->n_prims; i++) {
         const fr_prim *p = &s->prims[i];
         if (p->kind >= FR_PRIM_KINDS || p->index >= kind_count[p->kind])
-            return fr_fail(err, "section prims, byte %zu: primitive %u: bad kind %u or index %u", AT(p), i, p->kind,
+            return fr_fail(err, "section prims, byte %zu: primitive %u: bad kind %u or index %u",
+                           AT(p->kind >= FR_PRIM_KINDS ? &p->kind : &p->index), i, p->kind,
                            p->index);
         if (p->material >= s->n_materials)
-            return fr_fail(err, "section prims, byte %zu: primitive %u: material %u out of range", AT(p), i,
+            return fr_fail(err, "section prims, byte %zu: primitive %u: material %u out of range", AT(&p->material), i,
                            p->material);
         if (p->light != FR_NONE && (p->light >= s->n_lights || s->lights[p->light].kind != FR_LIGHT_PRIM ||
                                     s->lights[p->light].prim != i))
-            return fr_fail(err, "section prims, byte %zu: primitive %u: light %u does not point back", AT(p), i,
+            return fr_fail(err, "section prims, byte %zu: primitive %u: light %u does not point back", AT(&p->light), i,
                            p->light);
     }
     /* Vertex indices must be below the size of every array the triangle's
@@ -216,10 +227,13 @@ static int validate(const fr_scene *s, const void *base, fr_error *err)
         uint32_t hi = t->v[0] > t->v[1] ? t->v[0] : t->v[1];
         hi = hi > t->v[2] ? hi : t->v[2];
         if (t->flags & ~(uint32_t)(FR_TRI_NORMALS | FR_TRI_UVS))
-            return fr_fail(err, "section triangles, byte %zu: triangle %u: unknown flags 0x%x", AT(t), i, t->flags);
-        if (hi >= bound[t->flags])
+            return fr_fail(err, "section triangles, byte %zu: triangle %u: unknown flags 0x%x", AT(&t->flags), i,
+                           t->flags);
+        if (hi >= bound[t->flags]) {
+            int k = t->v[0] == hi ? 0 : t->v[1] == hi ? 1 : 2;
             return fr_fail(err, "section triangles, byte %zu: triangle %u: vertex index %u out of range (%u usable)",
-                           AT(t), i, hi, bound[t->flags]);
+                           AT(t->v + k), i, hi, bound[t->flags]);
+        }
     }
     for (uint32_t i = 0; i < s->n_planes; i++)
         if (s->planes[i].material >= s->n_materials || !finite3(s->planes[i].normal) ||
@@ -266,7 +280,7 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
     if (hash != get64(p + 32))
         return fr_fail(err, "byte 32: content hash mismatch (file is corrupt)");
     /* Sections follow the table in id order without overlapping. */
-    uint64_t next = HEADER_SIZE + (uint64_t)ENTRY_SIZE * nsec;
+    uint64_t next = HEADER_SIZE + (uint64_t)ENTRY_SIZE * nsec, offs[SEC_COUNT + 1] = {0};
     for (uint32_t k = 0; k < nsec; k++) {
         const unsigned char *e = p + HEADER_SIZE + (size_t)ENTRY_SIZE * k;
         size_t at = HEADER_SIZE + (size_t)ENTRY_SIZE * k;
@@ -282,6 +296,7 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
             return fr_fail(err, "byte %zu: section %s: offset %llu / count %llu out of bounds or overlapping", at,
                            d->name, (unsigned long long)off, (unsigned long long)count);
         next = off + bytes;
+        offs[id] = off;
         if (!d->count_off) {
             if (count != 1)
                 return fr_fail(err, "byte %zu: section %s: count %llu, expected 1", at, d->name, (unsigned long long)count);
@@ -291,7 +306,7 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
             *(uint32_t *)((char *)out + d->count_off) = (uint32_t)count;
         }
     }
-    if (validate(out, p, err) < 0) {
+    if (validate(out, p, offs, err) < 0) {
         memset(out, 0, sizeof *out);
         return -1;
     }

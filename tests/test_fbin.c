@@ -1,0 +1,361 @@
+/* test_fbin.c -- the binary scene loader refuses every damaged file with a
+ * message naming the place, and accepts what the builder wrote.
+ *
+ * Damage comes in two kinds: bytes changed behind the hash's back (caught
+ * by the header checks or the hash), and files rewritten with a correct
+ * hash but broken contents (caught by the structural checks, which are what
+ * stands between a hostile file and the renderer's unchecked indexing). */
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
+#include "bvh.h"
+#include "check.h"
+#include "fbin.h"
+#include "scenes.h"
+
+static const char *scene_json =
+    "{\"image\": {\"width\": 32, \"height\": 24, \"spp\": 2},"
+    " \"camera\": {\"position\": [0, 1, -4], \"target\": [0, 0.5, 0], \"fov\": 50},"
+    " \"materials\": {\"w\": {\"type\": \"lambert\", \"albedo\": [0.7, 0.7, 0.7]},"
+    "                \"l\": {\"type\": \"emitter\", \"emission\": [5, 5, 5]}},"
+    " \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": [10, 10, 10]}],"
+    " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0.5, 0], \"radius\": 0.5, \"material\": \"w\"},"
+    "  {\"type\": \"rect\", \"origin\": [-0.5, 2, -0.5], \"edge_u\": [1, 0, 0], \"edge_v\": [0, 0, 1],"
+    "   \"material\": \"l\"},"
+    "  {\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"w\"},"
+    "  {\"type\": \"triangle\", \"vertices\": [[-2, 0, 1], [2, 0, 1], [0, 2, 1]], \"material\": \"w\"},"
+    "  {\"type\": \"triangle\", \"vertices\": [[-2, 0, 2], [2, 0, 2], [0, 2, 2]], \"material\": \"w\"},"
+    "  {\"type\": \"quad\", \"vertices\": [[-1, 0, 3], [1, 0, 3], [1, 1.5, 3], [-1, 1, 3]], \"material\": \"w\"}]}";
+
+static fr_scene good;          /* the reference scene (owns its blob) */
+
+/* A 16-byte-aligned copy of the good blob. */
+static unsigned char *copy_blob(void)
+{
+    unsigned char *p = aligned_alloc(64, (good.blob_size + 63) / 64 * 64);
+    memcpy(p, good.blob, good.blob_size);
+    return p;
+}
+
+static void put32(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
+static void put64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
+static uint64_t get64(const unsigned char *p) { uint64_t v; memcpy(&v, p, 8); return v; }
+
+static void rehash(unsigned char *p, size_t size) { put64(p + 32, XXH3_64bits(p + 64, size - 64)); }
+
+/* Offset of section `id`'s data, from the table. */
+static size_t section(const unsigned char *p, int id) { return (size_t)get64(p + 64 + 32 * (id - 1) + 8); }
+
+/* Opening `p` (size bytes) must fail with a message containing every
+ * string in want (NULL-terminated). */
+static void refuse(const char *what, unsigned char *p, size_t size, const char *const *want)
+{
+    fr_scene s;
+    fr_error err = {{0}};
+    int rc = fbin_open_mem(p, size, 0, &s, &err);
+    CHECK(rc < 0, "%s: accepted", what);
+    if (rc == 0) {
+        memset(&s, 0, sizeof s);   /* s points into p, which the caller frees */
+        return;
+    }
+    for (int i = 0; want[i]; i++)
+        CHECK(strstr(err.msg, want[i]) != NULL, "%s: message \"%s\" lacks \"%s\"", what, err.msg, want[i]);
+}
+
+#define REFUSE(what, p, size, ...)                                     \
+    do {                                                               \
+        const char *const want_[] = {__VA_ARGS__, NULL};              \
+        refuse(what, p, size, want_);                                  \
+    } while (0)
+
+static void test_roundtrip(void)
+{
+    unsigned char *p = copy_blob();
+    fr_scene s;
+    fr_error err;
+    CHECK(fbin_open_mem(p, good.blob_size, 0, &s, &err) == 0, "reopen: %s", err.msg);
+    CHECK(s.hash == good.hash && s.n_prims == good.n_prims && s.n_nodes == good.n_nodes, "reopen differs");
+    scn_free(&s);   /* frees p */
+
+    char path[] = "/tmp/franja-test-fbin-XXXXXX";
+    int fd = mkstemp(path);
+    close(fd);
+    CHECK(fbin_write(&good, path, &err) == 0, "write: %s", err.msg);
+    CHECK(fbin_load(path, &s, &err) == 0, "load: %s", err.msg);
+    CHECK(s.mapped && s.hash == good.hash && s.blob_size == good.blob_size, "loaded scene differs");
+    scn_free(&s);
+    /* Files that are not scenes: named in the message. */
+    FILE *f = fopen(path, "wb");
+    fclose(f);
+    CHECK(fbin_load(path, &s, &err) < 0 && strstr(err.msg, path), "empty file accepted or unnamed: %s", err.msg);
+    unlink(path);
+    CHECK(fbin_load(path, &s, &err) < 0 && strstr(err.msg, path), "missing file: %s", err.msg);
+    CHECK(fbin_load("/tmp", &s, &err) < 0 && strstr(err.msg, "/tmp"), "directory accepted: %s", err.msg);
+}
+
+static void test_header(void)
+{
+    size_t n = good.blob_size;
+    unsigned char *p = copy_blob();
+    size_t cuts[] = {0, 10, 63, 64, 100, n / 2, n - 64, n - 1};
+    for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; i++) {
+        char what[64];
+        snprintf(what, sizeof what, "truncated to %zu bytes", cuts[i]);
+        if (cuts[i] < 64)
+            REFUSE(what, p, cuts[i], "shorter than the 64-byte header");
+        else
+            REFUSE(what, p, cuts[i], "byte 24", "truncated");
+    }
+    p[1] = 'X';
+    REFUSE("bad magic", p, n, "byte 0", "magic");
+    memcpy(p, good.blob, n);
+    put32(p + 8, FBIN_VERSION + 1);
+    REFUSE("newer version", p, n, "byte 8", "version");
+    put32(p + 8, FBIN_VERSION - 1);
+    REFUSE("older version", p, n, "byte 8", "version");
+    memcpy(p, good.blob, n);
+    put32(p + 12, 0x04030201u);
+    REFUSE("byte order", p, n, "byte 12", "byte order");
+    memcpy(p, good.blob, n);
+    p[50] = 1;
+    REFUSE("reserved byte", p, n, "byte 50", "reserved");
+    memcpy(p, good.blob, n);
+    p[n - 100] ^= 0x10;
+    REFUSE("flipped bit", p, n, "byte 32", "hash");
+    memcpy(p, good.blob, n);
+    put64(p + 32, get64(p + 32) + 1);
+    REFUSE("wrong hash", p, n, "hash");
+    memcpy(p, good.blob, n);
+    CHECK(fbin_open_mem(p + 1, n - 1, 0, &(fr_scene){0}, &(fr_error){{0}}) < 0, "misaligned bytes accepted");
+    free(p);
+}
+
+static void test_table(void)
+{
+    size_t n = good.blob_size;
+    unsigned char *p = copy_blob();
+    size_t e = 64 + 32 * 6;   /* entry of section 7, triangles */
+    put32(p + e + 4, 20);
+    rehash(p, n);
+    REFUSE("element size", p, n, "byte 256", "triangles", "element size");
+    memcpy(p, good.blob, n);
+    put64(p + e + 8, get64(p + e + 8) + 4);
+    rehash(p, n);
+    REFUSE("misaligned section", p, n, "byte 256", "triangles");
+    memcpy(p, good.blob, n);
+    put64(p + e + 16, 1u << 30);
+    put64(p + e + 24, (uint64_t)16 << 30);
+    rehash(p, n);
+    REFUSE("count past the end", p, n, "byte 256", "triangles", "out of bounds");
+    memcpy(p, good.blob, n);
+    put64(p + e + 8, get64(p + 64 + 32 * 5 + 8));   /* on top of rects */
+    rehash(p, n);
+    REFUSE("overlapping sections", p, n, "triangles", "overlapping");
+    memcpy(p, good.blob, n);
+    put32(p + e, 9);
+    rehash(p, n);
+    REFUSE("section id", p, n, "byte 256", "id 9");
+    memcpy(p, good.blob, n);
+    put64(p + 64 + 8, 1 << 12);   /* settings: count must be 1 */
+    rehash(p, n);
+    REFUSE("settings count", p, n, "settings");
+    free(p);
+}
+
+/* Rewrite one u32 at `off` and fix the hash: a well-formed file with bad
+ * contents, refused by section `sec` at byte `at` (the field itself unless
+ * the check is about a whole element). */
+static void poke_at(const char *what, size_t off, uint32_t v, const char *sec, size_t where)
+{
+    unsigned char *p = copy_blob();
+    put32(p + off, v);
+    rehash(p, good.blob_size);
+    char at[32];
+    snprintf(at, sizeof at, "byte %zu:", where);
+    REFUSE(what, p, good.blob_size, sec, at);
+    free(p);
+}
+
+static void poke(const char *what, size_t off, uint32_t v, const char *sec) { poke_at(what, off, v, sec, off); }
+
+static void test_contents(void)
+{
+    const unsigned char *g = good.blob;
+    size_t tri = section(g, 7), prim = section(g, 4), node = section(g, 13), leaf = section(g, 14);
+    poke("vertex index", tri + 4, 1000000, "section triangles");
+    poke("triangle flags", tri + 12, 8, "section triangles");
+    poke("prim kind", prim, 7, "section prims");
+    poke("prim index", prim + 4, 5000, "section prims");
+    poke("prim material", prim + 8, 99, "section prims");
+    poke("prim light", prim + 12, 42, "section prims");
+    /* Node 0: its slots, boxes, children and leaf words. */
+    poke("leaf bad bits", node + 224, 0x1201, "section nodes");
+    poke("leaf blocks past the end", node + 192, good.n_leaves, "section nodes");
+    float nan = NAN, big = 1e30f, inf = INFINITY;
+    uint32_t u;
+    memcpy(&u, &nan, 4);
+    poke("NaN box", node, u, "section nodes");
+    memcpy(&u, &big, 4);
+    poke("inverted box", node, u, "section nodes");
+    /* An empty slot must have the empty box. */
+    int empty = -1;
+    for (int k = 0; k < FR_BVH_WIDTH; k++)
+        if (good.nodes[0].child[k] == FR_NONE)
+            empty = k;
+    CHECK(empty >= 0, "node 0 has no empty slot (test scene too big)");
+    if (empty >= 0) {
+        memcpy(&u, &inf, 4);
+        poke_at("empty slot with a box", node + 4 * 3 * FR_BVH_WIDTH + 4 * (size_t)empty, 0, "section nodes",
+                node + 4 * 6 * FR_BVH_WIDTH + 4 * (size_t)empty);
+    }
+    /* Leaf blocks. */
+    poke("lane 0 unused", leaf + 144, FR_NONE, "section leaves");
+    poke("primitive out of order", leaf + 144, 3, "section leaves");
+    memcpy(&u, &inf, 4);
+    poke("infinite vertex", leaf + 8, u, "section leaves");
+    /* Lights and materials. */
+    size_t light = section(g, 12), mat = section(g, 3);
+    poke("light kind", light, 9, "section lights");
+    poke("material texture", mat + 88, 3, "section materials");
+    memcpy(&u, &nan, 4);
+    poke("camera NaN", section(g, 2), u, "section camera");
+    poke("settings width", section(g, 1), 0, "section settings");
+}
+
+/* A BVH written by hand (through fbin_serialize, so the hash is right). */
+static int open_with_bvh(const fr_bvh_node *nodes, uint32_t n_nodes, const fr_bvh_leaf *leaves, uint32_t n_leaves,
+                         fr_error *err)
+{
+    fr_scene view = good;
+    view.nodes = nodes;
+    view.n_nodes = n_nodes;
+    view.leaves = leaves;
+    view.n_leaves = n_leaves;
+    void *blob;
+    size_t size;
+    if (fbin_serialize(&view, &blob, &size, err) < 0)
+        return -1;
+    fr_scene s;
+    int rc = fbin_open_mem(blob, size, 0, &s, err);
+    if (rc == 0)
+        scn_free(&s);
+    else
+        free(blob);
+    return rc;
+}
+
+static fr_bvh_node empty_node(void)
+{
+    fr_bvh_node n;
+    for (int k = 0; k < FR_BVH_WIDTH; k++) {
+        for (int a = 0; a < 3; a++) {
+            n.box[a][k] = INFINITY;
+            n.box[3 + a][k] = -INFINITY;
+        }
+        n.child[k] = FR_NONE;
+        n.leaf[k] = 0;
+    }
+    return n;
+}
+
+static void set_slot(fr_bvh_node *n, int k, uint32_t child, uint32_t leaf)
+{
+    for (int a = 0; a < 3; a++) {
+        n->box[a][k] = -10.0f;
+        n->box[3 + a][k] = 10.0f;
+    }
+    n->child[k] = child;
+    n->leaf[k] = leaf;
+}
+
+static void test_shapes(void)
+{
+    /* One leaf with all of the good scene's primitives (mixed: spheres and
+     * rects), hung at the bottom of a chain of `depth` nodes. */
+    uint32_t np = good.n_prims, nblk = (np + 3) / 4;
+    fr_bvh_leaf *blocks = calloc(nblk, sizeof *blocks);
+    for (uint32_t i = 0; i < 4 * nblk; i++)
+        blocks[i / 4].prim[i % 4] = i < np ? i : FR_NONE;
+    int depths[] = {1, 2, 63, 64, 65, 90};
+    fr_bvh_node chain[100];
+    fr_error err;
+    for (size_t d = 0; d < sizeof depths / sizeof depths[0]; d++) {
+        int n = depths[d];
+        for (int i = 0; i < n; i++) {
+            chain[i] = empty_node();
+            if (i + 1 < n)
+                set_slot(&chain[i], 0, (uint32_t)i + 1, 0);
+            else
+                set_slot(&chain[i], 0, 0, nblk | FR_BVH_MIXED);
+        }
+        int rc = open_with_bvh(chain, (uint32_t)n, blocks, nblk, &err);
+        if (n <= 64)
+            CHECK(rc == 0, "chain of %d nodes refused: %s", n, err.msg);
+        else
+            CHECK(rc < 0 && strstr(err.msg, "deeper than 64") && strstr(err.msg, "section nodes"),
+                  "chain of %d nodes: %s", n, rc < 0 ? err.msg : "accepted");
+    }
+    /* Children must come after their parent, inside the array. */
+    chain[0] = empty_node();
+    set_slot(&chain[0], 0, 0, 0);
+    CHECK(open_with_bvh(chain, 1, blocks, nblk, &err) < 0 && strstr(err.msg, "child 0 not in"), "self loop: %s",
+          err.msg);
+    chain[1] = empty_node();
+    set_slot(&chain[0], 0, 1, 0);
+    set_slot(&chain[1], 0, 0, 0);
+    CHECK(open_with_bvh(chain, 2, blocks, nblk, &err) < 0 && strstr(err.msg, "node 1 slot 0: child 0"), "cycle: %s",
+          err.msg);
+    set_slot(&chain[0], 0, 7, 0);
+    CHECK(open_with_bvh(chain, 2, blocks, nblk, &err) < 0 && strstr(err.msg, "child 7 not in"), "child past the end: %s",
+          err.msg);
+    /* Not mixed although it holds a sphere. */
+    chain[0] = empty_node();
+    set_slot(&chain[0], 0, 0, nblk);
+    CHECK(open_with_bvh(chain, 1, blocks, nblk, &err) < 0 && strstr(err.msg, "mixed"), "unmarked mixed leaf: %s",
+          err.msg);
+    /* Two parents for one node; an unreachable node; a block in two leaves;
+     * a block in none. */
+    chain[0] = empty_node();
+    chain[1] = empty_node();
+    set_slot(&chain[0], 0, 1, 0);
+    set_slot(&chain[0], 1, 1, 0);
+    set_slot(&chain[1], 0, 0, nblk | FR_BVH_MIXED);
+    CHECK(open_with_bvh(chain, 2, blocks, nblk, &err) < 0 && strstr(err.msg, "two parents"), "DAG: %s", err.msg);
+    chain[0] = empty_node();
+    set_slot(&chain[0], 0, 0, nblk | FR_BVH_MIXED);
+    CHECK(open_with_bvh(chain, 2, blocks, nblk, &err) < 0 && strstr(err.msg, "not reachable"), "orphan: %s",
+          err.msg);
+    set_slot(&chain[0], 1, 0, 1 | FR_BVH_MIXED);
+    CHECK(open_with_bvh(chain, 1, blocks, nblk, &err) < 0 && strstr(err.msg, "two leaves"), "shared block: %s",
+          err.msg);
+    chain[0] = empty_node();
+    set_slot(&chain[0], 0, 0, (nblk - 1) | FR_BVH_MIXED);
+    if (nblk > 1)
+        CHECK(open_with_bvh(chain, 1, blocks, nblk, &err) < 0 && strstr(err.msg, "no leaf"), "lost block: %s",
+              err.msg);
+    /* A primitive left out. */
+    blocks[nblk - 1].prim[(np - 1) % 4] = FR_NONE;
+    set_slot(&chain[0], 0, 0, nblk | FR_BVH_MIXED);
+    CHECK(open_with_bvh(chain, 1, blocks, nblk, &err) < 0 && strstr(err.msg, "no BVH leaf"), "lost prim: %s",
+          err.msg);
+    /* No BVH at all for a scene with primitives. */
+    CHECK(open_with_bvh(chain, 0, blocks, 0, &err) < 0 && strstr(err.msg, "no BVH"), "no BVH: %s", err.msg);
+    free(blocks);
+}
+
+int main(void)
+{
+    test_scene(scene_json, &good);
+    CHECK(good.n_prims >= 6 && good.n_nodes >= 1, "test scene: %u prims, %u nodes", good.n_prims, good.n_nodes);
+    test_roundtrip();
+    test_header();
+    test_table();
+    test_contents();
+    test_shapes();
+    scn_free(&good);
+    return check_done();
+}
