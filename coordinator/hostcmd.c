@@ -71,8 +71,8 @@ static int check(const hosts_table *t, const tr_options *o)
         else
             snprintf(cache, sizeof cache, "%d scene%s, %.1f MB", files, files == 1 ? "" : "s", bytes / 1e6);
         int cores = h->entry->cores ? h->entry->cores : h->info.cores;
-        printf("%-16s %-6s %-8s %-7s %5d  %-36s %s%s%s%s\n", h->entry->name, "ok", h->info.arch, h->info.os, cores,
-               h->info.version, cache, warn, *warn ? h->entry->arch : "", "");
+        printf("%-16s %-6s %-8s %-7s %5d  %-36s %s%s%s\n", h->entry->name, "ok", h->info.arch, h->info.os, cores,
+               h->info.version, cache, warn, *warn ? h->entry->arch : "");
     }
     fr_error err;
     if (cl_check_versions(cl, t->n, &err)) {
