@@ -16,38 +16,6 @@
 enum { LOD_MAX = 16 };
 #define LOD_DENSITY 0.25f      /* default triangles per pixel of projected area */
 
-/* ---- materials ---- */
-
-void mesh_material(const obj_material *src, fr_material *m)
-{
-    bld_material_init(m);
-    m->diffuse = src->kd;
-    int il = src->illum;
-    if (il == 4 || il == 6 || il == 7 || il == 9) {
-        m->transmit = src->tf;
-        if (src->ni >= 1.0f / 16.0f && src->ni <= 16.0f && src->ni != 1.0f)
-            m->ior = src->ni;
-    } else if (il == 3 || il == 5) {
-        m->specular = src->ks;
-    } else if (il != 0 && il != 1 && !v3_is_zero(src->ks)) {
-        m->glossy = src->ks;
-        m->exponent = src->ns;
-    }
-    m->emission = src->ke;
-    /* Files often give Kd + Ks > 1: scale the lobes down together so the
-     * material never reflects more than it receives. */
-    vec3 sum = v3_add(v3_add(m->diffuse, m->glossy), v3_add(m->specular, m->transmit));
-    float mx = v3_max(sum);
-    if (mx > 1.0f) {
-        float k = 1.0f / mx;
-        m->diffuse = v3_scale(m->diffuse, k);
-        m->glossy = v3_scale(m->glossy, k);
-        m->specular = v3_scale(m->specular, k);
-        m->transmit = v3_scale(m->transmit, k);
-    }
-    bld_material_finish(m);
-}
-
 /* ---- reading files ---- */
 
 static int grow_mesh(obj_mesh *m, uint32_t nv, uint32_t nt, int normals, int uvs)
@@ -419,7 +387,7 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
                 break;
             }
             fr_material fm;
-            mesh_material(&m.mats[k], &fm);
+            obj_material_convert(&m.mats[k], &fm);
             if ((mat_of[k] = bld_push(&b->materials, &fm)) == FR_NONE)
                 rc = fr_fail(err, "%s: out of memory", where);
         }

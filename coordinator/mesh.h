@@ -27,10 +27,4 @@ int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *di
  * into the same structure (free with obj_free). */
 int mesh_read(const char *path, obj_mesh *m, fr_error *err);
 
-/** The Franja material for an MTL material (see scenes/README.md, "mesh"):
- * Kd diffuse, Ks with Ns Phong glossy (mirror for illum 3 and 5), Tf and Ni
- * glass for illum 4, 6, 7 and 9, Ke emission; lobes scaled down together
- * when they would reflect more than they receive. */
-void mesh_material(const obj_material *src, fr_material *out);
-
 #endif

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "builder.h"
 #include "scene.h"
 
 /* Polygons with more corners than this are triangulated as a fan (ear
@@ -135,11 +136,13 @@ typedef struct {
     uint32_t cap_mats;
 } mat_table;
 
+/* What a material is before its statements: black, not transmissive
+ * beyond Tf's default, Ni 1.5 (the default material for faces before any
+ * usemtl is then given Kd 0.8). */
 static void mat_defaults(obj_material *mt, const char *name)
 {
     memset(mt, 0, sizeof *mt);
     snprintf(mt->name, sizeof mt->name, "%s", name);
-    mt->kd = v3s(0.8f);
     mt->tf = v3s(1.0f);
     mt->ns = 0.0f;
     mt->ni = 1.5f;
@@ -271,6 +274,38 @@ static int parse_mtl(const char *text, const char *name, obj_mesh *m, uint32_t *
         c.p = next + 1;
     }
     return 0;
+}
+
+/* ---- MTL materials as Franja materials ---- */
+
+void obj_material_convert(const obj_material *src, fr_material *m)
+{
+    bld_material_init(m);
+    m->diffuse = src->kd;
+    int il = src->illum;
+    if (il == 4 || il == 6 || il == 7 || il == 9) {
+        m->transmit = src->tf;
+        if (src->ni >= 1.0f / 16.0f && src->ni <= 16.0f && src->ni != 1.0f)
+            m->ior = src->ni;
+    } else if (il == 3 || il == 5) {
+        m->specular = src->ks;
+    } else if (il != 0 && il != 1 && !v3_is_zero(src->ks)) {
+        m->glossy = src->ks;
+        m->exponent = src->ns;
+    }
+    m->emission = src->ke;
+    /* Files often give Kd + Ks > 1: scale the lobes down together so the
+     * material never reflects more than it receives. */
+    vec3 sum = v3_add(v3_add(m->diffuse, m->glossy), v3_add(m->specular, m->transmit));
+    float mx = v3_max(sum);
+    if (mx > 1.0f) {
+        float k = 1.0f / mx;
+        m->diffuse = v3_scale(m->diffuse, k);
+        m->glossy = v3_scale(m->glossy, k);
+        m->specular = v3_scale(m->specular, k);
+        m->transmit = v3_scale(m->transmit, k);
+    }
+    bld_material_finish(m);
 }
 
 /* ---- geometry ---- */
@@ -573,18 +608,23 @@ static int parse_line(parser *P, const char *kw)
     cursor *c = &P->c;
     obj_mesh *m = P->m;
     if (!strcmp(kw, "v")) {
-        vec3 p;
-        float extra;
-        if (number(c, &p.x, "v x") <= 0 || number(c, &p.y, "v y") <= 0 || number(c, &p.z, "v z") <= 0)
-            return fr_fail(c->err, "%s:%d: v: expected x y z", c->name, c->line);
-        int r = 0;
-        for (int i = 0; i < 4 && (r = number(c, &extra, "v")) > 0; i++)
-            ;   /* w or a vertex colour: not used */
-        if (r < 0 || end_of_line(c, "v x y z") < 0)
+        float num[7];
+        int n = 0, r = 0;
+        while (n < 7 && (r = number(c, &num[n], "v")) > 0)
+            n++;
+        if (r < 0)
+            return -1;
+        /* x y z, then w or a vertex colour (not used) */
+        if (n == 7)
+            return fr_fail(c->err, "%s:%d: v: too many numbers (expected x y z [w] or x y z r g b)", c->name, c->line);
+        if (n != 3 && n != 4 && n != 6)
+            return fr_fail(c->err, "%s:%d: v: expected x y z [w] or x y z r g b, got %d numbers", c->name, c->line,
+                           n);
+        if (end_of_line(c, "v x y z") < 0)
             return -1;
         if (grow(&P->v, &P->cap_v, P->n_v + 1ull, sizeof *P->v) < 0)
             return fr_fail(c->err, "%s:%d: out of memory", c->name, c->line);
-        P->v[P->n_v++] = p;
+        P->v[P->n_v++] = v3(num[0], num[1], num[2]);
     } else if (!strcmp(kw, "vt")) {
         vec2 t = {0.0f, 0.0f};
         float w;
@@ -599,8 +639,10 @@ static int parse_line(parser *P, const char *kw)
         P->vt[P->n_vt++] = t;
     } else if (!strcmp(kw, "vn")) {
         vec3 n;
-        if (number(c, &n.x, "vn x") <= 0 || number(c, &n.y, "vn y") <= 0 || number(c, &n.z, "vn z") <= 0)
-            return fr_fail(c->err, "%s:%d: vn: expected x y z", c->name, c->line);
+        int r;
+        if ((r = number(c, &n.x, "vn x")) <= 0 || (r = number(c, &n.y, "vn y")) <= 0 ||
+            (r = number(c, &n.z, "vn z")) <= 0)
+            return r < 0 ? -1 : fr_fail(c->err, "%s:%d: vn: expected x y z", c->name, c->line);
         if (end_of_line(c, "vn x y z") < 0)
             return -1;
         if (grow(&P->vn, &P->cap_vn, P->n_vn + 1ull, sizeof *P->vn) < 0)
@@ -658,6 +700,7 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, o
         rc = fr_fail(err, "%s: out of memory", name);
     if (rc == 0) {
         mat_defaults(&m->mats[0], "(default)");
+        m->mats[0].kd = v3s(0.8f);
         m->mats[0].defined = 1;
         m->n_mats = 1;
     }
@@ -695,8 +738,19 @@ int obj_parse_mtl(const char *text, size_t len, const char *name, obj_mesh *m, f
     memcpy(buf, text, len);
     buf[len] = 0;
     uint32_t cap = m->n_mats;
-    int rc = memchr(text, 0, len) ? fr_fail(err, "%s: NUL byte in a text file", name)
-                                  : parse_mtl(buf, name, m, &cap, err);
+    int rc = 0;
+    if (m->n_mats == 0) {
+        /* mats[0] is always the default material, never found by name. */
+        if (grow(&m->mats, &cap, 1, sizeof *m->mats) < 0) {
+            free(buf);
+            return fr_fail(err, "%s: out of memory", name);
+        }
+        mat_defaults(&m->mats[0], "(default)");
+        m->mats[0].kd = v3s(0.8f);
+        m->mats[0].defined = 1;
+        m->n_mats = 1;
+    }
+    rc = memchr(text, 0, len) ? fr_fail(err, "%s: NUL byte in a text file", name) : parse_mtl(buf, name, m, &cap, err);
     free(buf);
     return rc;
 }

@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "error.h"
+#include "scene.h"
 #include "vec.h"
 
 /** An MTL material, as written in the file (mapped to a Franja material by
@@ -61,6 +62,12 @@ int obj_read(const char *path, obj_mesh *m, fr_error *err);
 int obj_parse_mtl(const char *text, size_t len, const char *name, obj_mesh *m, fr_error *err);
 
 void obj_free(obj_mesh *m);
+
+/** The Franja material for an MTL material (see scenes/README.md, "mesh"):
+ * Kd diffuse, Ks with Ns Phong glossy (mirror for illum 3 and 5), Tf and Ni
+ * glass for illum 4, 6, 7 and 9, Ke emission; lobes scaled down together
+ * when they would reflect more than they receive. */
+void obj_material_convert(const obj_material *src, fr_material *out);
 
 /** Reads a whole file into a malloc'd, NUL-terminated buffer (*len bytes
  * without the NUL).  Errors name the path. */
