@@ -45,6 +45,25 @@ typedef struct {
     ssh_channel ch;
 } ssh_proc;
 
+/* The exit status of a channel's finished command; -1 if it has none
+ * (killed by a signal, or the connection ended first).  libssh 0.11
+ * (Debian 13) deprecates ssh_channel_get_exit_status for
+ * ssh_channel_get_exit_state. */
+static int exit_status(ssh_channel ch)
+{
+#if LIBSSH_VERSION_INT >= SSH_VERSION_INT(0, 11, 0)
+    uint32_t code = 0;
+    char *sig = NULL;
+    int core = 0;
+    int rc = ssh_channel_get_exit_state(ch, &code, &sig, &core);
+    int killed = sig != NULL;
+    ssh_string_free_char(sig);
+    return rc == SSH_OK && !killed ? (int)code : -1;
+#else
+    return ssh_channel_get_exit_status(ch);
+#endif
+}
+
 static double now_s(void)
 {
     struct timespec t;
@@ -167,9 +186,10 @@ static int ssh_connect_host(const hosts_entry *e, const tr_options *o, void **im
               (o->known_hosts && ssh_options_set(s, SSH_OPTIONS_KNOWNHOSTS, o->known_hosts)) ||
               ssh_options_set(s, SSH_OPTIONS_TIMEOUT, &timeout) ||
               ssh_options_set(s, SSH_OPTIONS_NODELAY, &nodelay);
+    int bad_identity = 0;
     if (!bad && e->identity[0]) {
         if (expand_tilde(e->identity, ident, sizeof ident) || access(ident, R_OK))
-            bad = fr_fail(err, "%s: identity file '%s' cannot be read", e->name, e->identity);
+            bad_identity = 1;
         else
             bad = ssh_options_set(s, SSH_OPTIONS_IDENTITY, ident);
     }
@@ -182,9 +202,12 @@ static int ssh_connect_host(const hosts_entry *e, const tr_options *o, void **im
     snprintf(h->label, sizeof h->label, "%s (%s@%s:%u)", e->name, user ? user : "?", h->host, port);
     ssh_string_free_char(user);
     ssh_string_free_char(host);
+    if (bad_identity) {
+        fr_fail(err, "%s: identity file '%s' cannot be read", h->label, e->identity);
+        goto fail;
+    }
     if (bad) {
-        if (!strstr(err->msg, "identity"))
-            fr_fail(err, "%s: bad SSH options: %s", h->label, ssh_get_error(s));
+        fr_fail(err, "%s: bad SSH options: %s", h->label, ssh_get_error(s));
         goto fail;
     }
     if (ssh_connect(s) != SSH_OK) {
@@ -265,7 +288,7 @@ static int run_remote(ssh_host *h, const char *cmd, tr_proc *p, int *status, fr_
         }
     }
     if (rc == 0)
-        *status = ssh_channel_get_exit_status(ch);
+        *status = exit_status(ch);
     ssh_channel_close(ch);
     ssh_channel_free(ch);
     return rc;
@@ -553,7 +576,7 @@ static int ssh_service(void *impl, tr_proc *procs, fr_error *err)
         }
         if (p->state == TR_RUNNING && (ssh_channel_is_eof(sp->ch) || ssh_channel_is_closed(sp->ch)) &&
             ssh_channel_poll(sp->ch, 0) <= 0 && ssh_channel_poll(sp->ch, 1) <= 0) {
-            int st = ssh_channel_get_exit_status(sp->ch);
+            int st = exit_status(sp->ch);
             if (st < 0)
                 tr_proc_fail(p, "worker ended without an exit status (killed by a signal?)");
             else {
