@@ -7,7 +7,9 @@
  *   genmesh terrain [--tris N] [--seed S]       -o FILE.obj   heightfield
  *
  * --tris is the approximate triangle count (default 100000, up to ~20 M).
- * --flat leaves out vertex normals, --no-uv texture coordinates.  Every
+ * --flat leaves out vertex normals, --no-uv texture coordinates;
+ * --material NAME adds `mtllib NAME.mtl` and `usemtl NAME` (the MTL file
+ * is the caller's).  Every
  * mesh has unit-ish size around the origin, +y up.  The numbers come from
  * fmath and integer hashing only, so a file is the same on every machine. */
 #include <errno.h>
@@ -21,7 +23,7 @@
 #include "vec.h"
 
 typedef struct {
-    const char *kind, *out;
+    const char *kind, *out, *material;
     long tris;
     int p, q, normals, uvs;
     uint32_t seed;
@@ -168,12 +170,16 @@ static int write_obj(const grid *g, const options *o, int flip)
     setvbuf(f, buf, _IOFBF, sizeof buf);
     int cu = g->wrap_u ? g->nu : g->nu - 1, cv = g->wrap_v ? g->nv : g->nv - 1;
     fprintf(f, "# genmesh %s: %d x %d grid, %ld triangles\n", o->kind, g->nu, g->nv, 2L * cu * cv);
+    if (o->material)
+        fprintf(f, "mtllib %s.mtl\n", o->material);
     fprintf(f, "o %s\n", o->kind);
     for (int i = 0; i < g->nu * g->nv; i++)
         fprintf(f, "v %.6f %.6f %.6f\n", (double)g->pos[i].x, (double)g->pos[i].y, (double)g->pos[i].z);
     if (o->normals)
         for (int i = 0; i < g->nu * g->nv; i++)
             fprintf(f, "vn %.5f %.5f %.5f\n", (double)g->nrm[i].x, (double)g->nrm[i].y, (double)g->nrm[i].z);
+    if (o->material)
+        fprintf(f, "usemtl %s\n", o->material);
     if (o->uvs)
         for (int i = 0; i < g->nu; i++)
             for (int j = 0; j < g->nv; j++)
@@ -204,11 +210,11 @@ static int write_obj(const grid *g, const options *o, int flip)
 
 static const char usage[] =
     "usage: genmesh knot|sphere|terrain [--tris N] [--p P] [--q Q] [--seed S]\n"
-    "               [--flat] [--no-uv] -o FILE.obj\n";
+    "               [--flat] [--no-uv] [--material NAME] -o FILE.obj\n";
 
 int main(int argc, char **argv)
 {
-    options o = {NULL, NULL, 100000, 2, 3, 1, 1, 1};
+    options o = {NULL, NULL, NULL, 100000, 2, 3, 1, 1, 1};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int more = i + 1 < argc;
@@ -220,6 +226,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--q") && more) o.q = atoi(argv[++i]);
         else if (!strcmp(a, "--seed") && more) o.seed = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(a, "-o") && more) o.out = argv[++i];
+        else if (!strcmp(a, "--material") && more) o.material = argv[++i];
         else if (a[0] != '-' && !o.kind) o.kind = a;
         else { fprintf(stderr, "genmesh: bad argument '%s'\n%s", a, usage); return 2; }
     }
