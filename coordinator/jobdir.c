@@ -171,8 +171,8 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     scan_ctx *c = vctx;
     char path[4200];
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    unsigned char *buf;
-    size_t len;
+    unsigned char *buf = NULL;
+    size_t len = 0;
     fr_error e;
     int bad = read_file(path, &buf, &len, &e);
     if (!bad) {
