@@ -79,8 +79,8 @@ static void draw(sched *s, int force)
         if (h->dropped)
             n += snprintf(line + n, sizeof line - (size_t)n, " %s:down", h->name);
         else
-            n += snprintf(line + n, sizeof line - (size_t)n, " %s:%d/%d,%dr", h->name, h->running, h->slots,
-                          h->rows);
+            n += snprintf(line + n, sizeof line - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
+                          el > 0 ? h->rows / el : 0.0);
     }
     fprintf(stderr, "\r\033[K%s", line);
     fflush(stderr);
