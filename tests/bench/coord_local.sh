@@ -10,7 +10,7 @@ T=$(mktemp -d /tmp/franja-bench.XXXXXX)
 trap 'rm -rf "$T"' EXIT
 machine
 bin/franja render "$SCENE" -o "$T/warm.pfm" $ARGS -j "$N" >/dev/null 2>&1
-median_time t1 bin/franja render "$SCENE" -o "$T/a.pfm" $ARGS -j 1 || exit 1
-median_time tn bin/franja render "$SCENE" -o "$T/b.pfm" $ARGS -j "$N" || exit 1
+compare "bin/franja render $SCENE -o $T/a.pfm $ARGS -j 1" "bin/franja render $SCENE -o $T/b.pfm $ARGS -j $N" || exit 1
 cmp -s "$T/a.pfm" "$T/b.pfm" || { echo "-j 1 and -j $N images differ"; exit 1; }
-echo "local -j 1: $t1 s, -j $N: $tn s; speed-up $(calc "$t1 / $tn"), parallel efficiency $(calc "$t1 / ($N * $tn)")"
+echo "local -j 1: $TA s, -j $N: $TB s; speed-up $(calc "$TA / $TB"), parallel efficiency $(calc "$TA / ($N * $TB)")"
+echo "machine after: load $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -22,7 +22,8 @@ done
 fr render "$SCENE" -o "$FH/first.pfm" --size 16x16 --spp 1 --hosts "$FH/hosts" 2>"$FH/first.log"
 fr render "$SCENE" -o "$FH/second.pfm" --size 16x16 --spp 1 --hosts "$FH/hosts" 2>"$FH/second.log"
 echo "scene uploads: first run $(grep -c 'scene uploaded' "$FH/first.log") of $N hosts, second run $(grep -c 'scene uploaded' "$FH/second.log")"
-median_time tl bin/franja render "$SCENE" -o "$FH/l.pfm" $ARGS -j "$N" || exit 1
-median_time ts fr render "$SCENE" -o "$FH/s.pfm" $ARGS --hosts "$FH/hosts" || exit 1
+SSH="env -u SSH_AUTH_SOCK bin/franja render $SCENE -o $FH/s.pfm $ARGS --hosts $FH/hosts --known-hosts $FH/known_hosts --no-ssh-config"
+compare "bin/franja render $SCENE -o $FH/l.pfm $ARGS -j $N" "$SSH" || exit 1
 cmp -s "$FH/l.pfm" "$FH/s.pfm" || { echo "SSH and local images differ"; exit 1; }
-echo "local $N slots: $tl s, $N fake SSH hosts x 1 slot: $ts s; ratio $(calc "$ts / $tl") (overhead $(calc "($ts - $tl) * 100 / $tl") %, $(calc "$ts - $tl") s)"
+echo "local $N slots: $TA s, $N fake SSH hosts x 1 slot: $TB s; ratio $(calc "$TB / $TA") (overhead $(calc "($TB - $TA) * 100 / $TA") %, $(calc "$TB - $TA") s)"
+echo "machine after: load $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,25 +1,34 @@
 # bench_common.sh -- sourced by the coordinator benchmarks (tests/bench/coord_*.sh).
-# median_time VAR CMD...: runs CMD $RUNS times, sets VAR to the median wall
-# seconds.  machine: prints what the figures were measured on.
+#
+# compare "A-CMD" "B-CMD": runs the two commands alternately $RUNS times
+# (alternating spreads a changing machine load over both), prints every
+# time, and sets TA and TB to the medians in seconds.  machine: prints what
+# the figures were measured on.
 RUNS=${RUNS:-3}
 
 calc() { awk "BEGIN { printf \"%.3f\", $1 }"; }
 
-median_time() {
-    var=$1
-    shift
-    times=""
+elapsed() {
+    s=$(date +%s.%N)
+    sh -c "$1" >/dev/null 2>&1 || { echo "benchmark command failed: $1" >&2; return 1; }
+    calc "$(date +%s.%N) - $s"
+}
+
+median() { printf '%s\n' "$@" | sort -n | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
+
+compare() {
+    la="" lb=""
     i=0
     while [ $i -lt "$RUNS" ]; do
-        s=$(date +%s.%N)
-        "$@" >/dev/null 2>&1 || { echo "benchmark command failed: $*"; return 1; }
-        e=$(date +%s.%N)
-        times="$times $(calc "$e - $s")"
+        a=$(elapsed "$1") || return 1
+        b=$(elapsed "$2") || return 1
+        la="$la $a" lb="$lb $b"
         i=$((i + 1))
     done
-    m=$(printf '%s\n' $times | sort -n | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
-    eval "$var=$m"
-    echo "  $(printf '%s ' $times| sed 's/ $//') s -> median $m s: $*"
+    TA=$(median $la)
+    TB=$(median $lb)
+    echo "  A:$la s (median $TA): $1"
+    echo "  B:$lb s (median $TB): $2"
 }
 
 machine() {
