@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "compile.h"
+#include "deploy.h"
 #include "fbin.h"
 #include "hostcmd.h"
 #include "rendercmd.h"
@@ -14,6 +15,7 @@ static const char usage[] =
     "                     [--exposure E] [--resume] [--accept-new-hosts] ...\n"
     "       franja compile ...\n"
     "       franja hosts check|list --hosts FILE\n"
+    "       franja deploy --hosts FILE [--dist DIR]\n"
     "       franja --help | --version\n"
     "\n"
     "Franja renders a scene with a path tracer, on this machine's cores or on a\n"
@@ -37,6 +39,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(cmd, "compile"))
         return cmd_compile(argc - 1, argv + 1);
+    if (!strcmp(cmd, "deploy"))
+        return cmd_deploy(argc - 1, argv + 1);
     int rc;
     if (!strcmp(cmd, "render") || !strcmp(cmd, "hosts")) {
         ssh_init();

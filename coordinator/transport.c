@@ -50,6 +50,43 @@ int tr_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err)
     return h->be->cache(h->impl, files, bytes, err);
 }
 
+int tr_sysinfo(tr_host *h, char *arch, char *os, fr_error *err)
+{
+    arch[0] = os[0] = 0;
+    return h->be->sysinfo(h->impl, arch, os, err);
+}
+
+int tr_install(tr_host *h, const char *local_path, const char *name, char *remote, size_t cap,
+               fr_error *err)
+{
+    return h->be->install(h->impl, local_path, name, remote, cap, err);
+}
+
+void tr_os_codename(const char *text, char *os)
+{
+    const char key[] = "VERSION_CODENAME=";
+    const size_t klen = sizeof key - 1;
+    os[0] = 0;
+    for (const char *l = text; *l;) {
+        const char *end = strchr(l, '\n');
+        size_t len = end ? (size_t)(end - l) : strlen(l);
+        if (len > klen && !strncmp(l, key, klen)) {
+            const char *v = l + klen;
+            size_t n = len - klen;
+            /* The value may be quoted: VERSION_CODENAME="bookworm". */
+            if (n >= 2 && (v[0] == '"' || v[0] == '\'') && v[n - 1] == v[0]) {
+                v++;
+                n -= 2;
+            }
+            snprintf(os, 64, "%.*s", (int)(n < 63 ? n : 63), v);
+            return;
+        }
+        if (!end)
+            break;
+        l = end + 1;
+    }
+}
+
 int tr_spawn(tr_host *h, const char *const *args, tr_proc **out, fr_error *err)
 {
     *out = NULL;

@@ -72,6 +72,19 @@ int tr_stage(tr_host *h, const char *local_path, uint64_t hash, char *remote, si
  * both 0 for a local host, which needs no cache). */
 int tr_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err);
 
+/** What the host's system is, found without running its worker (so it works
+ * before the first `franja deploy`): arch[32] from `uname -m`, os[64] the
+ * VERSION_CODENAME of its /etc/os-release ("" when there is none). */
+int tr_sysinfo(tr_host *h, char *arch, char *os, fr_error *err);
+
+/** Installs the local file at local_path on the host as WORKDIR/name with
+ * mode 0755, creating the work directory.  SSH: sent by SFTP under a private
+ * temporary name, checked for size and renamed into place, so a worker still
+ * running from the old copy is not disturbed.  The installed path goes to
+ * remote[cap].  Local hosts refuse: they run this machine's files. */
+int tr_install(tr_host *h, const char *local_path, const char *name, char *remote, size_t cap,
+               fr_error *err);
+
 /** Starts one worker process with the given arguments (argv without the
  * program name; NULL-terminated).  Remote arguments are shell-quoted.
  * *out is owned by the caller (tr_proc_free). */

@@ -22,6 +22,9 @@ typedef struct {
     void (*kill)(tr_proc *p);
     void (*release)(tr_proc *p);   /* frees p->impl; the process is no longer running */
     void (*close)(void *impl);
+    int (*sysinfo)(void *impl, char *arch, char *os, fr_error *err);
+    int (*install)(void *impl, const char *local_path, const char *name, char *remote, size_t cap,
+                   fr_error *err);
 } tr_backend;
 
 extern const tr_backend tr_local_backend;
@@ -46,6 +49,10 @@ int tr_proc_add_out(tr_proc *p, const void *data, size_t n);
 
 /** Keeps the tail of what p writes on stderr. */
 void tr_proc_add_err(tr_proc *p, const void *data, size_t n);
+
+/** Copies the VERSION_CODENAME of an os-release text (NUL-terminated) into
+ * os[64], without quotes; "" if it has none. */
+void tr_os_codename(const char *os_release, char *os);
 
 /** Marks p failed with a reason (printf-style). */
 void tr_proc_fail(tr_proc *p, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

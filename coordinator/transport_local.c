@@ -191,6 +191,31 @@ static int local_cache(void *impl, int *files, uint64_t *bytes, fr_error *err)
     return 0;
 }
 
+static int local_sysinfo(void *impl, char *arch, char *os, fr_error *err)
+{
+    (void)impl, (void)err;
+    struct utsname u;
+    if (uname(&u) == 0)
+        snprintf(arch, 32, "%.31s", u.machine);
+    char text[4096];
+    FILE *f = fopen("/etc/os-release", "r");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f)
+        fclose(f);
+    text[n] = 0;
+    tr_os_codename(text, os);
+    return 0;
+}
+
+static int local_install(void *impl, const char *local_path, const char *name, char *remote, size_t cap,
+                         fr_error *err)
+{
+    local_host *h = impl;
+    (void)local_path, (void)name, (void)remote, (void)cap;
+    return fr_fail(err, "%s: a local host runs this machine's worker (%s); nothing to install", h->entry.name,
+                   h->worker);
+}
+
 static int local_spawn(void *impl, tr_proc *p, const char *const *args, fr_error *err)
 {
     local_host *h = impl;
@@ -280,5 +305,5 @@ static void local_close(void *impl) { free(impl); }
 
 const tr_backend tr_local_backend = {
     "local", local_connect, local_probe, local_stage, local_cache, local_spawn, local_pollfds,
-    local_service, local_kill, local_release, local_close,
+    local_service, local_kill, local_release, local_close, local_sysinfo, local_install,
 };

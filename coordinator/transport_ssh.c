@@ -419,13 +419,13 @@ static int upload(ssh_host *h, const char *local, const char *tmp, fr_error *err
         if (n == 0)
             break;
         if (sftp_write(f, buf, (size_t)n) != n) {
-            rc = fr_fail(err, "%s: upload of the scene failed: %s", h->label, ssh_get_error(h->s));
+            rc = fr_fail(err, "%s: upload of %s failed: %s", h->label, local, ssh_get_error(h->s));
             break;
         }
     }
     close(fd);
     if (sftp_close(f) != SSH_NO_ERROR && rc == 0)
-        rc = fr_fail(err, "%s: upload of the scene failed on close: %s", h->label, ssh_get_error(h->s));
+        rc = fr_fail(err, "%s: upload of %s failed on close: %s", h->label, local, ssh_get_error(h->s));
     return rc;
 }
 
@@ -503,6 +503,71 @@ static int ssh_cache(void *impl, int *files, uint64_t *bytes, fr_error *err)
     }
     sftp_closedir(d);
     return 0;
+}
+
+static int ssh_sysinfo(void *impl, char *arch, char *os, fr_error *err)
+{
+    ssh_host *h = impl;
+    tr_proc p;
+    memset(&p, 0, sizeof p);
+    int status = -1;
+    int rc = run_remote(h, "uname -m && (cat /etc/os-release 2>/dev/null || true)", &p, &status, err);
+    if (rc == 0 && status != 0)
+        rc = fr_fail(err, "%s: uname -m failed (status %d): %s", h->label, status, p.err);
+    if (rc == 0 && tr_proc_add_out(&p, "", 1))
+        rc = fr_fail(err, "%s: out of memory", h->label);
+    if (rc == 0) {
+        const char *text = (const char *)p.out;
+        size_t n = strcspn(text, "\n");
+        if (n == 0 || n >= 32) {
+            rc = fr_fail(err, "%s: unexpected answer to uname -m", h->label);
+        } else {
+            snprintf(arch, 32, "%.*s", (int)n, text);
+            tr_os_codename(text + n, os);
+        }
+    }
+    free(p.out);
+    return rc;
+}
+
+static int ssh_install(void *impl, const char *local_path, const char *name, char *remote, size_t cap,
+                       fr_error *err)
+{
+    ssh_host *h = impl;
+    struct stat st;
+    if (stat(local_path, &st))
+        return fr_fail(err, "%s: %s", local_path, strerror(errno));
+    char path[800], tmp[900];
+    snprintf(path, sizeof path, "%s/%s", h->workdir, name);
+    if (strlen(path) >= cap)
+        return fr_fail(err, "%s: work directory path too long", h->label);
+    if (sftp_ready(h, err))
+        return -1;
+    /* As for scenes: a private temporary name, renamed into place. */
+    snprintf(tmp, sizeof tmp, "%s.part-%ld-%ld", path, (long)getpid(), (long)(now_s() * 1e3));
+    int rc = sftp_mkdirs(h, h->workdir, err);
+    if (rc == 0)
+        rc = upload(h, local_path, tmp, err);
+    if (rc == 0) {
+        sftp_attributes a = sftp_stat(h->sftp, tmp);
+        if (!a || a->size != (uint64_t)st.st_size)
+            rc = fr_fail(err, "%s: %s arrived incomplete", h->label, tmp);
+        sftp_attributes_free(a);
+    }
+    if (rc == 0 && sftp_chmod(h->sftp, tmp, 0755) != SSH_OK)
+        rc = fr_fail(err, "%s: cannot make %s executable: %s", h->label, tmp, ssh_get_error(h->s));
+    if (rc == 0 && sftp_rename(h->sftp, tmp, path) != SSH_OK) {
+        /* SFTP version 3 does not rename over an existing file. */
+        sftp_unlink(h->sftp, path);
+        if (sftp_rename(h->sftp, tmp, path) != SSH_OK)
+            rc = fr_fail(err, "%s: cannot rename %s into place: %s", h->label, tmp, ssh_get_error(h->s));
+    }
+    if (rc)
+        sftp_unlink(h->sftp, tmp);
+    else
+        strcpy(remote, path);
+    sftp_done(h);
+    return rc;
 }
 
 static int ssh_spawn(void *impl, tr_proc *p, const char *const *args, fr_error *err)
@@ -654,5 +719,5 @@ static void ssh_close_host(void *impl)
 
 const tr_backend tr_ssh_backend = {
     "ssh", ssh_connect_host, ssh_probe, ssh_stage, ssh_cache, ssh_spawn, ssh_pollfds,
-    ssh_service, ssh_kill, ssh_release, ssh_close_host,
+    ssh_service, ssh_kill, ssh_release, ssh_close_host, ssh_sysinfo, ssh_install,
 };
