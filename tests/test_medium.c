@@ -297,8 +297,38 @@ static void furnace(const char *what, const char *media_json, const char *extra_
     scn_free(&s);
 }
 
+/* Slabs of a render with media are the same bytes as the same rows of the
+ * whole image (the path's random numbers depend only on pixel and sample). */
+static void split_invariance(void)
+{
+    fr_scene s;
+    test_scene(HEAD(12, 9, 4, 6)
+               " \"camera\": {\"position\": [0, 0.5, 3], \"target\": [0, 0, 0], \"fov\": 50},"
+               " \"media\": {\"fog\": {\"sigma_a\": 0.05, \"sigma_s\": [0.3, 0.4, 0.5], \"g\": 0.4},"
+               "   \"ball\": {\"sigma_s\": 3}}, \"medium\": \"fog\","
+               " \"materials\": {\"w\": {\"type\": \"lambert\", \"albedo\": [0.6, 0.6, 0.6]},"
+               "   \"b\": {\"type\": \"interface\", \"medium\": \"ball\"}, \"lamp\": {\"type\": \"emitter\", \"emission\": [4, 4, 4]}},"
+               " \"shapes\": [{\"type\": \"plane\", \"point\": [0, -1, 0], \"normal\": [0, 1, 0], \"material\": \"w\"},"
+               "   {\"type\": \"sphere\", \"center\": [0.3, 0, 0], \"radius\": 0.7, \"material\": \"b\"},"
+               "   {\"type\": \"sphere\", \"center\": [-1, 1.5, 0], \"radius\": 0.3, \"material\": \"lamp\"}],"
+               " \"lights\": [{\"type\": \"point\", \"position\": [1, 1.2, 0.5], \"intensity\": [3, 3, 3]}]}",
+               &s);
+    float whole[12 * 9 * 3], part[12 * 9 * 3];
+    pt_render_rows(&s, PT_MIS, 0, 9, whole);
+    const uint32_t cuts[] = {0, 2, 3, 7, 9};
+    for (int k = 0; k < 4; k++)
+        pt_render_rows(&s, PT_MIS, cuts[k], cuts[k + 1], part + cuts[k] * 12 * 3);
+    CHECK(!memcmp(whole, part, sizeof whole), "slabs of a render with media differ from the whole image");
+    double sum = 0;
+    for (int i = 0; i < 12 * 9 * 3; i++)
+        sum += whole[i];
+    CHECK(sum > 0 && isfinite(sum), "the media split scene renders black or non-finite (%g)", sum);
+    scn_free(&s);
+}
+
 int main(void)
 {
+    split_invariance();
     transmittance_and_phase();
     distance_sampling();
     equiangular_sampling();
