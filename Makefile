@@ -80,6 +80,27 @@ bin/bench/%: tests/bench/%.c $(LIB)
 	@mkdir -p bin/bench
 	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
 
+# Fuzzing: libFuzzer targets tests/fuzz/fuzz_*.c, built with clang, ASan
+# and UBSan over the common sources, each run for FUZZ_SECONDS (tests/fuzz/run.sh).
+FUZZ_SECONDS ?= 60
+FUZZ_CC      ?= clang
+FUZZ_CFLAGS   = -std=c17 -D_GNU_SOURCE -g -O1 $(FPFLAGS) -Icommon $(CJSON_CFLAGS) -fno-sanitize-recover=all
+FUZZ_SRC      = $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_BIN      = $(FUZZ_SRC:tests/fuzz/%.c=bin/fuzz/%)
+FUZZ_OBJ      = $(COMMON_SRC:%.c=$(B)/fuzz/%.o)
+.SECONDARY: $(FUZZ_OBJ)
+
+$(B)/fuzz/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -c $< -o $@
+
+bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) coordinator/obj.c coordinator/obj.h
+	@mkdir -p bin/fuzz
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer,address,undefined -o $@ $< $(FUZZ_OBJ) $(CJSON_LIBS) -lm
+
+fuzz: bin/franja $(FUZZ_BIN)
+	sh tests/fuzz/run.sh $(FUZZ_SECONDS)
+
 deps:
 	sh tests/install-deps.sh
 

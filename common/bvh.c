@@ -16,8 +16,7 @@ enum { BINS = 32, LEAF_MIN = 4, LEAF_MAX = 16 };
 typedef struct { f4 lo, hi; } box4;   /* lane 3 unused (kept 0) */
 
 /* A contiguous range of references with its bounds and the bounds of its
- * centroids (stored doubled: lo + hi, which bins the same and saves a
- * multiply). */
+ * centroids. */
 typedef struct {
     uint32_t begin, end;
     box4 box, cent;
@@ -37,7 +36,8 @@ typedef struct {
 static box4 box_empty(void) { return (box4){f4_set1(INFINITY), f4_set1(-INFINITY)}; }
 static void box_grow(box4 *a, box4 b) { a->lo = f4_min_num(b.lo, a->lo); a->hi = f4_max_num(b.hi, a->hi); }
 static void box_add(box4 *a, f4 p) { a->lo = f4_min_num(p, a->lo); a->hi = f4_max_num(p, a->hi); }
-static f4 centroid(box4 b) { return b.lo + b.hi; }
+/* Box midpoints (halves added: no overflow for coordinates near FLT_MAX). */
+static f4 centroid(box4 b) { return b.lo * f4_set1(0.5f) + b.hi * f4_set1(0.5f); }
 
 /* Half the surface area: the SAH only compares areas. */
 static float half_area(box4 b)
@@ -97,11 +97,20 @@ static f4 bin_scale(const span *s)
     return k;
 }
 
+/* Bin of centroid coordinate(s) c: clamped to [0, BINS-1] while still a
+ * float (an extent that overflowed gives inf or NaN here, which must not
+ * reach the integer conversion); bin_of and bin_at agree lane for lane. */
 static i4 bin_of(f4 c, f4 lo, f4 scale)
 {
-    i4 k = __builtin_convertvector((c - lo) * scale, i4);
-    i4 top = i4_set1(BINS - 1), over = k > top;
-    return (k & ~over) | (top & over);
+    f4 f = f4_max_num(f4_min_num((c - lo) * scale, f4_set1((float)(BINS - 1))), f4_set1(0.0f));
+    return __builtin_convertvector(f, i4);
+}
+
+static int bin_at(float c, float lo, float scale)
+{
+    float f = (c - lo) * scale;
+    f = f < (float)(BINS - 1) ? f : (float)(BINS - 1);
+    return (int)(f > 0.0f ? f : 0.0f);
 }
 
 /* Split span s into *l and *r.  Returns 0 when s should rather be a leaf
@@ -172,10 +181,7 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
         uint32_t i = s->begin, j = s->end;
         while (i < j) {
             f4 c = centroid(B->box[i]);
-            int k = (int)((c[best_axis] - lo) * sc);
-            if (k > BINS - 1)
-                k = BINS - 1;
-            if (k < best_bin) {
+            if (bin_at(c[best_axis], lo, sc) < best_bin) {
                 i++;
             } else {
                 j--;

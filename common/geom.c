@@ -120,7 +120,10 @@ static float offset_coord(float p, float n)
     const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
     if (fabsf(p) < origin)
         return p + float_scale * n;
-    int32_t di = (int32_t)(int_scale * n);
+    /* n is a unit normal's component; a degenerate surface's NaN normal
+     * gives no step (and no out-of-range float-to-int conversion). */
+    float step = int_scale * n;
+    int32_t di = step >= -int_scale && step <= int_scale ? (int32_t)step : 0;
     int32_t bits = float_to_bits(p);
     return bits_to_float(bits + ((p < 0.0f) ? -di : di));
 }

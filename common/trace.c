@@ -230,7 +230,11 @@ static inline __attribute__((always_inline)) int walk(const fr_scene *s, const f
             hit->t = t; hit->prim = FR_NONE; hit->plane = i; hit->a = hit->b = 0.0f;
         }
     }
-    if (s->n_nodes == 0)
+    /* A ray with an infinite or NaN coordinate (from a degenerate surface)
+     * would make every box test true, empty slots included: it hits
+     * nothing in the BVH.  x * 0 is 0 for finite x, NaN otherwise. */
+    float nonfinite = r->o.x * 0.0f + r->o.y * 0.0f + r->o.z * 0.0f + r->d.x * 0.0f + r->d.y * 0.0f + r->d.z * 0.0f;
+    if (s->n_nodes == 0 || nonfinite != 0.0f)
         return H.found;
     ray4 R;
     ray_setup(&R, r);

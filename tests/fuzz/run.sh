@@ -1,0 +1,40 @@
+#!/bin/sh
+# make fuzz: run each libFuzzer target (bin/fuzz/fuzz_*, built with ASan
+# and UBSan) for SECONDS seconds (default 60) from its seed corpus, and
+# print the executions and what was found.  Work files, the grown corpora
+# and any crashing input go to build/fuzz/run/.  Exit status 1 if a target
+# crashed, leaked, hit undefined behaviour or timed out.
+#
+# Seeds: tests/fuzz/corpus/json and tests/fuzz/corpus/obj (inputs starting
+# with 'M' are MTL files); the binary-scene seeds are the example scenes
+# without meshes, compiled now so that they are always the current format.
+cd "$(dirname "$0")/../.." || exit 1
+SECS=${1:-60}
+W=build/fuzz/run
+rm -rf "$W"
+mkdir -p "$W/seed-fbin"
+for s in scenes/*.json; do
+    grep -q '"mesh"' "$s" && continue
+    bin/franja compile "$s" -o "$W/seed-fbin/$(basename "$s" .json).fbin" >/dev/null || exit 1
+done
+echo "== fuzz: ${SECS} s per target, clang $(clang --version | sed -n 's/.*version \([0-9.]*\).*/\1/p;q'), ASan + UBSan"
+rc=0
+for t in fbin json obj; do
+    seeds=tests/fuzz/corpus/$t
+    [ "$t" = fbin ] && seeds=$W/seed-fbin
+    mkdir -p "$W/corpus-$t"
+    bin/fuzz/fuzz_$t -max_total_time="$SECS" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+        -print_final_stats=1 -artifact_prefix="$W/$t-" "$W/corpus-$t" "$seeds" >"$W/$t.log" 2>&1
+    status=$?
+    execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$W/$t.log" | tail -n 1)
+    inputs=$(ls "$W/corpus-$t" | wc -l)
+    cov=$(grep -o 'cov: [0-9]*' "$W/$t.log" | tail -n 1)
+    if [ "$status" -eq 0 ]; then
+        echo "fuzz_$t: ${execs:-?} executions, $cov, corpus grew by $inputs inputs: nothing found"
+    else
+        rc=1
+        echo "fuzz_$t: FOUND a problem after ${execs:-?} executions (exit $status); input: $(ls "$W/$t-"* 2>/dev/null)"
+        grep -E 'ERROR|runtime error|SUMMARY' "$W/$t.log" | head -n 5
+    fi
+done
+exit $rc
