@@ -86,30 +86,34 @@ static void swap_refs(build *B, uint32_t i, uint32_t j)
     uint32_t ti = B->id[i]; B->id[i] = B->id[j]; B->id[j] = ti;
 }
 
-/* Bin scale per axis: BINS slightly shrunk so the largest centroid lands in
- * the last bin; 0 on an axis where every centroid is equal. */
-static f4 bin_scale(const span *s)
+/* Bins for a span of n references: fewer for small spans, whose SAH sweep
+ * would otherwise cost more than their binning. */
+static int bin_count(uint32_t n) { return n >= 4 * (BINS - 4) ? BINS : 4 + (int)(n / 4); }
+
+/* Bin scale per axis: nb bins slightly shrunk so the largest centroid
+ * lands in the last bin; 0 on an axis where every centroid is equal. */
+static f4 bin_scale(const span *s, int nb)
 {
     f4 ext = s->cent.hi - s->cent.lo, k = f4_set1(0.0f);
     for (int a = 0; a < 3; a++)
         if (ext[a] > 0.0f)
-            k[a] = ((float)BINS * 0.9999f) / ext[a];
+            k[a] = ((float)nb * 0.9999f) / ext[a];
     return k;
 }
 
-/* Bin of centroid coordinate(s) c: clamped to [0, BINS-1] while still a
+/* Bin of centroid coordinate(s) c: clamped to [0, nb-1] while still a
  * float (an extent that overflowed gives inf or NaN here, which must not
  * reach the integer conversion); bin_of and bin_at agree lane for lane. */
-static i4 bin_of(f4 c, f4 lo, f4 scale)
+static i4 bin_of(f4 c, f4 lo, f4 scale, int nb)
 {
-    f4 f = f4_max_num(f4_min_num((c - lo) * scale, f4_set1((float)(BINS - 1))), f4_set1(0.0f));
+    f4 f = f4_max_num(f4_min_num((c - lo) * scale, f4_set1((float)(nb - 1))), f4_set1(0.0f));
     return __builtin_convertvector(f, i4);
 }
 
-static int bin_at(float c, float lo, float scale)
+static int bin_at(float c, float lo, float scale, int nb)
 {
     float f = (c - lo) * scale;
-    f = f < (float)(BINS - 1) ? f : (float)(BINS - 1);
+    f = f < (float)(nb - 1) ? f : (float)(nb - 1);
     return (int)(f > 0.0f ? f : 0.0f);
 }
 
@@ -119,20 +123,20 @@ static int bin_at(float c, float lo, float scale)
 static int split_span(build *B, const span *s, span *l, span *r, int force, int median)
 {
     uint32_t n = s->end - s->begin;
-    int best_axis = -1, best_bin = 0;
+    int best_axis = -1, best_bin = 0, nb = bin_count(n);
     float best_cost = INFINITY;
-    f4 scale = bin_scale(s);
+    f4 scale = bin_scale(s, nb);
     if (!median) {
         box4 bins[3][BINS];
         uint32_t count[3][BINS];
         for (int a = 0; a < 3; a++)
-            for (int k = 0; k < BINS; k++) {
+            for (int k = 0; k < nb; k++) {
                 bins[a][k] = box_empty();
                 count[a][k] = 0;
             }
         for (uint32_t i = s->begin; i < s->end; i++) {
             box4 bx = B->box[i];
-            i4 k = bin_of(centroid(bx), s->cent.lo, scale);
+            i4 k = bin_of(centroid(bx), s->cent.lo, scale, nb);
             for (int a = 0; a < 3; a++) {
                 box_grow(&bins[a][k[a]], bx);
                 count[a][k[a]]++;
@@ -145,7 +149,7 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
             uint32_t right_count[BINS];
             box4 acc = box_empty();
             uint32_t c = 0;
-            for (int k = BINS - 1; k > 0; k--) {
+            for (int k = nb - 1; k > 0; k--) {
                 box_grow(&acc, bins[a][k]);
                 c += count[a][k];
                 right_count[k] = c;
@@ -153,7 +157,7 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
             }
             acc = box_empty();
             c = 0;
-            for (int k = 1; k < BINS; k++) {
+            for (int k = 1; k < nb; k++) {
                 box_grow(&acc, bins[a][k - 1]);
                 c += count[a][k - 1];
                 if (c == 0 || right_count[k] == 0)
@@ -172,28 +176,33 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
                 return 0;
         }
     }
-    uint32_t mid;
+    *l = (span){s->begin, s->begin, box_empty(), box_empty(), 0};
+    *r = (span){s->end, s->end, box_empty(), box_empty(), 0};
     if (best_axis < 0) {
         /* Every centroid in one bin (or the depth guard): halve the range. */
-        mid = s->begin + n / 2;
-    } else {
-        float lo = s->cent.lo[best_axis], sc = scale[best_axis];
-        uint32_t i = s->begin, j = s->end;
-        while (i < j) {
-            f4 c = centroid(B->box[i]);
-            if (bin_at(c[best_axis], lo, sc) < best_bin) {
-                i++;
-            } else {
-                j--;
-                swap_refs(B, i, j);
-            }
-        }
-        mid = i;
+        l->end = r->begin = s->begin + n / 2;
+        span_bounds(B, l);
+        span_bounds(B, r);
+        return 1;
     }
-    *l = (span){s->begin, mid, box_empty(), box_empty(), 0};
-    *r = (span){mid, s->end, box_empty(), box_empty(), 0};
-    span_bounds(B, l);
-    span_bounds(B, r);
+    /* Partition by bin, collecting both sides' bounds on the way. */
+    float lo = s->cent.lo[best_axis], sc = scale[best_axis];
+    uint32_t i = s->begin, j = s->end;
+    while (i < j) {
+        box4 bx = B->box[i];
+        f4 c = centroid(bx);
+        if (bin_at(c[best_axis], lo, sc, nb) < best_bin) {
+            box_grow(&l->box, bx);
+            box_add(&l->cent, c);
+            i++;
+        } else {
+            box_grow(&r->box, bx);
+            box_add(&r->cent, c);
+            j--;
+            swap_refs(B, i, j);
+        }
+    }
+    l->end = r->begin = i;
     return 1;
 }
 
