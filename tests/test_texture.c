@@ -347,7 +347,14 @@ static void textured_light(void)
     scn_free(&s);
 }
 
-/* Render a plane lit by a point light, with material `mat` (JSON). */
+/* The surfaces render_plane draws: a rectangle, and an infinite plane
+ * tilted off the axes (so a needless renormalization of its normal would
+ * change bits). */
+static const char *const RECT = "{\"type\": \"rect\", \"origin\": [-2, 0, 2], \"edge_u\": [4, 0, 0], \"edge_v\": [0, 0, -4], \"material\": \"m\"}";
+static const char *const PLANE = "{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0.1, 1, 0.23], \"material\": \"m\"}";
+static const char *surface = RECT;
+
+/* Render `surface` lit by a point light, with material `mat` (JSON). */
 static int render_plane(const char *textures, const char *mat, vec3 light, float *rgb, fr_error *err)
 {
     char json[2048];
@@ -356,10 +363,9 @@ static int render_plane(const char *textures, const char *mat, vec3 light, float
              " \"camera\": {\"position\": [0.3, 2, 1.5], \"target\": [0, 0, 0], \"fov\": 60},"
              " \"textures\": {%s},"
              " \"materials\": {\"m\": %s},"
-             " \"shapes\": [{\"type\": \"rect\", \"origin\": [-2, 0, 2], \"edge_u\": [4, 0, 0], \"edge_v\": [0, 0, -4],"
-             "   \"material\": \"m\"}],"
+             " \"shapes\": [%s],"
              " \"lights\": [{\"type\": \"point\", \"position\": [%g, %g, %g], \"intensity\": [5, 5, 5]}]}",
-             textures, mat, light.x, light.y, light.z);
+             textures, mat, surface, light.x, light.y, light.z);
     fr_scene s;
     if (load(json, &s, err) < 0)
         return -1;
@@ -496,6 +502,9 @@ int main(void)
     textured_quad();
     textured_light();
     flat_bump_changes_nothing();
+    surface = PLANE;
+    flat_bump_changes_nothing();
+    surface = RECT;
     ramp_bump_normal();
     no_leaks();
     remove_files();
