@@ -50,6 +50,16 @@ scene other '[0.45, 0.45, 0.45]'
 $F compile "$T/other.json" -o "$T/other.fbin" >/dev/null && $W --scene "$T/other.fbin" --rows 0:8 --format ppm16 -o "$T/other.ppm" || bad "render the other grey"
 if oiiotool "$T/tex.ppm" "$T/other.ppm" --fail 0.0001 --warn 0.0001 --diff >/dev/null 2>&1; then bad "the texture comparison cannot fail"; else ok; fi
 
+# A float image (EXR) holds linear values: no sRGB decoding by default.
+oiiotool --pattern constant:color=0.5,0.5,0.5 4x4 3 -d half -o "$T/grey.exr" 2>"$T/log" || bad "oiiotool exr: $(cat "$T/log")"
+sed 's/grey.png/grey.exr/' "$T/tex.json" >"$T/exr.json"
+scene half '[0.5, 0.5, 0.5]'
+$F compile "$T/exr.json" -o "$T/exr.fbin" >/dev/null && $W --scene "$T/exr.fbin" --rows 0:8 --format ppm16 -o "$T/exr.ppm" &&
+    $F compile "$T/half.json" -o "$T/half.fbin" >/dev/null && $W --scene "$T/half.fbin" --rows 0:8 --format ppm16 -o "$T/half.ppm" || bad "render the EXR scenes"
+if oiiotool "$T/exr.ppm" "$T/half.ppm" --fail 0.0001 --warn 0.0001 --diff >"$T/log" 2>&1; then ok; else
+    bad "an EXR texture of 0.5 renders differently from albedo 0.5: $(head -5 "$T/log")"
+fi
+
 # Tone mapping from the scene and the command line.
 $F render scenes/dof-spheres.json -o "$T/a.png" --size 32x16 --spp 2 -j 2 >/dev/null 2>&1 &&
     $F render scenes/dof-spheres.json -o "$T/b.png" --size 32x16 --spp 2 -j 2 --tonemap filmic --exposure 1 >/dev/null 2>&1 || bad "render with --tonemap"
