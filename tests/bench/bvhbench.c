@@ -12,9 +12,11 @@
  *   - with --worker: worker start-up, from process start to its first pixel
  *     written (a 1x1-pixel, 1-sample render of the scene);
  *   - the binary scene's bytes per triangle.
- * Every figure is the median of N runs; Embree's hits are checked against
- * Franja's (same triangle, t within 1e-4 relative).  Linked with Embree only
- * here: nothing else in Franja uses it. */
+ * Every figure is the median of N runs, timed in process CPU seconds (both
+ * sides run on one thread; CPU time keeps a busy machine's scheduling out
+ * of the figures; start-up is wall time).  Embree's hits are checked
+ * against Franja's (same triangle, t within 1e-4 relative).  Linked with
+ * Embree only here: nothing else in Franja uses it. */
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <stdio.h>
@@ -30,12 +32,15 @@
 #include "render.h"
 #include "trace.h"
 
-static double now(void)
+static double clock_s(clockid_t id)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(id, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+static double now(void) { return clock_s(CLOCK_PROCESS_CPUTIME_ID); }
+static double wall(void) { return clock_s(CLOCK_MONOTONIC); }
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -229,7 +234,7 @@ static double startup_ms(const char *worker, const char *scene, int reps)
 {
     double t[64];
     for (int k = 0; k < reps; k++) {
-        double t0 = now();
+        double t0 = wall();
         pid_t pid = fork();
         if (pid == 0) {
             execl(worker, worker, "--scene", scene, "--rows", "0:1", "--size", "1x1", "--spp", "1", "-o", "/dev/null",
@@ -238,7 +243,7 @@ static double startup_ms(const char *worker, const char *scene, int reps)
         }
         int st;
         waitpid(pid, &st, 0);
-        t[k] = (now() - t0) * 1e3;
+        t[k] = (wall() - t0) * 1e3;
         if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
             fprintf(stderr, "bvhbench: %s failed on %s\n", worker, scene);
             return -1.0;
