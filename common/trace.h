@@ -28,7 +28,11 @@ typedef struct {
     uint32_t light;            /* FR_NONE unless an area light */
 } fr_surface;
 
-/* Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0. */
+/* Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0.  The result
+ * is exactly what testing every plane and then every primitive in index
+ * order with trace_prim would give: of hits at the same t the plane or the
+ * lowest primitive index wins, whatever order the BVH visits them in.  A
+ * ray with a non-finite origin or direction hits no primitive. */
 int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit);
 /* 1 if anything but prim `skip` (FR_NONE: nothing skipped) is hit in
  * (0, tmax).  Shadow rays skip the light they aim at: a convex emitter
