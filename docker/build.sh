@@ -41,6 +41,10 @@ done
 case $dist in /*) ;; *) dist=$(pwd)/$dist ;; esac
 
 if [ $own = 1 ]; then
+    # One engine at a time on the cached data root (the tests take this lock too).
+    mkdir -p "$cache"
+    exec 9>"$cache/lock"
+    flock 9
     state=$(mktemp -d /tmp/franja-engine.XXXXXX)
     trap 'sh "$here/private-dockerd.sh" stop "$state"; rm -rf "$state"' EXIT
     DOCKER_HOST=$(sh "$here/private-dockerd.sh" start "$state" "$cache/engine-data")
