@@ -41,9 +41,9 @@ float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, flo
 typedef struct {
     vec3 o, d;
     f4 ox, oy, oz, ix, iy, iz;   /* origin and 1/direction, in every lane */
-    int near[3], far[3];         /* box row of the entry / exit plane per axis */
+    size_t near[3], far[3];      /* per axis, where the entry / exit plane's row starts in box[][] */
     /* the watertight triangle test's ray frame (see geo_triangle) */
-    int kx, ky, kz;
+    size_t kx, ky, kz;           /* where vertex 0's coordinate rows of the sheared axes start in a leaf's v[][] */
     f4 okx, oky, okz, sx, sy, sz;
 } ray4;
 
@@ -72,14 +72,14 @@ static void ray_setup(ray4 *R, const fr_ray *r)
     /* 1/-0 is -inf: the sign bit picks the planes, as it must. */
     int neg[3] = {signbit(r->d.x) != 0, signbit(r->d.y) != 0, signbit(r->d.z) != 0};
     for (int a = 0; a < 3; a++) {
-        R->near[a] = a + 3 * neg[a];
-        R->far[a] = a + 3 * !neg[a];
+        R->near[a] = (size_t)(a + 3 * neg[a]) * FR_BVH_WIDTH;
+        R->far[a] = (size_t)(a + 3 * !neg[a]) * FR_BVH_WIDTH;
     }
     int kz = max_axis(r->d);
     int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
     float dz = v3_get(r->d, kz);
     if (dz < 0.0f) { int t = kx; kx = ky; ky = t; }
-    R->kx = kx; R->ky = ky; R->kz = kz;
+    R->kx = (size_t)kx * 4; R->ky = (size_t)ky * 4; R->kz = (size_t)kz * 4;
     R->okx = f4_set1(v3_get(r->o, kx)); R->oky = f4_set1(v3_get(r->o, ky)); R->okz = f4_set1(v3_get(r->o, kz));
     R->sx = f4_set1(v3_get(r->d, kx) / dz);
     R->sy = f4_set1(v3_get(r->d, ky) / dz);
@@ -92,12 +92,13 @@ static inline unsigned node_hits(const fr_bvh_node *n, const ray4 *R, float tmax
 {
     unsigned m = 0;
     for (int h = 0; h < FR_BVH_WIDTH; h += 4) {
-        f4 nx = (f4_load(n->box[R->near[0]] + h) - R->ox) * R->ix;
-        f4 ny = (f4_load(n->box[R->near[1]] + h) - R->oy) * R->iy;
-        f4 nz = (f4_load(n->box[R->near[2]] + h) - R->oz) * R->iz;
-        f4 fx = (f4_load(n->box[R->far[0]] + h) - R->ox) * R->ix;
-        f4 fy = (f4_load(n->box[R->far[1]] + h) - R->oy) * R->iy;
-        f4 fz = (f4_load(n->box[R->far[2]] + h) - R->oz) * R->iz;
+        const float *b = n->box[0] + h;
+        f4 nx = (f4_load(b + R->near[0]) - R->ox) * R->ix;
+        f4 ny = (f4_load(b + R->near[1]) - R->oy) * R->iy;
+        f4 nz = (f4_load(b + R->near[2]) - R->oz) * R->iz;
+        f4 fx = (f4_load(b + R->far[0]) - R->ox) * R->ix;
+        f4 fy = (f4_load(b + R->far[1]) - R->oy) * R->iy;
+        f4 fz = (f4_load(b + R->far[2]) - R->oz) * R->iz;
         f4 t0 = f4_max_num(nx, f4_max_num(ny, f4_max_num(nz, f4_set1(0.0f))));
         f4 t1 = f4_min_num(fx, f4_min_num(fy, f4_min_num(fz, f4_set1(tmax))));
         f4_store(tn + h, t0);
@@ -135,15 +136,16 @@ static void record(hit_state *H, float t, uint32_t prim, float a, float b)
  * triangles to test.  With `any`, return 1 at the first hit. */
 static inline __attribute__((always_inline)) int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes, hit_state *H, int any)
 {
-    f4 az = f4_load(L->v[0 + R->kz]) - R->okz;
-    f4 bz = f4_load(L->v[3 + R->kz]) - R->okz;
-    f4 cz = f4_load(L->v[6 + R->kz]) - R->okz;
-    f4 ax = (f4_load(L->v[0 + R->kx]) - R->okx) - R->sx * az;
-    f4 ay = (f4_load(L->v[0 + R->ky]) - R->oky) - R->sy * az;
-    f4 bx = (f4_load(L->v[3 + R->kx]) - R->okx) - R->sx * bz;
-    f4 by = (f4_load(L->v[3 + R->ky]) - R->oky) - R->sy * bz;
-    f4 cx = (f4_load(L->v[6 + R->kx]) - R->okx) - R->sx * cz;
-    f4 cy = (f4_load(L->v[6 + R->ky]) - R->oky) - R->sy * cz;
+    const float *p = L->v[0];   /* vertex k's rows start at p + 12 k */
+    f4 az = f4_load(p + R->kz) - R->okz;
+    f4 bz = f4_load(p + 12 + R->kz) - R->okz;
+    f4 cz = f4_load(p + 24 + R->kz) - R->okz;
+    f4 ax = (f4_load(p + R->kx) - R->okx) - R->sx * az;
+    f4 ay = (f4_load(p + R->ky) - R->oky) - R->sy * az;
+    f4 bx = (f4_load(p + 12 + R->kx) - R->okx) - R->sx * bz;
+    f4 by = (f4_load(p + 12 + R->ky) - R->oky) - R->sy * bz;
+    f4 cx = (f4_load(p + 24 + R->kx) - R->okx) - R->sx * cz;
+    f4 cy = (f4_load(p + 24 + R->ky) - R->oky) - R->sy * cz;
     f4 u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
     f4 zero = f4_set1(0.0f);
     /* Inside or on the boundary when u, v and w share a sign: their min is
