@@ -16,7 +16,8 @@ set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
 DOCKER=${DOCKER:-docker}
-export DOCKER DOCKER_BUILDKIT=0
+DOCKER_BUILDKIT=${DOCKER_BUILDKIT:-0}
+export DOCKER DOCKER_BUILDKIT
 cache=${FRANJA_CACHE:-/var/cache/franja}
 
 dist=dist jobs=1 bootstrap=0 own=0
