@@ -61,7 +61,7 @@ build_one() {
         sh "$here/base-image.sh" "$t" >"$log" 2>&1 || { cat "$log" >&2; return 1; }
     fi
     if ! tar -C "$root" -cf - Makefile common worker coordinator docker |
-            $DOCKER build --network=host -f "docker/Dockerfile.$t" \
+            $DOCKER build --force-rm --network=host -f "docker/Dockerfile.$t" \
                 -t "franja-build:$t" - >>"$log" 2>&1; then
         tail -n 30 "$log" >&2
         echo "build.sh: docker build of $t failed (log: $log)" >&2

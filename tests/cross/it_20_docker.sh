@@ -102,6 +102,7 @@ for t in $TARGETS; do
 done
 
 # Old layers of earlier runs would pile up in the cached data root.
+$DOCKER container prune -f >/dev/null 2>&1
 $DOCKER image prune -f >/dev/null 2>&1
 DPID=$(cat "$ENGINE/dockerd.pid")
 stop_engine
