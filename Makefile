@@ -44,7 +44,7 @@ LIB         = $(B)/libfranja.a
 WORKER_LIBS = $(CJSON_LIBS) -lm
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm -pthread
 
-.PHONY: all deps check bench render clean docs fuzz static dist check-cross
+.PHONY: all deps check test bench render clean docs fuzz static dist check-cross
 all: bin/franja-worker bin/franja
 
 $(B)/%.o: %.c
@@ -104,7 +104,12 @@ fuzz: bin/franja $(FUZZ_BIN)
 deps:
 	sh tests/install-deps.sh
 
-check: all $(TEST_BIN) $(TOOL_BIN)
+# make check runs everything: the renderer's and coordinator's tests, then
+# the cross-build tests (Docker images, qemu, mixed clusters; needs root).
+# make test runs the first part alone.
+check: test check-cross
+
+test: all $(TEST_BIN) $(TOOL_BIN)
 	sh tests/run.sh
 
 bench: all $(TOOL_BIN) $(BENCH_BIN)
@@ -145,7 +150,7 @@ dist: static
 
 # Cross-architecture and cross-distribution tests (qemu, Docker; root).
 check-cross: all static
-	sh tests/cross/run.sh
+	sh tests/run.sh tests/cross/it_*.sh
 
 clean:
 	rm -rf $(B) bin

@@ -1,20 +1,22 @@
 #!/bin/sh
-# Run every test program (bin/tests/test_*) and integration script
-# (tests/it_*.sh), then print the total as "N passed, N failed".
-# Each test prints its own "N passed, N failed" line; a test that exits
-# non-zero counts at least one failure even if it printed nothing.
+# Run the given tests (default: every test program bin/tests/test_* and
+# integration script tests/it_*.sh) in name order, then print the total as
+# "N passed, N failed".  Each test prints its own "N passed, N failed"
+# line; a test that exits non-zero counts at least one failure even if it
+# printed nothing.  `make check-cross` runs tests/cross/it_*.sh through it.
 cd "$(dirname "$0")/.." || exit 1
+[ $# -gt 0 ] || set -- bin/tests/test_* tests/it_*.sh
 total_pass=0
 total_fail=0
 failed=""
-for t in bin/tests/test_* tests/it_*.sh; do
+for t in "$@"; do
     [ -e "$t" ] || continue
     case "$t" in *.sh) cmd="sh $t" ;; *) cmd="$t" ;; esac
     printf '== %s\n' "$t"
     start=$(date +%s)
     out=$($cmd 2>&1)
     rc=$?
-    printf '%s\n' "$out" | tail -n 40
+    printf '%s\n' "$out" | tail -n 60
     line=$(printf '%s\n' "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
     p=$(printf '%s' "$line" | sed -E 's/^([0-9]+) passed.*/\1/')
     f=$(printf '%s' "$line" | sed -E 's/^[0-9]+ passed, ([0-9]+) failed.*/\1/')
