@@ -47,7 +47,7 @@ static int check(const hosts_table *t, const tr_options *o)
         cl[i].entry = &t->v[i];
     cl_open(cl, t->n, o, NULL, 0);
     int bad = 0;
-    printf("%-16s %-6s %-8s %-7s %5s  %-36s %s\n", "host", "state", "arch", "os", "cores", "worker", "scene cache");
+    printf("%-16s %-6s %-8s %-9s %5s  %-36s %s\n", "host", "state", "arch", "os", "cores", "worker", "scene cache");
     for (int i = 0; i < t->n; i++) {
         cl_host *h = &cl[i];
         if (!h->tr) {
@@ -55,9 +55,18 @@ static int check(const hosts_table *t, const tr_options *o)
             printf("%-16s %-6s %s\n", h->entry->name, "FAIL", h->err.msg);
             continue;
         }
-        const char *warn = "";
+        /* The release (Debian codename) is what deploy matches builds on;
+         * uname's kernel name says little. */
+        char arch[64], os[64];
+        fr_error e1;
+        if (tr_sysinfo(h->tr, arch, os, &e1) || !os[0])
+            snprintf(os, sizeof os, "%s", h->info.os);
+        char warn[160] = "";
         if (h->entry->arch[0] && strcmp(h->entry->arch, h->info.arch)) {
-            warn = "  PROBLEM: the table says arch=";
+            snprintf(warn, sizeof warn, "  PROBLEM: the table says arch=%s", h->entry->arch);
+            bad++;
+        } else if (h->entry->os[0] && os[0] && strcmp(h->entry->os, os)) {
+            snprintf(warn, sizeof warn, "  PROBLEM: the table says os=%s", h->entry->os);
             bad++;
         }
         int files;
@@ -71,8 +80,8 @@ static int check(const hosts_table *t, const tr_options *o)
         else
             snprintf(cache, sizeof cache, "%d scene%s, %.1f MB", files, files == 1 ? "" : "s", bytes / 1e6);
         int cores = h->entry->cores ? h->entry->cores : h->info.cores;
-        printf("%-16s %-6s %-8s %-7s %5d  %-36s %s%s%s\n", h->entry->name, "ok", h->info.arch, h->info.os, cores,
-               h->info.version, cache, warn, *warn ? h->entry->arch : "");
+        printf("%-16s %-6s %-8s %-9s %5d  %-36s %s%s\n", h->entry->name, "ok", h->info.arch, os, cores,
+               h->info.version, cache, warn);
     }
     fr_error err;
     if (cl_check_versions(cl, t->n, &err)) {

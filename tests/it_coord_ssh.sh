@@ -57,6 +57,7 @@ fr hosts check --hosts hosts >check.out 2>&1
 check "hosts check passes" test $? -eq 0
 check "hosts check reports the worker version" test "$(grep -c 'franja-worker .* scene-format' check.out)" -eq 3
 check "hosts check reports the cache" grep -q "1 scene" check.out
+check "hosts check reports the release" grep -q " $(. /etc/os-release; echo "$VERSION_CODENAME") " check.out
 
 # Unknown host: refused with a fix-it message, accepted with --accept-new-hosts.
 cp known_hosts known_full
