@@ -6,7 +6,7 @@ export DEBIAN_FRONTEND=noninteractive
 apt-get update
 apt-get install -y --no-install-recommends \
     build-essential pkg-config \
-    libcjson-dev \
+    libcjson-dev libxxhash-dev libassimp-dev libembree-dev clang libclang-rt-14-dev \
     libssh-dev libopenimageio-dev openimageio-tools \
     openssh-server openssh-client iproute2 procps doxygen \
     docker.io debootstrap qemu-user-static \
