@@ -39,7 +39,6 @@ float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, flo
 #define FAR_SCALE 1.0000153f
 
 typedef struct {
-    vec3 o, d;
     f4 ox, oy, oz, ix, iy, iz;   /* origin and 1/direction, in every lane */
     size_t near[3], far[3];      /* per axis, where the entry / exit plane's row starts in box[][] */
     /* the watertight triangle test's ray frame (see geo_triangle) */
@@ -65,8 +64,6 @@ static int max_axis(vec3 v)
 
 static void ray_setup(ray4 *R, const fr_ray *r)
 {
-    R->o = r->o;
-    R->d = r->d;
     R->ox = f4_set1(r->o.x); R->oy = f4_set1(r->o.y); R->oz = f4_set1(r->o.z);
     R->ix = f4_set1(1.0f / r->d.x); R->iy = f4_set1(1.0f / r->d.y); R->iz = f4_set1(1.0f / r->d.z);
     /* 1/-0 is -inf: the sign bit picks the planes, as it must. */
@@ -134,7 +131,8 @@ static void record(hit_state *H, float t, uint32_t prim, float a, float b)
 
 /* Test the lanes of one leaf block.  `lanes` says which lanes hold
  * triangles to test.  With `any`, return 1 at the first hit. */
-static inline __attribute__((always_inline)) int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes, hit_state *H, int any)
+static inline __attribute__((always_inline)) int block_test(const fr_bvh_leaf *L, const ray4 *R, unsigned lanes,
+                                                            hit_state *H, int any)
 {
     const float *p = L->v[0];   /* vertex k's rows start at p + 12 k */
     f4 az = f4_load(p + R->kz) - R->okz;
