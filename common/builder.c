@@ -94,6 +94,28 @@ void bld_material_init(fr_material *m)
     m->normal_strength = 1.0f;
 }
 
+int bld_pad(fr_array *a, uint32_t count)
+{
+    char zero[32] = {0};
+    while (a->count < count)
+        if (bld_push(a, zero) == FR_NONE)
+            return -1;
+    return 0;
+}
+
+uint32_t bld_triangle_uv(fr_builder *b, const vec3 p[3], const vec2 uv[3], uint32_t material)
+{
+    if (bld_pad(&b->uvs, b->positions.count) < 0)
+        return FR_NONE;
+    for (int k = 0; k < 3; k++)
+        if (bld_push(&b->uvs, &uv[k]) == FR_NONE)
+            return FR_NONE;
+    uint32_t t = bld_triangle(b, p[0], p[1], p[2], material);
+    if (t != FR_NONE)
+        ((fr_triangle *)b->triangles.data)[((fr_prim *)b->prims.data)[t].index].flags |= FR_TRI_UVS;
+    return t;
+}
+
 void bld_material_finish(fr_material *m)
 {
     /* Lobes are picked in proportion to their brightest channel, so a lobe

@@ -39,6 +39,13 @@ uint32_t bld_push(fr_array *a, const void *elem);
 uint32_t bld_sphere(fr_builder *b, vec3 center, float radius, uint32_t material);
 uint32_t bld_rect(fr_builder *b, vec3 origin, vec3 edge_u, vec3 edge_v, uint32_t material);
 uint32_t bld_triangle(fr_builder *b, vec3 p0, vec3 p1, vec3 p2, uint32_t material);
+/* A triangle with texture coordinates at its vertices. */
+uint32_t bld_triangle_uv(fr_builder *b, const vec3 p[3], const vec2 uv[3], uint32_t material);
+
+/* Append zeroed elements until the array holds `count` (vertex attribute
+ * arrays are indexed like positions, so they are padded before use).
+ * Returns -1 when memory runs out. */
+int bld_pad(fr_array *a, uint32_t count);
 
 /* A material with no lobe, no emission and no texture (every texture index
  * FR_NONE, ior 1.5, normal-map strength 1): start every material here. */

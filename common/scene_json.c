@@ -262,11 +262,14 @@ static int vertices(ctx *c, const cJSON *o, const char *where, int n, vec3 *v)
     return 0;
 }
 
-static int add_triangle(ctx *c, const char *where, vec3 a, vec3 b, vec3 d, uint32_t mat)
+/* A triangle, with texture coordinates when uv is not NULL. */
+static int add_triangle(ctx *c, const char *where, vec3 a, vec3 b, vec3 d, const vec2 *uv, uint32_t mat)
 {
     if (!(v3_len2(v3_cross(v3_sub(b, a), v3_sub(d, a))) > 0.0f))
         return fr_fail(c->err, "%s: zero-area triangle", where);
-    return bld_triangle(c->b, a, b, d, mat) == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
+    vec3 p[3] = {a, b, d};
+    uint32_t t = uv ? bld_triangle_uv(c->b, p, uv, mat) : bld_triangle(c->b, a, b, d, mat);
+    return t == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
 }
 
 static int parse_shape(ctx *c, const cJSON *o, const char *where)
@@ -323,21 +326,17 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         vec3 v[4];
         if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 4, v) < 0)
             return -1;
-        vec3 d = v3_sub(v3_add(v[0], v[2]), v3_add(v[1], v[3]));
-        if (v3_is_zero(d)) {
-            /* An exact parallelogram: one rectangle, one light if emissive. */
-            vec3 eu = v3_sub(v[1], v[0]), ev = v3_sub(v[3], v[0]);
-            if (!(v3_len2(v3_cross(eu, ev)) > 0.0f))
-                return fr_fail(c->err, "%s: zero-area quad", where);
-            r = bld_rect(c->b, v[0], eu, ev, mat);
-        } else if (add_triangle(c, where, v[0], v[1], v[2], mat) < 0 || add_triangle(c, where, v[0], v[2], v[3], mat) < 0) {
+        /* Two triangles, even for a parallelogram: the BVH tests triangles
+         * four at a time, so they trace faster than one rectangle. */
+        /* UVs as on a rect: u along v0->v1, v along v0->v3. */
+        const vec2 uv1[3] = {{0, 0}, {1, 0}, {1, 1}}, uv2[3] = {{0, 0}, {1, 1}, {0, 1}};
+        if (add_triangle(c, where, v[0], v[1], v[2], uv1, mat) < 0 || add_triangle(c, where, v[0], v[2], v[3], uv2, mat) < 0)
             return -1;
-        }
     } else if (!strcmp(type, "triangle")) {
         static const char *const f[] = {"type", "material", "vertices", NULL};
         vec3 v[3];
         if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 3, v) < 0 ||
-            add_triangle(c, where, v[0], v[1], v[2], mat) < 0)
+            add_triangle(c, where, v[0], v[1], v[2], NULL, mat) < 0)
             return -1;
     } else if (!strcmp(type, "box")) {
         if (scn_box(c->b, o, where, mat, c->err) < 0)

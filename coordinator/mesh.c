@@ -323,15 +323,6 @@ static int level_paths(const cJSON *o, const char *where, const char *dir, char 
     return 0;
 }
 
-static int pad(fr_array *a, uint32_t count)
-{
-    char zero[16] = {0};
-    while (a->count < count)
-        if (bld_push(a, zero) == FR_NONE)
-            return -1;
-    return 0;
-}
-
 int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, uint32_t material, fr_error *err)
 {
     char paths[LOD_MAX][4096];
@@ -398,7 +389,7 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
     int use_n = m.nrm && !flat, use_uv = m.uv != NULL;
     float nmat[3][3];
     normal_matrix(&x, det, nmat);
-    if (rc == 0 && ((use_n && pad(&b->normals, base) < 0) || (use_uv && pad(&b->uvs, base) < 0)))
+    if (rc == 0 && ((use_n && bld_pad(&b->normals, base) < 0) || (use_uv && bld_pad(&b->uvs, base) < 0)))
         rc = fr_fail(err, "%s: out of memory", where);
     for (uint32_t i = 0; i < m.n_vert && rc == 0; i++) {
         vec3 p = xf_point(&x, m.pos[i]);
