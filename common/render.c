@@ -5,6 +5,9 @@
 #include "light.h"
 #include "medium.h"
 #include "sampler.h"
+
+/* Bounces before Russian roulette may end a path. */
+#define RR_DEPTH 4
 #include "texture.h"
 
 /* Power heuristic with beta = 2 (Veach 1997). */
@@ -12,6 +15,20 @@ static float power_heuristic(float a, float b)
 {
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* Russian roulette after a few bounces: the path survives with a
+ * probability that follows its throughput, and survivors are reweighted.
+ * Returns 0 when the path ends. */
+static int roulette(fr_sampler *smp, uint32_t depth, vec3 *beta)
+{
+    if (depth < RR_DEPTH)
+        return 1;
+    float m = v3_max(*beta), q = m < 0.95f ? m : 0.95f;
+    if (!(smp_random(smp) < q))
+        return 0;
+    *beta = v3_scale(*beta, 1.0f / q);
+    return 1;
 }
 
 fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly)
@@ -166,12 +183,8 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
                 prev_pdf = med_phase(md->g, v3_dot(seg.d, ray.d));
                 prev_delta = 0;
                 prev_p = p;
-                if (depth >= 3) {
-                    float q = fminf(0.95f, v3_max(beta));
-                    if (!(smp_random(&smp) < q))
-                        break;
-                    beta = v3_scale(beta, 1.0f / q);
-                }
+                if (!roulette(&smp, depth, &beta))
+                    break;
                 continue;
             }
             if (!found)
@@ -238,14 +251,8 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
         ray.o = geo_offset(sf.p, sf.ng, bs.wi);
         ray.d = bs.wi;
 
-        /* Russian roulette after a few bounces: survive with a probability
-         * that follows the path's throughput, reweight survivors. */
-        if (depth >= 3) {
-            float q = fminf(0.95f, v3_max(beta));
-            if (!(smp_random(&smp) < q))
-                break;
-            beta = v3_scale(beta, 1.0f / q);
-        }
+        if (!roulette(&smp, depth, &beta))
+            break;
     }
     /* A NaN or infinity from a degenerate configuration would poison the
      * pixel; drop the sample instead (it happens the same way everywhere). */
