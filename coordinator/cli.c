@@ -28,18 +28,25 @@ int cli_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
     return 0;
 }
 
+const char *cli_beside_exe(const char *name, char *buf, size_t cap)
+{
+    char exe[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return NULL;
+    exe[n] = 0;
+    char *slash = strrchr(exe, '/');
+    if (!slash)
+        return NULL;
+    *slash = 0;
+    int len = snprintf(buf, cap, "%s/%s", exe, name);
+    return len < 0 || (size_t)len >= cap ? NULL : buf;
+}
+
 const char *cli_local_worker(void)
 {
     static char path[PATH_MAX];
-    ssize_t n = readlink("/proc/self/exe", path, sizeof path - 32);
-    if (n <= 0)
-        return NULL;
-    path[n] = 0;
-    char *slash = strrchr(path, '/');
-    if (!slash)
-        return NULL;
-    strcpy(slash + 1, "franja-worker");
-    return path;
+    return cli_beside_exe("franja-worker", path, sizeof path);
 }
 
 void cli_transport_defaults(tr_options *o)
@@ -87,4 +94,34 @@ int cli_transport_option(int argc, char **argv, int *i, tr_options *o)
     }
     o->timeout_s = (int)t;
     return 1;
+}
+
+int cli_common_option(int argc, char **argv, int *i, const char *usage, tr_options *o, const char **hosts)
+{
+    int t = cli_transport_option(argc, argv, i, o);
+    if (t)
+        return t < 0 ? CLI_BAD : CLI_TAKEN;
+    const char *a = argv[*i];
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+        fputs(usage, stdout);
+        fputs(cli_transport_help, stdout);
+        return CLI_HELP;
+    }
+    if (strcmp(a, "--hosts"))
+        return CLI_OTHER;
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "franja: --hosts needs a value\n");
+        return CLI_BAD;
+    }
+    *hosts = argv[++*i];
+    return CLI_TAKEN;
+}
+
+int cli_load_hosts(const char *cmd, const char *path, hosts_table *t)
+{
+    fr_error err;
+    if (hosts_load(path, t, &err) == 0)
+        return 0;
+    fprintf(stderr, "franja %s: %s\n", cmd, err.msg);
+    return -1;
 }

@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include "cli.h"
 #include "fbin.h"
@@ -130,17 +129,7 @@ static const char *default_dist(char *buf, size_t cap)
 {
     if (is_dir("dist"))
         return "dist";
-    char exe[PATH_MAX];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0)
-        return NULL;
-    exe[n] = 0;
-    char *slash = strrchr(exe, '/');
-    if (!slash)
-        return NULL;
-    *slash = 0;
-    snprintf(buf, cap, "%s/../dist", exe);
-    return is_dir(buf) ? buf : NULL;
+    return cli_beside_exe("../dist", buf, cap) && is_dir(buf) ? buf : NULL;
 }
 
 static int deploy_all(const hosts_table *t, const tr_options *o, const char *dist)
@@ -177,19 +166,13 @@ int cmd_deploy(int argc, char **argv)
     cli_transport_defaults(&o);
     const char *path = NULL, *dist = NULL;
     for (int i = 1; i < argc; i++) {
-        int t = cli_transport_option(argc, argv, &i, &o);
-        if (t < 0)
-            return 2;
-        if (t)
-            continue;
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            fputs(usage, stdout);
-            fputs(cli_transport_help, stdout);
-            return 0;
+        int c = cli_common_option(argc, argv, &i, usage, &o, &path);
+        if (c != CLI_OTHER) {
+            if (c == CLI_TAKEN)
+                continue;
+            return c == CLI_HELP ? 0 : 2;
         }
-        if (!strcmp(argv[i], "--hosts") && i + 1 < argc)
-            path = argv[++i];
-        else if (!strcmp(argv[i], "--dist") && i + 1 < argc)
+        if (!strcmp(argv[i], "--dist") && i + 1 < argc)
             dist = argv[++i];
         else {
             fprintf(stderr, "franja deploy: unexpected '%s' (see franja deploy --help)\n", argv[i]);
@@ -211,11 +194,8 @@ int cmd_deploy(int argc, char **argv)
         return 2;
     }
     hosts_table t;
-    fr_error err;
-    if (hosts_load(path, &t, &err)) {
-        fprintf(stderr, "franja deploy: %s\n", err.msg);
+    if (cli_load_hosts("deploy", path, &t))
         return 2;
-    }
     ssh_init();
     int rc = deploy_all(&t, &o, dist);
     ssh_finalize();

@@ -103,19 +103,13 @@ int cmd_hosts(int argc, char **argv)
     cli_transport_defaults(&o);
     const char *path = NULL, *what = NULL;
     for (int i = 1; i < argc; i++) {
-        int t = cli_transport_option(argc, argv, &i, &o);
-        if (t < 0)
-            return 2;
-        if (t)
-            continue;
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            fputs(usage, stdout);
-            fputs(cli_transport_help, stdout);
-            return 0;
+        int c = cli_common_option(argc, argv, &i, usage, &o, &path);
+        if (c != CLI_OTHER) {
+            if (c == CLI_TAKEN)
+                continue;
+            return c == CLI_HELP ? 0 : 2;
         }
-        if (!strcmp(argv[i], "--hosts") && i + 1 < argc)
-            path = argv[++i];
-        else if (!what && (!strcmp(argv[i], "check") || !strcmp(argv[i], "list")))
+        if (!what && (!strcmp(argv[i], "check") || !strcmp(argv[i], "list")))
             what = argv[i];
         else {
             fprintf(stderr, "franja hosts: unexpected '%s' (see franja hosts --help)\n", argv[i]);
@@ -127,11 +121,8 @@ int cmd_hosts(int argc, char **argv)
         return 2;
     }
     hosts_table t;
-    fr_error err;
-    if (hosts_load(path, &t, &err)) {
-        fprintf(stderr, "franja hosts: %s\n", err.msg);
+    if (cli_load_hosts("hosts", path, &t))
         return 2;
-    }
     int rc = 0;
     if (!strcmp(what, "list"))
         list(&t);

@@ -82,15 +82,11 @@ static int parse(int argc, char **argv, render_args *a)
     cli_transport_defaults(&a->tr);
     for (int i = 1; i < argc; i++) {
         const char *s = argv[i];
-        int t = cli_transport_option(argc, argv, &i, &a->tr);
-        if (t < 0)
-            return 2;
-        if (t)
-            continue;
-        if (!strcmp(s, "--help") || !strcmp(s, "-h")) {
-            fputs(usage, stdout);
-            fputs(cli_transport_help, stdout);
-            return 1;
+        int c = cli_common_option(argc, argv, &i, usage, &a->tr, &a->hosts);
+        if (c != CLI_OTHER) {
+            if (c == CLI_TAKEN)
+                continue;
+            return c == CLI_HELP ? 1 : 2;
         }
         if (!strcmp(s, "--resume")) {
             a->resume = 1;
@@ -108,8 +104,8 @@ static int parse(int argc, char **argv, render_args *a)
             a->scene = s;
             continue;
         }
-        static const char *valued[] = {"-o", "--hosts", "-j", "--spp", "--size", "--exposure",
-                                       "--job", "--slab-rows", "--retries", "--tonemap"};
+        static const char *valued[] = {"-o", "-j", "--spp", "--size", "--exposure", "--job", "--slab-rows",
+                                       "--retries", "--tonemap"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(s, valued[k]);
@@ -125,8 +121,6 @@ static int parse(int argc, char **argv, render_args *a)
         int bad = 0;
         if (!strcmp(s, "-o"))
             a->out = v;
-        else if (!strcmp(s, "--hosts"))
-            a->hosts = v;
         else if (!strcmp(s, "--job"))
             a->jobdir = v;
         else if (!strcmp(s, "--tonemap")) {
@@ -306,10 +300,8 @@ int cmd_render(int argc, char **argv)
 
     hosts_table table;
     if (a.hosts) {
-        if (hosts_load(a.hosts, &table, &err)) {
-            fprintf(stderr, "franja render: %s\n", err.msg);
+        if (cli_load_hosts("render", a.hosts, &table))
             return 2;
-        }
     } else {
         table.n = 1;
         table.v = calloc(1, sizeof *table.v);
