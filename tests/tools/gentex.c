@@ -12,26 +12,19 @@
  *   tiles-normal.ppm   256x256 tangent-space normal map of bevelled tiles
  *   dimples-height.pgm 256x256 height map of hammered metal
  *
- * Every pattern comes from a small integer hash, so the files are the same
- * on every run. */
+ * Every pattern comes from the sampler's integer hash (smp_hash), so the
+ * files are the same on every run. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-static uint32_t hash(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
+#include "sampler.h"
 
 static double hash01(int a, int b, int c)
 {
-    return hash((uint32_t)a * 73856093u ^ hash((uint32_t)b * 19349663u ^ hash((uint32_t)c * 83492791u))) /
+    return smp_hash((uint32_t)a * 73856093u ^
+                    smp_hash((uint32_t)b * 19349663u ^ smp_hash((uint32_t)c * 83492791u))) /
            4294967296.0;
 }
 
