@@ -5,18 +5,10 @@
 # scene (a flat-coloured texture renders like the plain colour); tone
 # mapping options reach the output; bad textures are refused with the path.
 cd "$(dirname "$0")/.." || exit 1
+. tests/lib.sh
 F=bin/franja W=bin/franja-worker
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-
-expect_error() {
-    what=$1 frag=$2; shift 2
-    if "$@" >"$T/out" 2>"$T/err"; then bad "$what: exit status 0"; return; fi
-    grep -qF -- "$frag" "$T/err" && ok || bad "$what: stderr lacks '$frag': $(cat "$T/err")"
-}
 
 for s in cornell-textured dof-spheres fog-room bumpy; do
     if $F compile scenes/$s.json -o "$T/$s.fbin" >"$T/log" 2>&1; then ok; else bad "$s does not compile: $(cat "$T/log")"; continue; fi
@@ -76,5 +68,4 @@ expect_error "missing texture file" "textures.grey.file" $F compile "$T/missing.
 expect_error "unsupported format" "unsupported image format" $F compile "$T/gif.json" -o "$T/x.fbin"
 expect_error "corrupt image" "textures.grey.file" $F compile "$T/junk.json" -o "$T/x.fbin"
 
-echo "$pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+summary

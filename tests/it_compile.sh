@@ -4,19 +4,10 @@
 # formats, transforms, levels of detail) arrive, and bad input of every
 # kind is refused with a message that says where.
 cd "$(dirname "$0")/.." || exit 1
+. tests/lib.sh
 F=bin/franja W=bin/franja-worker G=bin/tools/genmesh
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-
-# expect_error "what" "fragment of stderr" command...
-expect_error() {
-    what=$1 frag=$2; shift 2
-    if "$@" >"$T/out" 2>"$T/err"; then bad "$what: exit status 0"; return; fi
-    grep -qF -- "$frag" "$T/err" && ok || bad "$what: stderr lacks '$frag': $(cat "$T/err")"
-}
 
 # triangles SCENE.json: the triangle count franja compile reports.
 triangles() {
@@ -145,5 +136,4 @@ cp "$T/cornell.fbin" "$T/ver.fbin"
 printf '\011' | dd of="$T/ver.fbin" bs=1 seek=8 conv=notrunc 2>/dev/null
 expect_error "other format version" "byte 8: scene format version 9" $W --scene "$T/ver.fbin" --rows 0:1 -o "$T/x"
 
-echo "$pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+summary

@@ -2,39 +2,36 @@
 # franja-worker end to end: its command line, its errors on bad input,
 # split invariance through real processes, and the formats it writes.
 cd "$(dirname "$0")/.." || exit 1
+. tests/lib.sh
 W=bin/franja-worker
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
 
-# expect_error "what it tests" "fragment of stderr" command...
-expect_error() {
-    what=$1 frag=$2; shift 2
-    if "$@" >"$T/out" 2>"$T/err"; then bad "$what: exit status 0"; return; fi
-    grep -qF -- "$frag" "$T/err" && ok || bad "$what: stderr lacks '$frag': $(cat "$T/err")"
-    [ ! -s "$T/out" ] && ok || bad "$what: wrote to stdout"
+# worker_error "what it tests" "fragment of stderr" command...: expect_error
+# (tests/lib.sh), and the failing worker wrote nothing on stdout.
+worker_error() {
+    expect_error "$@" || return
+    [ ! -s "$T/out" ] && ok || bad "$1: wrote to stdout"
 }
 
 $W --help | grep -q -- '--rows Y0:Y1' && ok || bad "--help"
 $W --version | grep -Eq '^franja-worker [0-9]+\.[0-9]+\.[0-9]+ scene-format [0-9]+$' && ok || bad "--version"
 
 S=scenes/cornell.json
-expect_error "rows past the end" "need 0 <= Y0 < Y1 <= 32" $W --scene $S --size 32x32 --rows 10:33 -o "$T/x"
-expect_error "empty rows" "need 0 <= Y0 < Y1" $W --scene $S --rows 5:5 -o "$T/x"
-expect_error "malformed rows" "--rows: expected Y0:Y1" $W --scene $S --rows 5-9 -o "$T/x"
-expect_error "negative spp" "--spp: expected an integer" $W --scene $S --rows 0:1 --spp -3
-expect_error "bad size" "--size: expected WxH" $W --scene $S --rows 0:1 --size 0x10
-expect_error "bad format" "--format: expected pf, ppm16 or ppm8" $W --scene $S --rows 0:1 --format png
-expect_error "missing scene" "No such file" $W --scene "$T/none.json" --rows 0:1 -o "$T/x"
-expect_error "unknown flag" "unknown argument" $W --scene $S --rows 0:1 --bogus
+worker_error "rows past the end" "need 0 <= Y0 < Y1 <= 32" $W --scene $S --size 32x32 --rows 10:33 -o "$T/x"
+worker_error "empty rows" "need 0 <= Y0 < Y1" $W --scene $S --rows 5:5 -o "$T/x"
+worker_error "malformed rows" "--rows: expected Y0:Y1" $W --scene $S --rows 5-9 -o "$T/x"
+worker_error "negative spp" "--spp: expected an integer" $W --scene $S --rows 0:1 --spp -3
+worker_error "bad size" "--size: expected WxH" $W --scene $S --rows 0:1 --size 0x10
+worker_error "bad format" "--format: expected pf, ppm16 or ppm8" $W --scene $S --rows 0:1 --format png
+worker_error "missing scene" "No such file" $W --scene "$T/none.json" --rows 0:1 -o "$T/x"
+worker_error "unknown flag" "unknown argument" $W --scene $S --rows 0:1 --bogus
 [ ! -e "$T/x" ] && ok || bad "a failed run left an output file"
 
 # Bad scenes: each names the JSON path and what was expected.
 scene_error() {
     printf '%s' "$2" >"$T/bad.json"
-    expect_error "scene: $1" "$1" $W --scene "$T/bad.json" --rows 0:1 -o "$T/x"
+    worker_error "scene: $1" "$1" $W --scene "$T/bad.json" --rows 0:1 -o "$T/x"
 }
 base='"image": {"width": 4, "height": 4}, "camera": {"position": [0,0,-5], "target": [0,0,0], "fov": 40}'
 mats='"materials": {"m": {"type": "lambert", "albedo": [0.5,0.5,0.5], "emission": [1,1,1]}}'
@@ -77,5 +74,4 @@ else
     ok
 fi
 
-echo "$pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+summary
