@@ -43,19 +43,10 @@ for h in s1 s2 s3; do mkdir -p "$FH/$h"; done
 fh_start s1 6 2 "$(fh_wrapper s1 slow)"
 fh_start s2 7 2 "$(fh_wrapper s2 slow)"
 fh_start s3 8 2 "$(fh_wrapper s3 slow)"
-wait_running() { # wait until host $1 runs a worker
-    i=0
-    while ! fh_pids "$1" | xargs -r ps -o args= -p 2>/dev/null | grep -q -- "--rows" && [ $i -lt 100 ]; do
-        sleep 0.1
-        i=$((i + 1))
-    done
-}
 fr_bg render scene.fbin -o killed.pfm --hosts hosts $SIZE --slab-rows 2 2>logk
-wait_running s2
+fh_until fh_busy s2
 fh_kill s2
-wait $FH_BG
-rc=$?
-FH_BG=
+fr_wait
 check "host killed mid-render: render succeeds" test $rc -eq 0
 check "host killed mid-render: byte-identical" cmp -s killed.pfm ref.pfm
 check "host killed mid-render: dropped with a message" grep -q "dropping host s2: .*connection" logk
@@ -63,12 +54,10 @@ check "host killed mid-render: dropped with a message" grep -q "dropping host s2
 # One-row slabs: the render outlasts the time-out, so the host is dropped
 # rather than merely overtaken by second copies.
 fr_bg render scene.fbin -o silent.pfm --hosts hosts $SIZE --slab-rows 1 2>logs
-wait_running s3
+fh_until fh_busy s3
 fh_stop s3
 t0=$(date +%s)
-wait $FH_BG
-rc=$?
-FH_BG=
+fr_wait
 fh_cont s3
 check "silent host: render succeeds" test $rc -eq 0
 check "silent host: byte-identical" cmp -s silent.pfm ref.pfm
@@ -77,15 +66,11 @@ check "silent host: noticed within a few time-outs" test $(($(date +%s) - t0)) -
 
 # The coordinator killed (SIGKILL, no chance to clean up), then --resume.
 fr_bg render scene.fbin -o resumed.pfm --hosts hosts $SIZE --slab-rows 2 2>logc1
-i=0
-while [ "$(ls resumed.pfm.franja-job 2>/dev/null | grep -c '^rows-.*\.pf$')" -lt 3 ] && [ $i -lt 100 ]; do
-    sleep 0.1
-    i=$((i + 1))
-done
+fh_until fh_has_slabs resumed.pfm.franja-job 3
 kill -KILL $FH_BG
 wait $FH_BG 2>/dev/null
 FH_BG=
-kept=$(ls resumed.pfm.franja-job | grep -c '^rows-.*\.pf$')
+kept=$(fh_slabs resumed.pfm.franja-job)
 check "killed coordinator leaves no image" test ! -e resumed.pfm
 check "killed coordinator leaves its finished slabs" test "$kept" -ge 3
 fr render scene.fbin -o resumed.pfm --hosts hosts $SIZE --slab-rows 2 --resume 2>logc2
@@ -93,4 +78,4 @@ check "resumed render is byte-identical" cmp -s resumed.pfm ref.pfm
 check "resume kept the finished rows" grep -q "resuming: $((kept * 2)) of 32 rows" logc2
 check "resume rendered only the rest" grep -q "; $((16 - kept)) slabs" logc2
 
-fh_summary
+summary

@@ -57,15 +57,9 @@ mkdir -p loc3
 printf 'here local - 1 worker=%s\n' "$(fh_wrapper loc3 slow)" >t_slow
 "$FRANJA" render scene.fbin -o int.pfm $SIZE --hosts t_slow --slab-rows 4 2>logi &
 FH_BG=$!
-i=0
-while [ "$(ls int.pfm.franja-job 2>/dev/null | grep -c '^rows-.*\.pf$')" -lt 2 ] && [ $i -lt 100 ]; do
-    sleep 0.1
-    i=$((i + 1))
-done
+fh_until fh_has_slabs int.pfm.franja-job 2
 kill -INT $FH_BG
-wait $FH_BG
-rc=$?
-FH_BG=
+fr_wait
 check "interrupted render exits 130" test $rc -eq 130
 check "interrupted render writes no image" test ! -e int.pfm
 check "interrupted render says how to resume" grep -q "rerun with --resume" logi
@@ -102,4 +96,4 @@ check "--help" grep -q "franja render SCENE" h
 "$FRANJA" frobnicate 2>/dev/null
 check "unknown command refused" test $? -eq 2
 
-fh_summary
+summary

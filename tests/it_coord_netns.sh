@@ -45,19 +45,13 @@ check "render across the veth works" cmp -s both.pfm ref.pfm
 check "the far host took slabs" grep -Eq "^  far +2 +[1-9]" log0
 
 fr_bg render scene.fbin -o cut.pfm --hosts hosts $SIZE --slab-rows 1 2>logc
-i=0
-while ! fh_pids far | xargs -r ps -o args= -p 2>/dev/null | grep -q -- "--rows" && [ $i -lt 100 ]; do
-    sleep 0.1
-    i=$((i + 1))
-done
+fh_until fh_busy far
 ip link set "$VH" down
 t0=$(date +%s)
-wait $FH_BG
-rc=$?
-FH_BG=
+fr_wait
 check "render with a cut link succeeds" test $rc -eq 0
 check "render with a cut link is byte-identical" cmp -s cut.pfm ref.pfm
 check "the silent host is dropped" grep -q "dropping host far: .*no answer for" logc
 check "the silence is noticed within a few time-outs" test $(($(date +%s) - t0)) -lt 20
 
-fh_summary
+summary

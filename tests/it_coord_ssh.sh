@@ -114,4 +114,4 @@ fr render scene.fbin -o q.pfm --hosts t_q $SIZE 2>logq
 check "shell syntax in paths reaches the worker unharmed" cmp -s q.pfm ref.pfm
 check "scene stored under the literal path" cmp -s "$QDIR/scenes/$HASH.fbin" scene.fbin
 
-fh_summary
+summary

@@ -1,13 +1,16 @@
-# lib.sh -- sourced by the shell tests (tests/it_*.sh): counts the checks
-# and prints the closing line that tests/run.sh reads.
+# lib.sh -- sourced by the shell tests (tests/it_*.sh, and through
+# tests/coord/fakehosts.sh and tests/cross/lib.sh by the others): counts the
+# checks and prints the closing line that tests/run.sh reads.
 #
 #   ok                      counts a passed check
 #   bad MESSAGE...          counts a failed check and prints "FAIL: MESSAGE"
+#   check DESC CMD...       runs CMD: passed if it succeeds, else "FAIL: DESC"
 #   expect_error WHAT FRAGMENT CMD...
 #                           CMD must fail with FRAGMENT (a fixed string) on
 #                           stderr; its output is left in $T/out and $T/err
 #                           ($T: the test's scratch directory).  Returns
 #                           non-zero when CMD succeeded
+#   need TOOL...            fails the whole test at once if a tool is missing
 #   summary                 prints "N passed, N failed"; returns non-zero on a
 #                           failure (the test's last command)
 
@@ -21,6 +24,12 @@ bad() {
     echo "FAIL: $*"
 }
 
+check() {
+    desc=$1
+    shift
+    if "$@"; then ok; else bad "$desc"; fi
+}
+
 expect_error() {
     what=$1 frag=$2
     shift 2
@@ -29,6 +38,16 @@ expect_error() {
         return 1
     fi
     grep -qF -- "$frag" "$T/err" && ok || bad "$what: stderr lacks '$frag': $(cat "$T/err")"
+}
+
+need() {
+    for tool in "$@"; do
+        if ! command -v "$tool" >/dev/null 2>&1; then
+            echo "FAIL: $tool is missing (run tests/install-deps.sh)"
+            echo "$PASSED passed, $((FAILED + 1)) failed"
+            exit 1
+        fi
+    done
 }
 
 summary() {

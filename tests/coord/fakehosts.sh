@@ -17,39 +17,23 @@
 #   fh_kill NAME / fh_stop NAME / fh_cont NAME
 #   fh_wrapper NAME MODE      a worker wrapper that misbehaves once (MODE:
 #                             kill, truncate, extra, slow, hang) and prints its path
-#   check DESC CMD...         counts a passed/failed check
-#   fh_summary                prints "N passed, N failed" and returns the status
+#   fh_busy NAME              true while host NAME runs a worker on a slab
+#   fh_slabs DIR              how many finished slabs job directory DIR holds
+#   fh_has_slabs DIR N        true once DIR holds N finished slabs or more
+#   fh_until CMD...           runs CMD every 0.1 s until it succeeds (10 s at most)
+#   fr CMD ARGS... / fr_bg CMD ARGS... / fr_wait
+#                             franja with the fake hosts' SSH settings; in the
+#                             background; waiting for that one (status in $rc)
+#
+# The checks and the closing line are tests/lib.sh's (check, summary ...).
 
 ROOT=${ROOT:-$(cd "$(dirname "$0")/.." && pwd)}
+. "$ROOT/tests/lib.sh"
 FRANJA="$ROOT/bin/franja"
 WORKER="$ROOT/bin/franja-worker"
-PASSED=0
-FAILED=0
-
-check() {
-    desc=$1
-    shift
-    if "$@"; then
-        PASSED=$((PASSED + 1))
-    else
-        FAILED=$((FAILED + 1))
-        echo "FAIL: $desc"
-    fi
-}
-
-fh_summary() {
-    echo "$PASSED passed, $FAILED failed"
-    [ "$FAILED" -eq 0 ]
-}
 
 fh_init() {
-    for tool in /usr/sbin/sshd ssh-keygen ps; do
-        if ! command -v "$tool" >/dev/null 2>&1; then
-            echo "FAIL: $tool is missing (run tests/install-deps.sh)"
-            echo "0 passed, 1 failed"
-            exit 1
-        fi
-    done
+    need /usr/sbin/sshd ssh-keygen ps
     FH=$(mktemp -d /tmp/franja-fh.XXXXXX)
     chmod 755 "$FH"
     mkdir -p -m0755 /run/sshd 2>/dev/null || true
@@ -118,6 +102,20 @@ fh_pids() {
     [ -s "$pidfile" ] && fh_tree "$(cat "$pidfile")"
 }
 
+fh_busy() { fh_pids "$1" | xargs -r ps -o args= -p 2>/dev/null | grep -q -- "--rows"; }
+
+fh_slabs() { ls "$1" 2>/dev/null | grep -c '^rows-.*\.pf$'; }
+
+fh_has_slabs() { [ "$(fh_slabs "$1")" -ge "$2" ]; }
+
+fh_until() {
+    i=0
+    while ! "$@" && [ $i -lt 100 ]; do
+        sleep 0.1
+        i=$((i + 1))
+    done
+}
+
 fh_kill() { for p in $(fh_pids "$1"); do kill -KILL "$p" 2>/dev/null; done; }
 fh_stop() { for p in $(fh_pids "$1"); do kill -STOP "$p" 2>/dev/null; done; }
 fh_cont() { for p in $(fh_pids "$1"); do kill -CONT "$p" 2>/dev/null; done; }
@@ -161,7 +159,9 @@ SH
 
 # franja with the test's SSH settings: private known_hosts, no ~/.ssh/config,
 # no agent, a short time-out (options given later win).  fr_bg runs it in
-# the background with FH_BG set to the coordinator's own PID.
+# the background with FH_BG set to the coordinator's own PID; fr_wait waits
+# for it (or for any command whose PID is in FH_BG) and puts its exit status
+# in $rc.
 fr() {
     cmd=$1
     shift
@@ -173,4 +173,10 @@ fr_bg() {
     shift
     env -u SSH_AUTH_SOCK "$FRANJA" "$cmd" --known-hosts "$FH/known_hosts" --no-ssh-config --timeout 3 "$@" &
     FH_BG=$!
+}
+
+fr_wait() {
+    wait "$FH_BG"
+    rc=$?
+    FH_BG=
 }

@@ -41,4 +41,4 @@ check "static worker refuses a JSON scene" test $? -ne 0
 check "and says so on stderr" test -s "$T/json.err"
 check "and writes no image" test ! -s "$T/json.pf"
 
-cross_summary
+summary

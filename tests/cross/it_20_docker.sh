@@ -110,4 +110,4 @@ check "dockerd stopped" sh -c "! kill -0 $DPID 2>/dev/null"
 unmounted() { ! awk '{print $5}' /proc/self/mountinfo | grep -q -e "^$1/"; }
 check "nothing left mounted under the engine's state" unmounted "$ENGINE"
 check "nothing left mounted under its data root" unmounted "$FRANJA_CACHE/engine-data"
-cross_summary
+summary

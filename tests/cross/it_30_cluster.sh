@@ -6,13 +6,8 @@
 # one-process amd64 render, every host must have rendered slabs, and a host
 # whose worker reports another version is refused by name.  The Docker builds
 # come from it_20_docker.sh (in $CROSS).
-. "$(dirname "$0")/../coord/fakehosts.sh"
 . "$(dirname "$0")/lib.sh"
-FRANJA="$ROOT/bin/franja"
-WORKER="$ROOT/bin/franja-worker"
-need "$QEMU" cmp
-fh_init
-cd "$FH" || exit 1
+cross_fakehosts
 SIZE="--size 64x64 --spp 4"
 
 OLD="$CROSS/dist/bullseye-amd64/franja-worker"
@@ -82,4 +77,4 @@ SH
     check "and writes no image" test ! -e out2.pfm
     check "the refusal names the host" grep -q "host other.*$bad" log2
 done
-cross_summary
+summary

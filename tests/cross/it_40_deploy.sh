@@ -5,13 +5,8 @@
 # through the host's worker command (qemu for the arm64 hosts), and the
 # deployed cluster renders the one-process image.  A host with no build, a
 # build of another version and a missing dist directory are refused.
-. "$(dirname "$0")/../coord/fakehosts.sh"
 . "$(dirname "$0")/lib.sh"
-FRANJA="$ROOT/bin/franja"
-WORKER="$ROOT/bin/franja-worker"
-need "$QEMU" cmp
-fh_init
-cd "$FH" || exit 1
+cross_fakehosts
 SIZE="--size 64x64 --spp 4"
 SYSROOT="$CROSS/sysroot-bookworm-arm64"
 
@@ -91,4 +86,4 @@ check "and the message names the host and both versions" \
 fr deploy --hosts deploy.hosts --dist "$FH/nowhere" >/dev/null 2>out5
 check "a missing dist directory is a usage error" test $? -eq 2
 check "and says so" grep -q "nowhere: not a directory" out5
-cross_summary
+summary

@@ -1,11 +1,13 @@
 # lib.sh -- sourced by the cross-build tests (tests/cross/it_*.sh).
 #
-#   check DESC CMD...    counts a passed or failed check (prints failures)
-#   need TOOL...         fails the whole test at once if a tool is missing
-#   cross_summary        prints "N passed, N failed"; returns non-zero on failure
 #   cross_refs DIR       compiles the test scene into DIR/scene.fbin and renders
 #                        the reference slabs DIR/ref-json.pf and DIR/ref-fbin.pf
 #                        with this machine's bin/franja-worker
+#   cross_fakehosts      starts the coordinator tests' fake-host harness
+#                        (tests/coord/fakehosts.sh: fh_start, fr ...) in $FH
+#                        and makes it the current directory
+#
+# The checks and the closing line are tests/lib.sh's (check, need, summary).
 #
 # Variables: ROOT (the repository), SLAB (worker arguments of the test slab),
 # CROSS (state shared by the tests in one run: the Docker builds' dist/),
@@ -13,40 +15,13 @@
 # QEMU (qemu-aarch64-static).
 
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+. "$ROOT/tests/lib.sh"
 # A small slab keeps qemu quick: 20 rows of a 64x64 image at 4 samples.
 SLAB="--rows 10:30 --spp 4 --size 64x64"
 CROSS=${FRANJA_CROSS_DIR:-$ROOT/build/cross}
 FRANJA_CACHE=${FRANJA_CACHE:-/var/cache/franja}
 export FRANJA_CACHE
 QEMU=${QEMU:-qemu-aarch64-static}
-PASSED=0
-FAILED=0
-
-check() {
-    desc=$1
-    shift
-    if "$@"; then
-        PASSED=$((PASSED + 1))
-    else
-        FAILED=$((FAILED + 1))
-        echo "FAIL: $desc"
-    fi
-}
-
-need() {
-    for tool in "$@"; do
-        if ! command -v "$tool" >/dev/null 2>&1; then
-            echo "FAIL: $tool is missing (run tests/install-deps.sh)"
-            echo "$PASSED passed, $((FAILED + 1)) failed"
-            exit 1
-        fi
-    done
-}
-
-cross_summary() {
-    echo "$PASSED passed, $FAILED failed"
-    [ "$FAILED" -eq 0 ]
-}
 
 cross_refs() {
     d=$1
@@ -56,6 +31,13 @@ cross_refs() {
         "$ROOT/bin/franja-worker" --scene "$ROOT/scenes/cornell.json" $SLAB -o "$d/ref-json.pf"
     check "reference slab from the binary scene" \
         "$ROOT/bin/franja-worker" --scene "$d/scene.fbin" $SLAB -o "$d/ref-fbin.pf"
+}
+
+cross_fakehosts() {
+    . "$ROOT/tests/coord/fakehosts.sh"
+    need "$QEMU" cmp
+    fh_init
+    cd "$FH" || exit 1
 }
 
 # True if the ELF file $1 has no program interpreter and no shared libraries.
