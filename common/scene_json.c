@@ -1,11 +1,11 @@
 #include "scene_json.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "file.h"
 #include "fmath.h"
 #include "scene_appear.h"
 
@@ -398,12 +398,7 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
         return fr_fail(err, "%s:%d: invalid JSON", file, line);
     }
     char dir[4096];
-    snprintf(dir, sizeof dir, "%s", file);
-    char *slash = strrchr(dir, '/');
-    if (slash)
-        *slash = 0;
-    else
-        snprintf(dir, sizeof dir, ".");
+    file_dir(file, dir, sizeof dir);
     scn_appear look;
     memset(&look, 0, sizeof look);
     ctx c = {file, dir, hooks, b, NULL, &e, &look};
@@ -451,28 +446,10 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
 
 int scn_load_json(const char *path, const scn_hooks *hooks, fr_scene *out, fr_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fr_fail(err, "%s: %s", path, strerror(errno));
-    size_t cap = 1 << 16, len = 0;
-    char *text = malloc(cap);
-    size_t n;
-    while (text && (n = fread(text + len, 1, cap - len - 1, f)) > 0) {
-        len += n;
-        if (len + 1 == cap) {
-            char *t = realloc(text, cap * 2);
-            if (!t) { free(text); text = NULL; break; }
-            text = t;
-            cap *= 2;
-        }
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (!text || bad) {
-        free(text);
-        return fr_fail(err, "%s: cannot read the file", path);
-    }
-    text[len] = 0;
+    char *text;
+    size_t len;
+    if (file_read(path, &text, &len, err))
+        return -1;
     fr_builder b;
     bld_init(&b);
     int rc = scn_parse_json(text, path, hooks, &b, err);

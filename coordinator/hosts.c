@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "file.h"
+
 #define HOSTS_MAX_LINE 4096
 
 /* Copies src into a fixed field, refusing what would not fit rather than
@@ -228,29 +230,10 @@ int hosts_load(const char *path, hosts_table *t, fr_error *err)
     FILE *f = fopen(path, "rb");
     if (!f)
         return fr_fail(err, "%s: cannot open host table: %s", path, strerror(errno));
-    size_t cap = 4096, n = 0;
-    char *text = malloc(cap);
-    for (;;) {
-        if (!text) {
-            fclose(f);
-            return fr_fail(err, "%s: out of memory", path);
-        }
-        n += fread(text + n, 1, cap - n - 1, f);
-        if (n < cap - 1)
-            break;
-        cap *= 2;
-        char *bigger = realloc(text, cap);
-        if (!bigger)
-            free(text);
-        text = bigger;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(text);
-        return fr_fail(err, "%s: read error", path);
-    }
-    text[n] = 0;
+    char *text;
+    size_t n;
+    if (file_read_stream(f, path, &text, &n, err))
+        return -1;
     if (memchr(text, 0, n)) {
         free(text);
         return fr_fail(err, "%s: binary data in host table", path);

@@ -10,6 +10,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "file.h"
+
 int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
                       uint32_t y1, fr_error *err)
 {
@@ -57,25 +59,6 @@ static int write_file(const char *path, const void *data, size_t len, fr_error *
         int e = errno;
         unlink(tmp);
         return fr_fail(err, "%s: %s", path, strerror(e));
-    }
-    return 0;
-}
-
-static int read_file(const char *path, unsigned char **buf, size_t *len, fr_error *err)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fr_fail(err, "%s: %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fileno(f), &st) || !(*buf = malloc((size_t)st.st_size + 1))) {
-        fclose(f);
-        return fr_fail(err, "%s: cannot read", path);
-    }
-    *len = fread(*buf, 1, (size_t)st.st_size, f);
-    fclose(f);
-    if (*len != (size_t)st.st_size) {
-        free(*buf);
-        return fr_fail(err, "%s: short read", path);
     }
     return 0;
 }
@@ -141,10 +124,10 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
         return fr_fail(err, "%s: cannot create job directory: %s", dir, strerror(errno));
     remove_temporaries(dir);
     if (resume) {
-        unsigned char *have = NULL;
-        size_t len = 0;
+        char *have;
+        size_t len;
         fr_error e2;
-        if (read_file(path, &have, &len, &e2) == 0) {
+        if (file_read(path, &have, &len, &e2) == 0) {
             int same = len == strlen(want) && !memcmp(have, want, len);
             free(have);
             if (!same)
@@ -171,11 +154,12 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     scan_ctx *c = vctx;
     char path[4200];
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    unsigned char *buf = NULL;
-    size_t len = 0;
+    char *text;
+    size_t len;
     fr_error e;
-    int bad = read_file(path, &buf, &len, &e);
+    int bad = file_read(path, &text, &len, &e);
     if (!bad) {
+        const unsigned char *buf = (const unsigned char *)text;
         bad = job_check_partial(buf, len, c->spec, y0, y1, &e);
         if (!bad && c->rgb) {
             img_partial_info info;
@@ -186,7 +170,7 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
                 free(rows);
             }
         }
-        free(buf);
+        free(text);
     }
     if (bad) {
         fprintf(stderr, "franja: %s: discarded (%s)\n", path, e.msg);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "builder.h"
+#include "file.h"
 #include "scene.h"
 
 /* Polygons with more corners than this are triangulated as a fan (ear
@@ -91,42 +92,6 @@ void obj_free(obj_mesh *m)
     free(m->tri); free(m->tri_flags); free(m->tri_mat);
     free(m->mats);
     memset(m, 0, sizeof *m);
-}
-
-int obj_slurp(const char *path, char **text, size_t *len, fr_error *err)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fr_fail(err, "%s: %s", path, strerror(errno));
-    char *buf = NULL;
-    size_t n = 0, cap = 0;
-    for (;;) {
-        if (n + 65536 + 1 > cap) {
-            size_t nc = cap ? cap * 2 : 1 << 20;
-            char *q = realloc(buf, nc);
-            if (!q) {
-                free(buf);
-                fclose(f);
-                return fr_fail(err, "%s: out of memory", path);
-            }
-            buf = q;
-            cap = nc;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return fr_fail(err, "%s: read error", path);
-    }
-    buf[n] = 0;
-    *text = buf;
-    *len = n;
-    return 0;
 }
 
 /* ---- materials ---- */
@@ -595,7 +560,7 @@ static int load_mtllib(parser *P, const char *file)
     char *text;
     size_t len;
     fr_error e;
-    if (obj_slurp(path, &text, &len, &e) < 0)
+    if (file_read(path, &text, &len, &e) < 0)
         return fr_fail(P->c.err, "%s:%d: mtllib: %s", P->c.name, P->c.line, e.msg);
     int rc = memchr(text, 0, len) ? fr_fail(P->c.err, "%s: NUL byte in a text file", path)
                                    : parse_mtl(text, path, P->m, &P->cap_mats, P->c.err);
@@ -759,15 +724,10 @@ int obj_read(const char *path, obj_mesh *m, fr_error *err)
 {
     char *text;
     size_t len;
-    if (obj_slurp(path, &text, &len, err) < 0)
+    if (file_read(path, &text, &len, err) < 0)
         return -1;
     char dir[4096];
-    snprintf(dir, sizeof dir, "%s", path);
-    char *slash = strrchr(dir, '/');
-    if (slash)
-        *slash = 0;
-    else
-        snprintf(dir, sizeof dir, ".");
+    file_dir(path, dir, sizeof dir);
     int rc = obj_parse(text, len, path, dir, m, err);
     free(text);
     return rc;

@@ -69,8 +69,4 @@ void obj_free(obj_mesh *m);
  * when they would reflect more than they receive. */
 void obj_material_convert(const obj_material *src, fr_material *out);
 
-/** Reads a whole file into a malloc'd, NUL-terminated buffer (*len bytes
- * without the NUL).  Errors name the path. */
-int obj_slurp(const char *path, char **text, size_t *len, fr_error *err);
-
 #endif
