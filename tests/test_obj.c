@@ -121,32 +121,36 @@ static void test_polygons(void)
     obj_free(&m);
 }
 
+/* Writes text into the file dir/name; its path is left in path[cap]. */
+static void put_file(char *path, size_t cap, const char *dir, const char *name, const char *text)
+{
+    snprintf(path, cap, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        CHECK(0, "%s: cannot create", path);
+        return;
+    }
+    fputs(text, f);
+    fclose(f);
+}
+
 static void test_groups_materials(void)
 {
     char dir[] = "/tmp/franja-test-obj-XXXXXX";
     CHECK(mkdtemp(dir) != NULL, "mkdtemp");
     char path[256];
-    snprintf(path, sizeof path, "%s/a.mtl", dir);
-    FILE *f = fopen(path, "w");
-    fputs("# materials\nnewmtl red\nKd 0.8 0.1 0.1\nKa 0.1 0.1 0.1\nmap_Kd red.png\n"
-          "newmtl shiny\nKd 0.5 0.5 0.5\nKs 0.9 0.9 0.9\nNs 200\nillum 2\n"
-          "newmtl lamp\nKd 0 0 0\nKe 4 4 3\n",
-          f);
-    fclose(f);
-    snprintf(path, sizeof path, "%s/b.mtl", dir);
-    f = fopen(path, "w");
-    fputs("newmtl glass\nKd 0 0 0\nTf 0.9 0.9 1\nNi 1.45\nillum 7\nd 0.5\n"
-          "newmtl mirror\nKs 0.95\nillum 3\n",
-          f);
-    fclose(f);
-    snprintf(path, sizeof path, "%s/m.obj", dir);
-    f = fopen(path, "w");
-    fputs("mtllib a.mtl b.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
-          "f 1 2 3\n"                                        /* before any usemtl: default */
-          "g left\nusemtl red\nf 1 2 3\ng right top\nusemtl shiny\nf 2 4 3\n"
-          "usemtl lamp\nf 1 2 4\ns 1\nusemtl glass\nf 1 3 4\nusemtl mirror\nf 3 2 1\nusemtl red\nf 4 3 2\n",
-          f);
-    fclose(f);
+    put_file(path, sizeof path, dir, "a.mtl",
+             "# materials\nnewmtl red\nKd 0.8 0.1 0.1\nKa 0.1 0.1 0.1\nmap_Kd red.png\n"
+             "newmtl shiny\nKd 0.5 0.5 0.5\nKs 0.9 0.9 0.9\nNs 200\nillum 2\n"
+             "newmtl lamp\nKd 0 0 0\nKe 4 4 3\n");
+    put_file(path, sizeof path, dir, "b.mtl",
+             "newmtl glass\nKd 0 0 0\nTf 0.9 0.9 1\nNi 1.45\nillum 7\nd 0.5\n"
+             "newmtl mirror\nKs 0.95\nillum 3\n");
+    put_file(path, sizeof path, dir, "m.obj",
+             "mtllib a.mtl b.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+             "f 1 2 3\n"                                        /* before any usemtl: default */
+             "g left\nusemtl red\nf 1 2 3\ng right top\nusemtl shiny\nf 2 4 3\n"
+             "usemtl lamp\nf 1 2 4\ns 1\nusemtl glass\nf 1 3 4\nusemtl mirror\nf 3 2 1\nusemtl red\nf 4 3 2\n");
     obj_mesh m;
     fr_error err;
     CHECK(obj_read(path, &m, &err) == 0, "%s", err.msg);
@@ -172,26 +176,16 @@ static void test_groups_materials(void)
     obj_free(&m);
 
     /* A usemtl without a definition is kept, marked undefined, with its line. */
-    f = fopen(path, "w");
-    fputs("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf 1 2 3\n", f);
-    fclose(f);
+    put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf 1 2 3\n");
     CHECK(obj_read(path, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 1 && !m.mats[m.tri_mat[0]].defined && m.mats[m.tri_mat[0]].line == 5, "undefined material");
     obj_free(&m);
     /* Missing MTL file, and MTL errors, name their file and line. */
-    f = fopen(path, "w");
-    fputs("v 0 0 0\nmtllib missing.mtl\n", f);
-    fclose(f);
+    put_file(path, sizeof path, dir, "m.obj", "v 0 0 0\nmtllib missing.mtl\n");
     CHECK(obj_read(path, &m, &err) < 0 && strstr(err.msg, "m.obj:2:") && strstr(err.msg, "missing.mtl"),
           "missing mtllib: %s", err.msg);
-    snprintf(path, sizeof path, "%s/a.mtl", dir);
-    f = fopen(path, "w");
-    fputs("newmtl x\nKd 1 1\n", f);
-    fclose(f);
-    snprintf(path, sizeof path, "%s/m.obj", dir);
-    f = fopen(path, "w");
-    fputs("mtllib a.mtl\n", f);
-    fclose(f);
+    put_file(path, sizeof path, dir, "a.mtl", "newmtl x\nKd 1 1\n");
+    put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\n");
     CHECK(obj_read(path, &m, &err) < 0 && strstr(err.msg, "a.mtl:2:") && strstr(err.msg, "Kd"), "MTL error: %s",
           err.msg);
     const char *files[] = {"a.mtl", "b.mtl", "m.obj"};
