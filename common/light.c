@@ -63,6 +63,19 @@ float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
     return l->pick * dist2 / (cosl * l->area);
 }
 
+/* Point the sample from `from` at out->p: fills dist and wi, returns the
+ * squared distance (0 when the two points coincide, wi then unset). */
+static float aim(fr_light_sample *out, vec3 from)
+{
+    vec3 d = v3_sub(out->p, from);
+    float d2 = v3_len2(d);
+    if (d2 > 0.0f) {
+        out->dist = sqrtf(d2);
+        out->wi = v3_scale(d, 1.0f / out->dist);
+    }
+    return d2;
+}
+
 int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out)
 {
     if (s->n_lights == 0)
@@ -70,15 +83,12 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
     uint32_t li = lgt_pick(s, upick);
     const fr_light *l = &s->lights[li];
     if (l->kind == FR_LIGHT_POINT) {
-        vec3 d = v3_sub(l->position, from);
-        float d2 = v3_len2(d);
+        out->p = l->position;
+        float d2 = aim(out, from);
         if (!(d2 > 0.0f))
             return 0;
-        out->dist = sqrtf(d2);
-        out->wi = v3_scale(d, 1.0f / out->dist);
         out->radiance = v3_scale(l->intensity, 1.0f / d2);
         out->pdf = l->pick;
-        out->p = l->position;
         out->n = v3_neg(out->wi);
         out->prim = FR_NONE;
         out->delta = 1;
@@ -135,12 +145,9 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
         ua = b1;
         ub = 1.0f - b0 - b1;
     }
-    vec3 d = v3_sub(out->p, from);
-    float d2 = v3_len2(d);
+    float d2 = aim(out, from);
     if (!(d2 > 0.0f))
         return 0;
-    out->dist = sqrtf(d2);
-    out->wi = v3_scale(d, 1.0f / out->dist);
     float cosl = fabsf(v3_dot(out->n, out->wi));
     if (cosl <= 0.0f)
         return 0;
