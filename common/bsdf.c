@@ -4,6 +4,20 @@
 
 int bsdf_has_smooth(const fr_material *m) { return m->p_lobe[1] > 0.0f; }
 
+void bsdf_lobe_probs(fr_material *m)
+{
+    /* Lobes are picked in proportion to their brightest channel, so a lobe
+     * that reflects little is rarely followed. */
+    float w[4] = {v3_max(m->diffuse), v3_max(m->glossy), v3_max(m->specular), v3_max(m->transmit)};
+    float sum = w[0] + w[1] + w[2] + w[3], acc = 0.0f;
+    for (int i = 0; i < 4; i++) {
+        acc += sum > 0.0f ? w[i] / sum : 0.0f;
+        m->p_lobe[i] = acc;
+    }
+    if (sum > 0.0f)
+        m->p_lobe[3] = 1.0f;
+}
+
 vec3 bsdf_sample_cosine(float u1, float u2)
 {
     float r = sqrtf(u1), s, c;

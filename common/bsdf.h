@@ -34,6 +34,12 @@ int bsdf_sample(const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe
 /* 1 if the material has a smooth lobe, so light sampling can help. */
 int bsdf_has_smooth(const fr_material *m);
 
+/* Set m->p_lobe, the cumulative probabilities with which bsdf_sample picks
+ * each lobe, from the lobe colours: in proportion to each lobe's brightest
+ * channel; all zero for a material without a lobe (it only emits).  Called
+ * when a material is made and again when textures change its colours. */
+void bsdf_lobe_probs(fr_material *m);
+
 /* Unpolarized Fresnel reflectance of a smooth dielectric boundary for light
  * arriving at cos_i (> 0) from the side of index 1 onto index `eta` (the
  * relative index), both polarizations exact.  *cos_t receives the cosine of

@@ -186,6 +186,9 @@ typedef struct {
 
 #define FR_BVH_LEAF_MAX 255u
 #define FR_BVH_MIXED 0x100u
+/* Deepest node (the root is at depth 1): a deeper tree is refused when a
+ * scene is loaded, so traversal's stack has a fixed size. */
+#define FR_BVH_MAX_DEPTH 64
 
 /* A leaf block: up to four primitives with their triangle vertices copied
  * in leaf order (structure of arrays: v[3*k + axis][lane] is coordinate

@@ -8,53 +8,12 @@
 #include <unistd.h>
 
 #include "geom.h"
+#include "jsonval.h"
 #include "texture.h"
 
 #define PATHLEN 200
 
 /* ---- small readers ------------------------------------------------------ */
-
-static int member_string(const cJSON *obj, const char *key, const char *where, const char *const *choices,
-                         int def, int *out, fr_error *err)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) {
-        *out = def;
-        return 0;
-    }
-    char list[200] = "";
-    for (int i = 0; choices[i]; i++) {
-        if (cJSON_IsString(v) && !strcmp(v->valuestring, choices[i])) {
-            *out = i;
-            return 0;
-        }
-        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? " or " : "", choices[i]);
-    }
-    return fr_fail(err, "%s.%s: expected %s", where, key, list);
-}
-
-/* A number or [u, v]. */
-static int read_vec2(const cJSON *obj, const char *key, const char *where, vec2 def, vec2 *out, fr_error *err)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    *out = def;
-    if (!v)
-        return 0;
-    if (cJSON_IsNumber(v)) {
-        float x;
-        if (scn_json_number(obj, key, where, 1, 0, &x, err) < 0)
-            return -1;
-        *out = (vec2){x, x};
-        return 0;
-    }
-    const cJSON *e0 = cJSON_GetArrayItem(v, 0), *e1 = cJSON_GetArrayItem(v, 1);
-    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2 || !cJSON_IsNumber(e0) || !cJSON_IsNumber(e1) ||
-        !isfinite(e0->valuedouble) || !isfinite(e1->valuedouble) || fabs(e0->valuedouble) > 3e38 ||
-        fabs(e1->valuedouble) > 3e38)
-        return fr_fail(err, "%s.%s: expected a finite number or [u, v]", where, key);
-    *out = (vec2){(float)e0->valuedouble, (float)e1->valuedouble};
-    return 0;
-}
 
 /* A number (grey) or [r, g, b], each >= 0. */
 static int read_coefficients(const cJSON *obj, const char *key, const char *where, vec3 *out, fr_error *err)
@@ -65,25 +24,15 @@ static int read_coefficients(const cJSON *obj, const char *key, const char *wher
         return 0;
     if (cJSON_IsNumber(v)) {
         float x;
-        if (scn_json_number(obj, key, where, 1, 0, &x, err) < 0)
+        if (jv_number(obj, key, where, 1, 0, &x, err) < 0)
             return -1;
         *out = v3s(x);
-    } else if (scn_json_vec3(obj, key, where, 1, v3s(0), out, err) < 0) {
+    } else if (jv_vec3(obj, key, where, 1, v3s(0), out, err) < 0) {
         return fr_fail(err, "%s.%s: expected a number or [r, g, b] in inverse scene units", where, key);
     }
     if (v3_min(*out) < 0.0f)
         return fr_fail(err, "%s.%s: coefficients must be >= 0", where, key);
     return 0;
-}
-
-/* Index of member `name` in object o, or -1. */
-static int member_index(const cJSON *o, const char *name)
-{
-    int i = 0;
-    for (const cJSON *m = o ? o->child : NULL; m; m = m->next, i++)
-        if (!strcmp(m->string, name))
-            return i;
-    return -1;
 }
 
 /* ---- textures ----------------------------------------------------------- */
@@ -138,12 +87,12 @@ static int check_texture(const scn_appear *a, const cJSON *t, const char *where,
     int kind;
     if (!cJSON_GetObjectItemCaseSensitive(t, "type"))
         return fr_fail(err, "%s.type: missing (expected image or checker)", where);
-    if (member_string(t, "type", where, tex_types, 0, &kind, err) < 0)
+    if (jv_choice(t, "type", where, tex_types, 0, &kind, err) < 0)
         return -1;
     tex->kind = (uint32_t)kind;
-    if (scn_json_only_fields(t, where, kind == FR_TEX_IMAGE ? image_fields : checker_fields, err) < 0 ||
-        read_vec2(t, "scale", where, (vec2){1, 1}, &tex->scale, err) < 0 ||
-        read_vec2(t, "offset", where, (vec2){0, 0}, &tex->offset, err) < 0)
+    if (jv_only_fields(t, where, kind == FR_TEX_IMAGE ? image_fields : checker_fields, err) < 0 ||
+        jv_vec2(t, "scale", where, (vec2){1, 1}, &tex->scale, err) < 0 ||
+        jv_vec2(t, "offset", where, (vec2){0, 0}, &tex->offset, err) < 0)
         return -1;
     if (kind == FR_TEX_CHECKER) {
         const cJSON *c = cJSON_GetObjectItemCaseSensitive(t, "colors");
@@ -171,9 +120,9 @@ static int check_texture(const scn_appear *a, const cJSON *t, const char *where,
         return 0;
     }
     int wrap, filter;
-    if (member_string(t, "colorspace", where, colorspaces, 0, colorspace, err) < 0 ||
-        member_string(t, "wrap", where, wraps, 0, &wrap, err) < 0 ||
-        member_string(t, "filter", where, filters, 0, &filter, err) < 0)
+    if (jv_choice(t, "colorspace", where, colorspaces, 0, colorspace, err) < 0 ||
+        jv_choice(t, "wrap", where, wraps, 0, &wrap, err) < 0 ||
+        jv_choice(t, "filter", where, filters, 0, &filter, err) < 0)
         return -1;
     tex->wrap = (uint32_t)wrap;
     tex->filter = (uint32_t)filter;
@@ -284,9 +233,9 @@ static int parse_medium(const cJSON *o, const char *where, fr_medium *m, fr_erro
     memset(m, 0, sizeof *m);
     if (!cJSON_IsObject(o))
         return fr_fail(err, "%s: expected an object", where);
-    if (scn_json_only_fields(o, where, fields, err) < 0 || read_coefficients(o, "sigma_a", where, &m->sigma_a, err) < 0 ||
+    if (jv_only_fields(o, where, fields, err) < 0 || read_coefficients(o, "sigma_a", where, &m->sigma_a, err) < 0 ||
         read_coefficients(o, "sigma_s", where, &m->sigma_s, err) < 0 ||
-        scn_json_number(o, "g", where, 0, 0.0f, &m->g, err) < 0)
+        jv_number(o, "g", where, 0, 0.0f, &m->g, err) < 0)
         return -1;
     if (!(m->g >= -0.99f && m->g <= 0.99f))
         return fr_fail(err, "%s.g: expected a Henyey-Greenstein asymmetry in [-0.99, 0.99]", where);
@@ -305,7 +254,7 @@ static int medium_ref(const scn_appear *a, const cJSON *obj, const char *key, co
         return 0;
     if (!cJSON_IsString(v))
         return fr_fail(err, "%s.%s: expected the name of a medium", where, key);
-    int i = member_index(a->media, v->valuestring);
+    int i = jv_member_index(a->media, v->valuestring);
     if (i < 0)
         return fr_fail(err, "%s.%s: no medium named '%s'", where, key, v->valuestring);
     *out = (uint32_t)i + 1;
@@ -362,7 +311,7 @@ int scn_colour(scn_appear *a, const cJSON *obj, const char *key, const char *whe
     snprintf(path, sizeof path, "%s.%s", where, key);
     *tex = FR_NONE;
     if (!v || cJSON_IsArray(v))
-        return scn_json_vec3(obj, key, where, required, def, tint, err);
+        return jv_vec3(obj, key, where, required, def, tint, err);
     *tint = v3s(1.0f);
     if (cJSON_IsString(v))
         return texture_ref(a, v->valuestring, 1, path, tex, err);
@@ -370,11 +319,11 @@ int scn_colour(scn_appear *a, const cJSON *obj, const char *key, const char *whe
         return fr_fail(err, "%s: expected [r, g, b], a texture name or {\"texture\": name, \"factor\": [r, g, b]}",
                        path);
     const cJSON *name = cJSON_GetObjectItemCaseSensitive(v, "texture");
-    if (scn_json_only_fields(v, path, fields, err) < 0)
+    if (jv_only_fields(v, path, fields, err) < 0)
         return -1;
     if (!cJSON_IsString(name))
         return fr_fail(err, "%s.texture: missing (expected a texture name)", path);
-    if (scn_json_vec3(v, "factor", path, 0, v3s(1.0f), tint, err) < 0)
+    if (jv_vec3(v, "factor", path, 0, v3s(1.0f), tint, err) < 0)
         return -1;
     return texture_ref(a, name->valuestring, 1, path, tex, err);
 }
@@ -396,8 +345,8 @@ static int map_ref(scn_appear *a, const cJSON *obj, const char *key, const char 
     if (!cJSON_IsObject(v))
         return fr_fail(err, "%s: expected a texture name or {\"texture\": name, \"strength\": s}", path);
     const cJSON *name = cJSON_GetObjectItemCaseSensitive(v, "texture");
-    if (scn_json_only_fields(v, path, fields, err) < 0 ||
-        scn_json_number(v, "strength", path, 0, def_strength, strength, err) < 0)
+    if (jv_only_fields(v, path, fields, err) < 0 ||
+        jv_number(v, "strength", path, 0, def_strength, strength, err) < 0)
         return -1;
     if (!cJSON_IsString(name))
         return fr_fail(err, "%s.texture: missing (expected a texture name)", path);
@@ -438,8 +387,8 @@ int scn_camera_lens(const cJSON *o, fr_camera *cam, fr_error *err)
     if (cJSON_GetObjectItemCaseSensitive(o, "aperture"))
         return fr_fail(err, "camera.aperture: give either aperture or fstop and focal_length, not both");
     float n, f;
-    if (scn_json_number(o, "fstop", "camera", 1, 0, &n, err) < 0 ||
-        scn_json_number(o, "focal_length", "camera", 1, 0, &f, err) < 0)
+    if (jv_number(o, "fstop", "camera", 1, 0, &n, err) < 0 ||
+        jv_number(o, "focal_length", "camera", 1, 0, &f, err) < 0)
         return -1;
     if (!(n > 0.0f))
         return fr_fail(err, "camera.fstop: expected an f-number > 0");
@@ -504,34 +453,12 @@ int scn_appear_finish(scn_appear *a, const cJSON *root, fr_error *err)
     int curve;
     if (!cJSON_IsObject(tm))
         return fr_fail(err, "tonemap: expected an object");
-    if (scn_json_only_fields(tm, "tonemap", tm_fields, err) < 0 ||
-        scn_json_number(tm, "exposure", "tonemap", 0, 0.0f, &b->tonemap.exposure, err) < 0 ||
-        member_string(tm, "curve", "tonemap", curves, 0, &curve, err) < 0)
+    if (jv_only_fields(tm, "tonemap", tm_fields, err) < 0 ||
+        jv_number(tm, "exposure", "tonemap", 0, 0.0f, &b->tonemap.exposure, err) < 0 ||
+        jv_choice(tm, "curve", "tonemap", curves, 0, &curve, err) < 0)
         return -1;
     if (!(b->tonemap.exposure >= -64.0f && b->tonemap.exposure <= 64.0f))
         return fr_fail(err, "tonemap.exposure: expected stops in [-64, 64]");
     b->tonemap.curve = (uint32_t)curve;
-    return 0;
-}
-
-int scn_box(fr_builder *b, const cJSON *o, const char *where, uint32_t material, fr_error *err)
-{
-    static const char *const fields[] = {"type", "material", "min", "max", NULL};
-    vec3 lo, hi;
-    if (scn_json_only_fields(o, where, fields, err) < 0 || scn_json_vec3(o, "min", where, 1, v3s(0), &lo, err) < 0 ||
-        scn_json_vec3(o, "max", where, 1, v3s(0), &hi, err) < 0)
-        return -1;
-    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
-        return fr_fail(err, "%s.max: expected every coordinate greater than min's", where);
-    vec3 dx = v3(hi.x - lo.x, 0, 0), dy = v3(0, hi.y - lo.y, 0), dz = v3(0, 0, hi.z - lo.z);
-    /* Each face: origin and two edges whose cross product points out. */
-    const vec3 faces[6][3] = {
-        {lo, dz, dy}, {v3_add(lo, dx), dy, dz},     /* -x, +x */
-        {lo, dx, dz}, {v3_add(lo, dy), dz, dx},     /* -y, +y */
-        {lo, dy, dx}, {v3_add(lo, dz), dx, dy},     /* -z, +z */
-    };
-    for (int i = 0; i < 6; i++)
-        if (bld_rect(b, faces[i][0], faces[i][1], faces[i][2], material) == FR_NONE)
-            return fr_fail(err, "%s: out of memory", where);
     return 0;
 }

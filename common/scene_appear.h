@@ -8,7 +8,10 @@
 #ifndef FRANJA_SCENE_APPEAR_H
 #define FRANJA_SCENE_APPEAR_H
 
-#include "scene_json.h"
+#include <cjson/cJSON.h>
+
+#include "builder.h"
+#include "scene_hooks.h"
 
 /* A decoded texture already in the builder: definition name, whether its
  * texels were converted from sRGB, and its index. */
@@ -56,8 +59,5 @@ int scn_camera_lens(const cJSON *cam_obj, fr_camera *cam, fr_error *err);
  * sits in (found by casting a ray from it across the shapes with interior
  * media), and the top-level "tonemap" object. */
 int scn_appear_finish(scn_appear *a, const cJSON *root, fr_error *err);
-
-/* Add an axis-aligned box of six outward-facing rectangles. */
-int scn_box(fr_builder *b, const cJSON *obj, const char *where, uint32_t material, fr_error *err);
 
 #endif

@@ -5,8 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bsdf.h"
 #include "file.h"
 #include "fmath.h"
+#include "freeze.h"
+#include "jsonval.h"
 #include "scene_appear.h"
 
 #define PATHLEN 160
@@ -21,89 +24,6 @@ typedef struct {
     scn_appear *look;          /* textures, media (scene_appear.h) */
 } ctx;
 
-int scn_json_number(const cJSON *obj, const char *key, const char *where, int required, float def, float *out,
-                    fr_error *err)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) {
-        if (required)
-            return fr_fail(err, "%s.%s: missing (expected a number)", where, key);
-        *out = def;
-        return 0;
-    }
-    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || fabs(v->valuedouble) > 3.0e38)
-        return fr_fail(err, "%s.%s: expected a finite number", where, key);
-    *out = (float)v->valuedouble;
-    return 0;
-}
-
-/* Read value v (at JSON path `path`) as [x, y, z]. */
-static int read_vec3(const cJSON *v, const char *path, vec3 *out, fr_error *err)
-{
-    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
-        return fr_fail(err, "%s: expected an array of 3 numbers", path);
-    float c[3];
-    for (int i = 0; i < 3; i++) {
-        const cJSON *e = cJSON_GetArrayItem(v, i);
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 3.0e38)
-            return fr_fail(err, "%s[%d]: expected a finite number", path, i);
-        c[i] = (float)e->valuedouble;
-    }
-    *out = v3(c[0], c[1], c[2]);
-    return 0;
-}
-
-int scn_json_vec3(const cJSON *obj, const char *key, const char *where, int required, vec3 def, vec3 *out,
-                  fr_error *err)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) {
-        if (required)
-            return fr_fail(err, "%s.%s: missing (expected [x, y, z])", where, key);
-        *out = def;
-        return 0;
-    }
-    char path[PATHLEN];
-    snprintf(path, sizeof path, "%s.%s", where, key);
-    return read_vec3(v, path, out, err);
-}
-
-/* Refuse members not in `allowed` (NULL-terminated): a typo must not be
- * silently ignored. */
-static int only_fields(const cJSON *obj, const char *where, const char *const *allowed, fr_error *err)
-{
-    for (const cJSON *m = obj->child; m; m = m->next) {
-        int ok = 0;
-        for (int i = 0; allowed[i] && !ok; i++)
-            ok = !strcmp(m->string, allowed[i]);
-        if (!ok)
-            return fr_fail(err, "%s.%s: unknown field", where, m->string);
-    }
-    return 0;
-}
-
-int scn_json_only_fields(const cJSON *obj, const char *where, const char *const *allowed, fr_error *err)
-{
-    return only_fields(obj, where, allowed, err);
-}
-
-static int get_uint(const cJSON *obj, const char *key, const char *where, int required, uint32_t def,
-                    uint32_t lo, uint32_t hi, uint32_t *out, fr_error *err)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) {
-        if (required)
-            return fr_fail(err, "%s.%s: missing (expected an integer in [%u, %u])", where, key, lo, hi);
-        *out = def;
-        return 0;
-    }
-    double d = v->valuedouble;
-    if (!cJSON_IsNumber(v) || !(d >= lo && d <= hi) || d != floor(d))
-        return fr_fail(err, "%s.%s: expected an integer in [%u, %u]", where, key, lo, hi);
-    *out = (uint32_t)d;
-    return 0;
-}
-
 static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
 
 static int parse_image(ctx *c, const cJSON *o)
@@ -112,12 +32,12 @@ static int parse_image(ctx *c, const cJSON *o)
     fr_settings *s = &c->b->settings;
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "image: missing or not an object");
-    if (only_fields(o, "image", fields, c->err) < 0 ||
-        get_uint(o, "width", "image", 1, 0, 1, 65536, &s->width, c->err) < 0 ||
-        get_uint(o, "height", "image", 1, 0, 1, 65536, &s->height, c->err) < 0 ||
-        get_uint(o, "spp", "image", 0, 16, 1, 1u << 20, &s->spp, c->err) < 0 ||
-        get_uint(o, "max_depth", "image", 0, 8, 0, 4096, &s->max_depth, c->err) < 0 ||
-        get_uint(o, "seed", "image", 0, 0, 0, 0xffffffffu, &s->seed, c->err) < 0)
+    if (jv_only_fields(o, "image", fields, c->err) < 0 ||
+        jv_uint(o, "width", "image", 1, 0, 1, 65536, &s->width, c->err) < 0 ||
+        jv_uint(o, "height", "image", 1, 0, 1, 65536, &s->height, c->err) < 0 ||
+        jv_uint(o, "spp", "image", 0, 16, 1, 1u << 20, &s->spp, c->err) < 0 ||
+        jv_uint(o, "max_depth", "image", 0, 8, 0, 4096, &s->max_depth, c->err) < 0 ||
+        jv_uint(o, "seed", "image", 0, 0, 0, 0xffffffffu, &s->seed, c->err) < 0)
         return -1;
     return 0;
 }
@@ -130,12 +50,12 @@ static int parse_camera(ctx *c, const cJSON *o)
     float fov;
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "camera: missing or not an object");
-    if (only_fields(o, "camera", fields, c->err) < 0 ||
-        scn_json_vec3(o, "position", "camera", 1, v3s(0), &cam->position, c->err) < 0 ||
-        scn_json_vec3(o, "target", "camera", 1, v3s(0), &cam->target, c->err) < 0 ||
-        scn_json_vec3(o, "up", "camera", 0, v3(0, 1, 0), &cam->up, c->err) < 0 ||
-        scn_json_number(o, "fov", "camera", 1, 0, &fov, c->err) < 0 ||
-        scn_json_number(o, "aperture", "camera", 0, 0, &cam->aperture, c->err) < 0 ||
+    if (jv_only_fields(o, "camera", fields, c->err) < 0 ||
+        jv_vec3(o, "position", "camera", 1, v3s(0), &cam->position, c->err) < 0 ||
+        jv_vec3(o, "target", "camera", 1, v3s(0), &cam->target, c->err) < 0 ||
+        jv_vec3(o, "up", "camera", 0, v3(0, 1, 0), &cam->up, c->err) < 0 ||
+        jv_number(o, "fov", "camera", 1, 0, &fov, c->err) < 0 ||
+        jv_number(o, "aperture", "camera", 0, 0, &cam->aperture, c->err) < 0 ||
         scn_camera_lens(o, cam, c->err) < 0)
         return -1;
     if (!(fov > 0.0f && fov < 180.0f))
@@ -147,7 +67,7 @@ static int parse_camera(ctx *c, const cJSON *o)
     if (bld_camera_finish(cam, &e) < 0)
         return fr_fail(c->err, "%s", e.msg);
     float dist = v3_len(v3_sub(cam->target, cam->position));
-    if (scn_json_number(o, "focus", "camera", 0, dist, &cam->focus, c->err) < 0)
+    if (jv_number(o, "focus", "camera", 0, dist, &cam->focus, c->err) < 0)
         return -1;
     if (!(cam->focus > 0.0f))
         return fr_fail(c->err, "camera.focus: expected a positive distance");
@@ -163,7 +83,7 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
     scn_appear *a = c->look;
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "%s: expected an object", where);
-    if (only_fields(o, where, fields, c->err) < 0)
+    if (jv_only_fields(o, where, fields, c->err) < 0)
         return -1;
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
@@ -177,19 +97,19 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
     } else if (!strcmp(type, "phong")) {
         rc = scn_colour(a, o, "diffuse", where, 0, v3s(0), &m->diffuse, &m->tex_diffuse, c->err) |
              scn_colour(a, o, "glossy", where, 1, v3s(0), &m->glossy, &m->tex_glossy, c->err) |
-             scn_json_number(o, "exponent", where, 1, 0, &m->exponent, c->err);
+             jv_number(o, "exponent", where, 1, 0, &m->exponent, c->err);
     } else if (!strcmp(type, "mirror")) {
         rc = scn_colour(a, o, "reflectance", where, 0, v3s(1), &m->specular, &m->tex_specular, c->err);
     } else if (!strcmp(type, "glass")) {
         rc = scn_colour(a, o, "tint", where, 0, v3s(1), &m->transmit, &m->tex_transmit, c->err) |
-             scn_json_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
+             jv_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
     } else if (!strcmp(type, "mix")) {
         rc = scn_colour(a, o, "diffuse", where, 0, v3s(0), &m->diffuse, &m->tex_diffuse, c->err) |
              scn_colour(a, o, "glossy", where, 0, v3s(0), &m->glossy, &m->tex_glossy, c->err) |
-             scn_json_number(o, "exponent", where, 0, 0, &m->exponent, c->err) |
+             jv_number(o, "exponent", where, 0, 0, &m->exponent, c->err) |
              scn_colour(a, o, "specular", where, 0, v3s(0), &m->specular, &m->tex_specular, c->err) |
              scn_colour(a, o, "transmit", where, 0, v3s(0), &m->transmit, &m->tex_transmit, c->err) |
-             scn_json_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
+             jv_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
     } else if (strcmp(type, "emitter") != 0 && strcmp(type, "interface") != 0) {
         return fr_fail(c->err, "%s.type: '%s' is not lambert, phong, mirror, glass, mix, emitter or interface", where,
                        type);
@@ -212,7 +132,7 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
         return fr_fail(c->err, "%s.exponent: expected a number in [0, 1e6]", where);
     if (!(m->ior >= 1.0f / 16.0f && m->ior <= 16.0f) || m->ior == 1.0f)
         return fr_fail(c->err, "%s.ior: expected an index of refraction in [1/16, 16], not 1", where);
-    bld_material_finish(m);
+    bsdf_lobe_probs(m);
     return 0;
 }
 
@@ -256,7 +176,7 @@ static int vertices(ctx *c, const cJSON *o, const char *where, int n, vec3 *v)
     for (int i = 0; i < n; i++) {
         char path[PATHLEN];
         snprintf(path, sizeof path, "%s.vertices[%d]", where, i);
-        if (read_vec3(cJSON_GetArrayItem(a, i), path, &v[i], c->err) < 0)
+        if (jv_vec3_value(cJSON_GetArrayItem(a, i), path, &v[i], c->err) < 0)
             return -1;
     }
     return 0;
@@ -270,6 +190,29 @@ static int add_triangle(ctx *c, const char *where, vec3 a, vec3 b, vec3 d, const
     vec3 p[3] = {a, b, d};
     uint32_t t = uv ? bld_triangle_uv(c->b, p, uv, mat) : bld_triangle(c->b, a, b, d, mat);
     return t == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
+}
+
+/* An axis-aligned box: six outward-facing rectangles. */
+static int parse_box(fr_builder *b, const cJSON *o, const char *where, uint32_t material, fr_error *err)
+{
+    static const char *const fields[] = {"type", "material", "min", "max", NULL};
+    vec3 lo, hi;
+    if (jv_only_fields(o, where, fields, err) < 0 || jv_vec3(o, "min", where, 1, v3s(0), &lo, err) < 0 ||
+        jv_vec3(o, "max", where, 1, v3s(0), &hi, err) < 0)
+        return -1;
+    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+        return fr_fail(err, "%s.max: expected every coordinate greater than min's", where);
+    vec3 dx = v3(hi.x - lo.x, 0, 0), dy = v3(0, hi.y - lo.y, 0), dz = v3(0, 0, hi.z - lo.z);
+    /* Each face: origin and two edges whose cross product points out. */
+    const vec3 faces[6][3] = {
+        {lo, dz, dy}, {v3_add(lo, dx), dy, dz},     /* -x, +x */
+        {lo, dx, dz}, {v3_add(lo, dy), dz, dx},     /* -y, +y */
+        {lo, dy, dx}, {v3_add(lo, dz), dx, dy},     /* -z, +z */
+    };
+    for (int i = 0; i < 6; i++)
+        if (bld_rect(b, faces[i][0], faces[i][1], faces[i][2], material) == FR_NONE)
+            return fr_fail(err, "%s: out of memory", where);
+    return 0;
 }
 
 static int parse_shape(ctx *c, const cJSON *o, const char *where)
@@ -291,8 +234,8 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         static const char *const f[] = {"type", "material", "center", "radius", NULL};
         vec3 center;
         float radius;
-        if (only_fields(o, where, f, c->err) < 0 || scn_json_vec3(o, "center", where, 1, v3s(0), &center, c->err) < 0 ||
-            scn_json_number(o, "radius", where, 1, 0, &radius, c->err) < 0)
+        if (jv_only_fields(o, where, f, c->err) < 0 || jv_vec3(o, "center", where, 1, v3s(0), &center, c->err) < 0 ||
+            jv_number(o, "radius", where, 1, 0, &radius, c->err) < 0)
             return -1;
         if (!(radius > 0.0f))
             return fr_fail(c->err, "%s.radius: expected a positive number", where);
@@ -301,8 +244,8 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         static const char *const f[] = {"type", "material", "point", "normal", NULL};
         fr_plane p;
         memset(&p, 0, sizeof p);
-        if (only_fields(o, where, f, c->err) < 0 || scn_json_vec3(o, "point", where, 1, v3s(0), &p.point, c->err) < 0 ||
-            scn_json_vec3(o, "normal", where, 1, v3s(0), &p.normal, c->err) < 0)
+        if (jv_only_fields(o, where, f, c->err) < 0 || jv_vec3(o, "point", where, 1, v3s(0), &p.point, c->err) < 0 ||
+            jv_vec3(o, "normal", where, 1, v3s(0), &p.normal, c->err) < 0)
             return -1;
         if (!(v3_len2(p.normal) > 0.0f))
             return fr_fail(c->err, "%s.normal: expected a non-zero vector", where);
@@ -314,9 +257,9 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
     } else if (!strcmp(type, "rect")) {
         static const char *const f[] = {"type", "material", "origin", "edge_u", "edge_v", NULL};
         vec3 org, eu, ev;
-        if (only_fields(o, where, f, c->err) < 0 || scn_json_vec3(o, "origin", where, 1, v3s(0), &org, c->err) < 0 ||
-            scn_json_vec3(o, "edge_u", where, 1, v3s(0), &eu, c->err) < 0 ||
-            scn_json_vec3(o, "edge_v", where, 1, v3s(0), &ev, c->err) < 0)
+        if (jv_only_fields(o, where, f, c->err) < 0 || jv_vec3(o, "origin", where, 1, v3s(0), &org, c->err) < 0 ||
+            jv_vec3(o, "edge_u", where, 1, v3s(0), &eu, c->err) < 0 ||
+            jv_vec3(o, "edge_v", where, 1, v3s(0), &ev, c->err) < 0)
             return -1;
         if (!(v3_len2(v3_cross(eu, ev)) > 0.0f))
             return fr_fail(c->err, "%s: zero-area rectangle (edges parallel or zero)", where);
@@ -324,7 +267,7 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
     } else if (!strcmp(type, "quad")) {
         static const char *const f[] = {"type", "material", "vertices", NULL};
         vec3 v[4];
-        if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 4, v) < 0)
+        if (jv_only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 4, v) < 0)
             return -1;
         /* Two triangles, even for a parallelogram: the BVH tests triangles
          * four at a time, so they trace faster than one rectangle. */
@@ -335,11 +278,11 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
     } else if (!strcmp(type, "triangle")) {
         static const char *const f[] = {"type", "material", "vertices", NULL};
         vec3 v[3];
-        if (only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 3, v) < 0 ||
+        if (jv_only_fields(o, where, f, c->err) < 0 || vertices(c, o, where, 3, v) < 0 ||
             add_triangle(c, where, v[0], v[1], v[2], NULL, mat) < 0)
             return -1;
     } else if (!strcmp(type, "box")) {
-        if (scn_box(c->b, o, where, mat, c->err) < 0)
+        if (parse_box(c->b, o, where, mat, c->err) < 0)
             return -1;
     } else if (!strcmp(type, "mesh")) {
         if (!c->hooks || !c->hooks->mesh)
@@ -373,9 +316,9 @@ static int parse_lights(ctx *c, const cJSON *a)
         memset(&l, 0, sizeof l);
         l.kind = FR_LIGHT_POINT;
         l.prim = FR_NONE;
-        if (only_fields(o, where, f, c->err) < 0 ||
-            scn_json_vec3(o, "position", where, 1, v3s(0), &l.position, c->err) < 0 ||
-            scn_json_vec3(o, "intensity", where, 1, v3s(0), &l.intensity, c->err) < 0)
+        if (jv_only_fields(o, where, f, c->err) < 0 ||
+            jv_vec3(o, "position", where, 1, v3s(0), &l.position, c->err) < 0 ||
+            jv_vec3(o, "intensity", where, 1, v3s(0), &l.intensity, c->err) < 0)
             return -1;
         if (!nonneg3(l.intensity) || v3_is_zero(l.intensity))
             return fr_fail(c->err, "%s.intensity: expected a non-negative, non-zero colour", where);
@@ -407,7 +350,7 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
     int rc = -1;
     if (!cJSON_IsObject(root)) {
         fr_fail(&e, "(top level): expected an object");
-    } else if (only_fields(root, "(top level)", top, &e) == 0 &&
+    } else if (jv_only_fields(root, "(top level)", top, &e) == 0 &&
                parse_image(&c, cJSON_GetObjectItemCaseSensitive(root, "image")) == 0 &&
                parse_camera(&c, cJSON_GetObjectItemCaseSensitive(root, "camera")) == 0 &&
                scn_appear_begin(&look, root, dir, hooks, b, &e) == 0 &&
@@ -456,7 +399,7 @@ int scn_load_json(const char *path, const scn_hooks *hooks, fr_scene *out, fr_er
     free(text);
     if (rc == 0) {
         fr_error e;
-        rc = bld_finish(&b, out, &e);
+        rc = frz_scene(&b, out, &e);
         if (rc < 0)
             fr_fail(err, "%s: %s", path, e.msg);
     }

@@ -1,6 +1,6 @@
 #include "texture.h"
 
-#include "builder.h"
+#include "bsdf.h"
 #include "fmath.h"
 
 float tex_srgb_to_linear(float v)
@@ -207,7 +207,7 @@ const fr_material *tex_material(const fr_scene *s, const fr_material *m, fr_surf
     if (m->tex_emission != FR_NONE)
         tmp->emission = tex_emission(s, m, sf->uv);
     if (lobes)
-        bld_material_finish(tmp);
+        bsdf_lobe_probs(tmp);
     if (m->tex_bump != FR_NONE)
         bump(s, m, sf);
     if (m->tex_normal != FR_NONE)

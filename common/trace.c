@@ -2,9 +2,12 @@
 
 #include <string.h>
 
-#include "bvh.h"
 #include "fmath.h"
 #include "simd4.h"
+
+/* Traversal's stack: at most FR_BVH_WIDTH - 1 entries wait per level of a
+ * tree no deeper than FR_BVH_MAX_DEPTH (the loader refuses deeper ones). */
+#define BVH_STACK ((FR_BVH_WIDTH - 1) * FR_BVH_MAX_DEPTH + 1)
 
 float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, float *a, float *b)
 {

@@ -11,7 +11,7 @@
 #include <strings.h>
 
 #include "fmath.h"
-#include "scene_json.h"
+#include "jsonval.h"
 
 enum { LOD_MAX = 16 };
 #define LOD_DENSITY 0.25f      /* default triangles per pixel of projected area */
@@ -205,14 +205,14 @@ static int read_xform(const cJSON *o, const char *where, xform *x, float *det, f
         const cJSON *sc = cJSON_GetObjectItemCaseSensitive(o, "scale");
         if (cJSON_IsNumber(sc)) {
             float k;
-            if (scn_json_number(o, "scale", where, 1, 1.0f, &k, err) < 0)
+            if (jv_number(o, "scale", where, 1, 1.0f, &k, err) < 0)
                 return -1;
             s = v3s(k);
-        } else if (scn_json_vec3(o, "scale", where, 0, v3s(1.0f), &s, err) < 0) {
+        } else if (jv_vec3(o, "scale", where, 0, v3s(1.0f), &s, err) < 0) {
             return -1;
         }
-        if (scn_json_vec3(o, "rotate", where, 0, v3s(0.0f), &r, err) < 0 ||
-            scn_json_vec3(o, "translate", where, 0, v3s(0.0f), &t, err) < 0)
+        if (jv_vec3(o, "rotate", where, 0, v3s(0.0f), &r, err) < 0 ||
+            jv_vec3(o, "translate", where, 0, v3s(0.0f), &t, err) < 0)
             return -1;
         float S[3][3] = {{s.x, 0, 0}, {0, s.y, 0}, {0, 0, s.z}};
         memcpy(x->m, S, sizeof S);
@@ -331,7 +331,7 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
     float det = 1.0f, density;
     if (only_fields(o, where, err) < 0 || level_paths(o, where, dir, paths, &levels, err) < 0 ||
         read_xform(o, where, &x, &det, err) < 0 ||
-        scn_json_number(o, "lod_density", where, 0, LOD_DENSITY, &density, err) < 0)
+        jv_number(o, "lod_density", where, 0, LOD_DENSITY, &density, err) < 0)
         return -1;
     if (!(density > 0.0f))
         return fr_fail(err, "%s.lod_density: expected triangles per pixel > 0", where);

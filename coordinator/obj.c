@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bsdf.h"
 #include "builder.h"
 #include "file.h"
 #include "scene.h"
@@ -270,7 +271,7 @@ void obj_material_convert(const obj_material *src, fr_material *m)
         m->specular = v3_scale(m->specular, k);
         m->transmit = v3_scale(m->transmit, k);
     }
-    bld_material_finish(m);
+    bsdf_lobe_probs(m);
 }
 
 /* ---- geometry ---- */

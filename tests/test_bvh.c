@@ -12,9 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bvh.h"
+#include "bsdf.h"
+#include "bvh_build.h"
 #include "check.h"
 #include "fbin.h"
+#include "freeze.h"
 #include "trace.h"
 
 static uint64_t rng_state = 0x853c49e6748fea9bull;
@@ -46,7 +48,7 @@ static void start(fr_builder *b)
     fr_material m;
     bld_material_init(&m);
     m.diffuse = v3s(0.5f);
-    bld_material_finish(&m);
+    bsdf_lobe_probs(&m);
     bld_push(&b->materials, &m);
     b->settings = (fr_settings){64, 64, 1, 4, 0, {0, 0, 0}};
     b->camera.position = v3(0, 0, -5);
@@ -202,7 +204,7 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
 {
     fr_scene s;
     fr_error err;
-    if (bld_finish(b, &s, &err) < 0) {
+    if (frz_scene(b, &s, &err) < 0) {
         CHECK(0, "%s: build failed: %s", name, err.msg);
         return;
     }
@@ -236,7 +238,7 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
     CHECK(hits > rays / 20, "%s: only %d of %d rays hit anything (test too weak)", name, hits, rays);
     /* The same input builds the same bytes. */
     fr_scene s2;
-    if (bld_finish(again, &s2, &err) == 0) {
+    if (frz_scene(again, &s2, &err) == 0) {
         CHECK(s2.hash == s.hash, "%s: rebuilding gives another hash", name);
         scn_free(&s2);
     }

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "scenes.h"
 
 enum { W = 96, H = 96, SPP = 4096 };

@@ -3,7 +3,7 @@
 #include <math.h>
 
 #include "check.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "scenes.h"
 
 /* Mean radiance over a few pixels and many samples. */

@@ -8,7 +8,7 @@
 
 #include "check.h"
 #include "medium.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "scenes.h"
 
 /* ---- building blocks ------------------------------------------------------ */

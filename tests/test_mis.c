@@ -5,7 +5,7 @@
 #include <math.h>
 
 #include "check.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "scenes.h"
 
 static const char scene[] =

@@ -195,12 +195,12 @@ int main(void)
     fr_material lam, pho;
     memset(&lam, 0, sizeof lam);
     lam.diffuse = v3s(0.8f);
-    bld_material_finish(&lam);
+    bsdf_lobe_probs(&lam);
     memset(&pho, 0, sizeof pho);
     pho.diffuse = v3s(0.3f);
     pho.glossy = v3s(0.6f);
     pho.exponent = 15;
-    bld_material_finish(&pho);
+    bsdf_lobe_probs(&pho);
     chi2_material("Lambert material", &lam, v3_norm(v3(0.3f, 0.1f, 1.0f)));
     chi2_material("Phong material, wo at 60 degrees", &pho, v3_norm(v3(1.7320508f, 0, 1)));
 

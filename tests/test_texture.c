@@ -9,7 +9,7 @@
 
 #include "bsdf.h"
 #include "check.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "scenes.h"
 #include "texture.h"
 
@@ -55,7 +55,7 @@ static int load(const char *json, fr_scene *out, fr_error *err)
     snprintf(file, sizeof file, "%s/scene.json", dir);
     int rc = scn_parse_json(json, file, &hooks, &b, err);
     if (rc == 0)
-        rc = bld_finish(&b, out, err);
+        rc = frz_scene(&b, out, err);
     bld_free(&b);
     return rc;
 }
@@ -201,7 +201,7 @@ static void uv_round_trips(void)
     fr_material m;
     bld_material_init(&m);
     m.diffuse = v3s(0.5f);
-    bld_material_finish(&m);
+    bsdf_lobe_probs(&m);
     bld_push(&b.materials, &m);
     vec3 c = v3(5, 1, -2);
     float rad = 1.5f;
@@ -226,7 +226,7 @@ static void uv_round_trips(void)
     fr_plane pl = {v3(0, 0, -20), v3(0, 0, 1), 0, 0};
     bld_push(&b.planes, &pl);
     fr_scene s;
-    if (bld_finish(&b, &s, &err) < 0) {
+    if (frz_scene(&b, &s, &err) < 0) {
         CHECK(0, "uv scene: %s", err.msg);
         bld_free(&b);
         return;

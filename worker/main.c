@@ -8,7 +8,7 @@
 
 #include "fbin.h"
 #include "image.h"
-#include "render.h"
+#include "pathtrace.h"
 #ifndef FRANJA_NO_JSON
 #include "scene_json.h"
 #endif

@@ -26,10 +26,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "bvh.h"
+#include "bvh_build.h"
 #include "fbin.h"
 #include "geom.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "trace.h"
 
 static double clock_s(clockid_t id)

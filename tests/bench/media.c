@@ -12,7 +12,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "render.h"
+#include "pathtrace.h"
 #include "scene_json.h"
 
 static double now(void)

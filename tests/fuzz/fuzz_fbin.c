@@ -13,7 +13,7 @@
 #include <xxhash.h>
 
 #include "fbin.h"
-#include "render.h"
+#include "pathtrace.h"
 #include "trace.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

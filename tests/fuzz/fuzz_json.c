@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "freeze.h"
 #include "scene_json.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -21,7 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     bld_init(&b);
     if (scn_parse_json(text, "fuzz.json", NULL, &b, &err) == 0) {
         fr_scene s;
-        if (bld_finish(&b, &s, &err) == 0)
+        if (frz_scene(&b, &s, &err) == 0)
             scn_free(&s);
     }
     bld_free(&b);

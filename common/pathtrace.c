@@ -1,4 +1,4 @@
-#include "render.h"
+#include "pathtrace.h"
 
 #include "bsdf.h"
 #include "fmath.h"

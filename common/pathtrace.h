@@ -1,11 +1,11 @@
-/* render.h -- the integrator: unidirectional path tracing with next-event
+/* pathtrace.h -- the integrator: unidirectional path tracing with next-event
  * estimation and multiple importance sampling, and the camera.
  *
  * Radiance estimates are linear RGB.  A pixel's value is the mean of its
  * samples; each sample's random numbers come from sampler.h, so any rows
  * rendered anywhere give the same bits. */
-#ifndef FRANJA_RENDER_H
-#define FRANJA_RENDER_H
+#ifndef FRANJA_PATHTRACE_H
+#define FRANJA_PATHTRACE_H
 
 #include "error.h"
 #include "scene.h"

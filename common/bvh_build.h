@@ -1,0 +1,28 @@
+/** @file bvh_build.h
+ * Building the BVH of a scene at compile time (the layout it produces is
+ * described in bvh.h and scene.h).
+ *
+ * A binned surface-area-heuristic build (32 bins per axis on primitive
+ * centroids, O(n log n)): a node takes the child range with the largest
+ * surface area and splits it at the cheapest bin boundary until it has
+ * eight children or the SAH prefers leaves; below the depth where the tree
+ * could exceed FR_BVH_MAX_DEPTH it halves ranges instead.  It is
+ * single-threaded and uses only exactly rounded float operations, so a
+ * scene gives the same bytes on every machine.
+ */
+#ifndef FRANJA_BVH_BUILD_H
+#define FRANJA_BVH_BUILD_H
+
+#include "builder.h"
+
+/** Build the BVH over b->prims, reordering b->prims into leaf order, and
+ * append its nodes to `nodes` (fr_array of fr_bvh_node) and its leaf blocks
+ * to `leaves` (fr_array of fr_bvh_leaf), both owned by the caller.  An empty
+ * scene gives neither.  Returns 0, or -1 with *err set on memory exhaustion
+ * or a primitive with non-finite bounds. */
+int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err);
+
+/** Bounding box of prim `i` of the builder, into *lo and *hi. */
+void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi);
+
+#endif
