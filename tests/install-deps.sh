@@ -9,5 +9,6 @@ apt-get install -y --no-install-recommends \
     libcjson-dev libxxhash-dev libassimp-dev libembree-dev clang libclang-rt-14-dev \
     libssh-dev libopenimageio-dev openimageio-tools \
     openssh-server openssh-client iproute2 procps doxygen \
+    slurmctld slurmd slurm-client munge \
     docker.io debootstrap qemu-user-static \
     gcc-aarch64-linux-gnu libc6-dev-arm64-cross
