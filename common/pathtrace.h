@@ -1,9 +1,16 @@
-/* pathtrace.h -- the integrator: unidirectional path tracing with next-event
- * estimation and multiple importance sampling, and the camera.
+/** @file pathtrace.h
+ * The integrator: unidirectional path tracing with next-event estimation
+ * and multiple importance sampling, through participating media, and the
+ * camera.
  *
- * Radiance estimates are linear RGB.  A pixel's value is the mean of its
- * samples; each sample's random numbers come from sampler.h, so any rows
- * rendered anywhere give the same bits. */
+ * A path is built from the pieces in vertex.h: the next vertex along a ray
+ * (through media), light sampling at each vertex, scattering onward, and
+ * Russian roulette after a few bounces.  Radiance estimates are linear
+ * RGB.  A pixel's value is the mean of its samples; each sample's random
+ * numbers come from sampler.h in a fixed order (camera, then per vertex:
+ * medium segments, light pick and lobe, light point, direction, roulette),
+ * so any rows rendered anywhere give the same bits.
+ */
 #ifndef FRANJA_PATHTRACE_H
 #define FRANJA_PATHTRACE_H
 
@@ -11,20 +18,22 @@
 #include "scene.h"
 #include "trace.h"
 
-/* How direct light is estimated.  Only PT_MIS is used for images; the
+/** How direct light is estimated.  Only PT_MIS is used for images; the
  * others exist so tests can show they agree (MIS is unbiased) and measure
  * what each technique brings.  PT_MIS_DISTANCE is PT_MIS with media
  * sampled by free-flight distance alone, without equiangular sampling. */
 typedef enum { PT_MIS = 0, PT_LIGHT_ONLY, PT_BSDF_ONLY, PT_MIS_DISTANCE } pt_strategy;
 
-/* The primary ray of pixel (x, y) for lens/pixel numbers in [0,1)^2:
- * box filter of one pixel, thin lens when the camera has an aperture. */
+/** The primary ray of pixel (x, y) for pixel numbers (px, py) and lens
+ * numbers (lx, ly) in [0,1)^2: box filter of one pixel, thin lens when the
+ * camera has an aperture.  The direction is unit length. */
 fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly);
 
-/* Radiance of sample `index` of pixel (x, y). */
+/** Radiance of sample `index` of pixel (x, y); 0 for a sample that came
+ * out NaN or infinite (dropped the same way everywhere). */
 vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index);
 
-/* Render rows [y0, y1) with s->settings' size and spp into rgb
+/** Render rows [y0, y1) with s->settings' size and spp into rgb
  * (3 floats per pixel, row y0 first, caller-owned, width*(y1-y0)*3). */
 void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb);
 

@@ -1,0 +1,156 @@
+#include "vertex.h"
+
+#include "fmath.h"
+#include "medium.h"
+
+/* Interfaces a path may cross between two vertices before it is given up
+ * (a ray caught between coincident boundaries). */
+#define MAX_CROSSINGS 64
+
+float vtx_power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* Equiangular sampling toward a point light over one medium segment
+ * (o + t d, t in [0, tmax), medium `medium`, throughput beta at o): the
+ * single-scattering estimate of light picked by upick, at a distance chosen
+ * by u, weighted by MIS against the free-flight sampling that the path
+ * itself does on the same segment (its vertices' point-light estimates take
+ * the complementary weight).  Area lights are left to the path's vertices. */
+static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, float tmax, vec3 beta, float upick,
+                        float u)
+{
+    const fr_medium *md = &s->media[medium - 1];
+    const fr_light *l = &s->lights[lgt_pick(s, upick)];
+    float t, pe;
+    if (l->kind != FR_LIGHT_POINT || v3_is_zero(md->sigma_s) ||
+        !med_equiangular(ray->o, ray->d, tmax, l->position, u, &t, &pe))
+        return v3s(0.0f);
+    vec3 x = v3_madd(ray->o, ray->d, t), to = v3_sub(l->position, x);
+    float d2 = v3_len2(to), d = sqrtf(d2);
+    fr_ray shadow = {x, v3_scale(to, 1.0f / d)};
+    vec3 tr = med_shadow(s, medium, &shadow, d, FR_NONE);
+    if (v3_is_zero(tr))
+        return v3s(0.0f);
+    float pd = med_distance_pdf(md, beta, t);
+    float w = vtx_power_heuristic(pe, pd) * med_phase(md->g, v3_dot(ray->d, shadow.d)) / (pe * l->pick * d2);
+    vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, l->intensity));
+    return v3_scale(v3_mul(beta, f), w);
+}
+
+int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vec3 *equi_L,
+             vtx_vertex *v)
+{
+    fr_hit hit;
+    int found = trace_closest(s, ray, INFINITY, &hit);
+    v->kind = VTX_ESCAPED;
+    if (!s->n_media) {
+        if (!found)
+            return VTX_ESCAPED;
+        trace_surface(s, ray, &hit, &v->sf);
+        return v->kind = VTX_SURFACE;
+    }
+    /* Sample each medium segment up to the next surface, crossing
+     * invisible media boundaries, until the path scatters in a medium or
+     * reaches a real surface. */
+    for (uint32_t crossings = 0;; crossings++) {
+        float tmax = found ? hit.t : INFINITY;
+        if (*medium) {
+            const fr_medium *md = &s->media[*medium - 1];
+            float uch, ud, ueq_pick, ueq, t;
+            smp_2d(smp, &uch, &ud);
+            smp_2d(smp, &ueq_pick, &ueq);
+            if (equi_L)
+                *equi_L = v3_add(*equi_L, equiangular(s, *medium, ray, tmax, *beta, ueq_pick, ueq));
+            vec3 w;
+            int scattered = med_sample_distance(md, tmax, *beta, uch, ud, &t, &w);
+            if (scattered) {
+                v->seg = *ray;
+                v->seg_beta = *beta;
+                v->seg_tmax = tmax;
+                v->t = t;
+            }
+            *beta = v3_mul(*beta, w);
+            if (scattered) {
+                v->p = v3_madd(v->seg.o, v->seg.d, t);
+                return v->kind = VTX_MEDIUM;
+            }
+        }
+        if (!found)
+            return VTX_ESCAPED;
+        trace_surface(s, ray, &hit, &v->sf);
+        const fr_material *mb = &s->materials[v->sf.material];
+        if (!mb->interface)
+            return v->kind = VTX_SURFACE;
+        if (crossings == MAX_CROSSINGS)
+            return VTX_ESCAPED;
+        *medium = med_after(s, *medium, mb, v->sf.ng, ray->d);
+        ray->o = geo_offset(v->sf.p, v->sf.ng, ray->d);
+        found = trace_closest(s, ray, INFINITY, &hit);
+    }
+}
+
+int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, uint32_t medium,
+                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, vtx_direct *out)
+{
+    fr_light_sample *ls = &out->ls;
+    if (!bsdf_has_smooth(m) || !lgt_sample(s, sf->p, upick, u1, u2, ls))
+        return 0;
+    vec3 f = bsdf_eval(m, sf, wo, ls->wi, &out->scatter_pdf);
+    if (v3_is_zero(f))
+        return 0;
+    fr_ray shadow = {geo_offset(sf->p, sf->ng, ls->wi), ls->wi};
+    float tmax = v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
+    vec3 tr = v3s(1.0f);
+    if (s->n_media && tmax > 0.0f)
+        tr = med_shadow(s, med_after(s, medium, m, sf->ng, ls->wi), &shadow, tmax, ls->prim);
+    if (!(tmax > 0.0f) || v3_is_zero(tr) || (!s->n_media && trace_occluded(s, &shadow, tmax, ls->prim)))
+        return 0;
+    out->weight = (ls->delta || !mis.area) ? 1.0f : vtx_power_heuristic(ls->pdf, out->scatter_pdf);
+    float cosi = fabsf(v3_dot(ls->wi, sf->ns));
+    out->L = v3_scale(v3_mul(beta, v3_mul(v3_mul(tr, f), ls->radiance)), out->weight * cosi / ls->pdf);
+    return 1;
+}
+
+int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, float upick,
+                      float u1, float u2, vtx_direct *out)
+{
+    fr_light_sample *ls = &out->ls;
+    if (!lgt_sample(s, v->p, upick, u1, u2, ls))
+        return 0;
+    const fr_medium *md = &s->media[medium - 1];
+    fr_ray shadow = {v->p, ls->wi};
+    vec3 tr = med_shadow(s, medium, &shadow, ls->dist, ls->prim);
+    float ph = med_phase(md->g, v3_dot(v->seg.d, ls->wi));
+    out->scatter_pdf = ph;
+    out->weight = 1.0f;
+    if (ls->delta && mis.equiangular)
+        out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t),
+                                          med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, ls->p, v->t));
+    else if (!ls->delta && mis.area)
+        out->weight = vtx_power_heuristic(ls->pdf, ph);
+    out->L = v3_scale(v3_mul(beta, v3_mul(tr, ls->radiance)), out->weight * ph / ls->pdf);
+    return 1;
+}
+
+void vtx_scatter_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, float u1, float u2, fr_ray *next,
+                        float *pdf)
+{
+    const fr_medium *md = &s->media[medium - 1];
+    next->o = v->p;
+    next->d = med_sample_phase(md->g, v->seg.d, u1, u2);
+    *pdf = med_phase(md->g, v3_dot(v->seg.d, next->d));
+}
+
+int vtx_scatter_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe,
+                        float u1, float u2, fr_bsdf_sample *bs, fr_ray *next, uint32_t *medium)
+{
+    if (!bsdf_sample(m, sf, wo, ulobe, u1, u2, bs))
+        return 0;
+    *medium = med_after(s, *medium, m, sf->ng, bs->wi);
+    next->o = geo_offset(sf->p, sf->ng, bs->wi);
+    next->d = bs->wi;
+    return 1;
+}

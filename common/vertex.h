@@ -1,0 +1,109 @@
+/** @file vertex.h
+ * The vertices of a light path, as path-space integrators build them:
+ * finding where a ray's path goes next through media (a surface, a
+ * scattering point in a medium, or nowhere), next-event estimation at a
+ * vertex (a light sample with its pdfs, MIS weight and contribution), and
+ * scattering onward from a vertex.
+ *
+ * pathtrace.c composes these into unidirectional path tracing (pbrt's
+ * Li); a bidirectional integrator reuses them for its subpaths and its
+ * light-sampling connections.  Random numbers are passed in, or drawn from
+ * the caller's sampler in the order documented here, so the caller decides
+ * which sampler dimensions each decision consumes: images depend on it
+ * (invariant 1).  Directions are propagation directions (medium.h) for
+ * rays, and point away from the vertex for wo and wi (bsdf.h).
+ */
+#ifndef FRANJA_VERTEX_H
+#define FRANJA_VERTEX_H
+
+#include "bsdf.h"
+#include "light.h"
+#include "sampler.h"
+
+/** What vtx_next found. */
+enum { VTX_ESCAPED = 0, VTX_SURFACE = 1, VTX_MEDIUM = 2 };
+
+/** The next vertex of a path. */
+typedef struct {
+    int kind;                  /**< VTX_ESCAPED, VTX_SURFACE or VTX_MEDIUM */
+    fr_surface sf;             /**< VTX_SURFACE: the surface (never a media interface) */
+    vec3 p;                    /**< VTX_MEDIUM: the scattering point */
+    fr_ray seg;                /**< VTX_MEDIUM: the segment scattered on (origin, unit direction) */
+    float seg_tmax;            /**< VTX_MEDIUM: the segment's length (INFINITY: no surface behind) */
+    float t;                   /**< VTX_MEDIUM: distance along seg to p */
+    vec3 seg_beta;             /**< VTX_MEDIUM: the path throughput at the segment's start */
+} vtx_vertex;
+
+/** Which estimators next-event estimation is weighed against (multiple
+ * importance sampling, power heuristic); a technique not weighed gets
+ * weight 1. */
+typedef struct {
+    int area;                  /**< area lights against the vertex's own scattering (BSDF or phase) */
+    int equiangular;           /**< point lights seen from a medium: distance sampling against equiangular */
+} vtx_mis;
+
+/** Power heuristic with beta = 2 (Veach 1997): the weight of a sample of
+ * density a against a technique of density b; 0 when both are 0. */
+float vtx_power_heuristic(float a, float b);
+
+/** Follow *ray, travelling in *medium (1 + index into media, 0: vacuum)
+ * with path throughput *beta, to the path's next vertex, into *v; returns
+ * v->kind.
+ *
+ * Without media in the scene: the closest surface, and nothing is drawn
+ * from smp.  With media: every segment inside a medium draws two pairs
+ * from smp, (colour channel, distance) for free-flight sampling
+ * (med_sample_distance), then (light pick, position) for equiangular
+ * sampling; the path scatters on the segment (VTX_MEDIUM) or reaches its
+ * end, and *beta takes the segment's weight.  Interface surfaces are
+ * crossed (updating *medium and ray->o; at most 64, then the path is lost:
+ * VTX_ESCAPED).  When equi_L is not NULL, each medium segment also adds to
+ * *equi_L the single-scattering estimate of a point light by equiangular
+ * sampling (Kulla and Fajardo 2012), weighted against the free-flight
+ * sampling this walk does; vtx_direct_medium gives the complementary
+ * weight.  The numbers are drawn either way. */
+int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vec3 *equi_L,
+             vtx_vertex *v);
+
+/** Next-event estimation at a vertex: one light sample and what it adds. */
+typedef struct {
+    fr_light_sample ls;        /**< the light point: direction, distance, radiance, light pdf, delta */
+    float scatter_pdf;         /**< solid-angle pdf of the vertex's own scattering toward ls.wi */
+    float weight;              /**< MIS weight of the light sample */
+    vec3 L;                    /**< beta * f * Tr * Le * weight / ls.pdf, f with |cos| at a surface or the
+                                    phase function in a medium (0 when the shadow ray is blocked) */
+} vtx_direct;
+
+/** Next-event estimation at surface vertex sf, of material m (as textured
+ * there), seen along wo, reached through `medium`: samples a light with
+ * (upick, u1, u2), evaluates the BSDF and traces the shadow ray (through
+ * media and their interfaces when the scene has media).  Returns 1 with
+ * *out filled when the sample brings light, 0 when it brings none (no
+ * smooth lobe, no light sample, a zero BSDF, a blocked shadow ray). */
+int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, uint32_t medium,
+                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, vtx_direct *out);
+
+/** Next-event estimation at medium vertex v (in `medium`), as
+ * vtx_direct_surface with the phase function for the BSDF.  A point light
+ * is weighted against the equiangular sampling of v's segment when
+ * mis.equiangular.  Returns 1 when a light was sampled (out->L may still
+ * be 0: blocked), 0 when none was. */
+int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, float upick,
+                      float u1, float u2, vtx_direct *out);
+
+/** Scatter onward from medium vertex v (in `medium`): *next leaves v->p in
+ * a direction sampled from the phase function with (u1, u2); *pdf is its
+ * solid-angle density.  The throughput does not change (the phase function
+ * is sampled exactly). */
+void vtx_scatter_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, float u1, float u2, fr_ray *next,
+                        float *pdf);
+
+/** Scatter onward from surface vertex sf (material m, seen along wo): the
+ * BSDF sampled with (ulobe, u1, u2) into *bs, *next leaving the surface on
+ * the side bs->wi goes to, *medium updated if the path enters or leaves
+ * the shape's medium.  Returns 0 when the path ends here (absorbed or a
+ * void sample; *next and *medium untouched). */
+int vtx_scatter_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe,
+                        float u1, float u2, fr_bsdf_sample *bs, fr_ray *next, uint32_t *medium);
+
+#endif
