@@ -1,4 +1,5 @@
-/* bsdf.h -- how materials scatter light.
+/** @file bsdf.h
+ * How materials scatter light.
  *
  * Directions point away from the surface: wo toward the viewer (the previous
  * path vertex), wi toward the light or the next vertex.  All unit length.
@@ -9,46 +10,48 @@
  * The shading normal shades; the geometric normal decides sides: a
  * reflected direction must leave on wo's side of the geometric surface and a
  * transmitted one on the other, or the sample is void.  So no light leaks
- * through a surface whatever the shading normal. */
+ * through a surface whatever the shading normal.
+ */
 #ifndef FRANJA_BSDF_H
 #define FRANJA_BSDF_H
 
 #include "trace.h"
 
+/** One sample of a material's BSDF: the direction and how it weighs the path. */
 typedef struct {
     vec3 wi;
-    vec3 weight;               /* f * |cos(wi, ns)| / pdf, or the lobe's colour for delta lobes */
-    float pdf;                 /* solid-angle pdf of the smooth lobes; 0 for a delta lobe */
-    int delta;                 /* 1 for mirror and dielectric */
+    vec3 weight;               /**< f * |cos(wi, ns)| / pdf, or the lobe's colour for delta lobes */
+    float pdf;                 /**< solid-angle pdf of the smooth lobes; 0 for a delta lobe */
+    int delta;                 /**< 1 for mirror and dielectric */
 } fr_bsdf_sample;
 
-/* The smooth (non-delta) part of the BSDF f(wo, wi), without the cosine,
+/** The smooth (non-delta) part of the BSDF f(wo, wi), without the cosine,
  * and in *pdf the solid-angle pdf with which bsdf_sample would pick wi. */
 vec3 bsdf_eval(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi, float *pdf);
 
-/* Sample wi given wo from three uniform numbers (lobe choice, direction).
+/** Sample wi given wo from three uniform numbers (lobe choice, direction).
  * Returns 0 when the path ends here (absorbed, or a void sample). */
 int bsdf_sample(const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe, float u1, float u2,
                 fr_bsdf_sample *out);
 
-/* 1 if the material has a smooth lobe, so light sampling can help. */
+/** 1 if the material has a smooth lobe, so light sampling can help. */
 int bsdf_has_smooth(const fr_material *m);
 
-/* Set m->p_lobe, the cumulative probabilities with which bsdf_sample picks
+/** Set m->p_lobe, the cumulative probabilities with which bsdf_sample picks
  * each lobe, from the lobe colours: in proportion to each lobe's brightest
  * channel; all zero for a material without a lobe (it only emits).  Called
  * when a material is made and again when textures change its colours. */
 void bsdf_lobe_probs(fr_material *m);
 
-/* Unpolarized Fresnel reflectance of a smooth dielectric boundary for light
+/** Unpolarized Fresnel reflectance of a smooth dielectric boundary for light
  * arriving at cos_i (> 0) from the side of index 1 onto index `eta` (the
  * relative index), both polarizations exact.  *cos_t receives the cosine of
  * the refracted direction, 0 on total internal reflection (F = 1). */
 float bsdf_fresnel(float cos_i, float eta, float *cos_t);
 
-/* Local-frame samplers (z up), exposed for the chi-square tests. */
-vec3 bsdf_sample_cosine(float u1, float u2);                 /* pdf cos(theta)/pi */
-vec3 bsdf_sample_phong(float exponent, float u1, float u2);  /* pdf (n+1)/(2 pi) cos^n around +z */
+/** Local-frame samplers (z up), exposed for the chi-square tests. */
+vec3 bsdf_sample_cosine(float u1, float u2);                 /**< pdf cos(theta)/pi */
+vec3 bsdf_sample_phong(float exponent, float u1, float u2);  /**< pdf (n+1)/(2 pi) cos^n around +z */
 float bsdf_phong_pdf(float exponent, float cos_alpha);
 
 #endif

@@ -1,4 +1,5 @@
-/* fbin.h -- the binary scene: one file a worker maps and renders from.
+/** @file fbin.h
+ * The binary scene: one file a worker maps and renders from.
  *
  * Layout (little-endian, specified in common/FORMAT.md): a 64-byte header
  * with magic, version and content hash, a table of sections, then each
@@ -10,7 +11,8 @@
  * and every index inside (vertex, material, light, BVH child, leaf block
  * and lane, tree shape and depth) before the scene is used, so a truncated
  * or corrupt file is refused with the section and byte offset at fault,
- * never a crash. */
+ * never a crash.
+ */
 #ifndef FRANJA_FBIN_H
 #define FRANJA_FBIN_H
 
@@ -19,22 +21,22 @@
 
 #define FBIN_VERSION 4
 
-/* Serialize the arrays `view` points at into a new malloc'd blob (owned by
+/** Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */
 int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err);
 
-/* Validate `blob` (16-byte aligned, as malloc and mmap give) and point *out
+/** Validate `blob` (16-byte aligned, as malloc and mmap give) and point *out
  * into it.  On success *out owns the blob (freed or unmapped by scn_free
  * according to `mapped`); on failure the caller still owns it. */
 int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *err);
 
-/* Map and validate a binary scene file.  Errors name the file. */
+/** Map and validate a binary scene file.  Errors name the file. */
 int fbin_load(const char *path, fr_scene *out, fr_error *err);
 
-/* Write a scene's blob to `path` atomically (temporary name, then rename). */
+/** Write a scene's blob to `path` atomically (temporary name, then rename). */
 int fbin_write(const fr_scene *s, const char *path, fr_error *err);
 
-/* The 16 lowercase hex digits of a hash, NUL-terminated, into buf[17]. */
+/** The 16 lowercase hex digits of a hash, NUL-terminated, into buf[17]. */
 void fbin_hash_hex(uint64_t hash, char buf[17]);
 
 #endif

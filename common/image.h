@@ -1,4 +1,5 @@
-/* image.h -- partial images of the PPM family, written by workers and
+/** @file image.h
+ * Partial images of the PPM family, written by workers and
  * read back (strictly) by the coordinator and the tests.
  *
  * Formats: PF (standard PFM: linear float32 RGB, little-endian, rows
@@ -6,7 +7,8 @@
  * sRGB-encoded and clamped.  Every header carries one comment line
  *     # franja scene=<16 hex> rows=<y0>:<y1> spp=<n> size=<W>x<H>
  * naming what the pixels are, so a partial can be checked against what was
- * asked for. */
+ * asked for.
+ */
 #ifndef FRANJA_IMAGE_H
 #define FRANJA_IMAGE_H
 
@@ -16,30 +18,32 @@
 
 #include "error.h"
 
+/** Partial-image formats: PF (linear float PFM), P6 16-bit and 8-bit sRGB. */
 typedef enum { IMG_PF = 0, IMG_PPM16, IMG_PPM8 } img_format;
 
+/** What a partial image's header comment says about it. */
 typedef struct {
-    uint64_t scene;            /* scene content hash */
-    uint32_t y0, y1;           /* rows of the full image */
+    uint64_t scene;            /**< scene content hash */
+    uint32_t y0, y1;           /**< rows of the full image */
     uint32_t spp;
-    uint32_t width, height;    /* size of the full image */
+    uint32_t width, height;    /**< size of the full image */
 } img_partial_info;
 
-/* Write rows (3 floats per pixel, top row first, width*(y1-y0) pixels) in
+/** Write rows (3 floats per pixel, top row first, width*(y1-y0) pixels) in
  * the given format.  Returns -1 with err set if writing fails. */
 int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, fr_error *err);
 
-/* Parse a PF partial image held in buf[0..len).  Checks the magic, the
+/** Parse a PF partial image held in buf[0..len).  Checks the magic, the
  * header comment, that the pixel rows match rows and width, and that the
  * data length is exact.  On success *rgb is a malloc'd array (caller
  * frees) of width*(y1-y0)*3 floats, top row first.  Errors give the byte
  * offset. */
 int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *info, float **rgb, fr_error *err);
 
-/* sRGB transfer curve of a linear value, clamped to [0,1]. */
+/** sRGB transfer curve of a linear value, clamped to [0,1]. */
 float img_srgb_encode(float linear);
 
-/* Parse "<name>" as pf|ppm16|ppm8; -1 if unknown. */
+/** Parse "<name>" as pf|ppm16|ppm8; -1 if unknown. */
 int img_format_parse(const char *name, img_format *fmt);
 
 #endif

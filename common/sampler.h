@@ -1,4 +1,5 @@
-/* sampler.h -- the random numbers of a pixel sample.
+/** @file sampler.h
+ * The random numbers of a pixel sample.
  *
  * Counter-based: every number is a pure function of (pixel x, pixel y,
  * sample index, dimension, scene seed), so a slab of rows renders the same
@@ -9,29 +10,31 @@
  * sample order shuffled per dimension pair so that pairs do not correlate
  * ("padding"; Burley 2020, "Practical hash-based Owen scrambling").  Any
  * prefix of a pixel's samples is well stratified, whatever the sample
- * count. */
+ * count.
+ */
 #ifndef FRANJA_SAMPLER_H
 #define FRANJA_SAMPLER_H
 
 #include <stdint.h>
 
+/** Where a pixel sample is in its sequence of random numbers. */
 typedef struct {
-    uint32_t pixel;            /* hash of pixel and seed */
-    uint32_t index;            /* sample index within the pixel */
-    uint32_t dim;              /* next dimension pair */
+    uint32_t pixel;            /**< hash of pixel and seed */
+    uint32_t index;            /**< sample index within the pixel */
+    uint32_t dim;              /**< next dimension pair */
 } fr_sampler;
 
-/* Start sample `index` of pixel (x, y). */
+/** Start sample `index` of pixel (x, y). */
 void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t seed);
-/* Next two numbers in [0, 1), from one stratified 2D pattern. */
+/** Next two numbers in [0, 1), from one stratified 2D pattern. */
 void smp_2d(fr_sampler *s, float *u, float *v);
-/* Next number in [0, 1), not stratified: for decisions that gain nothing
+/** Next number in [0, 1), not stratified: for decisions that gain nothing
  * from stratification (Russian roulette); cheaper than smp_1d. */
 float smp_random(fr_sampler *s);
-/* Next number in [0, 1) (uses a whole dimension pair). */
+/** Next number in [0, 1) (uses a whole dimension pair). */
 float smp_1d(fr_sampler *s);
 
-/* A 32-bit integer hash with good avalanche (used for seeds). */
+/** A 32-bit integer hash with good avalanche (used for seeds). */
 uint32_t smp_hash(uint32_t x);
 
 #endif

@@ -1,4 +1,5 @@
-/* scene.h -- the scene as the renderer sees it.
+/** @file scene.h
+ * The scene as the renderer sees it.
  *
  * A scene is a set of flat arrays of plain structs.  The same bytes are the
  * sections of the binary scene file (see fbin.h and docs in
@@ -10,7 +11,8 @@
  * linear RGB; angles in the scene file are degrees, radians here.
  *
  * Ownership: an fr_scene owns `blob` (malloc'd or mmap'd, per `mapped`);
- * every array points into it.  scn_free() releases it. */
+ * every array points into it.  scn_free() releases it.
+ */
 #ifndef FRANJA_SCENE_H
 #define FRANJA_SCENE_H
 
@@ -19,59 +21,60 @@
 
 #include "vec.h"
 
-#define FR_NONE 0xffffffffu /* "no index" for optional uint32 references */
+#define FR_NONE 0xffffffffu /**< "no index" for optional uint32 references */
 
+/** Image and sampling settings. */
 typedef struct {
-    uint32_t width, height;    /* pixels */
-    uint32_t spp;              /* samples per pixel */
-    uint32_t max_depth;        /* bounces; a path has at most max_depth+1 vertices after the camera */
-    uint32_t seed;             /* decorrelates renders of the same scene */
+    uint32_t width, height;    /**< pixels */
+    uint32_t spp;              /**< samples per pixel */
+    uint32_t max_depth;        /**< bounces; a path has at most max_depth+1 vertices after the camera */
+    uint32_t seed;             /**< decorrelates renders of the same scene */
     uint32_t pad[3];
 } fr_settings;
 
+/** A pinhole or thin-lens camera. */
 typedef struct {
     vec3 position, target, up;
-    float vfov;                /* vertical field of view, radians */
-    float aperture;            /* lens radius, scene units; 0 = pinhole */
-    float focus;               /* focus distance along the view axis */
-    /* derived by scn_finalize_camera: */
-    vec3 forward, right, upv;  /* orthonormal: right = image +x, upv = image -y */
-    float tan_half;            /* tan(vfov/2) */
+    float vfov;                /**< vertical field of view, radians */
+    float aperture;            /**< lens radius, scene units; 0 = pinhole */
+    float focus;               /**< focus distance along the view axis */
+    vec3 forward, right, upv;  /**< derived (bld_camera_finish): orthonormal; right = image +x, upv = image -y */
+    float tan_half;            /**< derived (bld_camera_finish): tan(vfov/2) */
     float pad;
 } fr_camera;
 
-/* A material is a weighted set of lobes, one of which is picked per
+/** A material is a weighted set of lobes, one of which is picked per
  * scattering event by Russian roulette with probability proportional to
  * its weight.  A plain Lambert material has only `diffuse`; a Phong
  * material `diffuse` and `glossy`; a mirror `specular`; glass `transmit`.
  * Lobe colours are the albedos the lobe contributes: energy is conserved
  * when the per-channel sum of the four is at most 1. */
 typedef struct {
-    vec3 diffuse;              /* Lambert albedo */
-    vec3 glossy;               /* normalized Phong albedo */
-    vec3 specular;             /* perfect mirror reflectance */
-    vec3 transmit;             /* smooth dielectric tint (Fresnel picks reflect/refract) */
-    vec3 emission;             /* emitted radiance, front side only (unless two_sided) */
-    float exponent;            /* Phong exponent, >= 0 */
-    float ior;                 /* dielectric index of refraction (inside / outside) */
-    float p_lobe[4];           /* cumulative lobe-selection probabilities: diffuse, glossy, specular, transmit */
-    uint32_t two_sided;        /* emission on both sides */
-    /* Textures (indices into textures, or FR_NONE).  A textured colour is
+    vec3 diffuse;              /**< Lambert albedo */
+    vec3 glossy;               /**< normalized Phong albedo */
+    vec3 specular;             /**< perfect mirror reflectance */
+    vec3 transmit;             /**< smooth dielectric tint (Fresnel picks reflect/refract) */
+    vec3 emission;             /**< emitted radiance, front side only (unless two_sided) */
+    float exponent;            /**< Phong exponent, >= 0 */
+    float ior;                 /**< dielectric index of refraction (inside / outside) */
+    float p_lobe[4];           /**< cumulative lobe-selection probabilities: diffuse, glossy, specular, transmit */
+    uint32_t two_sided;        /**< emission on both sides */
+    /** Textures (indices into textures, or FR_NONE).  A textured colour is
      * the colour above times the texture's value at the hit's UV, so the
      * colour above is a tint (white when the scene file gives a bare
      * texture); reflectance textures are clamped to [0, 1] when looked up,
      * which keeps the energy bound checked on the tints. */
     uint32_t tex_diffuse;
-    uint32_t tex_bump;         /* grey height map: displacement = bump_strength * value, scene units */
+    uint32_t tex_bump;         /**< grey height map: displacement = bump_strength * value, scene units */
     float bump_strength;
     uint32_t tex_glossy, tex_specular, tex_transmit, tex_emission;
-    uint32_t tex_normal;       /* tangent-space normal map (linear RGB, 0.5 = 0) */
-    float normal_strength;     /* scales the map's tangential components */
-    uint32_t medium;           /* medium inside the shape: 1 + index into media, 0 = none */
-    uint32_t interface;        /* 1: no surface at all, only a boundary between media */
+    uint32_t tex_normal;       /**< tangent-space normal map (linear RGB, 0.5 = 0) */
+    float normal_strength;     /**< scales the map's tangential components */
+    uint32_t medium;           /**< medium inside the shape: 1 + index into media, 0 = none */
+    uint32_t interface;        /**< 1: no surface at all, only a boundary between media */
 } fr_material;
 
-/* A texture: an image of decoded linear texels stored in the scene, or a
+/** A texture: an image of decoded linear texels stored in the scene, or a
  * procedural checkerboard.  Lookups map the surface's UV through
  * uv * scale + offset; v grows upward, so v = 0 is the image's bottom row
  * (the OBJ convention). */
@@ -79,18 +82,18 @@ enum { FR_TEX_IMAGE = 0, FR_TEX_CHECKER = 1 };
 enum { FR_WRAP_REPEAT = 0, FR_WRAP_CLAMP = 1 };
 enum { FR_FILTER_BILINEAR = 0, FR_FILTER_NEAREST = 1 };
 typedef struct {
-    uint32_t kind;             /* FR_TEX_* */
-    uint32_t width, height;    /* image: pixels */
-    uint32_t channels;         /* image: 1 (grey) or 3 (RGB) floats per texel */
-    uint32_t first;            /* image: index of its first float in texels */
-    uint32_t wrap;             /* FR_WRAP_* */
-    uint32_t filter;           /* FR_FILTER_* */
+    uint32_t kind;             /**< FR_TEX_* */
+    uint32_t width, height;    /**< image: pixels */
+    uint32_t channels;         /**< image: 1 (grey) or 3 (RGB) floats per texel */
+    uint32_t first;            /**< image: index of its first float in texels */
+    uint32_t wrap;             /**< FR_WRAP_* */
+    uint32_t filter;           /**< FR_FILTER_* */
     uint32_t pad;
-    vec2 scale, offset;        /* UV transform */
-    vec3 color0, color1;       /* checker: the square at the UV origin, the other one */
+    vec2 scale, offset;        /**< UV transform */
+    vec3 color0, color1;       /**< checker: the square at the UV origin, the other one */
 } fr_texture;
 
-/* A homogeneous participating medium: coefficients per colour channel in
+/** A homogeneous participating medium: coefficients per colour channel in
  * inverse scene units, Henyey-Greenstein phase function (g = 0 is
  * isotropic; g > 0 scatters forward). */
 typedef struct {
@@ -99,7 +102,7 @@ typedef struct {
     uint32_t pad;
 } fr_medium;
 
-/* Which medium fills space outside every shape with an interior medium
+/** Which medium fills space outside every shape with an interior medium
  * (fog), and which one the camera sits in: 1 + index into media, 0 = none.
  * Shapes with interior media must be closed, outward-facing and must not
  * overlap or nest. */
@@ -109,61 +112,63 @@ typedef struct {
     uint32_t pad[2];
 } fr_volume;
 
-/* Tone mapping defaults for the final image (the coordinator applies them
+/** Tone mapping defaults for the final image (the coordinator applies them
  * once, after stitching; the linear radiance in partial images and HDR
  * outputs is never tone-mapped). */
 enum { FR_CURVE_NONE = 0, FR_CURVE_FILMIC = 1 };
 typedef struct {
-    float exposure;            /* stops: LDR values are scaled by 2^exposure */
-    uint32_t curve;            /* FR_CURVE_* */
+    float exposure;            /**< stops: LDR values are scaled by 2^exposure */
+    uint32_t curve;            /**< FR_CURVE_* */
     uint32_t pad[2];
 } fr_tonemap;
 
 enum { FR_PRIM_TRIANGLE = 0, FR_PRIM_SPHERE = 1, FR_PRIM_RECT = 2, FR_PRIM_KINDS };
 
-/* One entry per bounded primitive; the BVH's leaves hold ranges of this
+/** One entry per bounded primitive; the BVH's leaves hold ranges of this
  * array.  `index` points into the array of the primitive's kind. */
 typedef struct {
-    uint32_t kind;             /* FR_PRIM_* */
-    uint32_t index;            /* into spheres, rects or triangles */
+    uint32_t kind;             /**< FR_PRIM_* */
+    uint32_t index;            /**< into spheres, rects or triangles */
     uint32_t material;
-    uint32_t light;            /* index into lights if emissive, else FR_NONE */
+    uint32_t light;            /**< index into lights if emissive, else FR_NONE */
 } fr_prim;
 
+/** A sphere (its front side faces out). */
 typedef struct { vec3 center; float radius; } fr_sphere;
 
-/* Parallelogram origin + s*edge_u + t*edge_v, s,t in [0,1]; its front side
+/** Parallelogram origin + s*edge_u + t*edge_v, s,t in [0,1]; its front side
  * faces cross(edge_u, edge_v). */
 typedef struct {
     vec3 origin, edge_u, edge_v;
-    /* Derived by geo_rect_make, so a ray test costs two dot products:
+    /** Derived by geo_rect_make, so a ray test costs two dot products:
      * normal = edge_u x edge_v (not unit), and the dual basis, with
      * (p - origin) . dual_u = s and (p - origin) . dual_v = t in the plane. */
     vec3 normal, dual_u, dual_v;
 } fr_rect;
 
-/* Vertex indices into positions (and normals/uvs when the mesh has them;
+/** Vertex indices into positions (and normals/uvs when the mesh has them;
  * one index per vertex for all three).  The front side faces
  * cross(p1-p0, p2-p0). */
 typedef struct { uint32_t v[3]; uint32_t flags; } fr_triangle;
 enum { FR_TRI_NORMALS = 1, FR_TRI_UVS = 2 };
 
-/* Infinite plane through `point` facing `normal` (unit).  Never a light. */
+/** Infinite plane through `point` facing `normal` (unit).  Never a light. */
 typedef struct { vec3 point, normal; uint32_t material; uint32_t pad; } fr_plane;
 
+/** A light: a point light, or an emissive primitive (an area light). */
 enum { FR_LIGHT_POINT = 0, FR_LIGHT_PRIM = 1 };
 typedef struct {
-    uint32_t kind;             /* FR_LIGHT_* */
-    uint32_t prim;             /* FR_LIGHT_PRIM: index into prims */
-    vec3 position;             /* FR_LIGHT_POINT */
-    vec3 intensity;            /* FR_LIGHT_POINT: W/sr, i.e. radiance*area units */
-    float area;                /* FR_LIGHT_PRIM: surface area */
-    float pick;                /* probability of picking this light (sums to 1) */
-    float cdf;                 /* sum of pick over lights[0..this], for binary search */
+    uint32_t kind;             /**< FR_LIGHT_* */
+    uint32_t prim;             /**< FR_LIGHT_PRIM: index into prims */
+    vec3 position;             /**< FR_LIGHT_POINT */
+    vec3 intensity;            /**< FR_LIGHT_POINT: W/sr, i.e. radiance*area units */
+    float area;                /**< FR_LIGHT_PRIM: surface area */
+    float pick;                /**< probability of picking this light (sums to 1) */
+    float cdf;                 /**< sum of pick over lights[0..this], for binary search */
     float pad;
 } fr_light;
 
-/* An 8-wide BVH node (256 bytes, four cache lines): the boxes of its
+/** An 8-wide BVH node (256 bytes, four cache lines): the boxes of its
  * eight children side by side (structure of arrays), so one ray is tested
  * against all of them with a few vector operations per plane.  box[0..2]
  * are the lower x, y, z bounds, box[3..5] the upper ones, one lane per
@@ -186,11 +191,11 @@ typedef struct {
 
 #define FR_BVH_LEAF_MAX 255u
 #define FR_BVH_MIXED 0x100u
-/* Deepest node (the root is at depth 1): a deeper tree is refused when a
+/** Deepest node (the root is at depth 1): a deeper tree is refused when a
  * scene is loaded, so traversal's stack has a fixed size. */
 #define FR_BVH_MAX_DEPTH 64
 
-/* A leaf block: up to four primitives with their triangle vertices copied
+/** A leaf block: up to four primitives with their triangle vertices copied
  * in leaf order (structure of arrays: v[3*k + axis][lane] is coordinate
  * `axis` of vertex k of lane `lane`), so traversal reads one contiguous
  * 160-byte block instead of following three indices per triangle.  prim[lane]
@@ -202,6 +207,8 @@ typedef struct {
     uint32_t prim[4];
 } fr_bvh_leaf;
 
+/** A whole scene: its settings and camera, and each section as an array
+ * and its length (pointing into `blob`). */
 typedef struct {
     fr_settings settings;
     fr_camera camera;
@@ -224,11 +231,11 @@ typedef struct {
     const fr_bvh_node *nodes;     uint32_t n_nodes;
     const fr_bvh_leaf *leaves;    uint32_t n_leaves;
 
-    uint64_t hash;                /* content hash of the binary scene */
+    uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;
 } fr_scene;
 
-/* Releases the scene's blob (free or munmap) and zeroes *s. */
+/** Releases the scene's blob (free or munmap) and zeroes *s. */
 void scn_free(fr_scene *s);
 
 #endif

@@ -1,10 +1,12 @@
-/* scene_appear.h -- the appearance part of the JSON scene format:
+/** @file scene_appear.h
+ * The appearance part of the JSON scene format:
  * textures, textured colours, bump and normal maps, participating media,
  * the camera's f-number form and tone-mapping defaults (documented in
  * scenes/README.md).  scene_json.c calls these while it reads a scene.
  *
  * Errors follow the scene reader's style: the JSON path and what was
- * expected, e.g. `materials.floor.albedo: no texture named 'wood'`. */
+ * expected, e.g. `materials.floor.albedo: no texture named 'wood'`.
+ */
 #ifndef FRANJA_SCENE_APPEAR_H
 #define FRANJA_SCENE_APPEAR_H
 
@@ -13,7 +15,7 @@
 #include "builder.h"
 #include "scene_hooks.h"
 
-/* A decoded texture already in the builder: definition name, whether its
+/** A decoded texture already in the builder: definition name, whether its
  * texels were converted from sRGB, and its index. */
 typedef struct {
     const char *name;
@@ -22,16 +24,16 @@ typedef struct {
 } scn_tex_entry;
 
 typedef struct {
-    const char *dir;           /* the scene file's directory */
-    const scn_hooks *hooks;    /* may be NULL: image textures then refused */
+    const char *dir;           /**< the scene file's directory */
+    const scn_hooks *hooks;    /**< may be NULL: image textures then refused */
     fr_builder *b;
-    const cJSON *textures;     /* the "textures" object, or NULL */
-    const cJSON *media;        /* the "media" object, or NULL */
-    scn_tex_entry *loaded;     /* textures decoded so far (malloc'd) */
+    const cJSON *textures;     /**< the "textures" object, or NULL */
+    const cJSON *media;        /**< the "media" object, or NULL */
+    scn_tex_entry *loaded;     /**< textures decoded so far (malloc'd) */
     uint32_t n_loaded, cap_loaded;
 } scn_appear;
 
-/* Check the top-level "textures" and "media" objects of `root` (every
+/** Check the top-level "textures" and "media" objects of `root` (every
  * field; image files must exist and have a supported extension) and add
  * the media to b.  Textures are decoded when a material first uses them.
  * Release with scn_appear_free. */
@@ -39,23 +41,23 @@ int scn_appear_begin(scn_appear *a, const cJSON *root, const char *dir, const sc
                      fr_error *err);
 void scn_appear_free(scn_appear *a);
 
-/* Read colour member `key` of obj (at path `where`): [r, g, b], a texture
+/** Read colour member `key` of obj (at path `where`): [r, g, b], a texture
  * name, or {"texture": name, "factor": [r, g, b]}.  *tint receives the
  * colour or the factor (white by default), *tex the texture index or
  * FR_NONE.  Absent and not required: *tint = def, *tex = FR_NONE. */
 int scn_colour(scn_appear *a, const cJSON *obj, const char *key, const char *where, int required, vec3 def,
                vec3 *tint, uint32_t *tex, fr_error *err);
 
-/* The material members this module owns: "bump", "normal_map" and
+/** The material members this module owns: "bump", "normal_map" and
  * "medium"; and the type "interface" (when is_interface). */
 int scn_material_appearance(scn_appear *a, const cJSON *obj, const char *where, int is_interface, fr_material *m,
                             fr_error *err);
 
-/* The camera's optional "fstop" and "focal_length" (both or neither; not
+/** The camera's optional "fstop" and "focal_length" (both or neither; not
  * with "aperture"): sets cam->aperture = focal_length / (2 fstop). */
 int scn_camera_lens(const cJSON *cam_obj, fr_camera *cam, fr_error *err);
 
-/* After the shapes: the top-level "medium" (fog) and the medium the camera
+/** After the shapes: the top-level "medium" (fog) and the medium the camera
  * sits in (found by casting a ray from it across the shapes with interior
  * media), and the top-level "tonemap" object. */
 int scn_appear_finish(scn_appear *a, const cJSON *root, fr_error *err);

@@ -1,4 +1,5 @@
-/* simd4.h -- four-lane float vectors for BVH traversal and construction.
+/** @file simd4.h
+ * Four-lane float vectors for BVH traversal and construction.
  *
  * Written with the GCC/Clang vector extension, so the same source becomes
  * SSE on x86_64 and NEON on aarch64 (and plain scalar code elsewhere).
@@ -9,7 +10,8 @@
  * here fix one rule: f4_max_num(a, acc) and f4_min_num(a, acc) return acc
  * in a lane where a is NaN, and acc must never be NaN.  Traversal relies on
  * it: 0 * inf (a ray in the plane of a box face) yields NaN, which must mean
- * "no constraint from this axis" on every host. */
+ * "no constraint from this axis" on every host.
+ */
 #ifndef FRANJA_SIMD4_H
 #define FRANJA_SIMD4_H
 
@@ -25,14 +27,14 @@
 typedef float f4 __attribute__((vector_size(16)));
 typedef int32_t i4 __attribute__((vector_size(16)));
 
-/* Unaligned load and store (the binary scene guarantees no alignment to
+/** Unaligned load and store (the binary scene guarantees no alignment to
  * vector loads, only to its 4-byte fields). */
 static inline f4 f4_load(const float *p) { f4 v; memcpy(&v, p, sizeof v); return v; }
 static inline void f4_store(float *p, f4 v) { memcpy(p, &v, sizeof v); }
 static inline f4 f4_set1(float x) { return (f4){x, x, x, x}; }
 static inline i4 i4_set1(int32_t x) { return (i4){x, x, x, x}; }
 
-/* Lane-wise max(a, acc), acc where a is NaN (acc: never NaN). */
+/** Lane-wise max(a, acc), acc where a is NaN (acc: never NaN). */
 static inline f4 f4_max_num(f4 a, f4 acc)
 {
 #if defined(__SSE2__)
@@ -46,7 +48,7 @@ static inline f4 f4_max_num(f4 a, f4 acc)
 #endif
 }
 
-/* Lane-wise min(a, acc), acc where a is NaN (acc: never NaN). */
+/** Lane-wise min(a, acc), acc where a is NaN (acc: never NaN). */
 static inline f4 f4_min_num(f4 a, f4 acc)
 {
 #if defined(__SSE2__)
@@ -60,7 +62,7 @@ static inline f4 f4_min_num(f4 a, f4 acc)
 #endif
 }
 
-/* Bit i set when lane i of mask m (a comparison result) is true. */
+/** Bit i set when lane i of mask m (a comparison result) is true. */
 static inline unsigned i4_bits(i4 m)
 {
 #if defined(__SSE2__)

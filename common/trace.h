@@ -1,47 +1,49 @@
-/* trace.h -- finding what a ray hits in a scene, and describing the hit.
+/** @file trace.h
+ * Finding what a ray hits in a scene, and describing the hit.
  *
  * trace_closest walks the BVH (or every primitive when the scene has no
  * BVH) and the infinite planes; trace_occluded stops at the first hit, for
- * shadow rays. */
+ * shadow rays.
+ */
 #ifndef FRANJA_TRACE_H
 #define FRANJA_TRACE_H
 
 #include "geom.h"
 
-/* Where a ray hit, before shading: which primitive and its local
+/** Where a ray hit, before shading: which primitive and its local
  * coordinates, enough to rebuild the surface with trace_surface(). */
 typedef struct {
     float t;
-    uint32_t prim;             /* index into prims, or FR_NONE for a plane */
-    uint32_t plane;            /* index into planes when prim == FR_NONE */
-    float a, b;                /* barycentrics (triangle) or edge coords (rect) */
+    uint32_t prim;             /**< index into prims, or FR_NONE for a plane */
+    uint32_t plane;            /**< index into planes when prim == FR_NONE */
+    float a, b;                /**< barycentrics (triangle) or edge coords (rect) */
 } fr_hit;
 
-/* The local geometry at a hit, for shading. */
+/** The local geometry at a hit, for shading. */
 typedef struct {
-    vec3 p;                    /* position */
-    vec3 ng;                   /* geometric normal (unit, front side) */
-    vec3 ns;                   /* shading normal (unit, same hemisphere as ng) */
-    vec2 uv;                   /* texture coordinates */
-    vec3 dpdu, dpdv;           /* how p moves with u and v (tangents for bump and normal maps) */
+    vec3 p;                    /**< position */
+    vec3 ng;                   /**< geometric normal (unit, front side) */
+    vec3 ns;                   /**< shading normal (unit, same hemisphere as ng) */
+    vec2 uv;                   /**< texture coordinates */
+    vec3 dpdu, dpdv;           /**< how p moves with u and v (tangents for bump and normal maps) */
     uint32_t material;
-    uint32_t light;            /* FR_NONE unless an area light */
+    uint32_t light;            /**< FR_NONE unless an area light */
 } fr_surface;
 
-/* Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0.  The result
+/** Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0.  The result
  * is exactly what testing every plane and then every primitive in index
  * order with trace_prim would give: of hits at the same t the plane or the
  * lowest primitive index wins, whatever order the BVH visits them in.  A
  * ray with a non-finite origin or direction hits no primitive. */
 int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit);
-/* 1 if anything but prim `skip` (FR_NONE: nothing skipped) is hit in
+/** 1 if anything but prim `skip` (FR_NONE: nothing skipped) is hit in
  * (0, tmax).  Shadow rays skip the light they aim at: a convex emitter
  * cannot hide its own sampled point, and near its silhouette rounding would
  * make it seem to. */
 int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip);
-/* Nearest hit on one primitive, for tests and the BVH: t or 0. */
+/** Nearest hit on one primitive, for tests and the BVH: t or 0. */
 float trace_prim(const fr_scene *s, uint32_t prim, const fr_ray *r, float tmax, float *a, float *b);
-/* Rebuild the surface at a hit. */
+/** Rebuild the surface at a hit. */
 void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out);
 
 #endif

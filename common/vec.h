@@ -1,9 +1,11 @@
-/* vec.h -- three-component float vectors, used for points, directions and
+/** @file vec.h
+ * Three-component float vectors, used for points, directions and
  * linear RGB colours alike.
  *
  * Everything here is inline and uses only + - * / and sqrt, so results are
  * the same bits on every IEEE 754 machine (the render path is compiled with
- * -ffp-contract=off so no fused multiply-add changes a rounding). */
+ * -ffp-contract=off so no fused multiply-add changes a rounding).
+ */
 #ifndef FRANJA_VEC_H
 #define FRANJA_VEC_H
 
@@ -26,7 +28,7 @@ static inline vec3 v3_cross(vec3 a, vec3 b) {
 static inline float v3_len2(vec3 a) { return v3_dot(a, a); }
 static inline float v3_len(vec3 a) { return sqrtf(v3_dot(a, a)); }
 static inline vec3 v3_norm(vec3 a) { return v3_scale(a, 1.0f / v3_len(a)); }
-/* a + b*s, written out so the compiler cannot fuse it */
+/** a + b*s, written out so the compiler cannot fuse it */
 static inline vec3 v3_madd(vec3 a, vec3 b, float s) { return v3_add(a, v3_scale(b, s)); }
 static inline float v3_max(vec3 a) { float m = a.x > a.y ? a.x : a.y; return m > a.z ? m : a.z; }
 static inline float v3_min(vec3 a) { float m = a.x < a.y ? a.x : a.y; return m < a.z ? m : a.z; }
@@ -38,10 +40,10 @@ static inline vec3 v3_vmax(vec3 a, vec3 b) {
 }
 static inline float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }
 static inline int v3_is_zero(vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
-/* Rec. 709 luminance of a linear RGB colour */
+/** Rec. 709 luminance of a linear RGB colour */
 static inline float v3_luma(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
-/* An orthonormal basis (t, b, n) around unit vector n, without branches on
+/** An orthonormal basis (t, b, n) around unit vector n, without branches on
  * near-parallel cases (Duff et al. 2017, "Building an orthonormal basis,
  * revisited"). */
 static inline void v3_basis(vec3 n, vec3 *t, vec3 *b) {
@@ -51,7 +53,7 @@ static inline void v3_basis(vec3 n, vec3 *t, vec3 *b) {
     *t = v3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
     *b = v3(c, sign + n.y * n.y * a, -n.y);
 }
-/* Local frame (x along t, y along b, z along n) to world */
+/** Local frame (x along t, y along b, z along n) to world */
 static inline vec3 v3_from_local(vec3 l, vec3 t, vec3 b, vec3 n) {
     return v3_add(v3_add(v3_scale(t, l.x), v3_scale(b, l.y)), v3_scale(n, l.z));
 }

@@ -6,13 +6,16 @@
 #     compile-time module: no render-side file includes a compile-time
 #     header, no render-side object calls into one, and the worker links
 #     and renders from the render-side objects alone;
-#   - no test compiles a common/ source into itself (#include "x.c").
+#   - no test compiles a common/ source into itself (#include "x.c");
+#   - every common/ header is documented in the comment style Doxygen reads
+#     (/** @file NAME ... */, no plain /* comments), and `make docs` (the
+#     same Doxyfile) shows the renderer's header contracts.
 # The compile-time modules are listed below; every other module of common/
 # is render-side.  A new module that builds scenes belongs in the list (it
 # fails the checks otherwise, since it calls the builder).
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
-need nm tsort cc
+need nm tsort cc doxygen
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
@@ -135,5 +138,21 @@ while IFS= read -r line; do
     [ -e "common/$(basename "$f")" ] && bad "test includes a common/ source: $line"
 done <"$T/cinc"
 ok
+
+# (d) Header comments Doxygen reads, and the documentation it makes.
+for h in common/*.h; do
+    head -n 1 "$h" | grep -qx "/\*\* @file $(basename "$h")" || bad "$h does not open with /** @file $(basename "$h")"
+    grep -n '/\*[^*]' "$h" | grep -v '/\*\*' >"$T/plain" && bad "$h: plain /* comments: $(head -2 "$T/plain")"
+done
+ok
+mkdir -p "$T/docs"
+if { cat coordinator/Doxyfile; echo "OUTPUT_DIRECTORY = $T/docs"; echo "WARN_LOGFILE = $T/docs/warnings.log"; } |
+    doxygen - >"$T/doxygen.log" 2>&1; then
+    # A function's contract from pathtrace.h and a field's from scene.h.
+    check "docs: pt_render_rows with its contract" grep -rqs "caller-owned, width" "$T/docs/html"
+    check "docs: fr_camera's fields" grep -rqs "lens radius, scene units" "$T/docs/html"
+else
+    bad "doxygen failed: $(tail -3 "$T/doxygen.log")"
+fi
 
 summary
