@@ -18,6 +18,7 @@
 #include "fbin.h"
 #include "jobdir.h"
 #include "output.h"
+#include "quick.h"
 #include "sched.h"
 #include "tonemap.h"
 
@@ -282,6 +283,11 @@ int cmd_render(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
 
+    uint32_t probe = UINT32_MAX;
+    if (quick_spp(&probe, &err) < 0) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return 2;
+    }
     double t0 = now_s();
     fr_scene sc;
     if (scene_binary(&a, jobdir, fbin, sizeof fbin, &sc, &err)) {
@@ -290,6 +296,9 @@ int cmd_render(int argc, char **argv)
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
                      a.spp ? a.spp : sc.settings.spp};
+    uint32_t asked = spec.spp;
+    if (quick_spp(&spec.spp, &err) > 0)
+        fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
     /* Tone mapping: the scene's defaults, overridden by the command line. */
     fr_tonemap tm = sc.tonemap;
     if (a.exposure_set)

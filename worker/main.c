@@ -9,6 +9,7 @@
 #include "fbin.h"
 #include "image.h"
 #include "pathtrace.h"
+#include "quick.h"
 #ifndef FRANJA_NO_JSON
 #include "scene_json.h"
 #endif
@@ -154,6 +155,11 @@ int main(int argc, char **argv)
     }
     if (spp)
         scene.settings.spp = spp;
+    if (quick_spp(&scene.settings.spp, &err) < 0) {
+        fprintf(stderr, "franja-worker: %s\n", err.msg);
+        scn_free(&scene);
+        return 2;
+    }
     if (y0 >= y1 || y1 > scene.settings.height) {
         fprintf(stderr, "franja-worker: --rows %u:%u: need 0 <= Y0 < Y1 <= %u (the image height)\n", y0, y1,
                 scene.settings.height);
