@@ -5,6 +5,7 @@
 #   make check      build and run every test
 #   make bench      benchmarks (see tests/bench/)
 #   make render     render scenes/cornell.json to cornell.png on this machine
+#   make refs       the Cycles references in tests/data (needs blender)
 
 CC      ?= cc
 CXX     ?= c++
@@ -44,7 +45,7 @@ LIB         = $(B)/libfranja.a
 WORKER_LIBS = $(CJSON_LIBS) -lm
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm -pthread
 
-.PHONY: all deps check test bench render clean docs fuzz static dist check-cross
+.PHONY: all deps check test bench render clean docs fuzz static dist check-cross refs
 all: bin/franja-worker bin/franja
 
 $(B)/%.o: %.c
@@ -73,7 +74,7 @@ bin/tests/%: tests/%.c $(LIB)
 
 bin/tools/%: tests/tools/%.c $(LIB)
 	@mkdir -p bin/tools
-	$(CC) $(CSTD) $(CFLAGS) -o $@ $< $(LIB) -lm
+	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm
 
 # Benchmark programs; only these link Embree (the reference they measure against).
 bin/bench/%: tests/bench/%.c $(LIB)
@@ -117,6 +118,12 @@ bench: all $(TOOL_BIN) $(BENCH_BIN)
 
 render: all
 	bin/franja render scenes/cornell.json -o cornell.png
+
+# The small Cycles renders in tests/data that tests/it_conventions.sh compares
+# against, made again with Debian's blender (apt-get install blender).  The
+# tests read the committed files: only this target needs blender.
+refs:
+	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 
 # HTML API documentation of the headers, in build/docs/html (Doxygen).
 docs:
