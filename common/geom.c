@@ -15,13 +15,28 @@ float geo_sphere(const fr_sphere *s, const fr_ray *r, float tmax)
     if (disc < 0.0f)
         return 0.0f;
     float q = b + (b >= 0.0f ? 1.0f : -1.0f) * sqrtf(a * disc);
-    float t0 = q / a, t1 = (v3_dot(f, f) - s->radius * s->radius) / q;
+    float ff = v3_dot(f, f), rr = s->radius * s->radius;
+    float t0 = q / a, t1 = (ff - rr) / q;
     if (q == 0.0f)
         t0 = t1 = 0.0f;
     if (t0 > t1) { float tmp = t0; t0 = t1; t1 = tmp; }
-    if (t0 > 0.0f && t0 < tmax) return t0;
-    if (t1 > 0.0f && t1 < tmax) return t1;
+    /* The root near 0 is (f.f - r^2) / q, whose numerator cancels when the
+     * origin is near the surface: its error is at most gamma(6) (f.f + r^2)
+     * (f's rounding included); twice that covers q's own error. */
+    float err = (ff + rr) * GEO_GAMMA(12) / fabsf(q);
+    if (t0 > err && t0 < tmax) return t0;
+    if (t1 > err && t1 < tmax) return t1;
     return 0.0f;
+}
+
+/* A bound on the error of t = (rel . n) / dn, rel the rounded difference
+ * of a point of the plane and the ray origin: the numerator's four
+ * roundings (gamma(4) of the sum of |rel_i n_i|), the denominator's and
+ * the division's. */
+static float plane_error(vec3 rel, vec3 n, float dn)
+{
+    float sum = fabsf(rel.x * n.x) + fabsf(rel.y * n.y) + fabsf(rel.z * n.z);
+    return sum * GEO_GAMMA(6) / fabsf(dn);
 }
 
 float geo_plane(const fr_plane *p, const fr_ray *r, float tmax)
@@ -29,8 +44,9 @@ float geo_plane(const fr_plane *p, const fr_ray *r, float tmax)
     float dn = v3_dot(r->d, p->normal);
     if (dn == 0.0f)
         return 0.0f;
-    float t = v3_dot(v3_sub(p->point, r->o), p->normal) / dn;
-    return t > 0.0f && t < tmax ? t : 0.0f;
+    vec3 rel = v3_sub(p->point, r->o);
+    float t = v3_dot(rel, p->normal) / dn;
+    return t > plane_error(rel, p->normal, dn) && t < tmax ? t : 0.0f;
 }
 
 fr_rect geo_rect_make(vec3 origin, vec3 edge_u, vec3 edge_v)
@@ -50,8 +66,9 @@ float geo_rect(const fr_rect *q, const fr_ray *r, float tmax, float *s, float *t
     float dn = v3_dot(r->d, q->normal);
     if (dn == 0.0f)
         return 0.0f;
-    float th = v3_dot(v3_sub(q->origin, r->o), q->normal) / dn;
-    if (!(th > 0.0f && th < tmax))
+    vec3 rel0 = v3_sub(q->origin, r->o);
+    float th = v3_dot(rel0, q->normal) / dn;
+    if (!(th > plane_error(rel0, q->normal, dn) && th < tmax))
         return 0.0f;
     /* Coordinates of the hit along the edges, by the dual basis (which
      * handles non-square parallelograms). */
@@ -63,6 +80,8 @@ float geo_rect(const fr_rect *q, const fr_ray *r, float tmax, float *s, float *t
     *t = b;
     return th;
 }
+
+static float max2(float a, float b) { return a > b ? a : b; }
 
 static int max_axis(vec3 v)
 {
@@ -104,33 +123,88 @@ float geo_triangle(vec3 p0, vec3 p1, vec3 p2, const fr_ray *r, float tmax, float
     float t = tz / det;
     if (!(t > 0.0f && t < tmax))
         return 0.0f;
+    /* Within its own rounding error of 0, t might be on either side. */
+    if (!(t > GEO_TRI_ERROR(float, fabsf, max2, ax, bx, cx, ay, by, cy, az, bz, cz, u, v, w, sz, det)))
+        return 0.0f;
     *b1 = v / det;
     *b2 = w / det;
     return t;
 }
 
-static float bits_to_float(int32_t i) { float f; memcpy(&f, &i, 4); return f; }
-static int32_t float_to_bits(float f) { int32_t i; memcpy(&i, &f, 4); return i; }
-
-static float offset_coord(float p, float n)
+vec3 geo_triangle_point(vec3 p0, vec3 p1, vec3 p2, float b1, float b2, vec3 *err)
 {
-    /* Far from the origin, step a fixed number of ulps (scaled by the
-     * normal's component); near it, where ulps vanish, a tiny absolute
-     * step. */
-    const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
-    if (fabsf(p) < origin)
-        return p + float_scale * n;
-    /* n is a unit normal's component; a degenerate surface's NaN normal
-     * gives no step (and no out-of-range float-to-int conversion). */
-    float step = int_scale * n;
-    int32_t di = step >= -int_scale && step <= int_scale ? (int32_t)step : 0;
-    int32_t bits = float_to_bits(p);
-    return bits_to_float(bits + ((p < 0.0f) ? -di : di));
+    float b0 = 1.0f - b1 - b2;
+    vec3 w0 = v3_scale(p0, b0), w1 = v3_scale(p1, b1), w2 = v3_scale(p2, b2);
+    /* Products, sums and the rounded b0 (whose error moves the point off
+     * the plane in proportion to its distance from the world origin). */
+    *err = v3_scale(v3_add(v3_add(v3_abs(w0), v3_abs(w1)), v3_abs(w2)), GEO_GAMMA(7));
+    return v3_add(v3_add(w0, w1), w2);
 }
 
-vec3 geo_offset(vec3 p, vec3 ng, vec3 dir)
+vec3 geo_sphere_point(const fr_sphere *s, vec3 n, vec3 *err)
 {
+    /* |n| is 1 within a few roundings, so c + r n lies on the sphere
+     * within those and the two of the sum. */
+    vec3 rn = v3_scale(n, s->radius);
+    *err = v3_scale(v3_add(v3_abs(s->center), v3_abs(rn)), GEO_GAMMA(6));
+    return v3_add(s->center, rn);
+}
+
+vec3 geo_rect_point(const fr_rect *q, float s, float t, vec3 *err)
+{
+    vec3 us = v3_scale(q->edge_u, s), vt = v3_scale(q->edge_v, t);
+    vec3 p = v3_add(q->origin, v3_add(us, vt));
+    /* The rectangle's test takes its plane through `origin` across the
+     * rounded normal, which tilts from the plane of the edges by the
+     * cross product's error (gamma(2) per term): a point s, t along the
+     * edges is off it by up to (s |edge_u| + t |edge_v|) . that error / |n|. */
+    vec3 eu = v3_abs(q->edge_u), ev = v3_abs(q->edge_v);
+    vec3 ce = v3(eu.y * ev.z + eu.z * ev.y, eu.z * ev.x + eu.x * ev.z, eu.x * ev.y + eu.y * ev.x);
+    float tilt = (fabsf(s) * v3_dot(eu, ce) + fabsf(t) * v3_dot(ev, ce)) * GEO_GAMMA(3) / v3_len(q->normal);
+    *err = v3_add(v3_scale(v3_add(v3_add(v3_abs(q->origin), v3_abs(us)), v3_abs(vt)), GEO_GAMMA(4)), v3s(tilt));
+    return p;
+}
+
+vec3 geo_plane_point(const fr_plane *p, const fr_ray *r, float t, vec3 *err)
+{
+    /* The point along the ray: t's error (plane_error, relative to the
+     * numerator, at most gamma(11) of sum |rel_i n_i| across the normal)
+     * and the two roundings of o + t d. */
+    vec3 dt = v3_scale(r->d, t), rel = v3_sub(p->point, r->o);
+    float sum = fabsf(rel.x * p->normal.x) + fabsf(rel.y * p->normal.y) + fabsf(rel.z * p->normal.z);
+    *err = v3_add(v3s(sum * GEO_GAMMA(11)), v3_scale(v3_add(v3_abs(r->o), v3_abs(dt)), GEO_GAMMA(2)));
+    return v3_add(r->o, dt);
+}
+
+/* The neighbouring floats of x toward +infinity and -infinity. */
+static float next_up(float x)
+{
+    if (x == INFINITY)
+        return x;
+    if (x == 0.0f)
+        return 0x1p-149f;
+    uint32_t i;
+    memcpy(&i, &x, 4);
+    i = x > 0.0f ? i + 1 : i - 1;
+    memcpy(&x, &i, 4);
+    return x;
+}
+
+static float next_down(float x) { return -next_up(-x); }
+
+static float push(float p, float step)
+{
+    float o = p + step;
+    return step > 0.0f ? next_up(o) : step < 0.0f ? next_down(o) : o;
+}
+
+vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
+{
+    float d = fabsf(ng.x) * err.x + fabsf(ng.y) * err.y + fabsf(ng.z) * err.z;
+    /* A degenerate surface's NaN normal or error: no push (and no NaN). */
+    if (!(d < INFINITY))
+        return p;
     if (v3_dot(ng, dir) < 0.0f)
-        ng = v3_neg(ng);
-    return v3(offset_coord(p.x, ng.x), offset_coord(p.y, ng.y), offset_coord(p.z, ng.z));
+        d = -d;
+    return v3(push(p.x, ng.x * d), push(p.y, ng.y * d), push(p.z, ng.z * d));
 }

@@ -166,7 +166,7 @@ vec3 med_shadow(const fr_scene *s, uint32_t medium, const fr_ray *r, float tmax,
         if (medium)
             tr = v3_mul(tr, med_transmittance(&s->media[medium - 1], h.t));
         medium = med_after(s, medium, m, sf.ng, ray.d);
-        vec3 o = geo_offset(sf.p, sf.ng, ray.d);
+        vec3 o = geo_offset(sf.p, sf.perr, sf.ng, ray.d);
         tmax -= v3_dot(v3_sub(o, ray.o), ray.d);
         ray.o = o;
         if (!(tmax > 0.0f))

@@ -34,6 +34,9 @@ static inline void f4_store(float *p, f4 v) { memcpy(p, &v, sizeof v); }
 static inline f4 f4_set1(float x) { return (f4){x, x, x, x}; }
 static inline i4 i4_set1(int32_t x) { return (i4){x, x, x, x}; }
 
+/** Lane-wise |a| (the sign bit cleared). */
+static inline f4 f4_abs(f4 a) { return (f4)((i4)a & i4_set1(0x7fffffff)); }
+
 /** Lane-wise max(a, acc), acc where a is NaN (acc: never NaN). */
 static inline f4 f4_max_num(f4 a, f4 acc)
 {

@@ -174,6 +174,12 @@ static inline __attribute__((always_inline)) int block_test(const fr_bvh_leaf *L
         return 0;
     f4 t = R->sz * (u * az + v * bz + w * cz) / det;
     m &= i4_bits((t > zero) & (t <= f4_set1(H->best)));
+    if (!m)
+        return 0;
+    /* As geo_triangle: not a hit unless t exceeds its rounding error
+     * (which is >= 0, so the test above only saves work). */
+    f4 err = GEO_TRI_ERROR(f4, f4_abs, f4_max_num, ax, bx, cx, ay, by, cy, az, bz, cz, u, v, w, R->sz, det);
+    m &= i4_bits(t > err);
     for (int i = 0; m; i++, m >>= 1) {
         if (!(m & 1) || !better(H, t[i], L->prim[i]))
             continue;
@@ -318,9 +324,9 @@ int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip
 
 void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out)
 {
-    out->p = v3_madd(r->o, r->d, hit->t);
     if (hit->prim == FR_NONE) {
         const fr_plane *pl = &s->planes[hit->plane];
+        out->p = geo_plane_point(pl, r, hit->t, &out->perr);
         out->ng = out->ns = pl->normal;
         vec3 t, b;
         v3_basis(pl->normal, &t, &b);
@@ -337,10 +343,10 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
     out->light = p->light;
     if (p->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[p->index];
-        vec3 n = v3_scale(v3_sub(out->p, sp->center), 1.0f / sp->radius);
+        vec3 n = v3_scale(v3_sub(v3_madd(r->o, r->d, hit->t), sp->center), 1.0f / sp->radius);
         out->ng = out->ns = v3_norm(n);
         /* Re-project onto the surface: removes most of the hit point's error. */
-        out->p = v3_madd(sp->center, out->ng, sp->radius);
+        out->p = geo_sphere_point(sp, out->ng, &out->perr);
         /* Longitude and latitude, seen from outside as an image is seen:
          * u grows eastward (+x toward -z), v from 0 at the -y pole to 1 at
          * +y, so cross(dpdu, dpdv) faces out and an image is not mirrored. */
@@ -354,7 +360,7 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
     } else if (p->kind == FR_PRIM_RECT) {
         const fr_rect *q = &s->rects[p->index];
         out->ng = out->ns = v3_norm(v3_cross(q->edge_u, q->edge_v));
-        out->p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, hit->a), v3_scale(q->edge_v, hit->b)));
+        out->p = geo_rect_point(q, hit->a, hit->b, &out->perr);
         out->uv = (vec2){hit->a, hit->b};
         out->dpdu = q->edge_u;
         out->dpdv = q->edge_v;
@@ -362,7 +368,7 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
         const fr_triangle *t = &s->triangles[p->index];
         vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
         float b0 = 1.0f - hit->a - hit->b;
-        out->p = v3_add(v3_add(v3_scale(p0, b0), v3_scale(p1, hit->a)), v3_scale(p2, hit->b));
+        out->p = geo_triangle_point(p0, p1, p2, hit->a, hit->b, &out->perr);
         out->ng = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
         out->ns = out->ng;
         if (t->flags & FR_TRI_NORMALS) {

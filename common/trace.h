@@ -22,6 +22,7 @@ typedef struct {
 /** The local geometry at a hit, for shading. */
 typedef struct {
     vec3 p;                    /**< position */
+    vec3 perr;                 /**< bound on p's error per coordinate (for geo_offset) */
     vec3 ng;                   /**< geometric normal (unit, front side) */
     vec3 ns;                   /**< shading normal (unit, same hemisphere as ng) */
     vec2 uv;                   /**< texture coordinates */

@@ -87,7 +87,7 @@ int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, 
         if (crossings == MAX_CROSSINGS)
             return VTX_ESCAPED;
         *medium = med_after(s, *medium, mb, v->sf.ng, ray->d);
-        ray->o = geo_offset(v->sf.p, v->sf.ng, ray->d);
+        ray->o = geo_offset(v->sf.p, v->sf.perr, v->sf.ng, ray->d);
         found = trace_closest(s, ray, INFINITY, &hit);
     }
 }
@@ -101,7 +101,7 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
     vec3 f = bsdf_eval(m, sf, wo, ls->wi, &out->scatter_pdf);
     if (v3_is_zero(f))
         return 0;
-    fr_ray shadow = {geo_offset(sf->p, sf->ng, ls->wi), ls->wi};
+    fr_ray shadow = {geo_offset(sf->p, sf->perr, sf->ng, ls->wi), ls->wi};
     float tmax = v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
     vec3 tr = v3s(1.0f);
     if (s->n_media && tmax > 0.0f)
@@ -150,7 +150,7 @@ int vtx_scatter_surface(const fr_scene *s, const fr_material *m, const fr_surfac
     if (!bsdf_sample(m, sf, wo, ulobe, u1, u2, bs))
         return 0;
     *medium = med_after(s, *medium, m, sf->ng, bs->wi);
-    next->o = geo_offset(sf->p, sf->ng, bs->wi);
+    next->o = geo_offset(sf->p, sf->perr, sf->ng, bs->wi);
     next->d = bs->wi;
     return 1;
 }

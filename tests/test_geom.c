@@ -119,45 +119,172 @@ static void test_watertight(void)
     CHECK(leaks == 0, "%d of %d rays through shared edges hit no triangle", leaks, rays);
 }
 
-/* A ray leaving a surface from geo_offset must not hit that surface again,
- * at small and large coordinates. */
+/* A random unit direction on the side of unit normal n, from grazing
+ * (cosine 1e-4) to along the normal. */
+static vec3 leave(uint32_t *st, vec3 n)
+{
+    vec3 t, b;
+    v3_basis(n, &t, &b);
+    float c = rnd(st) < 0.3f ? 1e-4f + rnd(st) * 1e-2f : rnd(st), sn = sqrtf(1.0f - c * c);
+    float a = 6.2831853f * rnd(st);
+    return v3_norm(v3_from_local(v3(sn * (float)cos(a), sn * (float)sin(a), c), t, b, n));
+}
+
+/* A quad as two triangles p0 p1 p2 and p0 p2 p3, as a scene's quad is. */
+static float quad_hit(const vec3 q[4], const fr_ray *r, vec3 *p, vec3 *err, vec3 *ng)
+{
+    float b1, b2, t = geo_triangle(q[0], q[1], q[2], r, INFINITY, &b1, &b2);
+    if (t > 0.0f) {
+        *p = geo_triangle_point(q[0], q[1], q[2], b1, b2, err);
+        *ng = v3_norm(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
+        return t;
+    }
+    t = geo_triangle(q[0], q[2], q[3], r, INFINITY, &b1, &b2);
+    if (t > 0.0f) {
+        *p = geo_triangle_point(q[0], q[2], q[3], b1, b2, err);
+        *ng = v3_norm(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[3], q[0])));
+    }
+    return t;
+}
+
+/* A ray leaving a surface from geo_offset must hit neither that surface
+ * nor, for a quad, its other triangle: rays from the hit point of a ray
+ * coming from either side, leaving to either side at any angle down to
+ * grazing.  Walls at coordinate 0 with vertices hundreds of units away
+ * (the Cornell box's), the same moved far from the origin, and shapes at
+ * scales from 1e-2 to 1e5. */
 static void test_offset(void)
 {
     uint32_t st = 7;
     int acne = 0, total = 0;
+    /* Quads: the Cornell box's green wall (x = 0), its floor (y = 0), both
+     * moved by (1000, 1000, 0), and tilted quads at several scales. */
+    vec3 quads[][4] = {
+        {v3(0, 0, 559.2f), v3(0, 0, 0), v3(0, 548.8f, 0), v3(0, 548.8f, 559.2f)},
+        {v3(0, 0, 0), v3(0, 548.8f, 0), v3(0, 548.8f, 559.2f), v3(0, 0, 559.2f)},
+        {v3(552.8f, 0, 0), v3(0, 0, 0), v3(0, 0, 559.2f), v3(552.8f, 0, 559.2f)},
+        {v3(1000, 1000, 559.2f), v3(1000, 1000, 0), v3(1000, 1548.8f, 0), v3(1000, 1548.8f, 559.2f)},
+        {v3(1552.8f, 1000, 0), v3(1000, 1000, 0), v3(1000, 1000, 559.2f), v3(1552.8f, 1000, 559.2f)},
+    };
+    int nq = sizeof quads / sizeof quads[0];
+    for (int qi = 0; qi < nq + 4; qi++) {
+        vec3 q[4];
+        if (qi < nq) {
+            for (int k = 0; k < 4; k++)
+                q[k] = quads[qi][k];
+        } else {
+            /* A planar tilted parallelogram, size and position by scale. */
+            float sc = qi == nq ? 1e-2f : qi == nq + 1 ? 1.0f : qi == nq + 2 ? 500.0f : 1e5f;
+            vec3 o = v3_scale(v3(rnd(&st) * 8 - 4, rnd(&st) * 8 - 4, rnd(&st) * 8 - 4), sc);
+            vec3 e1 = v3_scale(v3(1, 0.3f, -0.2f), sc), e2 = v3_scale(v3(-0.1f, 0.8f, 0.45f), sc);
+            q[0] = o; q[1] = v3_add(o, e1); q[2] = v3_add(q[1], e2); q[3] = v3_add(o, e2);
+        }
+        vec3 n = v3_norm(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
+        float size = v3_len(v3_sub(q[2], q[0]));
+        for (int k = 0; k < 4000; k++) {
+            float f = rnd(&st), g = rnd(&st);
+            /* Targets spread over the quad, a third of them on its diagonal. */
+            if (k % 3 == 0) g = f;
+            vec3 tgt = v3_add(q[0], v3_add(v3_scale(v3_sub(q[1], q[0]), f), v3_scale(v3_sub(q[3], q[0]), g)));
+            vec3 side = k & 1 ? n : v3_neg(n);
+            vec3 o = v3_add(tgt, v3_scale(v3_add(side, v3_scale(leave(&st, side), 0.9f)), size));
+            fr_ray r = {o, v3_sub(tgt, o)};
+            vec3 p, err, ng;
+            if (!(quad_hit(q, &r, &p, &err, &ng) > 0.0f))
+                continue;
+            for (int back = 0; back < 2; back++) {
+                vec3 out = leave(&st, back ? v3_neg(side) : side);
+                fr_ray r2 = {geo_offset(p, err, ng, out), out};
+                vec3 p2, e2, n2;
+                total++;
+                acne += quad_hit(q, &r2, &p2, &e2, &n2) > 0.0f;
+            }
+        }
+    }
+    CHECK(acne == 0, "%d of %d offset rays hit their own quad again", acne, total);
+
+    acne = total = 0;
     float scales[] = {1e-2f, 1.0f, 500.0f, 1e5f};
     for (int si = 0; si < 4; si++) {
         float sc = scales[si];
         fr_sphere s = {v3(sc * 3, sc * -2, sc * 5), sc};
-        vec3 a = v3(sc * 10, 0, sc), b = v3(sc * 11, sc * 0.3f, sc * 1.2f), c = v3(sc * 10.2f, sc * 1.1f, sc * 0.8f);
-        for (int k = 0; k < 20000; k++, total += 2) {
-            /* Sphere: hit from a random outside point, leave outward. */
-            vec3 o = v3_add(s.center, v3_scale(v3(rnd(&st) - 0.5f, rnd(&st) - 0.5f, rnd(&st) - 0.5f), sc * 8));
-            fr_ray r = {o, v3_norm(v3_sub(s.center, o))};
-            float t = geo_sphere(&s, &r, INFINITY);
+        fr_sphere s0 = {v3(sc, 0, 0), sc};     /* touching the origin */
+        fr_rect rc = geo_rect_make(v3(0, sc * 2, sc), v3(sc, sc * 0.1f, 0), v3(sc * 0.2f, sc * 0.3f, sc * 2));
+        fr_plane pl = {v3(sc * 7, 0, sc * 3), v3_norm(v3(0.3f, 1, -0.2f)), 0, 0};
+        for (int k = 0; k < 20000; k++) {
+            /* Spheres: hit from outside, leave outward or inward. */
+            const fr_sphere *sp = k & 1 ? &s : &s0;
+            vec3 o = v3_add(sp->center, v3_scale(v3(rnd(&st) - 0.5f, rnd(&st) - 0.5f, rnd(&st) - 0.5f), sc * 8));
+            fr_ray r = {o, v3_norm(v3_sub(v3_add(sp->center, v3_scale(v3(rnd(&st), rnd(&st), rnd(&st)), sc * 0.5f)), o))};
+            float t = geo_sphere(sp, &r, INFINITY);
             if (t > 0.0f) {
-                vec3 p = v3_madd(r.o, r.d, t), n = v3_norm(v3_sub(p, s.center));
-                vec3 out = v3_norm(v3_add(n, v3(rnd(&st) * 0.5f, rnd(&st) * 0.5f, rnd(&st) * 0.5f)));
-                if (v3_dot(out, n) > 0.05f) {
-                    fr_ray r2 = {geo_offset(p, n, out), out};
-                    acne += geo_sphere(&s, &r2, INFINITY) > 0.0f;
+                vec3 err, n = v3_norm(v3_sub(v3_madd(r.o, r.d, t), sp->center));
+                vec3 p = geo_sphere_point(sp, n, &err);
+                for (int side = 0; side < 2; side++) {
+                    vec3 out = leave(&st, side ? v3_neg(n) : n);
+                    fr_ray r2 = {geo_offset(p, err, n, out), out};
+                    float t2 = geo_sphere(sp, &r2, INFINITY);
+                    /* Outward: nothing; inward: only the far side. */
+                    acne += side ? t2 > 0.0f && t2 < sc * 1e-3f : t2 > 0.0f;
+                    total++;
                 }
             }
-            /* Triangle: hit, then leave to the side the ray came from. */
-            vec3 tgt = v3_add(a, v3_add(v3_scale(v3_sub(b, a), rnd(&st) * 0.5f), v3_scale(v3_sub(c, a), rnd(&st) * 0.5f)));
-            vec3 o2 = v3_add(tgt, v3_scale(v3(rnd(&st) - 0.5f, rnd(&st) - 0.5f, 1.0f), sc * 4));
-            fr_ray rt = {o2, v3_sub(tgt, o2)};
-            float b1, b2;
-            float tt = geo_triangle(a, b, c, &rt, INFINITY, &b1, &b2);
-            if (tt > 0.0f) {
-                vec3 p = v3_madd(rt.o, rt.d, tt), ng = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
-                vec3 back = v3_norm(v3_neg(rt.d));
-                fr_ray r2 = {geo_offset(p, ng, back), back};
-                acne += geo_triangle(a, b, c, &r2, INFINITY, &b1, &b2) > 0.0f;
+            /* Rectangle and plane: hit from a random side, leave to either. */
+            float s1, s2;
+            vec3 side = rnd(&st) < 0.5f ? v3_norm(rc.normal) : v3_neg(v3_norm(rc.normal));
+            vec3 tgt = v3_add(rc.origin, v3_add(v3_scale(rc.edge_u, rnd(&st)), v3_scale(rc.edge_v, rnd(&st))));
+            o = v3_add(tgt, v3_scale(v3_add(side, leave(&st, side)), sc * 3));
+            r = (fr_ray){o, v3_sub(tgt, o)};
+            if (geo_rect(&rc, &r, INFINITY, &s1, &s2) > 0.0f) {
+                vec3 err, p = geo_rect_point(&rc, s1, s2, &err), ng = v3_norm(rc.normal);
+                for (int back = 0; back < 2; back++) {
+                    vec3 out = leave(&st, back ? v3_neg(side) : side);
+                    fr_ray r2 = {geo_offset(p, err, ng, out), out};
+                    acne += geo_rect(&rc, &r2, INFINITY, &s1, &s2) > 0.0f;
+                    total++;
+                }
+            }
+            side = rnd(&st) < 0.5f ? pl.normal : v3_neg(pl.normal);
+            o = v3_add(pl.point, v3_scale(v3(rnd(&st) - 0.5f, rnd(&st) - 0.5f, rnd(&st) - 0.5f), sc * 20));
+            r = (fr_ray){o, leave(&st, v3_dot(v3_sub(pl.point, o), pl.normal) > 0.0f ? pl.normal : v3_neg(pl.normal))};
+            t = geo_plane(&pl, &r, INFINITY);
+            if (t > 0.0f) {
+                vec3 err, p = geo_plane_point(&pl, &r, t, &err);
+                for (int back = 0; back < 2; back++) {
+                    vec3 out = leave(&st, back ? v3_neg(side) : side);
+                    fr_ray r2 = {geo_offset(p, err, pl.normal, out), out};
+                    acne += geo_plane(&pl, &r2, INFINITY) > 0.0f;
+                    total++;
+                }
             }
         }
     }
-    CHECK(acne == 0, "%d of %d offset rays hit their own surface again", acne, total);
+    CHECK(acne == 0, "%d of %d offset rays hit their own sphere, rectangle or plane again", acne, total);
+    CHECK(total > 200000, "only %d offset rays tested", total);
+}
+
+/* The offset is small: a ray leaving a surface still finds a surface just
+ * in front of it.  A point of the wall at x = 0 is exact in x (a weighted
+ * sum of zeros), so it needs no push across the wall at all: the tests'
+ * own error bounds keep the ray from the wall. */
+static void test_offset_small(void)
+{
+    vec3 q[4] = {v3(0, 0, 559.2f), v3(0, 0, 0), v3(0, 548.8f, 0), v3(0, 548.8f, 559.2f)};
+    fr_ray r = {v3(300, 200, 100), v3(-1, 0.1f, 0.2f)};
+    vec3 p, err, ng;
+    float t = quad_hit(q, &r, &p, &err, &ng);
+    CHECK(t > 0.0f, "the wall is hit");
+    vec3 o = geo_offset(p, err, ng, v3(1, 0, 0));
+    CHECK(p.x == 0.0f && o.x == 0.0f && o.y == p.y && o.z == p.z, "offset from the wall at x=0: (%g %g %g)", o.x,
+          o.y - p.y, o.z - p.z);
+    /* A parallel wall 0.01 in front is hit from the offset point. */
+    vec3 q2[4] = {v3(0.01f, 0, 559.2f), v3(0.01f, 0, 0), v3(0.01f, 548.8f, 0), v3(0.01f, 548.8f, 559.2f)};
+    fr_ray r2 = {o, v3_norm(v3(1, 0.2f, 0.1f))};
+    vec3 p2, e2, n2;
+    CHECK(quad_hit(q2, &r2, &p2, &e2, &n2) > 0.0f, "a wall 0.01 away is found");
+    /* A degenerate normal gives no NaN origin. */
+    vec3 bad = geo_offset(p, err, v3(NAN, NAN, NAN), v3(1, 0, 0));
+    CHECK(bad.x == p.x && bad.y == p.y && bad.z == p.z, "NaN normal: origin unchanged");
 }
 
 int main(void)
@@ -167,5 +294,6 @@ int main(void)
     test_triangle();
     test_watertight();
     test_offset();
+    test_offset_small();
     return check_done();
 }

@@ -148,7 +148,7 @@ static fr_ray *make_rays(const fr_scene *s, uint32_t w, uint32_t h, uint32_t *n_
         v3_basis(ng, &t, &b);
         float u1 = rnd(&state), u2 = rnd(&state), rr = sqrtf(u1), phi = 2.0f * 3.14159265f * u2;
         vec3 d = v3_from_local(v3(rr * cosf(phi), rr * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u1))), t, b, ng);
-        r[n].o = geo_offset(sf.p, ng, d);
+        r[n].o = geo_offset(sf.p, sf.perr, ng, d);
         r[n].d = v3_norm(d);
         n++;
     }
