@@ -1,10 +1,11 @@
 #!/bin/sh
 # it_docs.sh -- the documentation's examples run, and show what they say.
 #
-# Every fenced example (```lang ... ```) of README.md, scenes/README.md and
-# coordinator/README.md, and every .nf/.fi or .EX/.EE block of the man pages
-# coordinator/man/*.[1-9], carries an annotation on the line(s) just before
-# it (blank lines may come between) saying what it shows:
+# Every fenced example (```lang ... ```) of the Markdown files of the
+# repository (README.md, scenes/README.md, coordinator/README.md ..., any
+# *.md outside bin/, build/ and dist/), and every .nf/.fi or .EX/.EE block of
+# the man pages (*/man/*.[1-9]), carries an annotation on the line(s) just
+# before it (blank lines may come between) saying what it shows:
 #
 #     <!-- expect: CHECK -->          in Markdown
 #     .\" expect: CHECK               in a man page
@@ -81,7 +82,8 @@ done
 if [ $# -gt 0 ]; then
     DOCS="$*"
 else
-    DOCS="README.md scenes/README.md coordinator/README.md $(ls coordinator/man/*.[1-9])"
+    DOCS=$(find . \( -path ./.git -o -path ./bin -o -path ./build -o -path ./dist \) -prune -o \
+        \( -name '*.md' -o -path '*/man/*.[1-9]' \) -type f -print | sed 's|^\./||' | sort)
 fi
 E="$T/ex"
 mkdir -p "$E"
@@ -388,7 +390,7 @@ while [ "$i" -lt "$n" ]; do
         else
             case "$lang" in
             json) "$DJ" parse outline "$body" >/dev/null 2>"$T/jerr" || json_fail_at ;;
-            sh | shell | roff | none) lint "$body" ;;
+            sh | shell | roff) lint "$body" ;;
             esac
         fi
     else
