@@ -291,10 +291,11 @@ room() {
 json_fail_at() {
     # docjson's "line L: ..." becomes a line of the document.
     file=${where%:*} line=${where##*:}
-    sed -n 's/^line \([0-9]*\): \(.*\)/\1 \2/p' "$T/jerr" | while read -r l msg; do
+    sed -n 's/^line \([0-9]*\): \(.*\)/\1 \2/p' "$T/jerr" >"$T/jlines"
+    while read -r l msg; do
         bad "$file:$((line + l)): $msg"
-    done
-    grep -q '^line ' "$T/jerr" || fail "$(cat "$T/jerr")"
+    done <"$T/jlines"
+    [ -s "$T/jlines" ] || fail "$(cat "$T/jerr")"
 }
 
 json_example() {
