@@ -138,11 +138,20 @@ static int validate_appearance(const fr_scene *s, const void *base, const uint64
             !finite3(t->color0) || !finite3(t->color1))
             return fr_fail(err, "section textures, byte %zu: texture %u: bad kind, wrap, filter or non-finite parameter",
                            AT(t), i);
-        if (t->kind == FR_TEX_IMAGE &&
-            (t->width == 0 || t->height == 0 || (t->channels != 1 && t->channels != 3) ||
-             (uint64_t)t->width * t->height * t->channels > (uint64_t)s->n_texels - t->first || t->first > s->n_texels))
-            return fr_fail(err, "section textures, byte %zu: texture %u: image size or texel range out of bounds", AT(t),
-                           i);
+        if (t->kind != FR_TEX_IMAGE)
+            continue;
+        if (t->width == 0 || t->height == 0 || t->width > FR_TEX_MAX_SIDE || t->height > FR_TEX_MAX_SIDE ||
+            (t->channels != 1 && t->channels != 3))
+            return fr_fail(err, "section textures, byte %zu: texture %u: image %ux%u with %u channels (at most "
+                           "%ux%u, 1 or 3 channels)", AT(t), i, t->width, t->height, t->channels, FR_TEX_MAX_SIDE,
+                           FR_TEX_MAX_SIDE);
+        /* width * height * channels <= the texels from `first` on, by
+         * division: no product that could wrap. */
+        uint32_t avail = t->first <= s->n_texels ? s->n_texels - t->first : 0;
+        if (t->first > s->n_texels || t->width > avail / t->channels / t->height)
+            return fr_fail(err, "section textures, byte %zu: texture %u: %ux%u image with %u channels does not fit "
+                           "in the %u texels from texel %u", AT(t), i, t->width, t->height, t->channels, avail,
+                           t->first);
     }
     for (uint32_t i = 0; i < s->n_texels; i++)
         if (!isfinite(s->texels[i]))

@@ -79,6 +79,8 @@ typedef struct {
  * uv * scale + offset; v grows upward, so v = 0 is the image's bottom row
  * (the OBJ convention). */
 enum { FR_TEX_IMAGE = 0, FR_TEX_CHECKER = 1 };
+/** The largest image width or height a texture may have, in pixels. */
+#define FR_TEX_MAX_SIDE 65536u
 enum { FR_WRAP_REPEAT = 0, FR_WRAP_CLAMP = 1 };
 enum { FR_FILTER_BILINEAR = 0, FR_FILTER_NEAREST = 1 };
 typedef struct {

@@ -146,6 +146,9 @@ static int store_image(fr_builder *b, const scn_image *img, int from_srgb, fr_te
     if (img->width == 0 || img->height == 0 || img->channels == 0 || img->channels > 4)
         return fr_fail(err, "%s: the image has %ux%u pixels and %u channels (expected 1 to 4)", where, img->width,
                        img->height, img->channels);
+    if (img->width > FR_TEX_MAX_SIDE || img->height > FR_TEX_MAX_SIDE)
+        return fr_fail(err, "%s: the image has %ux%u pixels (at most %u per side)", where, img->width, img->height,
+                       FR_TEX_MAX_SIDE);
     uint32_t keep = img->channels >= 3 ? 3 : 1;
     uint64_t count = (uint64_t)img->width * img->height * keep;
     if (count > (1u << 29) || b->texels.count > (1u << 29) - count)
@@ -205,7 +208,9 @@ static int texture_ref(scn_appear *a, const char *name, int as_colour, const cha
             free(img.pixels);
             return fr_fail(err, "%s.file: %s", tw, e.msg);
         }
-        int rc = store_image(a->b, &img, from_srgb, &tex, tw, err);
+        char iw[PATHLEN + 4096];
+        snprintf(iw, sizeof iw, "%s.file '%s'", tw, path);
+        int rc = store_image(a->b, &img, from_srgb, &tex, iw, err);
         free(img.pixels);
         if (rc < 0)
             return -1;

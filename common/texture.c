@@ -27,11 +27,12 @@ static uint32_t wrap_index(long i, uint32_t n, uint32_t wrap)
 
 /* Map one texture coordinate into the range the wrap mode allows: its
  * fraction for repeat (so huge plane coordinates stay precise), [0, 1] for
- * clamp. */
+ * clamp.  NaN (from coordinates that overflow) becomes 0, so pixel
+ * indices are always in range. */
 static float wrap_coord(float x, uint32_t wrap)
 {
     if (wrap == FR_WRAP_CLAMP)
-        return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
+        return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f;
     float f = x - floorf(x);
     return f < 1.0f ? f : 0.0f;   /* x = -tiny rounds to 1.0 */
 }

@@ -15,6 +15,8 @@
 #include "bvh.h"
 #include "check.h"
 #include "fbin.h"
+#include "freeze.h"
+#include "pathtrace.h"
 #include "scenes.h"
 
 static const char *scene_json =
@@ -347,6 +349,100 @@ static void test_shapes(void)
     free(blocks);
 }
 
+/* A scene whose one material is textured by a 2x2 RGB image (texels 0..11)
+ * followed by 4 spare texels, so a texture may also start later. */
+static int textured_scene(fr_scene *out, fr_error *err)
+{
+    static const char *json =
+        "{\"image\": {\"width\": 8, \"height\": 8, \"spp\": 1},"
+        " \"camera\": {\"position\": [0, 0, -4], \"target\": [0, 0, 0], \"fov\": 40},"
+        " \"textures\": {\"t\": {\"type\": \"checker\", \"colors\": [[1, 1, 1], [0, 0, 0]]}},"
+        " \"materials\": {\"m\": {\"type\": \"lambert\", \"albedo\": \"t\"}},"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0, 0, -3], \"intensity\": [5, 5, 5]}],"
+        " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"}]}";
+    fr_builder b;
+    bld_init(&b);
+    int rc = scn_parse_json(json, "(test)", NULL, &b, err);
+    if (rc == 0 && b.textures.count != 1)
+        rc = fr_fail(err, "%u textures, expected 1", b.textures.count);
+    if (rc == 0) {
+        fr_texture *t = b.textures.data;
+        t->kind = FR_TEX_IMAGE;
+        t->width = t->height = 2;
+        t->channels = 3;
+        t->first = 0;
+        for (int i = 0; i < 16 && rc == 0; i++) {
+            float v = (float)i / 16.0f;
+            if (bld_push(&b.texels, &v) == FR_NONE)
+                rc = fr_fail(err, "out of memory");
+        }
+    }
+    if (rc == 0)
+        rc = frz_scene(&b, out, err);
+    bld_free(&b);
+    return rc;
+}
+
+/* Image sizes and texel ranges: refused whenever the image does not fit in
+ * the texels after `first`, including sizes whose product wraps in 64
+ * bits, and accepted when it fits exactly. */
+static void test_texture_sizes(void)
+{
+    fr_scene ts;
+    fr_error err;
+    if (textured_scene(&ts, &err) < 0) {
+        CHECK(0, "textured scene: %s", err.msg);
+        return;
+    }
+    CHECK(ts.n_textures == 1 && ts.n_texels == 16, "textured scene: %u textures, %u texels", ts.n_textures,
+          ts.n_texels);
+    size_t tex = section(ts.blob, 15);
+    static const struct { uint32_t w, h, ch, first; int ok; const char *what; } cases[] = {
+        {2, 2, 3, 0, 1, "the image as written"},
+        {4, 4, 1, 0, 1, "grey, all 16 texels"},
+        {2, 2, 3, 4, 1, "starting at texel 4, ending at the last"},
+        {2, 2, 3, 5, 0, "one texel past the end"},
+        {1, 1, 1, 16, 0, "starting at the end"},
+        {1, 1, 1, 17, 0, "starting past the end"},
+        {1, 1, 1, 0xffffffffu, 0, "starting at 2^32 - 1"},
+        {3384208571u, 3633886365u, 3, 0, 0, "w*h*3 wraps to 13 in 64 bits"},
+        {4294901763u, 1431677610u, 3, 0, 0, "w*h*3 wraps to 327674 in 64 bits"},
+        {0x80000000u, 0x80000000u, 1, 0, 0, "w*h = 2^62"},
+        {0xffffffffu, 0xffffffffu, 3, 0, 0, "the largest 32-bit sizes"},
+        {16, 0x10000001u, 1, 0, 0, "w*h wraps to 16 in 32 bits"},
+        {0, 2, 3, 0, 0, "width 0"},
+        {2, 2, 2, 0, 0, "2 channels"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        unsigned char *p = aligned_alloc(64, (ts.blob_size + 63) / 64 * 64);
+        memcpy(p, ts.blob, ts.blob_size);
+        put32(p + tex + 4, cases[i].w);
+        put32(p + tex + 8, cases[i].h);
+        put32(p + tex + 12, cases[i].ch);
+        put32(p + tex + 16, cases[i].first);
+        rehash(p, ts.blob_size);
+        if (cases[i].ok) {
+            fr_scene s;
+            int rc = fbin_open_mem(p, ts.blob_size, 0, &s, &err);
+            CHECK(rc == 0, "%s: refused: %s", cases[i].what, err.msg);
+            if (rc == 0) {
+                /* Rendered: every lookup lands in the texels. */
+                vec3 c = pt_sample(&s, PT_MIS, 4, 4, 0);
+                CHECK(isfinite(c.x) && c.x > 0.0f, "%s: pixel (4, 4) is %g", cases[i].what, c.x);
+                scn_free(&s);
+            } else {
+                free(p);
+            }
+        } else {
+            char at[32];
+            snprintf(at, sizeof at, "byte %zu:", tex);
+            REFUSE(cases[i].what, p, ts.blob_size, "section textures", at, "texture 0");
+            free(p);
+        }
+    }
+    scn_free(&ts);
+}
+
 int main(void)
 {
     test_scene(scene_json, &good);
@@ -356,6 +452,7 @@ int main(void)
     test_table();
     test_contents();
     test_shapes();
+    test_texture_sizes();
     scn_free(&good);
     return check_done();
 }

@@ -26,6 +26,8 @@ static int synthetic(const char *path, scn_image *img, fr_error *err)
         img->width = 4, img->height = 2, img->channels = 3;
     } else if (!strncmp(base, "flat", 4) || !strncmp(base, "ramp", 4)) {
         img->width = 8, img->height = 8, img->channels = 1;
+    } else if (!strncmp(base, "wide", 4)) {
+        img->width = FR_TEX_MAX_SIDE + 1, img->height = 1, img->channels = 1;
     } else {
         return fr_fail(err, "%s: no such synthetic image", path);
     }
@@ -36,7 +38,7 @@ static int synthetic(const char *path, scn_image *img, fr_error *err)
             if (img->channels == 3) {
                 p[0] = x / 4.0f, p[1] = y / 2.0f, p[2] = 0.25f;
             } else {
-                p[0] = base[0] == 'f' ? 0.5f : x / 8.0f;
+                p[0] = base[0] == 'f' ? 0.5f : base[0] == 'w' ? 0.0f : x / 8.0f;
             }
         }
     return 0;
@@ -64,7 +66,7 @@ static void make_files(void)
 {
     snprintf(dir, sizeof dir, "/tmp/franja-tex-%ld", (long)getpid());
     char cmd[256];
-    snprintf(cmd, sizeof cmd, "mkdir -p %s && cd %s && touch grid.png grid.exr flat.png ramp.png", dir, dir);
+    snprintf(cmd, sizeof cmd, "mkdir -p %s && cd %s && touch grid.png grid.exr flat.png ramp.png wide.png", dir, dir);
     if (system(cmd) != 0) {
         printf("FAIL cannot create %s\n", dir);
         exit(1);
@@ -493,6 +495,40 @@ static void no_leaks(void)
     scn_free(&s);
 }
 
+/* An image wider than a texture may be is refused by name, and a lookup
+ * at a NaN coordinate (clamped or repeated) reads a texel of the image. */
+static void sizes_and_nan(void)
+{
+    fr_scene s;
+    fr_error err;
+    const char *wide = SCENE_HEAD "\"textures\": {\"w\": {\"type\": \"image\", \"file\": \"wide.png\"}},"
+        "\"materials\": {\"a\": {\"type\": \"lambert\", \"albedo\": \"w\"}},"
+        "\"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, -3], \"radius\": 1, \"material\": \"a\"}],"
+        "\"lights\": [{\"type\": \"point\", \"position\": [0, 0, 0], \"intensity\": [1, 1, 1]}]}";
+    int rc = load(wide, &s, &err);
+    CHECK(rc < 0 && strstr(err.msg, "wide.png") && strstr(err.msg, "65537x1") && strstr(err.msg, "65536"),
+          "an image 65537 pixels wide: %s", rc < 0 ? err.msg : "accepted");
+    if (rc == 0)
+        scn_free(&s);
+    const char *grid = SCENE_HEAD
+        "\"textures\": {\"c\": {\"type\": \"image\", \"file\": \"grid.png\", \"wrap\": \"clamp\"},"
+        "  \"n\": {\"type\": \"image\", \"file\": \"grid.png\", \"filter\": \"nearest\", \"wrap\": \"clamp\"},"
+        "  \"r\": {\"type\": \"image\", \"file\": \"grid.png\"}},"
+        "\"materials\": {\"a\": {\"type\": \"lambert\", \"albedo\": \"c\"}, \"b\": {\"type\": \"lambert\", \"albedo\": \"n\"},"
+        "  \"d\": {\"type\": \"lambert\", \"albedo\": \"r\"}},"
+        "\"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, -3], \"radius\": 1, \"material\": \"a\"}],"
+        "\"lights\": [{\"type\": \"point\", \"position\": [0, 0, 0], \"intensity\": [1, 1, 1]}]}";
+    if (load(grid, &s, &err) < 0) {
+        CHECK(0, "grid scene: %s", err.msg);
+        return;
+    }
+    for (uint32_t t = 0; t < s.n_textures; t++) {
+        vec3 c = tex_eval(&s, t, (vec2){NAN, 0.5f}), d = tex_eval(&s, t, (vec2){0.5f, -NAN});
+        CHECK(c.x >= 0.0f && c.x <= 1.0f && d.y >= 0.0f && d.y <= 1.0f, "texture %u at NaN: %g %g", t, c.x, d.y);
+    }
+    scn_free(&s);
+}
+
 int main(void)
 {
     make_files();
@@ -507,6 +543,7 @@ int main(void)
     surface = RECT;
     ramp_bump_normal();
     no_leaks();
+    sizes_and_nan();
     remove_files();
     return check_done();
 }

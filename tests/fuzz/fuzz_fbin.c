@@ -4,7 +4,9 @@
  * so the fuzzer explores the structural checks rather than stopping at the
  * hash (which any random change trips).  A scene the loader accepts is
  * then used as the renderer uses it: rays through the BVH, surfaces at the
- * hits, one path-traced sample: validation must make all of that safe. */
+ * hits, a few path-traced samples and lookups into every texture at
+ * ordinary, huge and NaN coordinates: validation must make all of that
+ * safe. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +16,7 @@
 
 #include "fbin.h"
 #include "pathtrace.h"
+#include "texture.h"
 #include "trace.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -48,7 +51,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         trace_occluded(&s, &r, 1.0f + (float)i, i);
     }
     s.settings.max_depth = s.settings.max_depth < 8 ? s.settings.max_depth : 8;
-    pt_sample(&s, PT_MIS, 1, 2, 0);
+    for (uint32_t i = 0; i < 4; i++)
+        pt_sample(&s, PT_MIS, i % 4, (i * 3) % 4, i);
+    static const vec2 uvs[] = {{0.3f, 0.7f}, {-0.2f, 1.5f}, {1e30f, -1e30f}, {NAN, 0.5f}, {0.5f, INFINITY}};
+    for (uint32_t t = 0; t < s.n_textures && t < 16; t++)
+        for (size_t k = 0; k < sizeof uvs / sizeof uvs[0]; k++)
+            tex_eval(&s, t, uvs[k]);
     scn_free(&s);
     return 0;
 }
