@@ -34,6 +34,13 @@ WORKER_OBJ  = $(WORKER_SRC:%.c=$(B)/%.o)
 COORD_SRC   = $(wildcard coordinator/*.c)
 COORD_CXX   = $(wildcard coordinator/*.cpp)
 COORD_OBJ   = $(COORD_SRC:%.c=$(B)/%.o) $(COORD_CXX:%.cpp=$(B)/%.o)
+# The coordinator's modules (all but main.c) as a library that the tests link.
+COORD_LIB_OBJ = $(filter-out $(B)/coordinator/main.o,$(COORD_OBJ))
+COORD_LIB   = $(B)/libfranja-coord.a
+# Test support code (fake backends ...) linked into every test program.
+TESTSUP_SRC = $(wildcard tests/support/*.c)
+TESTSUP_OBJ = $(TESTSUP_SRC:%.c=$(B)/%.o)
+TESTSUP_LIB = $(B)/libfranja-testsup.a
 TEST_SRC    = $(wildcard tests/test_*.c)
 TEST_BIN    = $(TEST_SRC:tests/%.c=bin/tests/%)
 TOOL_SRC    = $(wildcard tests/tools/*.c)
@@ -64,13 +71,25 @@ bin/franja-worker: $(WORKER_OBJ) $(LIB)
 	@mkdir -p bin
 	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(LIB) $(WORKER_LIBS)
 
-bin/franja: $(COORD_OBJ) $(LIB)
-	@mkdir -p bin
-	$(CC) $(CFLAGS) -o $@ $(COORD_OBJ) $(LIB) $(COORD_LIBS)
+$(COORD_LIB): $(COORD_LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && $(AR) rcs $@ $^
 
-bin/tests/%: tests/%.c $(LIB)
+$(TESTSUP_LIB): $(TESTSUP_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && $(AR) rcs $@ $^
+
+bin/franja: $(B)/coordinator/main.o $(COORD_LIB) $(LIB)
+	@mkdir -p bin
+	$(CC) $(CFLAGS) -o $@ $(B)/coordinator/main.o $(COORD_LIB) $(LIB) $(COORD_LIBS)
+
+# Tests see the headers of common/, coordinator/ and tests/, and link the
+# coordinator's library too; shared libraries that a test does not use are
+# dropped (--as-needed).
+bin/tests/%: tests/%.c $(TESTSUP_LIB) $(COORD_LIB) $(LIB)
 	@mkdir -p bin/tests
-	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -Itests -o $@ $< $(LIB) $(WORKER_LIBS)
+	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -Icoordinator -Itests -o $@ $< $(TESTSUP_LIB) $(COORD_LIB) $(LIB) \
+	    -Wl,--as-needed $(COORD_LIBS)
 
 bin/tools/%: tests/tools/%.c $(LIB)
 	@mkdir -p bin/tools
@@ -89,15 +108,23 @@ FUZZ_CFLAGS   = -std=c17 -D_GNU_SOURCE -g -O1 $(FPFLAGS) -Icommon $(CJSON_CFLAGS
 FUZZ_SRC      = $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_BIN      = $(FUZZ_SRC:tests/fuzz/%.c=bin/fuzz/%)
 FUZZ_OBJ      = $(COMMON_SRC:%.c=$(B)/fuzz/%.o)
-.SECONDARY: $(FUZZ_OBJ)
+# The coordinator's C modules, for the targets of its readers (obj.c): an
+# archive, so a target links only the members it uses.
+FUZZ_COORD_LIB = $(B)/fuzz/libfranja-coord.a
+FUZZ_COORD_OBJ = $(filter-out $(B)/fuzz/coordinator/main.o,$(COORD_SRC:%.c=$(B)/fuzz/%.o))
+.SECONDARY: $(FUZZ_OBJ) $(FUZZ_COORD_OBJ)
 
 $(B)/fuzz/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -c $< -o $@
 
-bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) coordinator/obj.c coordinator/obj.h
+$(FUZZ_COORD_LIB): $(FUZZ_COORD_OBJ)
+	rm -f $@ && $(AR) rcs $@ $^
+
+bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	@mkdir -p bin/fuzz
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer,address,undefined -o $@ $< $(FUZZ_OBJ) $(CJSON_LIBS) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Icoordinator -fsanitize=fuzzer,address,undefined -o $@ $< $(FUZZ_COORD_LIB) \
+	    $(FUZZ_OBJ) $(CJSON_LIBS) -lm
 
 fuzz: bin/franja $(FUZZ_BIN)
 	sh tests/fuzz/run.sh $(FUZZ_SECONDS)
@@ -162,4 +189,4 @@ check-cross: all static
 clean:
 	rm -rf $(B) bin
 
--include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d)
+-include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d) $(TESTSUP_OBJ:.o=.d)

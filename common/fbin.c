@@ -1,6 +1,7 @@
 #include "fbin.h"
 
 #include "bvh.h"
+#include "proto_limits.h"
 
 #include <errno.h>
 #include <stdint.h>
@@ -187,8 +188,8 @@ static int validate_appearance(const fr_scene *s, const void *base, const uint64
 static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
     const fr_settings *st = &s->settings;
-    if (st->width == 0 || st->height == 0 || st->width > 65536 || st->height > 65536 || st->spp == 0 ||
-        st->spp > (1u << 20) || st->max_depth > 4096)
+    if (st->width == 0 || st->height == 0 || st->width > PROTO_MAX_SIZE || st->height > PROTO_MAX_SIZE ||
+        st->spp == 0 || st->spp > PROTO_MAX_SPP || st->max_depth > PROTO_MAX_DEPTH)
         return fr_fail(err, "section settings, byte %zu: bad image size, sample count or depth",
                        AT1(SEC_SETTINGS, fr_settings, width));
     const fr_camera *c = &s->camera;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "proto_limits.h"
 
 float img_srgb_encode(float v)
 {
@@ -100,7 +101,7 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     at = pos;
     if (header_line(buf, len, &pos, line, sizeof line) < 0 || strcmp(line, "-1.0") != 0)
         return fr_fail(err, "byte %zu: expected scale -1.0 (little-endian)", at);
-    if (y0 >= y1 || y1 > fh || w != fw || h != y1 - y0 || w == 0 || fw > 65536 || fh > 65536)
+    if (y0 >= y1 || y1 > fh || w != fw || h != y1 - y0 || w == 0 || fw > PROTO_MAX_SIZE || fh > PROTO_MAX_SIZE)
         return fr_fail(err, "byte %zu: size %ux%u does not match rows %u:%u of a %ux%u image", at, w, h, y0, y1,
                        fw, fh);
     size_t n = (size_t)w * h * 3;

@@ -2,6 +2,8 @@
 
 #include <stdlib.h>
 
+#include "proto_limits.h"
+
 int quick_spp(uint32_t *spp, fr_error *err)
 {
     const char *s = getenv(QUICK_ENV);
@@ -9,10 +11,10 @@ int quick_spp(uint32_t *spp, fr_error *err)
         return 0;
     uint32_t cap = 0;
     const char *p = s;
-    for (; *p >= '0' && *p <= '9' && cap <= (1u << 20); p++)
+    for (; *p >= '0' && *p <= '9' && cap <= PROTO_MAX_SPP; p++)
         cap = cap * 10 + (uint32_t)(*p - '0');
-    if (p == s || *p != '\0' || cap < 1 || cap > (1u << 20))
-        return fr_fail(err, "%s='%s': expected an integer in [1, 1048576]", QUICK_ENV, s);
+    if (p == s || *p != '\0' || cap < 1 || cap > PROTO_MAX_SPP)
+        return fr_fail(err, "%s='%s': expected an integer in [1, %u]", QUICK_ENV, s, PROTO_MAX_SPP);
     if (*spp <= cap)
         return 0;
     *spp = cap;

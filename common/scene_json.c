@@ -10,6 +10,7 @@
 #include "fmath.h"
 #include "freeze.h"
 #include "jsonval.h"
+#include "proto_limits.h"
 #include "scene_appear.h"
 
 #define PATHLEN 160
@@ -33,10 +34,10 @@ static int parse_image(ctx *c, const cJSON *o)
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "image: missing or not an object");
     if (jv_only_fields(o, "image", fields, c->err) < 0 ||
-        jv_uint(o, "width", "image", 1, 0, 1, 65536, &s->width, c->err) < 0 ||
-        jv_uint(o, "height", "image", 1, 0, 1, 65536, &s->height, c->err) < 0 ||
-        jv_uint(o, "spp", "image", 0, 16, 1, 1u << 20, &s->spp, c->err) < 0 ||
-        jv_uint(o, "max_depth", "image", 0, 8, 0, 4096, &s->max_depth, c->err) < 0 ||
+        jv_uint(o, "width", "image", 1, 0, 1, PROTO_MAX_SIZE, &s->width, c->err) < 0 ||
+        jv_uint(o, "height", "image", 1, 0, 1, PROTO_MAX_SIZE, &s->height, c->err) < 0 ||
+        jv_uint(o, "spp", "image", 0, 16, 1, PROTO_MAX_SPP, &s->spp, c->err) < 0 ||
+        jv_uint(o, "max_depth", "image", 0, 8, 0, PROTO_MAX_DEPTH, &s->max_depth, c->err) < 0 ||
         jv_uint(o, "seed", "image", 0, 0, 0, 0xffffffffu, &s->seed, c->err) < 0)
         return -1;
     return 0;

@@ -49,9 +49,16 @@ const char *cli_local_worker(void)
     return cli_beside_exe("franja-worker", path, sizeof path);
 }
 
+void cli_note_stderr(void *ctx, const char *line)
+{
+    (void)ctx;
+    fprintf(stderr, "franja: %s\n", line);
+}
+
 void cli_transport_defaults(tr_options *o)
 {
     memset(o, 0, sizeof *o);
+    o->notes = (note_sink){cli_note_stderr, NULL};
     o->read_ssh_config = 1;
     o->timeout_s = 10;
     o->local_worker = cli_local_worker();

@@ -10,14 +10,12 @@
 #include "hosts.h"
 #include "transport.h"
 
-/** The version line printed by `franja --version`. */
-#define FRANJA_VERSION "0.1.0"
-
 /** Help text for the options cli_transport_option understands. */
 extern const char cli_transport_help[];
 
 /** Sets o's defaults: ~/.ssh/known_hosts, ~/.ssh/config read, 10 s time-out,
- * the worker next to this executable. */
+ * the worker next to this executable, remarks (tr_options.notes) printed on
+ * stderr as "franja: LINE". */
 void cli_transport_defaults(tr_options *o);
 
 /** If argv[*i] is a transport option (--known-hosts, --accept-new-hosts,
@@ -43,6 +41,10 @@ int cli_common_option(int argc, char **argv, int *i, const char *usage, tr_optio
  * prints "franja CMD: <what is wrong, with file:line>" on stderr and returns
  * -1, with nothing to free. */
 int cli_load_hosts(const char *cmd, const char *path, hosts_table *t);
+
+/** The note_sink function that prints "franja: LINE" on stderr (ctx
+ * unused). */
+void cli_note_stderr(void *ctx, const char *line);
 
 /** Parses a decimal integer in [lo, hi]; -1 if it is not one. */
 int cli_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);

@@ -1,50 +1,59 @@
-/* cluster.c -- connect, probe and stage all hosts in parallel. */
+/* cluster.c -- connect and prepare all hosts in parallel (see cluster.h). */
 #include "cluster.h"
 
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
+#include "clock.h"
 #include "fbin.h"
+#include "stage.h"
 
 typedef struct {
     cl_host *h;
-    const tr_options *o;
-    const char *scene;
-    uint64_t hash;
+    int i;
+    tr_options o;              /* the caller's, with notes collected into h */
+    cl_step step;
+    void *ctx;
 } job;
 
-static double now_s(void)
+/* Keeps a remark while the threads run; afterwards passes it on. */
+static void collect(void *ctx, const char *line)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + t.tv_nsec * 1e-9;
+    cl_host *h = ctx;
+    if (h->forward) {
+        note_say(h->forward, "%s", line);
+        return;
+    }
+    int n = snprintf(h->notes + h->notes_len, sizeof h->notes - h->notes_len, "%s\n", line);
+    if (n > 0)
+        h->notes_len += (size_t)n < sizeof h->notes - h->notes_len ? (size_t)n : sizeof h->notes - h->notes_len - 1;
 }
 
 static void *ready_one(void *arg)
 {
     job *j = arg;
     cl_host *h = j->h;
-    double t0 = now_s();
-    if (tr_connect(h->entry, j->o, &h->tr, &h->err) == 0) {
-        if (tr_probe(h->tr, &h->info, &h->err) ||
-            (j->scene && tr_stage(h->tr, j->scene, j->hash, h->scene, sizeof h->scene, &h->uploaded, &h->err))) {
-            tr_close(h->tr);
-            h->tr = NULL;
-        }
+    double t0 = clk_now();
+    if (tr_connect(h->entry, &j->o, &h->tr, &h->err) == 0 && j->step && j->step(h, j->i, j->ctx, &h->err)) {
+        tr_close(h->tr);
+        h->tr = NULL;
     }
-    h->ready_s = now_s() - t0;
+    h->ready_s = clk_now() - t0;
     return NULL;
 }
 
-void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash)
+void cl_each(cl_host *hosts, int n, const tr_options *o, cl_step step, void *ctx)
 {
     pthread_t tid[n > 0 ? n : 1];
     job jobs[n > 0 ? n : 1];
     int started[n > 0 ? n : 1];
     for (int i = 0; i < n; i++) {
-        jobs[i] = (job){&hosts[i], o, scene, hash};
+        hosts[i].notes_len = 0;
+        hosts[i].notes[0] = 0;
+        hosts[i].forward = NULL;
+        jobs[i] = (job){&hosts[i], i, *o, step, ctx};
+        jobs[i].o.notes = (note_sink){collect, &hosts[i]};
         started[i] = pthread_create(&tid[i], NULL, ready_one, &jobs[i]) == 0;
         if (!started[i])
             ready_one(&jobs[i]);
@@ -52,14 +61,34 @@ void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint
     for (int i = 0; i < n; i++)
         if (started[i])
             pthread_join(tid[i], NULL);
+    for (int i = 0; i < n; i++) {
+        for (char *line = hosts[i].notes, *nl; (nl = strchr(line, '\n')); line = nl + 1) {
+            *nl = 0;
+            note_say(&o->notes, "%s", line);
+        }
+        hosts[i].notes_len = 0;
+        hosts[i].forward = &o->notes;
+    }
 }
 
-/* The N of "... scene-format N", or -1. */
-static int scene_format(const char *version)
+typedef struct {
+    const char *scene;
+    uint64_t hash;
+} open_ctx;
+
+static int probe_and_stage(cl_host *h, int i, void *vctx, fr_error *err)
 {
-    const char *p = strstr(version, "scene-format ");
-    int v;
-    return p && sscanf(p + 13, "%d", &v) == 1 ? v : -1;
+    (void)i;
+    open_ctx *c = vctx;
+    if (stage_probe(h->tr, &h->info, err))
+        return -1;
+    return c->scene ? stage_scene(h->tr, c->scene, c->hash, h->scene, sizeof h->scene, &h->uploaded, err) : 0;
+}
+
+void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash)
+{
+    open_ctx c = {scene, hash};
+    cl_each(hosts, n, o, probe_and_stage, &c);
 }
 
 int cl_check_versions(const cl_host *hosts, int n, fr_error *err)
@@ -69,8 +98,9 @@ int cl_check_versions(const cl_host *hosts, int n, fr_error *err)
         const cl_host *h = &hosts[i];
         if (!h->tr)
             continue;
-        int fmt = scene_format(h->info.version);
-        if (fmt != FBIN_VERSION)
+        proto_version v;
+        fr_error e;
+        if (proto_parse_version(h->info.version, &v, &e) || v.scene_format != FBIN_VERSION)
             return fr_fail(err, "host %s: its worker ('%s') does not read scene format %d; install the "
                            "matching build (franja deploy)", h->entry->name, h->info.version, FBIN_VERSION);
         if (!first)

@@ -1,5 +1,6 @@
 /** @file compile.h
- * `franja compile`: a JSON scene with its meshes becomes a binary scene.
+ * The scene compiler: a JSON scene with its meshes becomes a binary scene
+ * (`franja compile`, and `franja render` of a JSON scene).
  *
  * The compiler is the JSON reader (common/scene_json.h) with the mesh hook
  * of mesh.h: meshes are read (OBJ/MTL by our own reader; PLY, STL, glTF and
@@ -16,9 +17,5 @@
  * fills *out (which then owns its blob; release with scn_free).  Returns 0,
  * or -1 with err naming the file and JSON path or line at fault. */
 int compile_json(const char *json_path, fr_scene *out, fr_error *err);
-
-/** `franja compile SCENE.json [-o SCENE.fbin]`: argv[0] is "compile".
- * Returns the process exit status (0 ok, 1 failure, 2 usage error). */
-int cmd_compile(int argc, char **argv);
 
 #endif

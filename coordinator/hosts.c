@@ -157,9 +157,9 @@ static int parse_line(hosts_entry *h, char **w, int nw, const char *path, int li
     if (strcmp(w[2], "-") && copy_field(h->user, sizeof h->user, w[2], path, line, "user", err))
         return -1;
     if (strcmp(w[3], "auto")) {
-        long c = parse_range(w[3], 1, 4096);
+        long c = parse_range(w[3], 1, HOSTS_MAX_CORES);
         if (c < 0)
-            return fr_fail(err, "%s:%d: cores '%s': expected 1..4096 or 'auto'", path, line, w[3]);
+            return fr_fail(err, "%s:%d: cores '%s': expected 1..%d or 'auto'", path, line, w[3], HOSTS_MAX_CORES);
         h->cores = (int)c;
     }
     for (int i = 4; i < nw; i++)

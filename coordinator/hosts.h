@@ -16,13 +16,16 @@
 
 #include "error.h"
 
+/** Most worker processes one host may run (cores, and franja render -j). */
+#define HOSTS_MAX_CORES 4096
+
 /** One line of the host table.  Empty strings mean "not given". */
 typedef struct {
     char name[64];       /**< unique label used in messages and logs */
     char address[256];   /**< DNS name, IPv4, IPv6 (no brackets), or "local" */
     int port;            /**< TCP port, 0 = SSH default */
     char user[64];       /**< login name, "" = SSH default */
-    int cores;           /**< worker processes, 0 = ask the host */
+    int cores;           /**< worker processes (1..HOSTS_MAX_CORES), 0 = ask the host */
     char identity[512];  /**< private key file, "" = agent / default keys */
     char worker[512];    /**< worker path on the host, "" = WORKDIR/franja-worker */
     char workdir[512];   /**< work directory on the host, "" = .cache/franja (home-relative) */

@@ -3,12 +3,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "cli.h"
-#include "compile.h"
-#include "deploy.h"
-#include "fbin.h"
-#include "hostcmd.h"
-#include "rendercmd.h"
+#include "cmd.h"
+#include "protocol.h"
 
 static const char usage[] =
     "usage: franja render SCENE -o OUT [--hosts FILE] [-j N] [--spp N] [--size WxH]\n"
@@ -34,7 +30,9 @@ int main(int argc, char **argv)
         return 0;
     }
     if (!strcmp(cmd, "--version")) {
-        printf("franja %s scene-format %d\n", FRANJA_VERSION, FBIN_VERSION);
+        char line[128];
+        proto_version_line("franja", line, sizeof line);
+        printf("%s\n", line);
         return 0;
     }
     if (!strcmp(cmd, "compile"))

@@ -6,7 +6,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+
+#include "clock.h"
+#include "protocol.h"
 
 typedef struct {
     uint32_t y0, y1;
@@ -36,13 +38,6 @@ typedef struct {
     int drawn;                 /* a progress line is on screen */
 } sched;
 
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + t.tv_nsec * 1e-9;
-}
-
 /* Messages go to stderr, after clearing the live line if one is shown. */
 static void say(sched *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void say(sched *s, const char *fmt, ...)
@@ -53,7 +48,7 @@ static void say(sched *s, const char *fmt, ...)
     }
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "franja: [%6.1fs] ", now_s() - s->t0);
+    fprintf(stderr, "franja: [%6.1fs] ", clk_now() - s->t0);
     vfprintf(stderr, fmt, ap);
     va_end(ap);
     fputc('\n', stderr);
@@ -61,7 +56,7 @@ static void say(sched *s, const char *fmt, ...)
 
 static void draw(sched *s, int force)
 {
-    double t = now_s();
+    double t = clk_now();
     if (!s->p->tty || (!force && t - s->last_draw < 0.25))
         return;
     s->last_draw = t;
@@ -159,14 +154,18 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
 {
     sched_host *h = &s->hosts[host_i];
     slab *sl = &s->slabs[slab_i];
-    char rows[32], spp[16], size[32];
-    snprintf(rows, sizeof rows, "%u:%u", sl->y0, sl->y1);
-    snprintf(spp, sizeof spp, "%u", s->p->spec.spp);
-    snprintf(size, sizeof size, "%ux%u", s->p->spec.width, s->p->spec.height);
-    const char *args[] = {"--scene", h->scene, "--rows", rows, "--spp", spp, "--size", size,
-                          "--format", "pf", "-o", "-", NULL};
+    const job_spec *sp = &s->p->spec;
+    proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-"};
+    proto_argv pa;
+    if (proto_slab_argv(&req, &pa, err))
+        return -1;
+    const char *argv[18] = {tr_host_worker(h->tr)};
+    for (int i = 0; pa.argv[i]; i++)
+        argv[i + 1] = pa.argv[i];
+    /* The partial image: its header (well under 4 KB) and 12 bytes a pixel. */
+    size_t max_out = 4096 + (size_t)sp->width * (sl->y1 - sl->y0) * 12;
     tr_proc *proc;
-    if (tr_spawn(h->tr, args, &proc, err))
+    if (tr_spawn(h->tr, argv, max_out, &proc, err))
         return -1;
     if (s->nrun == s->caprun) {
         int cap = s->caprun ? s->caprun * 2 : 16;
@@ -184,7 +183,7 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
         if (!s->p->tty)
             say(s, "rows %u:%u still running; starting a second copy on %s", sl->y0, sl->y1, h->name);
     }
-    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now_s()};
+    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, clk_now()};
     sl->copies++;
     h->running++;
     return 0;
@@ -262,7 +261,7 @@ static int accept_attempt(sched *s, int r, fr_error *err)
     }
     if (job_save(s->p->jobdir, sl->y0, sl->y1, out, len, err))
         return -1;
-    double dt = now_s() - a.start;
+    double dt = clk_now() - a.start;
     sl->done = 1;
     h->slabs++;
     h->rows += (int)(sl->y1 - sl->y0);
@@ -344,7 +343,7 @@ static int loop(sched *s, fr_error *err)
         }
         for (int i = 0; i < s->nhosts; i++) {
             sched_host *h = &s->hosts[i];
-            while (!h->dropped && h->running < h->slots && now_s() >= h->retry_at) {
+            while (!h->dropped && h->running < h->slots && clk_now() >= h->retry_at) {
                 int si = pick(s, i);
                 if (si < 0)
                     break;
@@ -366,7 +365,7 @@ static int loop(sched *s, fr_error *err)
                     /* The server may still be tearing down the channels of
                      * the set-up (probe, SFTP): try again a little later. */
                     h->failures++;
-                    h->retry_at = now_s() + 0.5 * h->start_streak;
+                    h->retry_at = clk_now() + 0.5 * h->start_streak;
                     say(s, "host %s: %s; trying again", h->name, e2.msg);
                 }
                 break;
@@ -374,7 +373,7 @@ static int loop(sched *s, fr_error *err)
         }
         int waiting = 0;
         for (int i = 0; i < s->nhosts; i++)
-            waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > now_s();
+            waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > clk_now();
         if (s->nrun == 0 && !waiting) {
             rc = fr_fail(err, alive_hosts(s) ? "nothing left to run" : "no host left to render on");
             break;
@@ -420,7 +419,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
     s.hosts = hosts;
     s.nhosts = nhosts;
     s.st = st;
-    s.t0 = now_s();
+    s.t0 = clk_now();
     if (make_slabs(&s))
         return fr_fail(err, "out of memory");
     st->slabs = s.nslabs;
@@ -439,7 +438,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         fr_fail(err, "%s; rows %s not rendered (finished slabs are kept in %s; rerun with --resume)",
                 why, missing, p->jobdir);
     }
-    st->wall_s = now_s() - s.t0;
+    st->wall_s = clk_now() - s.t0;
     free(s.slabs);
     free(s.run);
     return rc;

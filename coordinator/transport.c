@@ -1,5 +1,6 @@
-/* transport.c -- the generic side of tr_*: picks the backend of a host and
- * keeps what every backend shares (process buffers and lists). */
+/* transport.c -- the generic side of tr_*: picks the backend of a host,
+ * keeps what every backend shares (process buffers and lists), and builds
+ * tr_run from spawn and service. */
 #include "transport_backend.h"
 
 #include <stdarg.h>
@@ -7,12 +8,23 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clock.h"
+
 struct tr_host {
     const tr_backend *be;
     void *impl;
     hosts_entry entry;
+    tr_options opt;
+    tr_place place;
     tr_proc *procs;            /* every process not yet freed */
 };
+
+const tr_backend *tr_backend_for(const hosts_entry *e, const tr_options *o)
+{
+    if (o->backend)
+        return o->backend;
+    return hosts_is_local(e) ? &tr_local_backend : &tr_ssh_backend;
+}
 
 int tr_connect(const hosts_entry *e, const tr_options *o, tr_host **out, fr_error *err)
 {
@@ -21,80 +33,27 @@ int tr_connect(const hosts_entry *e, const tr_options *o, tr_host **out, fr_erro
     if (!h)
         return fr_fail(err, "%s: out of memory", e->name);
     h->entry = *e;
-    h->be = hosts_is_local(e) ? &tr_local_backend : &tr_ssh_backend;
-    if (h->be->connect(&h->entry, o, &h->impl, err)) {
+    h->opt = *o;
+    h->be = tr_backend_for(e, o);
+    if (h->be->connect(h, &h->impl, &h->place, err)) {
         free(h);
         return -1;
     }
+    if (!h->place.label[0])
+        snprintf(h->place.label, sizeof h->place.label, "%s", e->name);
     *out = h;
     return 0;
 }
 
-int tr_probe(tr_host *h, tr_info *info, fr_error *err)
-{
-    memset(info, 0, sizeof *info);
-    return h->be->probe(h->impl, info, err);
-}
-
-int tr_stage(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap,
-             int *uploaded, fr_error *err)
-{
-    *uploaded = 0;
-    return h->be->stage(h->impl, local_path, hash, remote, cap, uploaded, err);
-}
-
-int tr_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err)
-{
-    *files = 0;
-    *bytes = 0;
-    return h->be->cache(h->impl, files, bytes, err);
-}
-
-int tr_sysinfo(tr_host *h, char *arch, char *os, fr_error *err)
-{
-    arch[0] = os[0] = 0;
-    return h->be->sysinfo(h->impl, arch, os, err);
-}
-
-int tr_install(tr_host *h, const char *local_path, const char *name, char *remote, size_t cap,
-               fr_error *err)
-{
-    return h->be->install(h->impl, local_path, name, remote, cap, err);
-}
-
-void tr_os_codename(const char *text, char *os)
-{
-    const char key[] = "VERSION_CODENAME=";
-    const size_t klen = sizeof key - 1;
-    os[0] = 0;
-    for (const char *l = text; *l;) {
-        const char *end = strchr(l, '\n');
-        size_t len = end ? (size_t)(end - l) : strlen(l);
-        if (len > klen && !strncmp(l, key, klen)) {
-            const char *v = l + klen;
-            size_t n = len - klen;
-            /* The value may be quoted: VERSION_CODENAME="bookworm". */
-            if (n >= 2 && (v[0] == '"' || v[0] == '\'') && v[n - 1] == v[0]) {
-                v++;
-                n -= 2;
-            }
-            snprintf(os, 64, "%.*s", (int)(n < 63 ? n : 63), v);
-            return;
-        }
-        if (!end)
-            break;
-        l = end + 1;
-    }
-}
-
-int tr_spawn(tr_host *h, const char *const *args, tr_proc **out, fr_error *err)
+int tr_spawn(tr_host *h, const char *const *argv, size_t max_out, tr_proc **out, fr_error *err)
 {
     *out = NULL;
     tr_proc *p = calloc(1, sizeof *p);
     if (!p)
-        return fr_fail(err, "%s: out of memory", h->entry.name);
+        return fr_fail(err, "%s: out of memory", h->place.label);
     p->host = h;
-    if (h->be->spawn(h->impl, p, args, err)) {
+    p->out_max = max_out;
+    if (h->be->spawn(h->impl, p, argv, err)) {
         free(p);
         return -1;
     }
@@ -104,9 +63,50 @@ int tr_spawn(tr_host *h, const char *const *args, tr_proc **out, fr_error *err)
     return 0;
 }
 
+int tr_run(tr_host *h, const char *const *argv, size_t max_out, int timeout_s, tr_proc **out, fr_error *err)
+{
+    tr_proc *p;
+    if (tr_spawn(h, argv, max_out, &p, err))
+        return -1;
+    double end = clk_now() + timeout_s;
+    while (p->state == TR_RUNNING) {
+        struct pollfd pfd[16];
+        int n = tr_pollfds(h, pfd, 16);
+        poll(pfd, (nfds_t)n, 20);
+        if (tr_service(h, err)) {
+            tr_proc_free(p);
+            return -1;
+        }
+        if (p->state == TR_RUNNING && clk_now() > end) {
+            tr_proc_free(p);
+            return fr_fail(err, "%s: %s did not finish within %d s", h->place.label, argv[0], timeout_s);
+        }
+    }
+    *out = p;
+    return 0;
+}
+
+int tr_upload(tr_host *h, const char *local_path, const char *remote, int mode, fr_error *err)
+{
+    if (!h->place.workdir[0])
+        return fr_fail(err, "%s: the host uses this machine's files; nothing to upload", h->place.label);
+    return h->be->upload(h->impl, local_path, remote, mode, err);
+}
+
 int tr_pollfds(tr_host *h, struct pollfd *pfd, int max) { return h->be->pollfds(h->impl, h->procs, pfd, max); }
 
-int tr_service(tr_host *h, fr_error *err) { return h->be->service(h->impl, h->procs, err); }
+int tr_service(tr_host *h, fr_error *err)
+{
+    int rc = h->be->service(h->impl, h->procs, err);
+    /* A process failed for its output (too much of it) is stopped here, so
+     * that no backend has to remember to. */
+    for (tr_proc *p = h->procs; p; p = p->next)
+        if (p->kill_pending && p->impl) {
+            p->kill_pending = 0;
+            h->be->kill(h->impl, p);
+        }
+    return rc;
+}
 
 void tr_close(tr_host *h)
 {
@@ -119,6 +119,26 @@ void tr_close(tr_host *h)
 }
 
 const hosts_entry *tr_host_entry(const tr_host *h) { return &h->entry; }
+
+const tr_options *tr_host_options(const tr_host *h) { return &h->opt; }
+
+void *tr_host_backend_ctx(const tr_host *h) { return h->opt.backend_ctx; }
+
+const char *tr_host_label(const tr_host *h) { return h->place.label[0] ? h->place.label : h->entry.name; }
+
+const char *tr_host_worker(const tr_host *h) { return h->place.worker; }
+
+const char *tr_host_workdir(const tr_host *h) { return h->place.workdir; }
+
+void tr_note(tr_host *h, const char *fmt, ...)
+{
+    char msg[900];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    note_say(&h->opt.notes, "%s: %s", tr_host_label(h), msg);
+}
 
 int tr_proc_state(const tr_proc *p) { return p->state; }
 
@@ -141,7 +161,7 @@ void tr_proc_kill(tr_proc *p)
 {
     if (p->state != TR_RUNNING)
         return;
-    p->host->be->kill(p);
+    p->host->be->kill(p->host->impl, p);
     if (p->state == TR_RUNNING)
         tr_proc_fail(p, "killed");
 }
@@ -152,7 +172,7 @@ void tr_proc_free(tr_proc *p)
         return;
     tr_proc_kill(p);
     tr_host *h = p->host;
-    h->be->release(p);
+    h->be->release(h->impl, p);
     for (tr_proc **pp = &h->procs; *pp; pp = &(*pp)->next)
         if (*pp == p) {
             *pp = p->next;
@@ -164,13 +184,23 @@ void tr_proc_free(tr_proc *p)
 
 int tr_proc_add_out(tr_proc *p, const void *data, size_t n)
 {
+    if (p->state != TR_RUNNING)
+        return -1;
+    if (n > p->out_max - p->out_len) {
+        tr_proc_fail(p, "sent more than the %zu bytes expected", p->out_max);
+        p->kill_pending = 1;
+        return -1;
+    }
     if (p->out_len + n > p->out_cap) {
         size_t cap = p->out_cap ? p->out_cap : 65536;
         while (cap < p->out_len + n)
             cap *= 2;
         unsigned char *b = realloc(p->out, cap);
-        if (!b)
+        if (!b) {
+            tr_proc_fail(p, "out of memory for the output");
+            p->kill_pending = 1;
             return -1;
+        }
         p->out = b;
         p->out_cap = cap;
     }

@@ -1,16 +1,21 @@
 /** @file transport.h
- * How the coordinator reaches a host and runs worker processes on it.
+ * How the coordinator reaches a host and runs processes on it.
  *
- * One interface, two backends (transport_local.c: fork/exec and pipes;
- * transport_ssh.c: libssh, one session per host, one channel per worker
- * process).  The scheduler only sees tr_host and tr_proc, so it cannot tell
- * a local process from a remote one.
+ * One interface over several backends (transport_backend.h): local child
+ * processes (transport_local.c: posix_spawn and pipes), SSH
+ * (transport_ssh.c: libssh, one session per host, one channel per
+ * process, SFTP uploads), and whatever else implements the backend
+ * contract.  The scheduler sees only tr_host and tr_proc, so it cannot
+ * tell a local process from a remote one.  What to run and what the
+ * answers mean (probing a host, staging a scene, the worker's command
+ * line) is not here: see stage.h and protocol.h.
  *
- * Everything here is single-threaded except tr_connect, tr_probe and
- * tr_stage, which may run concurrently on different hosts.  Running
- * processes are driven by an event loop: the caller polls the descriptors
- * from tr_pollfds (with a short timeout) and then calls tr_service, which
- * moves whatever arrived into the processes' buffers and updates their state.
+ * Threads: different hosts may be used from different threads at once
+ * (cluster.c gets hosts ready in parallel); one host and its processes
+ * belong to one thread at a time.  Running processes are driven by an
+ * event loop: the caller polls the descriptors from tr_pollfds (with a
+ * short time-out) and then calls tr_service, which moves whatever arrived
+ * into the processes' buffers and updates their states.
  */
 #ifndef FRANJA_TRANSPORT_H
 #define FRANJA_TRANSPORT_H
@@ -21,6 +26,9 @@
 
 #include "error.h"
 #include "hosts.h"
+#include "note.h"
+
+typedef struct tr_backend tr_backend;
 
 /** Settings shared by all hosts of a run. */
 typedef struct {
@@ -30,15 +38,11 @@ typedef struct {
     const char *ssh_config;    /**< that configuration file; NULL = ~/.ssh/config */
     int timeout_s;             /**< connect time-out and longest silence of a live host, seconds */
     const char *local_worker;  /**< worker binary for local hosts without worker= */
+    const tr_backend *backend; /**< serves every host when set (tests); NULL = by host table entry */
+    void *backend_ctx;         /**< handed to that backend (tr_host_backend_ctx) */
+    note_sink notes;           /**< remarks of the backends (a key added to known_hosts);
+                                    called from the thread using the host */
 } tr_options;
-
-/** What a host says about itself (tr_probe). */
-typedef struct {
-    char arch[32];             /**< uname -m */
-    char os[64];               /**< uname -s */
-    int cores;                 /**< online processors */
-    char version[128];         /**< first line of `franja-worker --version` */
-} tr_info;
 
 typedef struct tr_host tr_host;
 typedef struct tr_proc tr_proc;
@@ -47,51 +51,41 @@ typedef struct tr_proc tr_proc;
 enum {
     TR_RUNNING = 0,            /**< started, not finished */
     TR_EXITED = 1,             /**< finished; tr_proc_status gives the exit status */
-    TR_FAILED = 2              /**< lost: killed, connection dropped, could not start */
+    TR_FAILED = 2              /**< lost: killed, connection dropped, too much output */
 };
 
-/** Opens a connection to the host (nothing to do for a local one).  For SSH
- * this checks the server key against known_hosts and authenticates; every
- * refusal says how to fix it.  On success *out is owned by the caller
- * (tr_close).  Connecting takes at most o->timeout_s per step. */
+/** Opens a connection to the host of table entry e with the backend that
+ * serves it.  For SSH this checks the server key against known_hosts and
+ * authenticates; every refusal says how to fix it.  On success *out is
+ * owned by the caller (tr_close).  Each step takes at most o->timeout_s.
+ * The entry and options are copied, except the strings o points to, which
+ * must outlive the host. */
 int tr_connect(const hosts_entry *e, const tr_options *o, tr_host **out, fr_error *err);
 
-/** Asks the host for its architecture, OS, core count and worker version.
- * Fails if the worker cannot be run there (with its error output). */
-int tr_probe(tr_host *h, tr_info *info, fr_error *err);
+/** Starts a process on the host.  argv[0] is the program as the host names
+ * it (tr_host_worker for the worker); arguments are passed as they are,
+ * never interpreted by a shell.  At most max_out bytes of its standard
+ * output are kept (beyond that the process is killed and TR_FAILED).  *out
+ * is owned by the caller (tr_proc_free). */
+int tr_spawn(tr_host *h, const char *const *argv, size_t max_out, tr_proc **out, fr_error *err);
 
-/** Makes the binary scene at local_path (content hash `hash`) available on
- * the host and writes the path the worker must be given into remote[cap].
- * SSH: the file goes by SFTP to WORKDIR/scenes/HASH.fbin unless an intact
- * copy (same size, and the worker reports the same hash) is already there;
- * a bad copy is replaced.  *uploaded says whether bytes were sent. */
-int tr_stage(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap,
-             int *uploaded, fr_error *err);
+/** Runs a short command to completion (tr_spawn, then the event loop for
+ * this host only) and returns the finished process in *out (TR_EXITED or
+ * TR_FAILED; caller frees).  Fails, with the process killed, when it runs
+ * longer than timeout_s, or when the host is lost. */
+int tr_run(tr_host *h, const char *const *argv, size_t max_out, int timeout_s, tr_proc **out, fr_error *err);
 
-/** Counts the scenes cached in the host's work directory (*files, *bytes;
- * both 0 for a local host, which needs no cache). */
-int tr_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err);
-
-/** What the host's system is, found without running its worker (so it works
- * before the first `franja deploy`): arch[32] from `uname -m`, os[64] the
- * VERSION_CODENAME of its /etc/os-release ("" when there is none). */
-int tr_sysinfo(tr_host *h, char *arch, char *os, fr_error *err);
-
-/** Installs the local file at local_path on the host as WORKDIR/name with
- * mode 0755, creating the work directory.  SSH: sent by SFTP under a private
- * temporary name, checked for size and renamed into place, so a worker still
- * running from the old copy is not disturbed.  The installed path goes to
- * remote[cap].  Local hosts refuse: they run this machine's files. */
-int tr_install(tr_host *h, const char *local_path, const char *name, char *remote, size_t cap,
-               fr_error *err);
-
-/** Starts one worker process with the given arguments (argv without the
- * program name; NULL-terminated).  Remote arguments are shell-quoted.
- * *out is owned by the caller (tr_proc_free). */
-int tr_spawn(tr_host *h, const char *const *args, tr_proc **out, fr_error *err);
+/** Copies the local file at local_path to the host as `remote` (a path as
+ * the host's commands see it; relative = under the login directory) with
+ * permission bits `mode`, creating its directory.  The file is written
+ * under a private temporary name and renamed into place, so a reader (a
+ * running worker) never sees it half-written.  Fails, leaving no temporary
+ * file, for a host that shares this machine's files (tr_host_workdir ""). */
+int tr_upload(tr_host *h, const char *local_path, const char *remote, int mode, fr_error *err);
 
 /** Fills up to `max` poll descriptors that signal activity on the host;
- * returns how many. */
+ * returns how many (possibly 0: then the caller's poll time-out paces the
+ * loop). */
 int tr_pollfds(tr_host *h, struct pollfd *pfd, int max);
 
 /** Reads what has arrived for the host's processes and notices the ones
@@ -100,12 +94,30 @@ int tr_pollfds(tr_host *h, struct pollfd *pfd, int max);
  * and err says why. */
 int tr_service(tr_host *h, fr_error *err);
 
-/** Closes the connection, killing any processes still running.  NULL is a
- * no-op.  Processes must be freed before (tr_proc_free). */
+/** Closes the connection, killing and freeing any processes still there.
+ * NULL is a no-op. */
 void tr_close(tr_host *h);
 
 /** The host table entry this host was opened from. */
 const hosts_entry *tr_host_entry(const tr_host *h);
+
+/** The options it was opened with. */
+const tr_options *tr_host_options(const tr_host *h);
+
+/** "name" or "name (user@address:port)": how messages name the host. */
+const char *tr_host_label(const tr_host *h);
+
+/** The worker program as the host's commands name it. */
+const char *tr_host_worker(const tr_host *h);
+
+/** The host's work directory as its commands name it, where scenes are
+ * cached and workers installed; "" when the host sees this machine's files
+ * (a local host: scenes are used where they are). */
+const char *tr_host_workdir(const tr_host *h);
+
+/** Hands a remark about host h to the person (tr_options.notes), prefixed
+ * with the host's label once connect has set it. */
+void tr_note(tr_host *h, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /** TR_RUNNING, TR_EXITED or TR_FAILED. */
 int tr_proc_state(const tr_proc *p);
@@ -126,9 +138,5 @@ void tr_proc_kill(tr_proc *p);
 
 /** Kills the process if still running and frees it.  NULL is a no-op. */
 void tr_proc_free(tr_proc *p);
-
-/** Quotes one word for a POSIX shell ('...' with ' as '\'') into out[cap].
- * Fails if it would not fit. */
-int tr_shell_quote(const char *word, char *out, size_t cap, fr_error *err);
 
 #endif

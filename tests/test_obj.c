@@ -1,15 +1,16 @@
-/* test_obj.c -- the OBJ/MTL reader (coordinator/obj.c, compiled in here
- * since tests link only the common library): corner forms, negative
+/* test_obj.c -- the OBJ/MTL reader (coordinator/obj.h): corner forms, negative
  * indices, polygons (convex and concave), groups, several materials per
  * file, MTL statements and their mapping to Franja materials, and errors
  * that name the file, the line and what was expected. */
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "../coordinator/obj.c"
 #include "check.h"
+#include "obj.h"
 
 static int parse(const char *text, obj_mesh *m, fr_error *err)
 {

@@ -9,12 +9,11 @@
 #include "fbin.h"
 #include "image.h"
 #include "pathtrace.h"
+#include "protocol.h"
 #include "quick.h"
 #ifndef FRANJA_NO_JSON
 #include "scene_json.h"
 #endif
-
-#define FRANJA_VERSION "0.1.0"
 
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
@@ -32,29 +31,6 @@ static const char usage[] =
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n";
-
-static int parse_u32(const char *s, uint32_t *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (errno || end == s || *end || v > 0xffffffffUL || s[0] == '-' || s[0] == '+')
-        return -1;
-    *out = (uint32_t)v;
-    return 0;
-}
-
-/* "A:B" or "AxB" into two integers. */
-static int parse_pair(const char *s, char sep, uint32_t *a, uint32_t *b)
-{
-    const char *p = strchr(s, sep);
-    char first[32];
-    if (!p || (size_t)(p - s) >= sizeof first)
-        return -1;
-    memcpy(first, s, (size_t)(p - s));
-    first[p - s] = 0;
-    return parse_u32(first, a) < 0 || parse_u32(p + 1, b) < 0 ? -1 : 0;
-}
 
 static int load_scene(const char *path, fr_scene *s, fr_error *err)
 {
@@ -75,86 +51,44 @@ static int load_scene(const char *path, fr_scene *s, fr_error *err)
 
 int main(int argc, char **argv)
 {
-    const char *scene_path = NULL, *rows = NULL, *out = "-", *fmt_name = "pf";
-    uint32_t spp = 0, w = 0, h = 0;
-    int check = 0, have_size = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int has_arg = i + 1 < argc;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(usage, stdout);
-            return 0;
-        } else if (!strcmp(a, "--version")) {
-            printf("franja-worker %s scene-format %d\n", FRANJA_VERSION, FBIN_VERSION);
-            return 0;
-        } else if (!strcmp(a, "--check")) {
-            check = 1;
-        } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
-                                !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "-o"))) {
-            fprintf(stderr, "franja-worker: %s needs a value\n", a);
-            return 2;
-        } else if (!strcmp(a, "--scene")) {
-            scene_path = argv[++i];
-        } else if (!strcmp(a, "--rows")) {
-            rows = argv[++i];
-        } else if (!strcmp(a, "--spp")) {
-            if (parse_u32(argv[++i], &spp) < 0 || spp == 0 || spp > (1u << 20)) {
-                fprintf(stderr, "franja-worker: --spp: expected an integer in [1, 1048576], got '%s'\n", argv[i]);
-                return 2;
-            }
-        } else if (!strcmp(a, "--size")) {
-            if (parse_pair(argv[++i], 'x', &w, &h) < 0 || w == 0 || h == 0 || w > 65536 || h > 65536) {
-                fprintf(stderr, "franja-worker: --size: expected WxH with 1 <= W,H <= 65536, got '%s'\n", argv[i]);
-                return 2;
-            }
-            have_size = 1;
-        } else if (!strcmp(a, "--format")) {
-            fmt_name = argv[++i];
-        } else if (!strcmp(a, "-o")) {
-            out = argv[++i];
-        } else {
-            fprintf(stderr, "franja-worker: unknown argument '%s' (see --help)\n", a);
-            return 2;
-        }
-    }
-    img_format fmt;
-    if (img_format_parse(fmt_name, &fmt) < 0) {
-        fprintf(stderr, "franja-worker: --format: expected pf, ppm16 or ppm8, got '%s'\n", fmt_name);
+    proto_request req;
+    fr_error err;
+    if (proto_parse_args(argc, argv, &req, &err) < 0) {
+        fprintf(stderr, "franja-worker: %s\n", err.msg);
         return 2;
     }
-    if (!scene_path) {
-        fprintf(stderr, "franja-worker: --scene is required (see --help)\n");
-        return 2;
+    if (req.mode == PROTO_HELP) {
+        fputs(usage, stdout);
+        return 0;
     }
-    if (!rows && !check) {
-        fprintf(stderr, "franja-worker: --rows is required (see --help)\n");
-        return 2;
+    if (req.mode == PROTO_VERSION) {
+        char line[128];
+        proto_version_line("franja-worker", line, sizeof line);
+        printf("%s\n", line);
+        return 0;
     }
-    uint32_t y0 = 0, y1 = 0;
-    if (rows && parse_pair(rows, ':', &y0, &y1) < 0) {
-        fprintf(stderr, "franja-worker: --rows: expected Y0:Y1 (two integers), got '%s'\n", rows);
-        return 2;
-    }
+    const proto_slab *sl = &req.slab;
+    const char *out = sl->out;
+    uint32_t y0 = sl->y0, y1 = sl->y1;
 
     fr_scene scene;
-    fr_error err;
-    if (load_scene(scene_path, &scene, &err) < 0) {
+    if (load_scene(sl->scene, &scene, &err) < 0) {
         fprintf(stderr, "franja-worker: %s\n", err.msg);
         return 1;
     }
     char hex[17];
     fbin_hash_hex(scene.hash, hex);
-    if (check) {
+    if (req.mode == PROTO_CHECK) {
         printf("%s\n", hex);
         scn_free(&scene);
         return 0;
     }
-    if (have_size) {
-        scene.settings.width = w;
-        scene.settings.height = h;
+    if (sl->width) {
+        scene.settings.width = sl->width;
+        scene.settings.height = sl->height;
     }
-    if (spp)
-        scene.settings.spp = spp;
+    if (sl->spp)
+        scene.settings.spp = sl->spp;
     if (quick_spp(&scene.settings.spp, &err) < 0) {
         fprintf(stderr, "franja-worker: %s\n", err.msg);
         scn_free(&scene);
@@ -187,7 +121,7 @@ int main(int argc, char **argv)
     if (!f) {
         fprintf(stderr, "franja-worker: %s: %s\n", out, strerror(errno));
         rc = 1;
-    } else if (img_write(f, fmt, &info, rgb, &err) < 0) {
+    } else if (img_write(f, sl->format, &info, rgb, &err) < 0) {
         fprintf(stderr, "franja-worker: %s: %s\n", to_stdout ? "standard output" : out, err.msg);
         rc = 1;
     }

@@ -1,11 +1,12 @@
 /* fuzz_obj.c -- libFuzzer target for the OBJ and MTL readers
- * (coordinator/obj.c, compiled in).  An input whose first byte is 'M' is
+ * (coordinator/obj.h).  An input whose first byte is 'M' is
  * read as MTL, any other as OBJ (mtllib statements are skipped: no files
  * are opened). */
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
-#include "../../coordinator/obj.c"
+#include "obj.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

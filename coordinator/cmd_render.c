@@ -1,6 +1,6 @@
-/* render.c -- `franja render`: compile if needed, get the hosts ready,
+/* cmd_render.c -- `franja render`: compile if needed, get the hosts ready,
  * schedule the slabs, stitch, tone-map once and write the image. */
-#include "rendercmd.h"
+#include "cmd.h"
 
 #include <errno.h>
 #include <signal.h>
@@ -9,15 +9,16 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "cli.h"
+#include "clock.h"
 #include "cluster.h"
 #include "compile.h"
 #include "fbin.h"
 #include "jobdir.h"
 #include "output.h"
+#include "protocol.h"
 #include "quick.h"
 #include "sched.h"
 #include "tonemap.h"
@@ -50,13 +51,6 @@ static void on_signal(int sig)
 {
     (void)sig;
     stop_flag = 1;
-}
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + t.tv_nsec * 1e-9;
 }
 
 static int ends_with(const char *s, const char *suffix)
@@ -130,23 +124,16 @@ static int parse(int argc, char **argv, render_args *a)
             bad = tm_curve_parse(v, &c) < 0;
         }
         else if (!strcmp(s, "-j"))
-            bad = cli_uint(v, 1, 4096, &a->jobs);
+            bad = cli_uint(v, 1, HOSTS_MAX_CORES, &a->jobs);
         else if (!strcmp(s, "--spp"))
-            bad = cli_uint(v, 1, 1u << 20, &a->spp);
+            bad = cli_uint(v, 1, PROTO_MAX_SPP, &a->spp);
         else if (!strcmp(s, "--slab-rows"))
-            bad = cli_uint(v, 1, 65536, &a->slab_rows);
+            bad = cli_uint(v, 1, PROTO_MAX_SIZE, &a->slab_rows);
         else if (!strcmp(s, "--retries"))
             bad = cli_uint(v, 1, 1000, &a->retries);
-        else if (!strcmp(s, "--size")) {
-            char w[16];
-            const char *x = strchr(v, 'x');
-            bad = !x || x - v >= (long)sizeof w;
-            if (!bad) {
-                memcpy(w, v, (size_t)(x - v));
-                w[x - v] = 0;
-                bad = cli_uint(w, 1, 65536, &a->width) || cli_uint(x + 1, 1, 65536, &a->height);
-            }
-        } else {
+        else if (!strcmp(s, "--size"))
+            bad = proto_parse_size(v, &a->width, &a->height);
+        else {
             char *end;
             errno = 0;
             a->exposure = strtof(v, &end);
@@ -249,9 +236,9 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     if (rc == 0) {
         sched_params p = {*spec, jobdir, have, (int)a->slab_rows, (int)a->retries, 3, isatty(2), &stop_flag};
         sched_stats st;
-        double t0 = now_s();
+        double t0 = clk_now();
         rc = sched_run(&p, sh, ns, &st, err);
-        summary(sh, ns, spec, &st, rows_missing, now_s() - t0);
+        summary(sh, ns, spec, &st, rows_missing, clk_now() - t0);
     }
     cl_close(cl, n);
     free(cl);
@@ -288,7 +275,7 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         return 2;
     }
-    double t0 = now_s();
+    double t0 = clk_now();
     fr_scene sc;
     if (scene_binary(&a, jobdir, fbin, sizeof fbin, &sc, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
@@ -353,7 +340,7 @@ int cmd_render(int argc, char **argv)
     if (!a.keep_job)
         job_remove(jobdir);
     fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, spec.width, spec.height, spec.spp,
-            now_s() - t0);
+            clk_now() - t0);
     rc = 0;
 done:
     if (rc && stop_flag)

@@ -1,17 +1,18 @@
-/* deploy.c -- franja deploy: the matching worker build onto every host. */
-#include "deploy.h"
+/* cmd_deploy.c -- franja deploy: the matching worker build onto every host. */
+#include "cmd.h"
 
 #include <libssh/libssh.h>
 #include <limits.h>
-#include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "fbin.h"
+#include "cluster.h"
 #include "hosts.h"
-#include "transport.h"
+#include "protocol.h"
+#include "stage.h"
 
 static const char usage[] =
     "usage: franja deploy --hosts FILE [--dist DIR] [options]\n"
@@ -28,16 +29,13 @@ static const char usage[] =
     "  --dist DIR           where the builds are (default: dist in the current\n"
     "                       directory, else the dist beside this program's bin/)\n";
 
-/* One host's deployment, run in its own thread. */
+/* What every host's deployment needs, and what each one found. */
 typedef struct {
-    const hosts_entry *e;
-    const tr_options *o;
     const char *dist;
     const char *expect;        /* the version line the worker must print */
-    int local;
-    int ok;
-    char report[2048];
-} job;
+    char (*report)[1200];      /* per host: what was installed */
+    char (*note)[700];         /* per host: remarks */
+} deploy_ctx;
 
 static int is_dir(const char *p)
 {
@@ -83,45 +81,32 @@ static int pick(const char *dist, const char *os, const char *arch, char *path, 
                    "(make dist, or give os= in the host table)", dist, arch);
 }
 
-static void *deploy_one(void *arg)
+/* One host's deployment (a cl_step, in the host's own thread). */
+static int deploy_one(cl_host *ch, int i, void *vctx, fr_error *err)
 {
-    job *j = arg;
-    const hosts_entry *e = j->e;
-    if (hosts_is_local(e)) {
-        j->local = 1;
-        snprintf(j->report, sizeof j->report, "%s: local host, runs this machine's worker; skipped", e->name);
-        return NULL;
-    }
-    fr_error err;
-    tr_host *h = NULL;
-    tr_info info;
-    char arch[32], os[64], path[PATH_MAX], build[128], remote[1024], note[700] = "";
-    if (tr_connect(e, j->o, &h, &err) || tr_sysinfo(h, arch, os, &err))
-        goto fail;
+    deploy_ctx *c = vctx;
+    const hosts_entry *e = ch->entry;
+    tr_host *h = ch->tr;
+    char *note = c->note[i];
+    char arch[32], os[64], path[PATH_MAX], build[128], remote[1024];
+    if (stage_sysinfo(h, arch, os, err))
+        return -1;
     /* The table wins over what the host says: an emulated or chrooted host
      * may report the machine it runs on. */
     const char *want = debian_arch(e->arch[0] ? e->arch : arch);
     if (e->arch[0] && strcmp(want, debian_arch(arch)))
-        snprintf(note, sizeof note, " (the table says arch=%s, the host reports %s)", e->arch, arch);
-    if (pick(j->dist, e->os[0] ? e->os : os, want, path, sizeof path, build, &err) ||
-        tr_install(h, path, "franja-worker", remote, sizeof remote, &err) || tr_probe(h, &info, &err))
-        goto fail;
-    if (strcmp(info.version, j->expect)) {
-        fr_fail(&err, "installed %s as %s, but the host's worker%s%s reports '%s', not '%s'", build, remote,
-                e->worker[0] ? " " : "", e->worker, info.version, j->expect);
-        goto fail;
-    }
+        snprintf(note, 700, " (the table says arch=%s, the host reports %s)", e->arch, arch);
+    proto_host info;
+    if (pick(c->dist, e->os[0] ? e->os : os, want, path, sizeof path, build, err) ||
+        stage_install(h, path, "franja-worker", remote, sizeof remote, err) || stage_probe(h, &info, err))
+        return -1;
+    if (strcmp(info.version, c->expect))
+        return fr_fail(err, "installed %s as %s, but the host's worker%s%s reports '%s', not '%s'", build, remote,
+                       e->worker[0] ? " " : "", e->worker, info.version, c->expect);
     if (e->worker[0] && strcmp(e->worker, remote))
-        snprintf(note + strlen(note), sizeof note - strlen(note), " (checked through the table's worker=%s)",
-                 e->worker);
-    snprintf(j->report, sizeof j->report, "%s: %s -> %s: %s%s", e->name, build, remote, info.version, note);
-    j->ok = 1;
-    tr_close(h);
-    return NULL;
-fail:
-    snprintf(j->report, sizeof j->report, "%s: FAILED: %s%s", e->name, err.msg, note);
-    tr_close(h);
-    return NULL;
+        snprintf(note + strlen(note), 700 - strlen(note), " (checked through the table's worker=%s)", e->worker);
+    snprintf(c->report[i], 1200, "%s -> %s: %s", build, remote, info.version);
+    return 0;
 }
 
 /* ./dist, else the dist beside the bin/ directory this program is in. */
@@ -135,28 +120,45 @@ static const char *default_dist(char *buf, size_t cap)
 static int deploy_all(const hosts_table *t, const tr_options *o, const char *dist)
 {
     char expect[128];
-    snprintf(expect, sizeof expect, "franja-worker %s scene-format %d", FRANJA_VERSION, FBIN_VERSION);
-    job jobs[t->n > 0 ? t->n : 1];
-    pthread_t tid[t->n > 0 ? t->n : 1];
-    int started[t->n > 0 ? t->n : 1];
-    for (int i = 0; i < t->n; i++) {
-        jobs[i] = (job){.e = &t->v[i], .o = o, .dist = dist, .expect = expect};
-        started[i] = pthread_create(&tid[i], NULL, deploy_one, &jobs[i]) == 0;
-        if (!started[i])
-            deploy_one(&jobs[i]);
+    proto_version_line("franja-worker", expect, sizeof expect);
+    int n = t->n;
+    cl_host *hosts = calloc((size_t)n, sizeof *hosts);
+    int *remote_of = calloc((size_t)n, sizeof *remote_of);
+    deploy_ctx c = {dist, expect, calloc((size_t)n, sizeof *c.report), calloc((size_t)n, sizeof *c.note)};
+    if (!hosts || !remote_of || !c.report || !c.note) {
+        free(hosts), free(remote_of), free(c.report), free(c.note);
+        fprintf(stderr, "franja deploy: out of memory\n");
+        return 1;
     }
-    int remote = 0, done = 0;
-    for (int i = 0; i < t->n; i++) {
-        if (started[i])
-            pthread_join(tid[i], NULL);
-        printf("%s\n", jobs[i].report);
-        remote += !jobs[i].local;
-        done += jobs[i].ok;
+    /* Local hosts run this machine's worker: only SSH hosts are deployed to. */
+    int remote = 0;
+    for (int i = 0; i < n; i++)
+        if (!hosts_is_local(&t->v[i])) {
+            remote_of[i] = remote;
+            hosts[remote++].entry = &t->v[i];
+        }
+    cl_each(hosts, remote, o, deploy_one, &c);
+    int done = 0;
+    for (int i = 0; i < n; i++) {
+        const hosts_entry *e = &t->v[i];
+        if (hosts_is_local(e)) {
+            printf("%s: local host, runs this machine's worker; skipped\n", e->name);
+            continue;
+        }
+        int k = remote_of[i];
+        if (hosts[k].tr) {
+            printf("%s: %s%s\n", e->name, c.report[k], c.note[k]);
+            done++;
+        } else {
+            printf("%s: FAILED: %s%s\n", e->name, hosts[k].err.msg, c.note[k]);
+        }
     }
     if (remote == 0)
         printf("no SSH host in %s: nothing to deploy\n", t->path);
     else
         printf("deployed to %d of %d SSH host%s\n", done, remote, remote == 1 ? "" : "s");
+    cl_close(hosts, remote);
+    free(hosts), free(remote_of), free(c.report), free(c.note);
     return done == remote ? 0 : 1;
 }
 

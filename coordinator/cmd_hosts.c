@@ -1,6 +1,6 @@
-/* hostcmd.c -- `franja hosts check` (connect to every host and say what is
+/* cmd_hosts.c -- `franja hosts check` (connect to every host and say what is
  * wrong) and `franja hosts list` (parse the table only). */
-#include "hostcmd.h"
+#include "cmd.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "cluster.h"
+#include "stage.h"
 
 static const char usage[] =
     "usage: franja hosts check --hosts FILE [options]\n"
@@ -59,7 +60,7 @@ static int check(const hosts_table *t, const tr_options *o)
          * uname's kernel name says little. */
         char arch[64], os[64];
         fr_error e1;
-        if (tr_sysinfo(h->tr, arch, os, &e1) || !os[0])
+        if (stage_sysinfo(h->tr, arch, os, &e1) || !os[0])
             snprintf(os, sizeof os, "%s", h->info.os);
         char warn[160] = "";
         if (h->entry->arch[0] && strcmp(h->entry->arch, h->info.arch)) {
@@ -73,9 +74,9 @@ static int check(const hosts_table *t, const tr_options *o)
         uint64_t bytes;
         char cache[64];
         fr_error e2;
-        if (hosts_is_local(h->entry))
+        if (!tr_host_workdir(h->tr)[0])
             snprintf(cache, sizeof cache, "local, none needed");
-        else if (tr_cache(h->tr, &files, &bytes, &e2))
+        else if (stage_cache(h->tr, &files, &bytes, &e2))
             snprintf(cache, sizeof cache, "unreadable");
         else
             snprintf(cache, sizeof cache, "%d scene%s, %.1f MB", files, files == 1 ? "" : "s", bytes / 1e6);

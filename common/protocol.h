@@ -1,0 +1,121 @@
+/** @file protocol.h
+ * The worker protocol: everything franja (the coordinator) and
+ * franja-worker must agree on, written once and used by both.
+ *
+ * - The limits of a render (image size, samples per pixel, path depth):
+ *   proto_limits.h, included here.
+ * - The slab command line: the coordinator builds it (proto_slab_argv),
+ *   the worker reads it (proto_parse_args), so the two cannot drift apart.
+ * - The `--version` line, which names the release and the binary scene
+ *   format a worker reads, and its parser (the coordinator refuses hosts
+ *   whose workers differ).
+ * - `--check`: the worker validates a scene file and prints its content
+ *   hash; the coordinator trusts a cached copy only when the hash matches.
+ * - The probe: one POSIX shell command that reports a host's architecture,
+ *   OS, processor count and worker version, and its parser.
+ *
+ * Nothing here touches a file, a process or the network: these are
+ * strings, parsers and constants.
+ */
+#ifndef FRANJA_PROTOCOL_H
+#define FRANJA_PROTOCOL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "error.h"
+#include "image.h"
+#include "proto_limits.h"
+
+/** The release of this source tree, in every `--version` line. */
+#define FRANJA_VERSION "0.1.0"
+
+/** One slab as the coordinator asks a worker for it. */
+typedef struct {
+    const char *scene;         /**< the binary scene's path on the host */
+    uint32_t y0, y1;           /**< rows [y0, y1) of the full image */
+    uint32_t width, height;    /**< full image size; both 0 = the scene's */
+    uint32_t spp;              /**< samples per pixel; 0 = the scene's */
+    img_format format;         /**< output format */
+    const char *out;           /**< output file; "-" = standard output */
+} proto_slab;
+
+/** A worker command line built by proto_slab_argv: argv points into the
+ * struct's own buffers (and at the caller's strings), NULL-terminated,
+ * without the program name. */
+typedef struct {
+    const char *argv[16];
+    char rows[32], size[32], spp[16];
+} proto_argv;
+
+/** Builds the worker arguments that ask for slab s.  Fails when a number
+ * is out of the protocol's limits or the rows are empty. */
+int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err);
+
+/** What a worker command line asks for. */
+typedef enum {
+    PROTO_RENDER = 0,          /**< render the slab */
+    PROTO_CHECK,               /**< --check: validate the scene, print its hash */
+    PROTO_VERSION,             /**< --version */
+    PROTO_HELP                 /**< --help / -h */
+} proto_mode;
+
+/** A parsed worker command line. */
+typedef struct {
+    proto_mode mode;
+    proto_slab slab;           /**< scene, rows, size, spp, format, out */
+    int have_rows;             /**< --rows was given */
+} proto_request;
+
+/** Reads a worker command line (argv[0] is the program).  Checks the syntax
+ * and the limits; whether the rows fit the image is the worker's to check
+ * once the scene is loaded.  A usage error returns -1 with err saying which
+ * option is wrong and what was expected (the text a worker prints after
+ * "franja-worker: "). */
+int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *err);
+
+/** Parses "WxH" with 1 <= W, H <= PROTO_MAX_SIZE; -1 if it is not that. */
+int proto_parse_size(const char *s, uint32_t *w, uint32_t *h);
+
+/** Writes "PROGRAM VERSION scene-format N" (this build's version and
+ * binary scene format) into out[cap]. */
+void proto_version_line(const char *program, char *out, size_t cap);
+
+/** A parsed `--version` line. */
+typedef struct {
+    char program[32];          /**< "franja-worker" */
+    char version[32];          /**< "0.1.0" */
+    int scene_format;          /**< the binary scene format it reads */
+} proto_version;
+
+/** Parses a `--version` line ("PROGRAM VERSION scene-format N").  Fails,
+ * quoting the line, when it has another shape. */
+int proto_parse_version(const char *line, proto_version *v, fr_error *err);
+
+/** The arguments (no program name) that make a worker check the scene at
+ * path and print its content hash: write them to argv[4]. */
+void proto_check_argv(const char *path, const char *argv[4]);
+
+/** Reads the output of `--check` (len bytes): one line of 16 hex digits.
+ * Fails if it is anything else. */
+int proto_parse_check(const char *out, size_t len, uint64_t *hash, fr_error *err);
+
+/** The probe, as a command for a POSIX shell run as
+ * `sh -c PROTO_PROBE_SCRIPT WORKER`: four lines, uname -m, uname -s, the
+ * number of online processors and the worker's `--version` line.  The
+ * worker path travels as $0, never inside the script. */
+extern const char PROTO_PROBE_SCRIPT[];
+
+/** What a host says about itself (the probe's answer). */
+typedef struct {
+    char arch[32];             /**< uname -m */
+    char os[64];               /**< uname -s */
+    int cores;                 /**< online processors */
+    char version[128];         /**< the worker's --version line */
+} proto_host;
+
+/** Parses the probe's output (len bytes).  Fails if a line is missing, too
+ * long, or the processor count is not a positive number. */
+int proto_parse_probe(const char *out, size_t len, proto_host *h, fr_error *err);
+
+#endif

@@ -1,0 +1,235 @@
+/* stage.c -- probing a host and putting files there, above the transport
+ * backends (see stage.h). */
+#include "stage.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fbin.h"
+
+/* The exit status of the cache check when there is no cached copy (the
+ * worker's own statuses are 0, 1 and 2). */
+enum { ABSENT = 97 };
+
+/* `sh -c CHECK_SCRIPT WORKER --scene PATH --check`: the worker checks the
+ * copy if there is one. */
+static const char CHECK_SCRIPT[] = "[ -e \"$2\" ] || exit 97; exec \"$0\" \"$@\"";
+
+static const char CACHE_SCRIPT[] =
+    "cd \"$0\" 2>/dev/null || exit 0; for f in *.fbin; do [ -f \"$f\" ] && wc -c <\"$f\"; done; exit 0";
+
+static const char SYSINFO_SCRIPT[] = "uname -m && (cat /etc/os-release 2>/dev/null || true)";
+
+/* Runs a short command; *p is the finished process (TR_EXITED or
+ * TR_FAILED), to be freed. */
+static int run(tr_host *h, const char *const *argv, tr_proc **p, fr_error *err)
+{
+    int t = tr_host_options(h)->timeout_s;
+    return tr_run(h, argv, 65536, 3 * (t > 0 ? t : 10), p, err);
+}
+
+/* A failed process's reason as an error. */
+static int failed(tr_host *h, tr_proc *p, const char *what, fr_error *err)
+{
+    if (tr_proc_state(p) == TR_FAILED)
+        return fr_fail(err, "%s: %s: %s", tr_host_label(h), what, tr_proc_reason(p));
+    return fr_fail(err, "%s: %s failed (status %d): %s", tr_host_label(h), what, tr_proc_status(p),
+                   tr_proc_reason(p));
+}
+
+int stage_probe(tr_host *h, proto_host *info, fr_error *err)
+{
+    const char *argv[] = {"sh", "-c", PROTO_PROBE_SCRIPT, tr_host_worker(h), NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    int rc = 0;
+    size_t len;
+    const char *out = (const char *)tr_proc_output(p, &len);
+    fr_error e;
+    if (tr_proc_state(p) == TR_FAILED)
+        rc = failed(h, p, "probe", err);
+    else if (tr_proc_status(p) != 0)
+        rc = fr_fail(err, "%s: worker '%s' cannot be run (status %d): %s -- %s", tr_host_label(h), tr_host_worker(h),
+                     tr_proc_status(p), tr_proc_reason(p),
+                     tr_host_workdir(h)[0] ? "install it with franja deploy or give worker= in the host table"
+                                           : "build it with make, or give worker=");
+    else if (proto_parse_probe(out, len, info, &e))
+        rc = fr_fail(err, "%s: %s", tr_host_label(h), e.msg);
+    tr_proc_free(p);
+    return rc;
+}
+
+/* 1 when the cached copy at path checks out, 0 when there is none, 2 when
+ * it is damaged (or unreadable for this worker), -1 on error. */
+static int cached(tr_host *h, const char *path, uint64_t hash, fr_error *err)
+{
+    const char *check[4];
+    proto_check_argv(path, check);
+    const char *argv[] = {"sh", "-c", CHECK_SCRIPT, tr_host_worker(h), check[0], check[1], check[2], NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    int rc;
+    size_t len;
+    const char *out = (const char *)tr_proc_output(p, &len);
+    uint64_t got;
+    fr_error e;
+    if (tr_proc_state(p) == TR_FAILED)
+        rc = failed(h, p, "scene check", err);
+    else if (tr_proc_status(p) == ABSENT)
+        rc = 0;
+    else
+        rc = tr_proc_status(p) == 0 && proto_parse_check(out, len, &got, &e) == 0 && got == hash ? 1 : 2;
+    tr_proc_free(p);
+    return rc;
+}
+
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, int *uploaded,
+                fr_error *err)
+{
+    *uploaded = 0;
+    const char *wd = tr_host_workdir(h);
+    if (!wd[0]) {
+        char abs[PATH_MAX];
+        if (!realpath(local_path, abs))
+            return fr_fail(err, "%s: %s: %s", tr_host_label(h), local_path, strerror(errno));
+        if (strlen(abs) >= cap)
+            return fr_fail(err, "%s: scene path too long", tr_host_label(h));
+        strcpy(remote, abs);
+        return 0;
+    }
+    char hex[17];
+    fbin_hash_hex(hash, hex);
+    if (snprintf(remote, cap, "%s/scenes/%s.fbin", wd, hex) >= (int)cap)
+        return fr_fail(err, "%s: work directory path too long", tr_host_label(h));
+    int ok = cached(h, remote, hash, err);
+    if (ok < 0 || ok == 1)
+        return ok < 0 ? -1 : 0;
+    if (ok == 2)
+        tr_note(h, "cached scene %s is damaged; uploading it again", remote);
+    if (tr_upload(h, local_path, remote, 0644, err))
+        return -1;
+    *uploaded = 1;
+    ok = cached(h, remote, hash, err);
+    if (ok < 0)
+        return -1;
+    if (ok != 1)
+        return fr_fail(err, "%s: the uploaded scene %s does not check out (size or hash); "
+                       "is the worker '%s' able to read this scene format?", tr_host_label(h), remote,
+                       tr_host_worker(h));
+    return 0;
+}
+
+int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err)
+{
+    *files = 0;
+    *bytes = 0;
+    const char *wd = tr_host_workdir(h);
+    if (!wd[0])
+        return 0;
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/scenes", wd);
+    const char *argv[] = {"sh", "-c", CACHE_SCRIPT, dir, NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    int rc = 0;
+    if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0) {
+        rc = failed(h, p, "listing the scene cache", err);
+    } else {
+        size_t len;
+        const char *out = (const char *)tr_proc_output(p, &len);
+        for (size_t i = 0; i < len;) {
+            size_t j = i;
+            uint64_t v = 0;
+            int digits = 0;
+            while (j < len && out[j] != '\n') {
+                if (out[j] >= '0' && out[j] <= '9' && v < UINT64_MAX / 16) {
+                    v = v * 10 + (uint64_t)(out[j] - '0');
+                    digits++;
+                } else if (out[j] != ' ' && out[j] != '\t') {
+                    digits = -1000;
+                }
+                j++;
+            }
+            if (digits <= 0) {
+                rc = fr_fail(err, "%s: unexpected answer listing the scene cache", tr_host_label(h));
+                break;
+            }
+            (*files)++;
+            *bytes += v;
+            i = j + 1;
+        }
+    }
+    tr_proc_free(p);
+    return rc;
+}
+
+void stage_os_codename(const char *text, char *os)
+{
+    const char key[] = "VERSION_CODENAME=";
+    const size_t klen = sizeof key - 1;
+    os[0] = 0;
+    for (const char *l = text; *l;) {
+        const char *end = strchr(l, '\n');
+        size_t len = end ? (size_t)(end - l) : strlen(l);
+        if (len > klen && !strncmp(l, key, klen)) {
+            const char *v = l + klen;
+            size_t n = len - klen;
+            /* The value may be quoted: VERSION_CODENAME="bookworm". */
+            if (n >= 2 && (v[0] == '"' || v[0] == '\'') && v[n - 1] == v[0]) {
+                v++;
+                n -= 2;
+            }
+            snprintf(os, 64, "%.*s", (int)(n < 63 ? n : 63), v);
+            return;
+        }
+        if (!end)
+            break;
+        l = end + 1;
+    }
+}
+
+int stage_sysinfo(tr_host *h, char *arch, char *os, fr_error *err)
+{
+    arch[0] = os[0] = 0;
+    const char *argv[] = {"sh", "-c", SYSINFO_SCRIPT, NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    int rc = 0;
+    if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0) {
+        rc = failed(h, p, "uname -m", err);
+    } else {
+        size_t len;
+        const char *out = (const char *)tr_proc_output(p, &len);
+        char *text = strndup(out ? out : "", len);
+        size_t n = text ? strcspn(text, "\n") : 0;
+        if (!text)
+            rc = fr_fail(err, "%s: out of memory", tr_host_label(h));
+        else if (n == 0 || n >= 32 || strlen(text) != len)
+            rc = fr_fail(err, "%s: unexpected answer to uname -m", tr_host_label(h));
+        else {
+            snprintf(arch, 32, "%.*s", (int)n, text);
+            stage_os_codename(text + n, os);
+        }
+        free(text);
+    }
+    tr_proc_free(p);
+    return rc;
+}
+
+int stage_install(tr_host *h, const char *local_path, const char *name, char *remote, size_t cap, fr_error *err)
+{
+    const char *wd = tr_host_workdir(h);
+    if (!wd[0])
+        return fr_fail(err, "%s: a local host runs this machine's worker (%s); nothing to install", tr_host_label(h),
+                       tr_host_worker(h));
+    if (snprintf(remote, cap, "%s/%s", wd, name) >= (int)cap)
+        return fr_fail(err, "%s: work directory path too long", tr_host_label(h));
+    return tr_upload(h, local_path, remote, 0755, err);
+}

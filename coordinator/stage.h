@@ -1,0 +1,57 @@
+/** @file stage.h
+ * Getting one host ready, written once for every backend: asking it what
+ * it is, putting a scene or a worker there, and listing its scene cache.
+ * Everything is done with tr_run (short commands: the worker, `sh -c` with
+ * fixed scripts whose variable parts travel as arguments) and tr_upload.
+ *
+ * The scene cache of a host with a work directory is
+ * WORKDIR/scenes/HASH.fbin.  A cached copy is trusted when the host's own
+ * worker, run with `--check` on it, prints the expected content hash (the
+ * worker verifies the hash of the whole file); otherwise it is uploaded
+ * again and checked again.  A host without a work directory (a local one)
+ * reads the scene where it is.
+ *
+ * Each function uses one host and may run in a thread of its own; each
+ * command may take up to three times the host's time-out.
+ */
+#ifndef FRANJA_STAGE_H
+#define FRANJA_STAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "protocol.h"
+#include "transport.h"
+
+/** Asks the host for its architecture, OS, processor count and worker
+ * version (protocol.h's probe).  Fails, saying how to install a worker,
+ * when the worker cannot be run there. */
+int stage_probe(tr_host *h, proto_host *info, fr_error *err);
+
+/** Makes the binary scene at local_path (content hash `hash`) available on
+ * the host and writes the path its worker must be given into remote[cap].
+ * *uploaded says whether the file was sent.  A damaged cached copy is
+ * noted (tr_options.notes) and replaced. */
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, int *uploaded,
+                fr_error *err);
+
+/** Counts the scenes in the host's cache (*files, *bytes; 0 and 0 for a
+ * host without a work directory). */
+int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err);
+
+/** What the host's system is, found without running its worker (so it works
+ * before the first `franja deploy`): arch[32] from `uname -m`, os[64] the
+ * VERSION_CODENAME of its /etc/os-release ("" when there is none). */
+int stage_sysinfo(tr_host *h, char *arch, char *os, fr_error *err);
+
+/** Installs the local file at local_path on the host as WORKDIR/name,
+ * executable (tr_upload), and writes its path into remote[cap].  Fails for
+ * a host without a work directory: it runs this machine's files. */
+int stage_install(tr_host *h, const char *local_path, const char *name, char *remote, size_t cap,
+                  fr_error *err);
+
+/** Copies the VERSION_CODENAME of an os-release text (NUL-terminated) into
+ * os[64], without quotes; "" if it has none. */
+void stage_os_codename(const char *os_release, char *os);
+
+#endif

@@ -1,0 +1,175 @@
+/* transport_pipe.c -- child processes of this machine: posix_spawnp,
+ * non-blocking pipes for stdout and stderr, waitpid for the exit status
+ * (see the tr_pipe_* functions in transport_backend.h). */
+#include "transport_backend.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "clock.h"
+
+extern char **environ;
+
+typedef struct {
+    pid_t pid;
+    int fd_out, fd_err;        /* -1 once at end of file */
+    int reaped;
+} pipe_proc;
+
+int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err)
+{
+    pipe_proc *pp = calloc(1, sizeof *pp);
+    if (!pp)
+        return fr_fail(err, "out of memory");
+    int po[2], pe[2];
+    if (pipe2(po, O_CLOEXEC)) {
+        free(pp);
+        return fr_fail(err, "pipe: %s", strerror(errno));
+    }
+    if (pipe2(pe, O_CLOEXEC)) {
+        close(po[0]);
+        close(po[1]);
+        free(pp);
+        return fr_fail(err, "pipe: %s", strerror(errno));
+    }
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_adddup2(&fa, po[1], 1);
+    posix_spawn_file_actions_adddup2(&fa, pe[1], 2);
+    pid_t pid;
+    int rc = posix_spawnp(&pid, argv[0], &fa, NULL, (char *const *)argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    close(po[1]);
+    close(pe[1]);
+    if (rc) {
+        close(po[0]);
+        close(pe[0]);
+        free(pp);
+        return fr_fail(err, "cannot start %s: %s", argv[0], strerror(rc));
+    }
+    fcntl(po[0], F_SETFL, O_NONBLOCK);
+    fcntl(pe[0], F_SETFL, O_NONBLOCK);
+    pp->pid = pid;
+    pp->fd_out = po[0];
+    pp->fd_err = pe[0];
+    p->impl = pp;
+    p->state = TR_RUNNING;
+    return 0;
+}
+
+/* Reads what is there; closes the descriptor at end of file.  Output that
+ * the process may no longer keep is read and dropped, so that the child
+ * never blocks on a full pipe. */
+static void drain(int *fd, tr_proc *p, int is_err)
+{
+    char buf[65536];
+    while (*fd >= 0) {
+        ssize_t n = read(*fd, buf, sizeof buf);
+        if (n > 0) {
+            if (is_err)
+                tr_proc_add_err(p, buf, (size_t)n);
+            else if (p->state == TR_RUNNING)
+                tr_proc_add_out(p, buf, (size_t)n);
+            continue;
+        }
+        if (n < 0 && (errno == EAGAIN || errno == EINTR))
+            return;
+        close(*fd);
+        *fd = -1;
+    }
+}
+
+static int wait_status(int ws) { return WIFSIGNALED(ws) ? 128 + WTERMSIG(ws) : WEXITSTATUS(ws); }
+
+int tr_pipe_pollfds(tr_proc *procs, struct pollfd *pfd, int max)
+{
+    int n = 0;
+    for (tr_proc *p = procs; p; p = p->next) {
+        pipe_proc *pp = p->impl;
+        if (p->state != TR_RUNNING || !pp)
+            continue;
+        int fds[2] = {pp->fd_out, pp->fd_err};
+        for (int i = 0; i < 2; i++)
+            if (fds[i] >= 0 && n < max)
+                pfd[n++] = (struct pollfd){fds[i], POLLIN, 0};
+    }
+    return n;
+}
+
+void tr_pipe_service(tr_proc *procs)
+{
+    for (tr_proc *p = procs; p; p = p->next) {
+        pipe_proc *pp = p->impl;
+        if (p->state != TR_RUNNING || !pp)
+            continue;
+        drain(&pp->fd_out, p, 0);
+        drain(&pp->fd_err, p, 1);
+        if (p->state != TR_RUNNING || pp->fd_out >= 0 || pp->fd_err >= 0)
+            continue;
+        int ws;
+        if (waitpid(pp->pid, &ws, WNOHANG) == pp->pid) {
+            pp->reaped = 1;
+            p->status = wait_status(ws);
+            p->state = TR_EXITED;
+        }
+    }
+}
+
+void tr_pipe_kill(tr_proc *p)
+{
+    pipe_proc *pp = p->impl;
+    if (pp && !pp->reaped)
+        kill(pp->pid, SIGKILL);
+}
+
+void tr_pipe_release(tr_proc *p)
+{
+    pipe_proc *pp = p->impl;
+    if (!pp)
+        return;
+    if (!pp->reaped) {
+        kill(pp->pid, SIGKILL);
+        waitpid(pp->pid, NULL, 0);
+    }
+    if (pp->fd_out >= 0)
+        close(pp->fd_out);
+    if (pp->fd_err >= 0)
+        close(pp->fd_err);
+    free(pp);
+    p->impl = NULL;
+}
+
+int tr_pipe_run(const char *const *argv, int timeout_s, fr_error *err)
+{
+    tr_proc p;
+    memset(&p, 0, sizeof p);
+    p.out_max = (size_t)1 << 20;
+    if (tr_pipe_spawn(&p, argv, err))
+        return -1;
+    double end = clk_now() + timeout_s;
+    while (p.state == TR_RUNNING && clk_now() < end) {
+        struct pollfd pfd[2];
+        int n = tr_pipe_pollfds(&p, pfd, 2);
+        poll(pfd, (nfds_t)n, 50);
+        tr_pipe_service(&p);
+        p.out_len = 0; /* stdout is not wanted */
+    }
+    int rc = 0;
+    if (p.state == TR_RUNNING)
+        rc = fr_fail(err, "%s did not finish within %d s", argv[0], timeout_s);
+    else if (p.state == TR_FAILED)
+        rc = fr_fail(err, "%s: %s", argv[0], p.why);
+    else if (p.status)
+        rc = fr_fail(err, "%s failed (status %d): %s", argv[0], p.status, p.err);
+    tr_pipe_release(&p);
+    free(p.out);
+    return rc;
+}
