@@ -30,10 +30,13 @@ typedef struct {
     fr_camera camera;
     fr_array materials, prims, spheres, rects, triangles;
     fr_array positions, normals, uvs, planes;
-    fr_array lights;           /**< point lights; frz_scene adds the area lights */
+    fr_array lights;           /**< point, spot, sun and environment lights (builder_light.h); frz_scene
+                                    orders them and adds the area lights */
     fr_array textures, texels, media;   /**< fr_texture, float, fr_medium */
     fr_volume volume;
     fr_tonemap tonemap;
+    fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
+    fr_array distrib;          /**< float: filled by frz_scene */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero. */

@@ -23,8 +23,8 @@ enum { HEADER_SIZE = 64, ENTRY_SIZE = 32, ALIGN = 64 };
 enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
-    SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP,
-    SEC_COUNT = SEC_TONEMAP
+    SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
+    SEC_COUNT = SEC_DISTRIB
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -57,6 +57,8 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_MEDIA, "media", media, fr_medium),
     [SEC_VOLUME] = {"volume", sizeof(fr_volume), offsetof(fr_scene, volume), 0},
     [SEC_TONEMAP] = {"tonemap", sizeof(fr_tonemap), offsetof(fr_scene, tonemap), 0},
+    [SEC_WORLD] = {"world", sizeof(fr_world), offsetof(fr_scene, world), 0},
+    ARR(SEC_DISTRIB, "distrib", distrib, float),
 };
 #undef ARR
 
@@ -184,6 +186,91 @@ static int validate_appearance(const fr_scene *s, const void *base, const uint64
     return 0;
 }
 
+static int unit3(vec3 v) { return finite3(v) && fabsf(v3_len2(v) - 1.0f) < 1e-4f; }
+
+/* A cumulative table of n + 1 entries: 0 first, 1 last, non-decreasing. */
+static int cdf_ok(const float *c, uint32_t n)
+{
+    if (c[0] != 0.0f || c[n] != 1.0f)
+        return 0;
+    for (uint32_t i = 1; i <= n; i++)
+        if (!(c[i] >= c[i - 1]))
+            return 0;
+    return 1;
+}
+
+/* The environment's map and sampling tables (fr_world in scene.h). */
+static int validate_envmap(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
+{
+    const fr_world *w = &s->world;
+    size_t at = AT1(SEC_WORLD, fr_world, env_texture);
+    if (w->env_texture >= s->n_textures || s->textures[w->env_texture].kind != FR_TEX_IMAGE)
+        return fr_fail(err, "section world, byte %zu: environment texture %u is not an image texture", at,
+                       w->env_texture);
+    const fr_texture *t = &s->textures[w->env_texture];
+    uint64_t n = (uint64_t)t->width * t->height, need = n + t->height + 1 + (uint64_t)t->height * (t->width + 1);
+    if (w->dist_first > s->n_distrib || need > (uint64_t)s->n_distrib - w->dist_first)
+        return fr_fail(err, "section world, byte %zu: environment tables (%llu values) outside distrib",
+                       AT1(SEC_WORLD, fr_world, dist_first), (unsigned long long)need);
+    const float *pdf = s->distrib + w->dist_first, *marg = pdf + n, *cond = marg + t->height + 1;
+    for (uint64_t i = 0; i < n; i++)
+        if (!(pdf[i] >= 0.0f) || !isfinite(pdf[i]))
+            return fr_fail(err, "section distrib, byte %zu: environment density %llu negative or not finite",
+                           AT(pdf + i), (unsigned long long)i);
+    if (!cdf_ok(marg, t->height))
+        return fr_fail(err, "section distrib, byte %zu: environment row table is not cumulative from 0 to 1",
+                       AT(marg));
+    for (uint32_t r = 0; r < t->height; r++)
+        if (!cdf_ok(cond + (size_t)r * (t->width + 1), t->width))
+            return fr_fail(err, "section distrib, byte %zu: environment table of row %u is not cumulative from 0 to 1",
+                           AT(cond + (size_t)r * (t->width + 1)), r);
+    return 0;
+}
+
+/* Lights and the world: kinds and their parameters, distant lights first,
+ * one environment light that the world points at. */
+static int validate_lights(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
+{
+    const fr_world *w = &s->world;
+    if (!finite3(w->center) || !(w->radius > 0.0f) || !isfinite(w->radius) || w->env > FR_ENV_MAP ||
+        !finite3(w->env_color) || v3_min(w->env_color) < 0.0f || !isfinite(w->rot_cos) || !isfinite(w->rot_sin) ||
+        fabsf(w->rot_cos * w->rot_cos + w->rot_sin * w->rot_sin - 1.0f) > 1e-4f)
+        return fr_fail(err, "section world, byte %zu: bad bounds, environment kind, colour or rotation",
+                       AT1(SEC_WORLD, fr_world, center));
+    if ((w->env == FR_ENV_NONE) != (w->env_light == FR_NONE) ||
+        (w->env_light != FR_NONE && (w->env_light >= s->n_lights || s->lights[w->env_light].kind != FR_LIGHT_ENV)))
+        return fr_fail(err, "section world, byte %zu: environment light %u missing or not an environment",
+                       AT1(SEC_WORLD, fr_world, env_light), w->env_light);
+    if (w->env == FR_ENV_MAP && validate_envmap(s, base, off, err) < 0)
+        return -1;
+    int local = 0;
+    for (uint32_t i = 0; i < s->n_lights; i++) {
+        const fr_light *l = &s->lights[i];
+        int distant = l->kind == FR_LIGHT_SUN || l->kind == FR_LIGHT_ENV;
+        if (l->kind >= FR_LIGHT_KINDS || (l->kind == FR_LIGHT_PRIM) != (l->prim != FR_NONE) ||
+            (l->kind == FR_LIGHT_PRIM && (l->prim >= s->n_prims || s->prims[l->prim].light != i)))
+            return fr_fail(err, "section lights, byte %zu: light %u: bad kind or primitive", AT(l), i);
+        if (distant && local)
+            return fr_fail(err, "section lights, byte %zu: light %u: a distant light after a local one", AT(l), i);
+        local |= !distant;
+        if (l->kind == FR_LIGHT_ENV && i != w->env_light)
+            return fr_fail(err, "section lights, byte %zu: light %u: a second environment", AT(l), i);
+        if (!(l->pick > 0.0f && l->pick <= 1.0f) || !(l->cdf >= 0.0f && l->cdf <= 1.0f))
+            return fr_fail(err, "section lights, byte %zu: light %u: bad pick probability", AT(l), i);
+        if (!finite3(l->position) || !finite3(l->intensity) || v3_min(l->intensity) < 0.0f)
+            return fr_fail(err, "section lights, byte %zu: light %u: non-finite position or bad intensity", AT(l), i);
+        if (l->kind == FR_LIGHT_SPOT &&
+            (!unit3(l->axis) || !(l->cone_cos >= -1.0f && l->cone_cos < l->cone_aux && l->cone_aux <= 1.0f)))
+            return fr_fail(err, "section lights, byte %zu: spot light %u: axis not unit or cone cosines not "
+                           "-1 <= outer < inner <= 1", AT(l), i);
+        if (l->kind == FR_LIGHT_SUN &&
+            (!unit3(l->axis) || !(l->cone_cos >= 0.0f && l->cone_cos <= 1.0f) ||
+             !(l->cone_aux >= 0.0f && l->cone_aux <= 1.0f) || (l->cone_aux == 0.0f && l->cone_cos != 1.0f)))
+            return fr_fail(err, "section lights, byte %zu: sun %u: axis not unit or bad disk", AT(l), i);
+    }
+    return 0;
+}
+
 /* Check every cross-reference so that rendering can index without checks. */
 static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
@@ -250,15 +337,8 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
             !finite3(s->planes[i].point))
             return fr_fail(err, "section planes, byte %zu: plane %u: material out of range or non-finite geometry",
                            AT(s->planes + i), i);
-    for (uint32_t i = 0; i < s->n_lights; i++) {
-        const fr_light *l = &s->lights[i];
-        if (l->kind > FR_LIGHT_PRIM || (l->kind == FR_LIGHT_PRIM && (l->prim >= s->n_prims || s->prims[l->prim].light != i)))
-            return fr_fail(err, "section lights, byte %zu: light %u: bad kind or primitive", AT(l), i);
-        if (!(l->pick > 0.0f && l->pick <= 1.0f) || !(l->cdf >= 0.0f && l->cdf <= 1.0f))
-            return fr_fail(err, "section lights, byte %zu: light %u: bad pick probability", AT(l), i);
-        if (l->kind == FR_LIGHT_POINT && (!finite3(l->position) || !finite3(l->intensity)))
-            return fr_fail(err, "section lights, byte %zu: light %u: non-finite point light", AT(l), i);
-    }
+    if (validate_lights(s, base, off, err) < 0)
+        return -1;
     return bvh_validate(s, base, err);
 }
 

@@ -1,5 +1,6 @@
 #include "light.h"
 
+#include "envmap.h"
 #include "fmath.h"
 #include "texture.h"
 
@@ -37,12 +38,60 @@ uint32_t lgt_pick(const fr_scene *s, float u)
     return lo;
 }
 
+static int is_distant(const fr_light *l) { return l->kind == FR_LIGHT_SUN || l->kind == FR_LIGHT_ENV; }
+
+uint32_t lgt_n_distant(const fr_scene *s)
+{
+    uint32_t n = 0;
+    while (n < s->n_lights && is_distant(&s->lights[n]))
+        n++;
+    return n;
+}
+
+float lgt_spot_falloff(const fr_light *l, float c)
+{
+    float d = l->cone_aux - l->cone_cos;
+    float t = (c - l->cone_cos) / (d > 0.001f ? d : 0.001f);
+    t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+    return t * t;
+}
+
+vec3 lgt_intensity(const fr_light *l, vec3 w)
+{
+    if (l->kind != FR_LIGHT_SPOT)
+        return l->intensity;
+    return v3_scale(l->intensity, lgt_spot_falloff(l, v3_dot(l->axis, w)));
+}
+
 /* 1 - cos of the half-angle of the cone a sphere subtends from distance d,
  * written without the cancellation of 1 - sqrt(1 - x) for small x. */
 static float cone_one_minus_cos(float r2, float d2)
 {
     float sin2 = r2 / d2;
     return sin2 / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - sin2)));
+}
+
+/* A direction uniform in the cone of unit axis w whose half-angle has
+ * 1 - cos = omc. */
+static vec3 cone_sample(vec3 w, float omc, float u1, float u2)
+{
+    float one_minus_ct = u1 * omc, ct = 1.0f - one_minus_ct;
+    float st = sqrtf(fmaxf(0.0f, one_minus_ct * (2.0f - one_minus_ct))), sn, cs;
+    fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
+    vec3 t, b;
+    v3_basis(w, &t, &b);
+    return v3_norm(v3_from_local(v3(st * cs, st * sn, ct), t, b, w));
+}
+
+/* Is unit d inside the cone of unit axis a with 1 - cos = omc?  Compared
+ * as |d - a|^2 = 2 (1 - cos), exact for small cones. */
+static int in_cone(vec3 d, vec3 a, float omc) { return v3_len2(v3_sub(d, a)) <= 2.0f * omc; }
+
+/* Radiance of a sun's disk: its irradiance over pi sin^2 of the half-angle. */
+static vec3 sun_radiance(const fr_light *l)
+{
+    float sin2 = l->cone_aux * (1.0f + l->cone_cos);
+    return v3_scale(l->intensity, 1.0f / (FM_PI * sin2));
 }
 
 float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
@@ -63,6 +112,20 @@ float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
     return l->pick * dist2 / (cosl * l->area);
 }
 
+vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf)
+{
+    const fr_light *l = &s->lights[light];
+    *pdf = 0.0f;
+    if (l->kind == FR_LIGHT_ENV) {
+        *pdf = l->pick * env_pdf(s, dir);
+        return env_radiance(s, dir);
+    }
+    if (l->kind != FR_LIGHT_SUN || l->cone_aux == 0.0f || !in_cone(dir, l->axis, l->cone_aux))
+        return v3s(0.0f);
+    *pdf = l->pick / (2.0f * FM_PI * l->cone_aux);
+    return sun_radiance(l);
+}
+
 /* Point the sample from `from` at out->p: fills dist and wi, returns the
  * squared distance (0 when the two points coincide, wi then unset). */
 static float aim(fr_light_sample *out, vec3 from)
@@ -76,29 +139,90 @@ static float aim(fr_light_sample *out, vec3 from)
     return d2;
 }
 
+/* Light samples of the lights that are not primitives. */
+static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u1, float u2, fr_light_sample *out)
+{
+    out->prim = FR_NONE;
+    if (l->kind == FR_LIGHT_POINT || l->kind == FR_LIGHT_SPOT) {
+        out->p = l->position;
+        float d2 = aim(out, from);
+        if (!(d2 > 0.0f))
+            return 0;
+        out->radiance = v3_scale(lgt_intensity(l, v3_neg(out->wi)), 1.0f / d2);
+        out->pdf = l->pick;
+        out->n = v3_neg(out->wi);
+        out->delta = 1;
+        out->distant = 0;
+        return !v3_is_zero(out->radiance);
+    }
+    out->dist = INFINITY;
+    out->distant = 1;
+    out->p = from;
+    if (l->kind == FR_LIGHT_SUN) {
+        out->delta = l->cone_aux == 0.0f;
+        if (out->delta) {
+            out->wi = l->axis;
+            out->radiance = l->intensity;
+            out->pdf = l->pick;
+        } else {
+            out->wi = cone_sample(l->axis, l->cone_aux, u1, u2);
+            out->radiance = sun_radiance(l);
+            out->pdf = l->pick / (2.0f * FM_PI * l->cone_aux);
+        }
+    } else {
+        float pdf;
+        out->delta = 0;
+        out->wi = env_sample(s, u1, u2, &pdf, &out->radiance);
+        out->pdf = l->pick * pdf;
+        if (!(out->pdf > 0.0f))
+            return 0;
+    }
+    out->n = v3_neg(out->wi);
+    return !v3_is_zero(out->radiance);
+}
+
+/* A point uniform by area on primitive `pr` from (u1, u2): its position,
+ * unit geometric normal, and the coordinates trace_surface takes. */
+static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2, vec3 *p, vec3 *n, float *ua, float *ub)
+{
+    if (pr->kind == FR_PRIM_SPHERE) {
+        const fr_sphere *sp = &s->spheres[pr->index];
+        float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
+        fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
+        *n = v3(r * cs, r * sn, z);
+        *p = v3_madd(sp->center, *n, sp->radius);
+        *ua = *ub = 0.0f;
+    } else if (pr->kind == FR_PRIM_RECT) {
+        const fr_rect *q = &s->rects[pr->index];
+        *p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, u1), v3_scale(q->edge_v, u2)));
+        *n = v3_norm(q->normal);
+        *ua = u1;
+        *ub = u2;
+    } else {
+        const fr_triangle *t = &s->triangles[pr->index];
+        vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
+        float su = sqrtf(u1), b1 = u2 * su, b0 = 1.0f - su;
+        *p = v3_add(v3_add(v3_scale(p0, b0), v3_scale(p1, b1)), v3_scale(p2, 1.0f - b0 - b1));
+        *n = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+        *ua = b1;
+        *ub = 1.0f - b0 - b1;
+    }
+}
+
 int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out)
 {
     if (s->n_lights == 0)
         return 0;
     uint32_t li = lgt_pick(s, upick);
     const fr_light *l = &s->lights[li];
-    if (l->kind == FR_LIGHT_POINT) {
-        out->p = l->position;
-        float d2 = aim(out, from);
-        if (!(d2 > 0.0f))
-            return 0;
-        out->radiance = v3_scale(l->intensity, 1.0f / d2);
-        out->pdf = l->pick;
-        out->n = v3_neg(out->wi);
-        out->prim = FR_NONE;
-        out->delta = 1;
-        return 1;
-    }
+    out->light = li;
+    if (l->kind != FR_LIGHT_PRIM)
+        return sample_other(s, l, from, u1, u2, out);
     const fr_prim *pr = &s->prims[l->prim];
     const fr_material *m = &s->materials[pr->material];
     out->delta = 0;
+    out->distant = 0;
     out->prim = l->prim;
-    float ua, ub;              /* the sampled point's coordinates on its primitive */
     if (pr->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[pr->index];
         vec3 dc = v3_sub(sp->center, from);
@@ -106,13 +230,7 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
         if (d2 > r2 * 1.0001f) {
             /* Uniform in the cone of directions that hit the sphere. */
             float omc = cone_one_minus_cos(r2, d2);
-            float one_minus_ct = u1 * omc, ct = 1.0f - one_minus_ct;
-            float st = sqrtf(fmaxf(0.0f, one_minus_ct * (2.0f - one_minus_ct))), sn, cs;
-            fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
-            float dlen = sqrtf(d2);
-            vec3 w = v3_scale(dc, 1.0f / dlen), t, b;
-            v3_basis(w, &t, &b);
-            out->wi = v3_norm(v3_from_local(v3(st * cs, st * sn, ct), t, b, w));
+            out->wi = cone_sample(v3_scale(dc, 1.0f / sqrtf(d2)), omc, u1, u2);
             /* Nearest intersection of the ray with the sphere, from the
              * projected half-chord. */
             float proj = v3_dot(dc, out->wi);
@@ -124,27 +242,10 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
             out->radiance = textured(s, m, l->prim, out->p, 0.0f, 0.0f, lgt_emitted(m, out->n, v3_neg(out->wi)));
             return out->pdf > 0.0f && !v3_is_zero(out->radiance);
         }
-        /* Inside the sphere: uniform on its surface. */
-        float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
-        fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
-        out->n = v3(r * cs, r * sn, z);
-        out->p = v3_madd(sp->center, out->n, sp->radius);
-        ua = ub = 0.0f;
-    } else if (pr->kind == FR_PRIM_RECT) {
-        const fr_rect *q = &s->rects[pr->index];
-        out->p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, u1), v3_scale(q->edge_v, u2)));
-        out->n = v3_norm(q->normal);
-        ua = u1;
-        ub = u2;
-    } else {
-        const fr_triangle *t = &s->triangles[pr->index];
-        vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
-        float su = sqrtf(u1), b1 = u2 * su, b0 = 1.0f - su;
-        out->p = v3_add(v3_add(v3_scale(p0, b0), v3_scale(p1, b1)), v3_scale(p2, 1.0f - b0 - b1));
-        out->n = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
-        ua = b1;
-        ub = 1.0f - b0 - b1;
     }
+    /* Uniform by area (a sphere seen from inside: over its whole surface). */
+    float ua, ub;
+    prim_point(s, pr, u1, u2, &out->p, &out->n, &ua, &ub);
     float d2 = aim(out, from);
     if (!(d2 > 0.0f))
         return 0;
@@ -154,4 +255,142 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
     out->pdf = l->pick * d2 / (cosl * l->area);
     out->radiance = textured(s, m, l->prim, out->p, ua, ub, lgt_emitted(m, out->n, v3_neg(out->wi)));
     return !v3_is_zero(out->radiance);
+}
+
+/* ---- rays leaving lights ------------------------------------------------ */
+
+/* A direction uniform over the sphere. */
+static vec3 sphere_dir(float u1, float u2)
+{
+    float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
+    fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
+    return v3(r * cs, r * sn, z);
+}
+
+/* The origin of a ray travelling along unit d into the world from outside
+ * it: a point uniform on the disk of the world's radius facing d, one
+ * radius back from the centre. */
+static vec3 disk_origin(const fr_world *w, vec3 d, float u1, float u2)
+{
+    vec3 t, b;
+    v3_basis(d, &t, &b);
+    float r = sqrtf(u1) * w->radius, sn, cs;
+    fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
+    vec3 c = v3_madd(w->center, d, -w->radius);
+    return v3_add(c, v3_add(v3_scale(t, r * cs), v3_scale(b, r * sn)));
+}
+
+int lgt_sample_emit(const fr_scene *s, float upick, float u1, float u2, float u3, float u4, fr_light_emit *out)
+{
+    if (s->n_lights == 0)
+        return 0;
+    uint32_t li = lgt_pick(s, upick);
+    const fr_light *l = &s->lights[li];
+    out->light = li;
+    out->prim = FR_NONE;
+    out->delta_pos = out->delta_dir = out->distant = 0;
+    if (l->kind == FR_LIGHT_POINT || l->kind == FR_LIGHT_SPOT) {
+        out->delta_pos = 1;
+        out->ray.o = l->position;
+        out->pdf_pos = l->pick;
+        if (l->kind == FR_LIGHT_POINT) {
+            out->ray.d = sphere_dir(u3, u4);
+            out->pdf_dir = 1.0f / (4.0f * FM_PI);
+        } else {
+            float omc = 1.0f - l->cone_cos;
+            out->ray.d = cone_sample(l->axis, omc, u3, u4);
+            out->pdf_dir = 1.0f / (2.0f * FM_PI * omc);
+        }
+        out->n = out->ray.d;
+        out->Le = lgt_intensity(l, out->ray.d);
+        return !v3_is_zero(out->Le);
+    }
+    if (l->kind == FR_LIGHT_SUN || l->kind == FR_LIGHT_ENV) {
+        const fr_world *w = &s->world;
+        vec3 toward;           /* from the scene toward the light */
+        out->distant = 1;
+        if (l->kind == FR_LIGHT_ENV) {
+            float pdf;
+            toward = env_sample(s, u3, u4, &pdf, &out->Le);
+            out->pdf_dir = pdf;
+            if (!(pdf > 0.0f))
+                return 0;
+        } else if (l->cone_aux == 0.0f) {
+            toward = l->axis;
+            out->delta_dir = 1;
+            out->pdf_dir = 1.0f;
+            out->Le = l->intensity;
+        } else {
+            toward = cone_sample(l->axis, l->cone_aux, u3, u4);
+            out->pdf_dir = 1.0f / (2.0f * FM_PI * l->cone_aux);
+            out->Le = sun_radiance(l);
+        }
+        out->ray.d = v3_neg(toward);
+        out->ray.o = disk_origin(w, out->ray.d, u1, u2);
+        out->n = out->ray.d;
+        out->pdf_pos = l->pick / (FM_PI * w->radius * w->radius);
+        return !v3_is_zero(out->Le);
+    }
+    const fr_prim *pr = &s->prims[l->prim];
+    const fr_material *m = &s->materials[pr->material];
+    float ua, ub;
+    vec3 p, n;
+    prim_point(s, pr, u1, u2, &p, &n, &ua, &ub);
+    float side_pdf = 1.0f;
+    if (m->two_sided) {
+        side_pdf = 0.5f;
+        if (u3 < 0.5f) {
+            u3 = 2.0f * u3;
+        } else {
+            u3 = 2.0f * u3 - 1.0f;
+            n = v3_neg(n);
+        }
+    }
+    /* Cosine-weighted about n. */
+    float r = sqrtf(u3), sn, cs;
+    fm_sincosf(2.0f * FM_PI * u4, &sn, &cs);
+    float z = sqrtf(fmaxf(0.0f, 1.0f - u3));
+    vec3 t, b;
+    v3_basis(n, &t, &b);
+    out->ray.o = p;
+    out->ray.d = v3_norm(v3_from_local(v3(r * cs, r * sn, z), t, b, n));
+    out->n = n;
+    out->prim = l->prim;
+    out->pdf_pos = l->pick / l->area;
+    out->pdf_dir = side_pdf * z * FM_INV_PI;
+    out->Le = textured(s, m, l->prim, p, ua, ub, lgt_emitted(m, n, out->ray.d));
+    return out->pdf_dir > 0.0f && !v3_is_zero(out->Le);
+}
+
+void lgt_pdf_emit(const fr_scene *s, uint32_t light, vec3 p, vec3 n, vec3 dir, float *pdf_pos, float *pdf_dir)
+{
+    const fr_light *l = &s->lights[light];
+    (void)p;
+    switch (l->kind) {
+    case FR_LIGHT_POINT:
+        *pdf_pos = l->pick;
+        *pdf_dir = 1.0f / (4.0f * FM_PI);
+        return;
+    case FR_LIGHT_SPOT:
+        *pdf_pos = l->pick;
+        *pdf_dir = v3_dot(dir, l->axis) >= l->cone_cos ? 1.0f / (2.0f * FM_PI * (1.0f - l->cone_cos)) : 0.0f;
+        return;
+    case FR_LIGHT_SUN:
+    case FR_LIGHT_ENV:
+        *pdf_pos = l->pick / (FM_PI * s->world.radius * s->world.radius);
+        if (l->kind == FR_LIGHT_ENV)
+            *pdf_dir = env_pdf(s, v3_neg(dir));
+        else
+            *pdf_dir = l->cone_aux > 0.0f && in_cone(v3_neg(dir), l->axis, l->cone_aux)
+                           ? 1.0f / (2.0f * FM_PI * l->cone_aux) : 0.0f;
+        return;
+    default: {
+        const fr_material *m = &s->materials[s->prims[l->prim].material];
+        float c = v3_dot(n, dir);
+        if (m->two_sided)
+            c = 0.5f * fabsf(c);
+        *pdf_pos = l->pick / l->area;
+        *pdf_dir = c > 0.0f ? c * FM_INV_PI : 0.0f;
+    }
+    }
 }

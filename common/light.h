@@ -1,10 +1,24 @@
 /** @file light.h
- * Sampling lights for next-event estimation, and the pdf of
- * having done so, for multiple importance sampling.
+ * Lights seen from the scene and lights as the start of paths.
  *
- * A light is picked with probability `pick` (proportional to its power);
- * then a point on it: uniform by area on rectangles and triangles, uniform
- * in the visible cone (solid angle) on spheres seen from outside.
+ * For next-event estimation: lgt_sample picks a light with probability
+ * `pick` (proportional to its power, binary search over the running sums)
+ * and a point or direction on it, and gives the solid-angle pdf of having
+ * done so; lgt_pdf and lgt_distant give the same pdf for a point or
+ * direction that a BSDF sample found, for multiple importance sampling.
+ * Points are chosen uniformly by area on rectangles and triangles,
+ * uniformly in the visible cone on spheres seen from outside and on a sun's
+ * disk, in proportion to the map (times sin theta) on an environment.
+ *
+ * For paths that start on a light (light tracing, bidirectional methods):
+ * lgt_sample_emit starts a ray on a light with the densities of its origin
+ * and direction, and lgt_pdf_emit gives those densities for a given ray.
+ *
+ * Light kinds and units are in scene.h (fr_light, fr_world).  Delta lights
+ * (point, spot, a sun without a disk) cannot be hit by a ray: they are
+ * reached by light sampling only.  Distant lights (sun, environment) are
+ * hit by rays that leave the scene; they come first in s->lights, and
+ * lgt_n_distant counts them.
  */
 #ifndef FRANJA_LIGHT_H
 #define FRANJA_LIGHT_H
@@ -14,27 +28,81 @@
 /** A point sampled on a light, as seen from a shading point. */
 typedef struct {
     vec3 wi;                   /**< unit direction from the shading point to the light */
-    float dist;                /**< distance to the sampled point */
-    vec3 radiance;             /**< incident radiance (area) or intensity/dist^2 (point) */
-    float pdf;                 /**< solid-angle pdf including the pick; for a point light the pick alone */
-    vec3 p, n;                 /**< sampled point and its light's normal */
-    uint32_t prim;             /**< the emitting prim, FR_NONE for a point light */
-    int delta;                 /**< 1 for point lights: no MIS */
+    float dist;                /**< distance to the sampled point; INFINITY for distant lights */
+    vec3 radiance;             /**< incident radiance (area, sun disk, environment), intensity/dist^2 (point, spot)
+                                    or irradiance (sun without a disk) */
+    float pdf;                 /**< solid-angle pdf including the pick; for a delta light the pick alone */
+    vec3 p, n;                 /**< sampled point and its light's normal (local lights only) */
+    uint32_t light;            /**< index into lights */
+    uint32_t prim;             /**< the emitting prim, FR_NONE for other lights */
+    int delta;                 /**< 1 for point, spot and a sun without a disk: no MIS */
+    int distant;               /**< 1 for sun and environment: the shadow ray is unbounded */
 } fr_light_sample;
 
 /** The light that lgt_sample picks with number u (the scene has lights). */
 uint32_t lgt_pick(const fr_scene *s, float u);
 
+/** Number of distant lights: lights[0 .. n) are the sun and environment lights. */
+uint32_t lgt_n_distant(const fr_scene *s);
+
 /** Sample a light as seen from point `from`.  Returns 0 if the scene has no
- * lights or the sample carries no light (back side of a one-sided emitter). */
+ * lights or the sample carries no light (back side of a one-sided emitter,
+ * outside a spot's cone, a black part of a map). */
 int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out);
 
 /** Solid-angle pdf that lgt_sample would have produced the point `p` (normal
  * `n`) of area light `light` from `from`. */
 float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n);
 
+/** Radiance that distant light `light` sends along -dir toward the scene
+ * (dir: unit, from the scene toward the sky), and in *pdf the solid-angle
+ * pdf, including the pick, with which lgt_sample picks that direction of
+ * that light.  Both 0 for a sun without a disk, and outside the disk. */
+vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf);
+
 /** Radiance an emissive material sends toward direction `w` from a surface
  * with geometric normal `ng` (front side only unless two-sided). */
 vec3 lgt_emitted(const fr_material *m, vec3 ng, vec3 w);
+
+/** Intensity (W/sr) that a point or spot light sends toward unit direction w. */
+vec3 lgt_intensity(const fr_light *l, vec3 w);
+
+/** glTF's spot falloff at cosine `c` from the axis: 1 inside the inner cone,
+ * 0 outside the outer one, ((c - cos_outer) / (cos_inner - cos_outer))^2
+ * between them (KHR_lights_punctual's reference, its denominator at least
+ * 0.001). */
+float lgt_spot_falloff(const fr_light *l, float c);
+
+/** A ray leaving a light. */
+typedef struct {
+    fr_ray ray;                /**< origin on the light, unit direction; for distant lights the origin lies on
+                                    a disk of the world's radius, facing the scene from outside its bounds */
+    vec3 n;                    /**< the surface normal at the origin (area lights, on the side emitted into);
+                                    ray.d for the other kinds */
+    vec3 Le;                   /**< radiance along the ray (area, sun disk, environment), intensity toward
+                                    ray.d (point, spot) or irradiance (sun without a disk) */
+    float pdf_pos;             /**< area density of the origin including the pick; the pick alone for point and
+                                    spot lights; pick / (pi r^2) for distant lights */
+    float pdf_dir;             /**< solid-angle density of ray.d; 1 for a sun without a disk */
+    uint32_t light;            /**< index into lights */
+    uint32_t prim;             /**< the emitting prim, FR_NONE for other lights */
+    int delta_pos;             /**< point and spot lights */
+    int delta_dir;             /**< a sun without a disk */
+    int distant;               /**< sun, environment */
+} fr_light_emit;
+
+/** Start a ray on a light: the light picked by upick as lgt_sample does,
+ * the origin from (u1, u2), the direction from (u3, u4): cosine-weighted
+ * about the normal for area lights (two-sided ones pick a side with u3),
+ * uniform over the sphere (point) or the outer cone (spot), from the disk
+ * (sun) or the map (environment).  Returns 0 when the ray carries no
+ * light. */
+int lgt_sample_emit(const fr_scene *s, float upick, float u1, float u2, float u3, float u4, fr_light_emit *out);
+
+/** The densities lgt_sample_emit gives a ray of light `light` leaving point
+ * p (with the light's normal n there; both ignored by distant lights) in
+ * unit direction dir.  Zero where it never starts one; pdf_dir is 0 for a
+ * sun without a disk. */
+void lgt_pdf_emit(const fr_scene *s, uint32_t light, vec3 p, vec3 n, vec3 dir, float *pdf_pos, float *pdf_dir);
 
 #endif

@@ -74,6 +74,30 @@ static vec3 emission(const fr_scene *s, pt_strategy strategy, const fr_material 
     return v3_scale(v3_mul(beta, le), w);
 }
 
+/* Light from the distant lights (sun disks, environment) that a ray
+ * leaving the scene along unit dir sees, times beta, each weighted against
+ * light sampling from the previous vertex as emission() weighs hits. */
+static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta, float prev_pdf, int prev_delta)
+{
+    vec3 L = v3s(0.0f);
+    uint32_t n = lgt_n_distant(s);
+    for (uint32_t i = 0; i < n; i++) {
+        float pdf;
+        vec3 le = lgt_distant(s, i, dir, &pdf);
+        if (v3_is_zero(le))
+            continue;
+        float w = 1.0f;
+        if (!prev_delta) {
+            if (strategy == PT_LIGHT_ONLY)
+                w = 0.0f;
+            else if (strategy != PT_BSDF_ONLY)
+                w = vtx_power_heuristic(prev_pdf, pdf);
+        }
+        L = v3_add(L, v3_scale(v3_mul(beta, le), w));
+    }
+    return L;
+}
+
 vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index)
 {
     fr_sampler smp;
@@ -96,6 +120,8 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
         int equi = mis.equiangular && depth < max_depth && s->n_lights;
         int kind = vtx_next(s, &smp, &ray, &medium, &beta, equi ? &L : NULL, &v);
         if (kind == VTX_ESCAPED)
+            L = v3_add(L, escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta));
+        if (kind == VTX_ESCAPED || kind == VTX_LOST)
             break;
         /* Each vertex draws three pairs: light pick and lobe, light
          * point, scattered direction (a medium vertex leaves the lobe

@@ -157,18 +157,59 @@ enum { FR_TRI_NORMALS = 1, FR_TRI_UVS = 2 };
 /** Infinite plane through `point` facing `normal` (unit).  Never a light. */
 typedef struct { vec3 point, normal; uint32_t material; uint32_t pad; } fr_plane;
 
-/** A light: a point light, or an emissive primitive (an area light). */
-enum { FR_LIGHT_POINT = 0, FR_LIGHT_PRIM = 1 };
+/** A light.  Kinds:
+ *  - FR_LIGHT_POINT: light from `position`, `intensity` W/sr in every direction;
+ *  - FR_LIGHT_PRIM: an emissive primitive (area light), `prim` and its `area`;
+ *  - FR_LIGHT_SPOT: a point light shining along unit `axis`, `intensity`
+ *    W/sr on the axis, scaled by glTF's smooth falloff between the cosines
+ *    `cone_cos` (outer cone) and `cone_aux` (inner cone), lgt_spot_falloff;
+ *  - FR_LIGHT_SUN: a distant light in direction `axis` (unit, from the scene
+ *    toward the sun); `intensity` is the irradiance (W/m^2) of a surface
+ *    facing it; a disk of half-angle acos(cone_cos), cone_aux = 1 - cone_cos
+ *    (kept exact for small angles); both 1 and 0 for a delta sun;
+ *  - FR_LIGHT_ENV: the environment; its parameters are in fr_world.
+ * Distant lights (sun, environment) come first in the table, so escaping
+ * rays test only them.  The pick probabilities follow the lights' power. */
+enum { FR_LIGHT_POINT = 0, FR_LIGHT_PRIM = 1, FR_LIGHT_SPOT = 2, FR_LIGHT_SUN = 3, FR_LIGHT_ENV = 4, FR_LIGHT_KINDS };
 typedef struct {
     uint32_t kind;             /**< FR_LIGHT_* */
-    uint32_t prim;             /**< FR_LIGHT_PRIM: index into prims */
-    vec3 position;             /**< FR_LIGHT_POINT */
-    vec3 intensity;            /**< FR_LIGHT_POINT: W/sr, i.e. radiance*area units */
+    uint32_t prim;             /**< FR_LIGHT_PRIM: index into prims; FR_NONE for the other kinds */
+    vec3 position;             /**< FR_LIGHT_POINT, FR_LIGHT_SPOT */
+    vec3 intensity;            /**< POINT, SPOT: W/sr (radiance x area units); SUN: irradiance normal to axis */
+    vec3 axis;                 /**< SPOT: unit direction it shines along; SUN: unit direction toward the sun */
     float area;                /**< FR_LIGHT_PRIM: surface area */
+    float cone_cos;            /**< SPOT: cosine of the outer cone angle; SUN: cosine of the disk's half-angle */
+    float cone_aux;            /**< SPOT: cosine of the inner cone angle; SUN: 1 - cone_cos */
     float pick;                /**< probability of picking this light (sums to 1) */
     float cdf;                 /**< sum of pick over lights[0..this], for binary search */
-    float pad;
 } fr_light;
+
+/** What surrounds the scene: its bounding sphere (distant lights enter
+ * through it) and the environment light.  The environment is a constant
+ * radiance `env_color`, or an equirectangular map (texture `env_texture`,
+ * an image) times env_color.  A direction d (unit, away from the scene) is
+ * first turned about +y: d' = (c x + s z, y, -s x + c z), c = rot_cos,
+ * s = rot_sin; then u = 1/2 + atan2(d'.z, d'.x) / (2 pi) and
+ * v = 1 - acos(d'.y) / pi pick the texel (v = 1 is the image's top row),
+ * which is Cycles' mapping for the same scene in Blender's +z-up frame.
+ *
+ * The map is importance-sampled from tables in `distrib`, starting at
+ * dist_first, for a map of w x h texels: pdf[h*w] (piecewise-constant
+ * density over the unit square (u, 1 - v), row 0 at the top, integrating
+ * to 1), then marginal[h+1] (cumulative over rows, from 0 to 1), then
+ * conditional[h][w+1] (cumulative over each row's columns, 0 to 1). */
+enum { FR_ENV_NONE = 0, FR_ENV_CONSTANT = 1, FR_ENV_MAP = 2 };
+typedef struct {
+    vec3 center;               /**< bounding sphere of the bounded shapes and the planes' points */
+    float radius;              /**< > 0 */
+    uint32_t env;              /**< FR_ENV_* */
+    uint32_t env_light;        /**< index of the FR_LIGHT_ENV light, FR_NONE without an environment */
+    uint32_t env_texture;      /**< FR_ENV_MAP: index into textures */
+    uint32_t dist_first;       /**< FR_ENV_MAP: index of the tables in distrib */
+    vec3 env_color;            /**< radiance (constant), or the map's multiplier (colour x strength) */
+    float rot_cos, rot_sin;    /**< the turn about +y */
+    uint32_t pad[3];
+} fr_world;
 
 /** An 8-wide BVH node (256 bytes, four cache lines): the boxes of its
  * eight children side by side (structure of arrays), so one ray is tested
@@ -232,6 +273,8 @@ typedef struct {
     const fr_light *lights;       uint32_t n_lights;
     const fr_bvh_node *nodes;     uint32_t n_nodes;
     const fr_bvh_leaf *leaves;    uint32_t n_leaves;
+    fr_world world;
+    const float *distrib;         uint32_t n_distrib;
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

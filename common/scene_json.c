@@ -12,6 +12,7 @@
 #include "jsonval.h"
 #include "proto_limits.h"
 #include "scene_appear.h"
+#include "scene_light.h"
 
 #define PATHLEN 160
 
@@ -297,38 +298,6 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
     return r == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
 }
 
-static int parse_lights(ctx *c, const cJSON *a)
-{
-    if (!a)
-        return 0;
-    if (!cJSON_IsArray(a))
-        return fr_fail(c->err, "lights: expected an array");
-    int i = 0;
-    for (const cJSON *o = a->child; o; o = o->next, i++) {
-        static const char *const f[] = {"type", "position", "intensity", NULL};
-        char where[PATHLEN];
-        snprintf(where, sizeof where, "lights[%d]", i);
-        if (!cJSON_IsObject(o))
-            return fr_fail(c->err, "%s: expected an object", where);
-        const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
-        if (!cJSON_IsString(t) || strcmp(t->valuestring, "point") != 0)
-            return fr_fail(c->err, "%s.type: expected \"point\" (area lights are shapes with emission)", where);
-        fr_light l;
-        memset(&l, 0, sizeof l);
-        l.kind = FR_LIGHT_POINT;
-        l.prim = FR_NONE;
-        if (jv_only_fields(o, where, f, c->err) < 0 ||
-            jv_vec3(o, "position", where, 1, v3s(0), &l.position, c->err) < 0 ||
-            jv_vec3(o, "intensity", where, 1, v3s(0), &l.intensity, c->err) < 0)
-            return -1;
-        if (!nonneg3(l.intensity) || v3_is_zero(l.intensity))
-            return fr_fail(c->err, "%s.intensity: expected a non-negative, non-zero colour", where);
-        if (bld_push(&c->b->lights, &l) == FR_NONE)
-            return fr_fail(c->err, "%s: out of memory", where);
-    }
-    return 0;
-}
-
 int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, fr_builder *b, fr_error *err)
 {
     fr_error e;
@@ -347,7 +316,7 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
     memset(&look, 0, sizeof look);
     ctx c = {file, dir, hooks, b, NULL, &e, &look};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
-                                      "textures", "media", "medium", "tonemap", NULL};
+                                      "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
     if (!cJSON_IsObject(root)) {
         fr_fail(&e, "(top level): expected an object");
@@ -356,7 +325,8 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
                parse_camera(&c, cJSON_GetObjectItemCaseSensitive(root, "camera")) == 0 &&
                scn_appear_begin(&look, root, dir, hooks, b, &e) == 0 &&
                parse_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials")) == 0 &&
-               parse_lights(&c, cJSON_GetObjectItemCaseSensitive(root, "lights")) == 0) {
+               scn_lights(&look, cJSON_GetObjectItemCaseSensitive(root, "lights"), &e) == 0 &&
+               scn_environment(&look, cJSON_GetObjectItemCaseSensitive(root, "environment"), &e) == 0) {
         const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
         if (!cJSON_IsArray(shapes)) {
             fr_fail(&e, "shapes: missing or not an array");
@@ -377,7 +347,8 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
                     emissive |= !v3_is_zero(((const fr_material *)b->materials.data)[p->material].emission);
                 }
                 if (!emissive)
-                    rc = fr_fail(&e, "lights: the scene has no light (no point light, no emissive shape)");
+                    rc = fr_fail(&e, "lights: the scene has no light (no point, spot or sun light, no environment, no "
+                                 "emissive shape)");
             }
             if (rc == 0)
                 rc = scn_appear_finish(&look, root, &e);

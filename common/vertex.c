@@ -25,7 +25,7 @@ static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, f
     const fr_medium *md = &s->media[medium - 1];
     const fr_light *l = &s->lights[lgt_pick(s, upick)];
     float t, pe;
-    if (l->kind != FR_LIGHT_POINT || v3_is_zero(md->sigma_s) ||
+    if ((l->kind != FR_LIGHT_POINT && l->kind != FR_LIGHT_SPOT) || v3_is_zero(md->sigma_s) ||
         !med_equiangular(ray->o, ray->d, tmax, l->position, u, &t, &pe))
         return v3s(0.0f);
     vec3 x = v3_madd(ray->o, ray->d, t), to = v3_sub(l->position, x);
@@ -36,7 +36,7 @@ static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, f
         return v3s(0.0f);
     float pd = med_distance_pdf(md, beta, t);
     float w = vtx_power_heuristic(pe, pd) * med_phase(md->g, v3_dot(ray->d, shadow.d)) / (pe * l->pick * d2);
-    vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, l->intensity));
+    vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, lgt_intensity(l, v3_neg(shadow.d))));
     return v3_scale(v3_mul(beta, f), w);
 }
 
@@ -85,7 +85,7 @@ int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, 
         if (!mb->interface)
             return v->kind = VTX_SURFACE;
         if (crossings == MAX_CROSSINGS)
-            return VTX_ESCAPED;
+            return v->kind = VTX_LOST;
         *medium = med_after(s, *medium, mb, v->sf.ng, ray->d);
         ray->o = geo_offset(v->sf.p, v->sf.perr, v->sf.ng, ray->d);
         found = trace_closest(s, ray, INFINITY, &hit);
@@ -102,7 +102,7 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
     if (v3_is_zero(f))
         return 0;
     fr_ray shadow = {geo_offset(sf->p, sf->perr, sf->ng, ls->wi), ls->wi};
-    float tmax = v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
+    float tmax = ls->distant ? INFINITY : v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
     vec3 tr = v3s(1.0f);
     if (s->n_media && tmax > 0.0f)
         tr = med_shadow(s, med_after(s, medium, m, sf->ng, ls->wi), &shadow, tmax, ls->prim);
@@ -126,7 +126,7 @@ int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, v
     float ph = med_phase(md->g, v3_dot(v->seg.d, ls->wi));
     out->scatter_pdf = ph;
     out->weight = 1.0f;
-    if (ls->delta && mis.equiangular)
+    if (ls->delta && !ls->distant && mis.equiangular)
         out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t),
                                           med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, ls->p, v->t));
     else if (!ls->delta && mis.area)

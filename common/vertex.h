@@ -21,11 +21,12 @@
 #include "sampler.h"
 
 /** What vtx_next found. */
-enum { VTX_ESCAPED = 0, VTX_SURFACE = 1, VTX_MEDIUM = 2 };
+enum { VTX_ESCAPED = 0, VTX_SURFACE = 1, VTX_MEDIUM = 2, VTX_LOST = 3 };
 
 /** The next vertex of a path. */
 typedef struct {
-    int kind;                  /**< VTX_ESCAPED, VTX_SURFACE or VTX_MEDIUM */
+    int kind;                  /**< VTX_ESCAPED (the ray left the scene along its direction: distant lights),
+                                    VTX_SURFACE, VTX_MEDIUM, or VTX_LOST (caught between interfaces: no light) */
     fr_surface sf;             /**< VTX_SURFACE: the surface (never a media interface) */
     vec3 p;                    /**< VTX_MEDIUM: the scattering point */
     fr_ray seg;                /**< VTX_MEDIUM: the segment scattered on (origin, unit direction) */
@@ -38,8 +39,10 @@ typedef struct {
  * importance sampling, power heuristic); a technique not weighed gets
  * weight 1. */
 typedef struct {
-    int area;                  /**< area lights against the vertex's own scattering (BSDF or phase) */
-    int equiangular;           /**< point lights seen from a medium: distance sampling against equiangular */
+    int area;                  /**< lights a ray can hit (area lights, sun disks, the environment) against the
+                                    vertex's own scattering (BSDF or phase) */
+    int equiangular;           /**< point and spot lights seen from a medium: distance sampling against
+                                    equiangular */
 } vtx_mis;
 
 /** Power heuristic with beta = 2 (Veach 1997): the weight of a sample of
@@ -57,8 +60,8 @@ float vtx_power_heuristic(float a, float b);
  * sampling; the path scatters on the segment (VTX_MEDIUM) or reaches its
  * end, and *beta takes the segment's weight.  Interface surfaces are
  * crossed (updating *medium and ray->o; at most 64, then the path is lost:
- * VTX_ESCAPED).  When equi_L is not NULL, each medium segment also adds to
- * *equi_L the single-scattering estimate of a point light by equiangular
+ * VTX_LOST).  When equi_L is not NULL, each medium segment also adds to
+ * *equi_L the single-scattering estimate of a point or spot light by equiangular
  * sampling (Kulla and Fajardo 2012), weighted against the free-flight
  * sampling this walk does; vtx_direct_medium gives the complementary
  * weight.  The numbers are drawn either way. */

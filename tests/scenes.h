@@ -8,18 +8,22 @@
 #include "freeze.h"
 #include "scene_json.h"
 
-/* Parse and freeze a scene from JSON text; aborts the test on error since
- * every later check would be meaningless. */
-static inline void test_scene(const char *json, fr_scene *out)
+/* Parse and freeze a scene from JSON text as if read from `file` (relative
+ * names resolve beside it), with asset loaders `hooks` (may be NULL);
+ * aborts the test on error since every later check would be meaningless. */
+static inline void test_scene_with(const char *json, const char *file, const scn_hooks *hooks, fr_scene *out)
 {
     fr_builder b;
     fr_error err;
     bld_init(&b);
-    if (scn_parse_json(json, "(test)", NULL, &b, &err) < 0 || frz_scene(&b, out, &err) < 0) {
+    if (scn_parse_json(json, file, hooks, &b, &err) < 0 || frz_scene(&b, out, &err) < 0) {
         printf("FAIL scene: %s\n", err.msg);
         exit(1);
     }
     bld_free(&b);
 }
+
+/* Parse and freeze a scene from JSON text (no asset loaders). */
+static inline void test_scene(const char *json, fr_scene *out) { test_scene_with(json, "(test)", NULL, out); }
 
 #endif

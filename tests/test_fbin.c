@@ -17,6 +17,7 @@
 #include "fbin.h"
 #include "freeze.h"
 #include "pathtrace.h"
+#include "pfmmap.h"
 #include "scenes.h"
 
 static const char *scene_json =
@@ -226,6 +227,68 @@ static void test_contents(void)
     memcpy(&u, &nan, 4);
     poke("camera NaN", section(g, 2), u, "section camera");
     poke("settings width", section(g, 1), 0, "section settings");
+}
+
+/* The lights and the world of a scene with every kind of light and an
+ * environment map: damaged values are refused, naming the section. */
+static void test_lights(void)
+{
+    char dir[] = "/tmp/franja-fbinXXXXXX", path[256], file[256];
+    CHECK(mkdtemp(dir) != NULL, "mkdtemp");
+    snprintf(path, sizeof path, "%s/m.pfm", dir);
+    snprintf(file, sizeof file, "%s/s.json", dir);
+    float map[4 * 2 * 3];
+    for (int i = 0; i < 24; i++)
+        map[i] = 0.1f * (float)(i + 1);
+    CHECK(pfm_write(path, 4, 2, map) == 0, "write %s", path);
+    fr_scene lit;
+    test_scene_with(
+        "{\"image\": {\"width\": 8, \"height\": 8}, \"camera\": {\"position\": [0, 0, -5], \"target\": [0, 0, 0],"
+        " \"fov\": 40}, \"materials\": {\"g\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]}},"
+        " \"textures\": {\"m\": {\"type\": \"image\", \"file\": \"m.pfm\"}}, \"environment\": {\"color\": \"m\"},"
+        " \"lights\": [{\"type\": \"spot\", \"position\": [0, 3, 0], \"direction\": [0, -1, 0], \"intensity\": [5, 5, 5]},"
+        "  {\"type\": \"sun\", \"direction\": [0, -1, 0], \"irradiance\": [1, 1, 1], \"angle\": 1}],"
+        " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"g\"}]}",
+        file, &pfm_hooks, &lit);
+    unlink(path);
+    rmdir(dir);
+    CHECK(lit.n_lights == 3 && lit.lights[0].kind == FR_LIGHT_ENV && lit.lights[1].kind == FR_LIGHT_SUN &&
+              lit.lights[2].kind == FR_LIGHT_SPOT && lit.world.env_light == 0,
+          "lights not in the order environment, sun, spot");
+    CHECK(lit.n_distrib == 4 * 2 + 3 + 2 * 5, "environment tables: %u values", lit.n_distrib);
+    fr_scene keep = good;
+    good = lit;
+    const unsigned char *g = good.blob;
+    size_t light = section(g, 12), world = section(g, 20), dist = section(g, 21);
+    float neg = -1.0f, half = 0.5f, two = 2.0f;
+    uint32_t u;
+    memcpy(&u, &neg, 4);
+    poke_at("world radius", world + 12, u, "section world", world);
+    poke_at("environment light index", world + 20, 2, "section world", world + 20);
+    poke_at("environment kind", world + 16, 7, "section world", world);
+    poke_at("environment texture", world + 24, 5, "section world", world + 24);
+    memcpy(&u, &two, 4);
+    poke_at("rotation not a rotation", world + 44, u, "section world", world);
+    memcpy(&u, &neg, 4);
+    poke_at("negative density", dist + 4, u, "section distrib", dist + 4);
+    memcpy(&u, &half, 4);
+    poke_at("row table not ending at 1", dist + 4 * (8 + 2), u, "section distrib", dist + 4 * 8);
+    poke_at("column table not increasing", dist + 4 * (8 + 3 + 1), u, "section distrib", dist + 4 * (8 + 3));
+    /* Sun and spot swap kinds: the spot's fields make a valid sun, after a local light. */
+    unsigned char *p = copy_blob();
+    put32(p + light + 64, FR_LIGHT_POINT);
+    put32(p + light + 2 * 64, FR_LIGHT_SUN);
+    rehash(p, good.blob_size);
+    char at[32];
+    snprintf(at, sizeof at, "byte %zu:", light + 2 * 64);
+    REFUSE("a distant light after a local one", p, good.blob_size, "section lights", at, "after a local");
+    free(p);
+    poke_at("spot cone inverted", light + 2 * 64 + 52, u, "section lights", light + 2 * 64);
+    poke_at("sun axis not unit", light + 64 + 32, u, "section lights", light + 64);
+    poke_at("second environment", light + 64, FR_LIGHT_ENV, "section lights", light + 64);
+    poke_at("light kind", light + 64, 9, "section lights", light + 64);
+    good = keep;
+    scn_free(&lit);
 }
 
 /* A BVH written by hand (through fbin_serialize, so the hash is right). */
@@ -453,6 +516,7 @@ int main(void)
     test_contents();
     test_shapes();
     test_texture_sizes();
+    test_lights();
     scn_free(&good);
     return check_done();
 }

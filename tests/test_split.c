@@ -1,11 +1,14 @@
 /* Split invariance: the full image and its concatenation from uneven
  * slabs (2, 3 and 7 of them) are byte-identical, on a scene with every
- * material kind and both light kinds. */
+ * material kind, point and area lights, and on one lit by an environment
+ * map, a sun disk and a spot, with a medium inside a box. */
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "pathtrace.h"
+#include "pfmmap.h"
 #include "scenes.h"
 
 static const char scene[] =
@@ -24,6 +27,22 @@ static const char scene[] =
     "   {\"type\": \"triangle\", \"vertices\": [[-2, 0, 2], [2, 0, 2], [0, 2.5, 2]], \"material\": \"mix\"},"
     "   {\"type\": \"rect\", \"origin\": [-1, 3, -1], \"edge_u\": [2, 0, 0], \"edge_v\": [0, 0, 1], \"material\": \"lamp\"}]}";
 
+static const char sky_scene[] =
+    "{\"image\": {\"width\": 21, \"height\": 17, \"spp\": 3, \"max_depth\": 6, \"seed\": 2},"
+    " \"camera\": {\"position\": [0, 1, -5], \"target\": [0, 0.8, 0], \"fov\": 50},"
+    " \"textures\": {\"sky\": {\"type\": \"image\", \"file\": \"sky.pfm\"}},"
+    " \"environment\": {\"color\": \"sky\", \"rotation\": 20},"
+    " \"media\": {\"smoke\": {\"sigma_s\": 0.8, \"sigma_a\": 0.1}},"
+    " \"materials\": {"
+    "   \"floor\": {\"type\": \"phong\", \"diffuse\": [0.4, 0.3, 0.3], \"glossy\": [0.3, 0.3, 0.3], \"exponent\": 40},"
+    "   \"glass\": {\"type\": \"glass\", \"ior\": 1.5}, \"smoke\": {\"type\": \"interface\", \"medium\": \"smoke\"}},"
+    " \"lights\": [{\"type\": \"sun\", \"direction\": [1, -2, 1], \"irradiance\": [3, 3, 2], \"angle\": 3},"
+    "   {\"type\": \"spot\", \"position\": [0, 3, 0], \"target\": [0, 0, 0], \"intensity\": [9, 9, 9]}],"
+    " \"shapes\": ["
+    "   {\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"floor\"},"
+    "   {\"type\": \"sphere\", \"center\": [0.8, 0.6, -0.5], \"radius\": 0.6, \"material\": \"glass\"},"
+    "   {\"type\": \"box\", \"min\": [-2, 0.01, 0], \"max\": [-0.5, 1.5, 1.5], \"material\": \"smoke\"}]}";
+
 static void check_split(const fr_scene *s, const float *full, const uint32_t *cuts, int n)
 {
     uint32_t w = s->settings.width, h = s->settings.height;
@@ -34,32 +53,56 @@ static void check_split(const fr_scene *s, const float *full, const uint32_t *cu
     free(img);
 }
 
+static void split_all(const fr_scene *s);
+
 int main(void)
 {
     fr_scene s;
     test_scene(scene, &s);
-    uint32_t w = s.settings.width, h = s.settings.height;
-    float *full = malloc((size_t)w * h * 3 * sizeof *full);
-    pt_render_rows(&s, PT_MIS, 0, h, full);
-    /* The image is not black (the test would be empty otherwise). */
-    double sum = 0;
-    for (size_t i = 0; i < (size_t)w * h * 3; i++)
-        sum += full[i];
-    CHECK(sum > 1.0, "the test image is black");
-    const uint32_t two[] = {0, 11, 19};
-    const uint32_t three[] = {0, 1, 13, 19};
-    const uint32_t seven[] = {0, 2, 3, 7, 8, 12, 18, 19};
-    check_split(&s, full, two, 3);
-    check_split(&s, full, three, 4);
-    check_split(&s, full, seven, 8);
+    split_all(&s);
     /* A different seed gives a different image: the seed is really used. */
+    uint32_t w = s.settings.width, h = s.settings.height;
+    float *full = malloc((size_t)w * h * 3 * sizeof *full), *other = malloc((size_t)w * h * 3 * sizeof *other);
+    pt_render_rows(&s, PT_MIS, 0, h, full);
     fr_scene s2 = s;
     s2.settings.seed = 6;
-    float *other = malloc((size_t)w * h * 3 * sizeof *other);
     pt_render_rows(&s2, PT_MIS, 0, h, other);
     CHECK(memcmp(other, full, (size_t)w * h * 3 * sizeof *other) != 0, "seed does not change the image");
     free(other);
     free(full);
     scn_free(&s);
+    char dir[] = "/tmp/franja-splitXXXXXX", path[256], file[256];
+    CHECK(mkdtemp(dir) != NULL, "mkdtemp");
+    snprintf(path, sizeof path, "%s/sky.pfm", dir);
+    snprintf(file, sizeof file, "%s/sky.json", dir);
+    float map[16 * 8 * 3];
+    for (int i = 0; i < 16 * 8 * 3; i++)
+        map[i] = 0.2f + (float)((i * 7) % 11) * 0.1f;
+    CHECK(pfm_write(path, 16, 8, map) == 0, "write %s", path);
+    test_scene_with(sky_scene, file, &pfm_hooks, &s);
+    unlink(path);
+    rmdir(dir);
+    split_all(&s);
+    scn_free(&s);
     return check_done();
+}
+
+/* The full image of s against its slabs. */
+static void split_all(const fr_scene *s)
+{
+    uint32_t w = s->settings.width, h = s->settings.height;
+    float *full = malloc((size_t)w * h * 3 * sizeof *full);
+    pt_render_rows(s, PT_MIS, 0, h, full);
+    /* The image is not black (the test would be empty otherwise). */
+    double sum = 0;
+    for (size_t i = 0; i < (size_t)w * h * 3; i++)
+        sum += full[i];
+    CHECK(sum > 1.0, "the test image is black");
+    const uint32_t two[] = {0, 11, h};
+    const uint32_t three[] = {0, 1, 13, h};
+    const uint32_t seven[] = {0, 2, 3, 7, 8, 12, h - 1, h};
+    check_split(s, full, two, 3);
+    check_split(s, full, three, 4);
+    check_split(s, full, seven, 8);
+    free(full);
 }
