@@ -17,7 +17,8 @@ vec2 env_uv(const fr_scene *s, vec3 dir)
     vec3 d = turn(&s->world, dir);
     float u = 0.5f + fm_atan2f(d.z, d.x) * FM_INV_2PI;
     float v = 1.0f - fm_acosf(d.y) * FM_INV_PI;
-    vec2 r = {u < 0.0f ? 0.0f : u > 1.0f ? 1.0f : u, v < 0.0f ? 0.0f : v > 1.0f ? 1.0f : v};
+    /* Clamped, NaN (from a NaN direction) to 0, so texel indices stay in range. */
+    vec2 r = {u >= 0.0f ? (u <= 1.0f ? u : 1.0f) : 0.0f, v >= 0.0f ? (v <= 1.0f ? v : 1.0f) : 0.0f};
     return r;
 }
 
