@@ -1,6 +1,8 @@
 /* cli.c -- option parsing shared by the subcommands. */
 #include "cli.h"
 
+#include "transport_backend.h"
+
 #include <errno.h>
 #include <limits.h>
 #include <stdio.h>
@@ -122,6 +124,91 @@ int cli_common_option(int argc, char **argv, int *i, const char *usage, tr_optio
     }
     *hosts = argv[++*i];
     return CLI_TAKEN;
+}
+
+int cli_slurm_option(int argc, char **argv, int *i, cli_slurm *s)
+{
+    const char *a = argv[*i];
+    if (!strcmp(a, "--slurm")) {
+        s->on = 1;
+        return CLI_TAKEN;
+    }
+    if (strcmp(a, "--worker") && strcmp(a, "--workdir") && strcmp(a, "--shared-workdir"))
+        return CLI_OTHER;
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "franja: %s needs a value\n", a);
+        return CLI_BAD;
+    }
+    const char *v = argv[++*i];
+    if (v[0] != '/') {
+        fprintf(stderr, "franja: %s: '%s' is not an absolute path (the nodes must find it wherever they run)\n",
+                a, v);
+        return CLI_BAD;
+    }
+    if (strlen(v) >= 400) {
+        fprintf(stderr, "franja: %s: path too long\n", a);
+        return CLI_BAD;
+    }
+    if (!strcmp(a, "--worker"))
+        s->worker = v;
+    else {
+        if (s->workdir) {
+            fprintf(stderr, "franja: give one of --workdir and --shared-workdir, once\n");
+            return CLI_BAD;
+        }
+        s->workdir = v;
+        s->shared = !strcmp(a, "--shared-workdir");
+    }
+    return CLI_TAKEN;
+}
+
+int cli_slurm_check(const char *cmd, const cli_slurm *s, const char *hosts)
+{
+    if (s->on && hosts) {
+        fprintf(stderr, "franja %s: --slurm and --hosts exclude each other (the allocation is the host list)\n",
+                cmd);
+        return -1;
+    }
+    if (!s->on && (s->worker || s->workdir)) {
+        fprintf(stderr, "franja %s: %s applies to --slurm only (a host table has worker= and workdir=)\n", cmd,
+                s->worker ? "--worker" : s->shared ? "--shared-workdir" : "--workdir");
+        return -1;
+    }
+    return 0;
+}
+
+int cli_slurm_hosts(const char *cmd, const cli_slurm *s, int argc, char **argv, tr_options *o, slurm_alloc *a,
+                    hosts_table *t)
+{
+    fr_error err;
+    const char *worker = s->worker ? s->worker : o->local_worker;
+    if (slurm_open(a, worker, o->timeout_s, &err) == 0) {
+        if (s->workdir) {
+            snprintf(a->workdir, sizeof a->workdir, "%s", s->workdir);
+            a->shared = s->shared;
+        }
+        if (slurm_hosts(a, t, &err) == 0) {
+            o->backend = &tr_slurm_backend;
+            o->backend_ctx = a;
+            return 0;
+        }
+    }
+    fprintf(stderr, "franja %s: --slurm: %s\n", cmd, err.msg);
+    if (!a->job[0] && !getenv("SLURM_JOB_ID")) {
+        /* The command as typed, program name first. */
+        char **words = calloc((size_t)argc + 1, sizeof *words);
+        if (words) {
+            words[0] = program_invocation_name;
+            for (int k = 0; k < argc; k++)
+                words[k + 1] = argv[k];
+            char hint[6000];
+            slurm_hint(argc + 1, words, hint, sizeof hint);
+            fprintf(stderr, "%s\n", hint);
+            free(words);
+        }
+    }
+    slurm_close(a);
+    return -1;
 }
 
 int cli_load_hosts(const char *cmd, const char *path, hosts_table *t)

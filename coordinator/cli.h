@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "hosts.h"
+#include "slurm.h"
 #include "transport.h"
 
 /** Help text for the options cli_transport_option understands. */
@@ -36,6 +37,45 @@ enum {
  * *hosts, which points into argv) or --help / -h (prints usage, then
  * cli_transport_help).  Advances *i past a consumed value. */
 int cli_common_option(int argc, char **argv, int *i, const char *usage, tr_options *o, const char **hosts);
+
+/** Where the hosts come from when they are a Slurm allocation (--slurm). */
+typedef struct {
+    int on;                    /**< --slurm */
+    const char *worker;        /**< --worker PATH, or NULL */
+    const char *workdir;       /**< --workdir DIR or --shared-workdir DIR, or NULL */
+    int shared;                /**< it was --shared-workdir */
+} cli_slurm;
+
+/** Help text for the options cli_slurm_option understands (a string
+ * literal, to be joined to a command's usage). */
+#define CLI_SLURM_HELP                                                                    \
+    "  --slurm              run the workers as job steps of the Slurm allocation this\n" \
+    "                       runs in (salloc, sbatch): one per allocated CPU\n"           \
+    "  --worker PATH        (--slurm) the worker program on the nodes (default: the\n"   \
+    "                       franja-worker beside this franja)\n"                         \
+    "  --workdir DIR        (--slurm) scene cache on each node's own disk (default\n"    \
+    "                       /tmp/franja-USER); scenes are sent there with sbcast\n"      \
+    "  --shared-workdir DIR (--slurm) a directory that this machine and every node\n"    \
+    "                       share: scenes are copied there once, no sbcast\n"
+
+/** If argv[*i] is --slurm, --worker, --workdir or --shared-workdir,
+ * consumes it (and its value) into *s and returns CLI_TAKEN; CLI_OTHER if
+ * it is not one; CLI_BAD (after a message) for a missing or relative path. */
+int cli_slurm_option(int argc, char **argv, int *i, cli_slurm *s);
+
+/** Opens the Slurm allocation franja runs in (slurm_open) as the host
+ * table t: one host per node, served by the Slurm backend (o->backend and
+ * o->backend_ctx point at *a, which must outlive the hosts).  Refuses
+ * --hosts with --slurm, and --worker or a work directory without it.  On
+ * failure prints "franja CMD: ..." (outside an allocation: the salloc and
+ * sbatch lines to use, built from argv) and returns -1 with nothing to
+ * free; on success free with hosts_free and slurm_close. */
+int cli_slurm_hosts(const char *cmd, const cli_slurm *s, int argc, char **argv, tr_options *o, slurm_alloc *a,
+                    hosts_table *t);
+
+/** Checks the combination of --slurm and its options with --hosts; on a
+ * conflict prints "franja CMD: ..." and returns -1. */
+int cli_slurm_check(const char *cmd, const cli_slurm *s, const char *hosts);
 
 /** Loads the host table at path into t (freed with hosts_free); on failure
  * prints "franja CMD: <what is wrong, with file:line>" on stderr and returns

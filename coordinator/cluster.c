@@ -112,6 +112,20 @@ int cl_check_versions(const cl_host *hosts, int n, fr_error *err)
     return 0;
 }
 
+void cl_drop_other_versions(cl_host *hosts, int n)
+{
+    char want[128];
+    proto_version_line("franja-worker", want, sizeof want);
+    for (int i = 0; i < n; i++) {
+        cl_host *h = &hosts[i];
+        if (!h->tr || !strcmp(h->info.version, want))
+            continue;
+        fr_fail(&h->err, "its worker reports '%s', this franja needs '%s'", h->info.version, want);
+        tr_close(h->tr);
+        h->tr = NULL;
+    }
+}
+
 void cl_close(cl_host *hosts, int n)
 {
     for (int i = 0; i < n; i++) {

@@ -44,6 +44,13 @@ void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint
  * or a scene format other than this build's; the message names the host. */
 int cl_check_versions(const cl_host *hosts, int n, fr_error *err);
 
+/** Closes every ready host whose worker's version line is not this
+ * build's ("franja-worker VERSION scene-format N"), setting its err to say
+ * which version it has and which is needed: for hosts that are meant to
+ * run one and the same worker (the nodes of a Slurm allocation), where one
+ * that differs is a broken node rather than a reason to stop. */
+void cl_drop_other_versions(cl_host *hosts, int n);
+
 /** Closes every host (tr_close). */
 void cl_close(cl_host *hosts, int n);
 

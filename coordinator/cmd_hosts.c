@@ -12,15 +12,18 @@
 
 static const char usage[] =
     "usage: franja hosts check --hosts FILE [options]\n"
-    "       franja hosts list --hosts FILE\n"
+    "       franja hosts check --slurm [options]\n"
+    "       franja hosts list --hosts FILE | --slurm\n"
     "\n"
     "check: connects to every host of the table, verifies its key against\n"
     "known_hosts, and reports its architecture, OS, cores, worker version and\n"
     "scene cache, or exactly what is wrong with it.  Exit status 0 only if every\n"
-    "host is usable.\n"
+    "host is usable.  With --slurm the hosts are the nodes of the allocation\n"
+    "this runs in, reached with job steps, and cores are the CPUs allocated.\n"
     "list:  parses the table and prints it with the defaults filled in.\n"
     "\n"
-    "  --hosts FILE         host table (franja-hosts(5))\n";
+    "  --hosts FILE         host table (franja-hosts(5))\n"
+    CLI_SLURM_HELP;
 
 static void list(const hosts_table *t)
 {
@@ -39,7 +42,7 @@ static void list(const hosts_table *t)
     }
 }
 
-static int check(const hosts_table *t, const tr_options *o)
+static int check(const hosts_table *t, const tr_options *o, int slurm)
 {
     cl_host *cl = calloc((size_t)t->n, sizeof *cl);
     if (!cl)
@@ -47,6 +50,8 @@ static int check(const hosts_table *t, const tr_options *o)
     for (int i = 0; i < t->n; i++)
         cl[i].entry = &t->v[i];
     cl_open(cl, t->n, o, NULL, 0);
+    if (slurm)
+        cl_drop_other_versions(cl, t->n);
     int bad = 0;
     printf("%-16s %-6s %-8s %-9s %5s  %-36s %s\n", "host", "state", "arch", "os", "cores", "worker", "scene cache");
     for (int i = 0; i < t->n; i++) {
@@ -102,9 +107,12 @@ int cmd_hosts(int argc, char **argv)
 {
     tr_options o;
     cli_transport_defaults(&o);
+    cli_slurm sl = {0};
     const char *path = NULL, *what = NULL;
     for (int i = 1; i < argc; i++) {
-        int c = cli_common_option(argc, argv, &i, usage, &o, &path);
+        int c = cli_slurm_option(argc, argv, &i, &sl);
+        if (c == CLI_OTHER)
+            c = cli_common_option(argc, argv, &i, usage, &o, &path);
         if (c != CLI_OTHER) {
             if (c == CLI_TAKEN)
                 continue;
@@ -117,18 +125,24 @@ int cmd_hosts(int argc, char **argv)
             return 2;
         }
     }
-    if (!what || !path) {
-        fprintf(stderr, "franja hosts: expected 'check' or 'list' and --hosts FILE (see franja hosts --help)\n");
+    if (!what || (!path && !sl.on)) {
+        fprintf(stderr, "franja hosts: expected 'check' or 'list' and --hosts FILE or --slurm "
+                        "(see franja hosts --help)\n");
         return 2;
     }
+    if (cli_slurm_check("hosts", &sl, path))
+        return 2;
     hosts_table t;
-    if (cli_load_hosts("hosts", path, &t))
+    slurm_alloc alloc;
+    memset(&alloc, 0, sizeof alloc);
+    if (sl.on ? cli_slurm_hosts("hosts", &sl, argc, argv, &o, &alloc, &t) : cli_load_hosts("hosts", path, &t))
         return 2;
     int rc = 0;
     if (!strcmp(what, "list"))
         list(&t);
     else
-        rc = check(&t, &o);
+        rc = check(&t, &o, sl.on);
     hosts_free(&t);
+    slurm_close(&alloc);
     return rc;
 }

@@ -26,13 +26,14 @@
 static const char usage[] =
     "usage: franja render SCENE(.json|.fbin) -o OUT [options]\n"
     "\n"
-    "Renders SCENE on this machine's cores, or on the hosts of a host table over\n"
-    "SSH, and writes OUT (.png .exr .tif .jpg .hdr .ppm .bmp .pfm, by extension).\n"
+    "Renders SCENE on this machine's cores, on the hosts of a host table over SSH,\n"
+    "or on the CPUs of a Slurm allocation, and writes OUT (.png .exr .tif .jpg .hdr\n"
+    ".ppm .bmp .pfm, by extension).\n"
     "\n"
     "  -o OUT               output image (written atomically, only when complete)\n"
     "  --hosts FILE         host table (franja-hosts(5)); default: this machine\n"
     "  -j N                 worker processes (local: default one per core;\n"
-    "                       with --hosts: at most N per host)\n"
+    "                       with --hosts or --slurm: at most N per host)\n"
     "  --spp N              samples per pixel (default: the scene's)\n"
     "  --size WxH           image size (default: the scene's)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
@@ -43,7 +44,8 @@ static const char usage[] =
     "  --job DIR            job directory (default OUT.franja-job)\n"
     "  --keep-job           keep the job directory after success\n"
     "  --slab-rows N        rows per slab (default: about 4 slabs per slot)\n"
-    "  --retries N          attempts per slab before giving up (default 5)\n";
+    "  --retries N          attempts per slab before giving up (default 5)\n"
+    CLI_SLURM_HELP;
 
 static volatile sig_atomic_t stop_flag;
 
@@ -67,6 +69,7 @@ typedef struct {
     const char *curve;         /* --tonemap, or NULL for the scene's */
     int resume, keep_job;
     tr_options tr;
+    cli_slurm slurm;
 } render_args;
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -77,7 +80,9 @@ static int parse(int argc, char **argv, render_args *a)
     cli_transport_defaults(&a->tr);
     for (int i = 1; i < argc; i++) {
         const char *s = argv[i];
-        int c = cli_common_option(argc, argv, &i, usage, &a->tr, &a->hosts);
+        int c = cli_slurm_option(argc, argv, &i, &a->slurm);
+        if (c == CLI_OTHER)
+            c = cli_common_option(argc, argv, &i, usage, &a->tr, &a->hosts);
         if (c != CLI_OTHER) {
             if (c == CLI_TAKEN)
                 continue;
@@ -150,7 +155,7 @@ static int parse(int argc, char **argv, render_args *a)
                 a->scene ? "-o OUT" : "a SCENE");
         return 2;
     }
-    return 0;
+    return cli_slurm_check("render", &a->slurm, a->hosts) ? 2 : 0;
 }
 
 /* Gets the binary scene: loads an .fbin, or compiles a JSON scene into the
@@ -207,6 +212,8 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     for (int i = 0; i < n; i++)
         cl[i].entry = &table->v[i];
     cl_open(cl, n, &a->tr, fbin, spec->hash);
+    if (a->slurm.on)
+        cl_drop_other_versions(cl, n);
     int ready = 0, ns = 0;
     for (int i = 0; i < n; i++) {
         if (!cl[i].tr) {
@@ -215,14 +222,15 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         }
         ready++;
         int slots = cl[i].entry->cores ? cl[i].entry->cores : cl[i].info.cores;
-        if (a->jobs && (!a->hosts || slots > (int)a->jobs))
+        int table = a->hosts || a->slurm.on;
+        if (a->jobs && (!table || slots > (int)a->jobs))
             slots = (int)a->jobs;
         sched_host *h = &sh[ns++];
         h->tr = cl[i].tr;
         h->name = cl[i].entry->name;
         h->slots = slots > 0 ? slots : 1;
         snprintf(h->scene, sizeof h->scene, "%s", cl[i].scene);
-        if (a->hosts || !isatty(2))
+        if (table || !isatty(2))
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", h->name, cl[i].info.os,
                     cl[i].info.arch, h->slots, cl[i].info.version,
                     hosts_is_local(cl[i].entry) ? "local" : cl[i].uploaded ? "uploaded" : "already there",
@@ -275,10 +283,31 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         return 2;
     }
+    hosts_table table;
+    slurm_alloc alloc;
+    memset(&alloc, 0, sizeof alloc);
+    if (a.slurm.on) {
+        if (cli_slurm_hosts("render", &a.slurm, argc, argv, &a.tr, &alloc, &table))
+            return 2;
+    } else if (a.hosts) {
+        if (cli_load_hosts("render", a.hosts, &table))
+            return 2;
+    } else {
+        table.n = 1;
+        table.v = calloc(1, sizeof *table.v);
+        if (!table.v)
+            return 1;
+        snprintf(table.path, sizeof table.path, "(this machine)");
+        strcpy(table.v[0].name, "local");
+        strcpy(table.v[0].address, "local");
+    }
+
     double t0 = clk_now();
     fr_scene sc;
     if (scene_binary(&a, jobdir, fbin, sizeof fbin, &sc, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
+        hosts_free(&table);
+        slurm_close(&alloc);
         return 1;
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
@@ -293,20 +322,6 @@ int cmd_render(int argc, char **argv)
     if (a.curve)
         tm_curve_parse(a.curve, &tm.curve);
     scn_free(&sc);
-
-    hosts_table table;
-    if (a.hosts) {
-        if (cli_load_hosts("render", a.hosts, &table))
-            return 2;
-    } else {
-        table.n = 1;
-        table.v = calloc(1, sizeof *table.v);
-        if (!table.v)
-            return 1;
-        snprintf(table.path, sizeof table.path, "(this machine)");
-        strcpy(table.v[0].name, "local");
-        strcpy(table.v[0].address, "local");
-    }
 
     unsigned char *have = calloc(spec.height, 1);
     float *rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *rgb);
@@ -348,5 +363,6 @@ done:
     free(have);
     free(rgb);
     hosts_free(&table);
+    slurm_close(&alloc);
     return rc;
 }

@@ -87,6 +87,7 @@ struct tr_backend {
 
 extern const tr_backend tr_local_backend;
 extern const tr_backend tr_ssh_backend;
+extern const tr_backend tr_slurm_backend;
 
 /** The backend that serves entry e: o->backend if set, else the local one
  * for `local` hosts and SSH for the others.  New backends are chosen here. */
@@ -135,7 +136,12 @@ int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err);
 int tr_pipe_pollfds(tr_proc *procs, struct pollfd *pfd, int max);
 void tr_pipe_service(tr_proc *procs);
 void tr_pipe_kill(tr_proc *p);
+/** Sends signal sig to the process unless it has been reaped. */
+void tr_pipe_signal(tr_proc *p, int sig);
 void tr_pipe_release(tr_proc *p);
+/** Like tr_pipe_release, but neither kills nor waits: returns the PID of
+ * a child still to be reaped (the caller waits for it), or 0. */
+int tr_pipe_detach(tr_proc *p);
 /** Runs a local command to completion (at most timeout_s), discarding its
  * stdout; fails with its status and the tail of its stderr. */
 int tr_pipe_run(const char *const *argv, int timeout_s, fr_error *err);

@@ -130,6 +130,28 @@ void tr_pipe_kill(tr_proc *p)
         kill(pp->pid, SIGKILL);
 }
 
+void tr_pipe_signal(tr_proc *p, int sig)
+{
+    pipe_proc *pp = p->impl;
+    if (pp && !pp->reaped)
+        kill(pp->pid, sig);
+}
+
+int tr_pipe_detach(tr_proc *p)
+{
+    pipe_proc *pp = p->impl;
+    if (!pp)
+        return 0;
+    int pid = pp->reaped ? 0 : (int)pp->pid;
+    if (pp->fd_out >= 0)
+        close(pp->fd_out);
+    if (pp->fd_err >= 0)
+        close(pp->fd_err);
+    free(pp);
+    p->impl = NULL;
+    return pid;
+}
+
 void tr_pipe_release(tr_proc *p)
 {
     pipe_proc *pp = p->impl;

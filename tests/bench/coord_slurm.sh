@@ -1,0 +1,52 @@
+#!/bin/sh
+# The cost of Slurm: the same render as job steps in an allocation of a
+# real Slurm cluster on this machine (tests/slurm/cluster.sh: one node per
+# core, one CPU each) against local worker processes with the same number
+# of slots, alternated inside one allocation.  ratio = T(slurm) / T(local).
+# Also measured: the launch latency of one job step (srun of `true` on a
+# node, against starting `true` here), and the scene broadcast (a first
+# render that sbcasts the scene to every node, against a second one that
+# finds it cached).
+cd "$(dirname "$0")/../.." || exit 1
+ROOT=$(pwd)
+. tests/coord/bench_common.sh
+. tests/slurm/lib.sh
+N=$(nproc)
+ARGS="--size ${SIZE:-256x256} --spp ${SPP:-128}"
+sl_init "$N" 1
+machine
+bin/franja compile scenes/cornell.json -o "$T/scene.fbin" >/dev/null 2>&1 || { echo "compile failed"; exit 1; }
+SCENE="$T/scene.fbin"
+
+# Step launch latency, inside one allocation: 20 steps one after the other.
+cat >"$T/launch.sh" <<'SH'
+i=0; s=$(date +%s.%N)
+while [ $i -lt 20 ]; do srun --exclusive -N1 -n1 -c1 --mem=0 -Q -w n1 true </dev/null || exit 1; i=$((i + 1)); done
+a=$(date +%s.%N)
+i=0
+while [ $i -lt 20 ]; do true </dev/null; /bin/true; i=$((i + 1)); done
+b=$(date +%s.%N)
+awk "BEGIN { printf \"step launch: %.1f ms per srun step, %.2f ms per local process\n\", ($a - $s) * 50, ($b - $a) * 50 }"
+SH
+sl_alloc 120 -N"$N" -n"$N" sh "$T/launch.sh" 2>/dev/null
+
+# Scene broadcast: the first render on fresh nodes sends the scene, the second finds it.
+cat >"$T/bcast.sh" <<SH
+bin/franja render "$SCENE" -o "$T/b1.pfm" --size 16x16 --spp 1 --slurm --workdir "$T/work" 2>"$T/b1.log" &&
+bin/franja render "$SCENE" -o "$T/b2.pfm" --size 16x16 --spp 1 --slurm --workdir "$T/work" 2>"$T/b2.log"
+SH
+sl_alloc 120 -N"$N" -n"$N" sh "$T/bcast.sh" 2>/dev/null || { echo "broadcast renders failed"; cat "$T/b1.log"; exit 1; }
+ready() { sed -n 's/.*scene \(uploaded\|already there\) (\([0-9.]*\) s).*/\2/p' "$1" | sort -n | tail -n 1; }
+echo "scene broadcast ($(($(wc -c <"$SCENE") / 1024)) KB): node ready in $(ready "$T/b1.log") s with sbcast, $(ready "$T/b2.log") s when cached (slowest node; includes probing)"
+
+# The render, alternated in one allocation.
+cat >"$T/compare.sh" <<SH
+. tests/coord/bench_common.sh
+RUNS=${RUNS:-3}
+compare "bin/franja render $SCENE -o $T/l.pfm $ARGS -j $N" \
+    "bin/franja render $SCENE -o $T/s.pfm $ARGS --slurm --workdir $T/work" || exit 1
+cmp -s "$T/l.pfm" "$T/s.pfm" || { echo "Slurm and local images differ"; exit 1; }
+echo "local $N slots: \$TA s, $N Slurm nodes x 1 CPU: \$TB s; ratio \$(calc "\$TB / \$TA") (overhead \$(calc "(\$TB - \$TA) * 100 / \$TA") %, \$(calc "\$TB - \$TA") s)"
+SH
+sl_alloc 600 -N"$N" -n"$N" sh "$T/compare.sh" 2>/dev/null || exit 1
+echo "machine after: load $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,0 +1,115 @@
+#!/bin/sh
+# franja render --slurm and franja hosts check --slurm on a real Slurm
+# cluster of three nodes on this machine (tests/slurm/cluster.sh): renders
+# inside salloc and sbatch allocations are byte-identical to a one-process
+# render whatever the node count; the scene is broadcast once per node;
+# a node killed mid-render loses only its slabs; scancel mid-render leaves
+# no step and no worker running; --resume finishes in a second allocation;
+# a node whose worker is another version is dropped, by name; outside an
+# allocation --slurm says what to run instead.
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+. "$ROOT/tests/slurm/lib.sh"
+sl_init 3
+cd "$T" || exit 1
+SIZE="--size 40x30 --spp 4"
+WD="$T/work" # the nodes' scene cache (node-local as far as franja knows)
+
+"$FRANJA" compile "$ROOT/scenes/cornell.json" -o scene.fbin >/dev/null 2>&1
+"$WORKER" --scene scene.fbin --rows 0:30 $SIZE -o ref.pfm
+check "reference render" test -s ref.pfm
+
+# A worker wrapper: slow (each slab waits first), or another version on one node.
+wrapper() {
+    cat >"$T/worker-$1" <<SH
+#!/bin/sh
+case "$1" in
+slow) case " \$* " in *" --rows "*) sleep $2 ;; esac ;;
+version) if [ "\$SLURMD_NODENAME" = "$2" ] && [ "\$1" = --version ]; then
+        echo "franja-worker 0.0.1 scene-format 1"; exit 0; fi ;;
+esac
+exec "$WORKER" "\$@"
+SH
+    chmod +x "$T/worker-$1"
+    echo "$T/worker-$1"
+}
+
+# render LOG ARGS...: franja render inside an allocation of the test cluster.
+render() {
+    log=$1
+    shift
+    sl_alloc 90 "$@" >/dev/null 2>"$log"
+}
+
+no_leftovers() {
+    test -z "$(sl_steps)" && test -z "$(sl_pids)"
+}
+
+# Outside an allocation: a clear refusal with the lines to use.
+expect_error "--slurm outside an allocation" "not inside a Slurm allocation" \
+    "$FRANJA" render scene.fbin -o x.pfm --slurm
+check "it shows the salloc line" grep -q "salloc .*franja render scene.fbin -o x.pfm --slurm" "$T/err"
+check "it shows the sbatch line" grep -q "sbatch " "$T/err"
+check "and renders nothing" test ! -e x.pfm
+
+# hosts check --slurm: every node, its CPUs, its worker.
+sl_alloc 60 -N3 -n6 "$FRANJA" hosts check --slurm >check.out 2>check.err
+check "hosts check --slurm succeeds ($(cat check.err))" test $? -eq 0
+for n in n1 n2 n3; do
+    check "hosts check lists $n with 2 CPUs and the worker" grep -Eq "^$n +ok +$(uname -m) .* 2 +franja-worker" check.out
+done
+
+# Three nodes, then two of unequal size: the same bytes as one process.
+render log3 -N3 -n6 "$FRANJA" render scene.fbin -o n3.pfm $SIZE --slurm --workdir "$WD"
+check "3-node render is byte-identical to the one-process render ($(tail -n 3 log3))" cmp -s n3.pfm ref.pfm
+check "the scene was broadcast to each node" test "$(grep -c 'scene uploaded\|uploaded' log3)" -ge 3
+check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
+check "no step is left after the render" no_leftovers
+render log2 -N2 -n3 "$FRANJA" render scene.fbin -o n2.pfm $SIZE --slurm --workdir "$WD" --slab-rows 3
+check "2 nodes (2 + 1 CPUs) give the same bytes" cmp -s n2.pfm ref.pfm
+check "the second render finds the scene cached" grep -q "already there" log2
+check "a 1-CPU node runs one worker" grep -Eq "^  n2 +1 " log2
+
+# A node whose worker is another version is dropped, by name.
+render logv -N3 -n6 "$FRANJA" render scene.fbin -o v.pfm $SIZE --slurm --workdir "$WD" --worker "$(wrapper version n2)"
+check "a wrong worker version on n2 does not stop the render" cmp -s v.pfm ref.pfm
+check "the message names n2 and its version" grep -q "n2.*0.0.1" logv
+check "n2 rendered nothing" sh -c "! grep -Eq '^  n2 +[0-9]+ +[1-9]' logv"
+
+# A node killed mid-render (slurmd, its slurmstepd and its workers): its
+# slabs go to the others and the image is the same.
+sl_alloc_bg 90 -N3 -n6 --no-kill "$FRANJA" render scene.fbin -o k.pfm $SIZE --slurm --workdir "$WD" \
+    --worker "$(wrapper slow 0.6)" --slab-rows 1 --job kjob >/dev/null 2>logk
+sl_until 40 sh -c "ls kjob/rows-* 2>/dev/null | wc -l | grep -qv '^[0-2]$'"
+sh "$CLUSTER" kill-node "$T/cl" n3
+wait "$SL_BG"
+rc=$?
+SL_BG=
+check "a render that lost a node succeeds (status $rc: $(tail -n 3 logk))" test $rc -eq 0
+check "and is byte-identical" cmp -s k.pfm ref.pfm
+check "n3's loss is reported" grep -q "n3" logk
+check "nothing of the render is left running" no_leftovers
+sh "$CLUSTER" start-node "$T/cl" n3
+sl_until 30 sh -c "timeout 5 sinfo -h -N -n n3 -t idle -o %N </dev/null | grep -q n3"
+
+# scancel mid-render: every step goes, franja stops and keeps its slabs;
+# --resume in a second allocation (a batch job) finishes the same image.
+sl_alloc_bg 90 -N3 -n6 "$FRANJA" render scene.fbin -o c.pfm $SIZE --slurm --workdir "$WD" \
+    --worker "$(wrapper slow 0.6)" --slab-rows 1 >/dev/null 2>logc
+sl_until 40 sh -c "ls c.pfm.franja-job/rows-* 2>/dev/null | wc -l | grep -qv '^[0-2]$'"
+job=$(sl_q squeue -h -o %i | head -n 1)
+sl_q scancel "$job"
+sl_until 30 sh -c "! kill -0 $SL_BG 2>/dev/null"
+check "franja ends after scancel" sh -c "! kill -0 $SL_BG 2>/dev/null"
+sl_bg_stop
+check "scancel leaves no step and no worker running ($(sl_steps) $(sl_pids))" no_leftovers
+check "the finished slabs are kept" test -n "$(ls c.pfm.franja-job/rows-* 2>/dev/null)"
+check "no image was written" test ! -e c.pfm
+FRANJA="$FRANJA" sl_q sbatch -N2 -n4 -o "$T/resume.log" "$ROOT/hosts/franja.sbatch" \
+    scene.fbin -o c.pfm $SIZE --workdir "$WD" --resume >/dev/null
+sl_until 60 sh -c "test -z \"\$(timeout 5 squeue -h </dev/null)\""
+check "--resume in a batch job finishes the image ($(tail -n 3 resume.log))" cmp -s c.pfm ref.pfm
+check "it renders only the missing rows" grep -q "resuming: [1-9][0-9]* of 30 rows already done" resume.log
+check "progress in a batch job is plain lines" sh -c "! grep -q \"$(printf '\r')\" resume.log"
+check "nothing left running after the batch job" no_leftovers
+
+summary
