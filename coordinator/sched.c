@@ -54,28 +54,42 @@ static void say(sched *s, const char *fmt, ...)
     fputc('\n', stderr);
 }
 
+/* "rows 120/512 (23%)  ETA 40s  1.20 Msamples/s  alpha:8/8 3.1r/s ..." */
+static void progress_text(sched *s, double t, char *line, size_t cap)
+{
+    double el = t - s->t0;
+    double rate = el > 0 ? s->rows_done / el : 0;
+    int n = snprintf(line, cap, "rows %d/%d (%3.0f%%)", s->rows_done, s->rows_total,
+                     s->rows_total ? 100.0 * s->rows_done / s->rows_total : 100.0);
+    if (rate > 0 && s->rows_done < s->rows_total)
+        n += snprintf(line + n, cap - (size_t)n, "  ETA %.0fs", (s->rows_total - s->rows_done) / rate);
+    n += snprintf(line + n, cap - (size_t)n, "  %.2f Msamples/s ", rate * s->p->spec.width * s->p->spec.spp / 1e6);
+    for (int i = 0; i < s->nhosts && n < (int)cap - 40; i++) {
+        sched_host *h = &s->hosts[i];
+        if (h->dropped)
+            n += snprintf(line + n, cap - (size_t)n, " %s:down", h->name);
+        else
+            n += snprintf(line + n, cap - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
+                          el > 0 ? h->rows / el : 0.0);
+    }
+}
+
+/* Progress: a live line on a terminal (4 times a second); otherwise (a
+ * batch job's log) a plain line every LOG_EVERY seconds and at the end. */
+enum { LOG_EVERY = 10 };
+
 static void draw(sched *s, int force)
 {
     double t = clk_now();
-    if (!s->p->tty || (!force && t - s->last_draw < 0.25))
+    double every = s->p->tty ? 0.25 : LOG_EVERY;
+    if (!force && t - s->last_draw < every)
         return;
     s->last_draw = t;
-    double el = t - s->t0;
-    double rate = el > 0 ? s->rows_done / el : 0;
     char line[1024];
-    int n = snprintf(line, sizeof line, "rows %d/%d (%3.0f%%)", s->rows_done, s->rows_total,
-                     s->rows_total ? 100.0 * s->rows_done / s->rows_total : 100.0);
-    if (rate > 0 && s->rows_done < s->rows_total)
-        n += snprintf(line + n, sizeof line - (size_t)n, "  ETA %.0fs", (s->rows_total - s->rows_done) / rate);
-    n += snprintf(line + n, sizeof line - (size_t)n, "  %.2f Msamples/s ",
-                  rate * s->p->spec.width * s->p->spec.spp / 1e6);
-    for (int i = 0; i < s->nhosts && n < (int)sizeof line - 40; i++) {
-        sched_host *h = &s->hosts[i];
-        if (h->dropped)
-            n += snprintf(line + n, sizeof line - (size_t)n, " %s:down", h->name);
-        else
-            n += snprintf(line + n, sizeof line - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
-                          el > 0 ? h->rows / el : 0.0);
+    progress_text(s, t, line, sizeof line);
+    if (!s->p->tty) {
+        say(s, "%s", line);
+        return;
     }
     fprintf(stderr, "\r\033[K%s", line);
     fflush(stderr);
@@ -274,9 +288,6 @@ static int accept_attempt(sched *s, int r, fr_error *err)
             tr_proc_kill(s->run[k].proc);
             finish(s, k);
         }
-    if (!s->p->tty)
-        say(s, "rows %u:%u from %s in %.2f s (%d/%d rows)", sl->y0, sl->y1, h->name, dt, s->rows_done,
-            s->rows_total);
     return 0;
 }
 
@@ -419,7 +430,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
     s.hosts = hosts;
     s.nhosts = nhosts;
     s.st = st;
-    s.t0 = clk_now();
+    s.t0 = s.last_draw = clk_now();
     if (make_slabs(&s))
         return fr_fail(err, "out of memory");
     st->slabs = s.nslabs;

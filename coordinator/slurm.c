@@ -173,6 +173,33 @@ int slurm_open(slurm_alloc *a, const char *worker, int timeout_s, fr_error *err)
     return 0;
 }
 
+int slurm_job_ended(slurm_alloc *a, int ask)
+{
+    pthread_mutex_lock(&a->lock);
+    int ended = a->ended;
+    pthread_mutex_unlock(&a->lock);
+    if (ended || !ask)
+        return ended;
+    const char *argv[] = {"squeue", "--noheader", "--jobs", a->job, "--format", "%T", NULL};
+    char *text;
+    fr_error e;
+    if (capture(argv, a->timeout_s, &text, &e)) {
+        /* squeue fails for a job the controller no longer knows. */
+        ended = strstr(e.msg, "Invalid job id") != NULL;
+    } else {
+        static const char *const alive[] = {"RUNNING", "SUSPENDED", "CONFIGURING", "RESIZING"};
+        ended = 1;
+        for (size_t i = 0; i < sizeof alive / sizeof *alive; i++)
+            if (!strncmp(text, alive[i], strlen(alive[i])))
+                ended = 0;
+        free(text);
+    }
+    pthread_mutex_lock(&a->lock);
+    a->ended |= ended;
+    pthread_mutex_unlock(&a->lock);
+    return ended;
+}
+
 void slurm_close(slurm_alloc *a)
 {
     free(a->node);

@@ -36,6 +36,7 @@ typedef struct {
     char worker[512];          /**< the worker program on the nodes (absolute) */
     int timeout_s;             /**< longest wait for a Slurm command that should be quick */
     pthread_mutex_t lock;      /**< guards what follows */
+    int ended;                 /**< the job was seen to have ended */
     char copied[8][1024];      /**< shared workdir: files already copied this run */
     int ncopied;
 } slurm_alloc;
@@ -49,6 +50,12 @@ typedef struct {
  * a job step, and on environment values that do not parse (naming the
  * variable and the offset). */
 int slurm_open(slurm_alloc *a, const char *worker, int timeout_s, fr_error *err);
+
+/** Whether the job has ended (cancelled, timed out, failed).  With ask,
+ * asks the controller (`squeue`, at most timeout_s) and remembers an
+ * ended job; without, only says what is known.  A job the controller
+ * cannot be asked about is taken as still running. */
+int slurm_job_ended(slurm_alloc *a, int ask);
 
 /** Frees what slurm_open allocated.  Safe on a zeroed struct. */
 void slurm_close(slurm_alloc *a);

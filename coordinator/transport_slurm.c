@@ -56,7 +56,6 @@ typedef struct {
     char node[SLURM_NODE_MAX];
     char label[400];
     pid_t leaving[64];         /* sruns told to stop, not yet reaped */
-    double leaving_since[64];
     int nleaving;
     int lost;
 } slurm_host;
@@ -116,25 +115,37 @@ static int slurm_pollfds(void *impl, tr_proc *procs, struct pollfd *pfd, int max
 }
 
 /* srun's words for a node that is gone or unusable for this job. */
-static int node_gone(const char *err)
+static int says(const char *err, const char *const *words)
 {
-    static const char *const says[] = {"Node failure on", "Communication connection failure",
-                                       "Requested node configuration is not available"};
-    for (size_t i = 0; i < sizeof says / sizeof *says; i++)
-        if (strstr(err, says[i]))
+    for (; *words; words++)
+        if (strstr(err, *words))
             return 1;
     return 0;
 }
+
+static const char *const NODE_GONE[] = {"Node failure on", "Application launch failed",
+                                        "Requested node configuration is not available", NULL};
+/* ... and for a job that has ended (cancelled, out of time). */
+static const char *const JOB_GONE[] = {"has expired", "has been revoked", "Invalid job id", NULL};
 
 static void reap(slurm_host *s)
 {
     for (int i = s->nleaving - 1; i >= 0; i--) {
         pid_t r = waitpid(s->leaving[i], NULL, WNOHANG);
-        if (r == s->leaving[i] || (r < 0 && errno == ECHILD)) {
+        if (r == s->leaving[i] || (r < 0 && errno == ECHILD))
             s->leaving[i] = s->leaving[--s->nleaving];
-            s->leaving_since[i] = s->leaving_since[s->nleaving];
-        }
     }
+}
+
+/* Fails every running process of the host, which is lost. */
+static int lost(slurm_host *s, tr_proc *procs, fr_error *err, const char *fmt, const char *detail)
+{
+    s->lost = 1;
+    fr_fail(err, fmt, s->label, detail);
+    for (tr_proc *p = procs; p; p = p->next)
+        if (p->state == TR_RUNNING)
+            tr_proc_fail(p, "%s", err->msg);
+    return -1;
 }
 
 static int slurm_service(void *impl, tr_proc *procs, fr_error *err)
@@ -142,18 +153,19 @@ static int slurm_service(void *impl, tr_proc *procs, fr_error *err)
     slurm_host *s = impl;
     reap(s);
     tr_pipe_service(procs);
-    const char *why = NULL;
-    for (tr_proc *p = procs; p; p = p->next)
-        if (p->state != TR_RUNNING && p->impl && node_gone(p->err))
-            why = p->err;
-    if (!why)
-        return 0;
-    s->lost = 1;
-    fr_fail(err, "%s: the node is lost to the job (srun: %s)", s->label, why);
-    for (tr_proc *p = procs; p; p = p->next)
-        if (p->state == TR_RUNNING)
-            tr_proc_fail(p, "the node is lost to the job");
-    return -1;
+    if (slurm_job_ended(s->a, 0))
+        return lost(s, procs, err, "%s: %s", "the Slurm job has ended (cancelled, or out of time)");
+    /* Processes that ended by themselves (those killed here are TR_FAILED):
+     * srun's last words say whether the node or the whole job is gone. */
+    for (tr_proc *p = procs; p; p = p->next) {
+        if (p->state != TR_EXITED || !p->impl)
+            continue;
+        if (says(p->err, NODE_GONE))
+            return lost(s, procs, err, "%s: the node is lost to the job (srun: %s)", p->err);
+        if ((says(p->err, JOB_GONE) || strstr(p->err, "CANCELLED")) && slurm_job_ended(s->a, 1))
+            return lost(s, procs, err, "%s: %s", "the Slurm job has ended (cancelled, or out of time)");
+    }
+    return 0;
 }
 
 static void slurm_kill(void *impl, tr_proc *p)
@@ -179,7 +191,6 @@ static void slurm_release(void *impl, tr_proc *p)
         usleep(5000);
     }
     if (s->nleaving < (int)(sizeof s->leaving / sizeof *s->leaving)) {
-        s->leaving_since[s->nleaving] = clk_now();
         s->leaving[s->nleaving++] = pid;
         return;
     }

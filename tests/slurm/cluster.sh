@@ -81,7 +81,7 @@ step_pids() {
         p=${d#/proc/}
         [ "$p" = "$$" ] && continue
         alive "$p" || continue
-        node=$(tr '\0' '\n' <"$d/environ" 2>/dev/null | sed -n 's/^SLURMD_NODENAME=//p')
+        node=$({ tr '\0' '\n' <"$d/environ"; } 2>/dev/null | sed -n 's/^SLURMD_NODENAME=//p')
         [ -n "$node" ] || continue
         [ -z "${2:-}" ] || [ "$node" = "$2" ] && echo "$p"
     done
