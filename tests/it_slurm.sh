@@ -3,8 +3,9 @@
 # cluster of three nodes on this machine (tests/slurm/cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process
 # render whatever the node count; the scene is broadcast once per node;
-# a node killed mid-render loses only its slabs; scancel mid-render leaves
-# no step and no worker running; --resume finishes in a second allocation;
+# a node killed mid-render loses only its slabs; Ctrl-C and scancel
+# mid-render leave no step and no worker running; --resume finishes in a
+# second allocation (a batch job from hosts/franja.sbatch);
 # a node whose worker is another version is dropped, by name; outside an
 # allocation --slurm says what to run instead.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -94,6 +95,22 @@ check "no step is left on the live nodes ($(sl_steps))" test -z "$(sl_steps | gr
 sh "$CLUSTER" start-node "$T/cl" n3
 sl_until 30 sh -c "timeout 5 sinfo -h -N -n n3 -t idle -o %N </dev/null | grep -q n3"
 check "once n3 is back, the controller lists no step either" sl_until 10 sh -c "test -z \"\$(timeout 5 squeue -h -s </dev/null)\""
+
+# Ctrl-C (SIGINT to franja): it stops its steps, keeps its slabs, exits 130.
+sl_alloc_bg 90 -N3 -n6 "$FRANJA" render scene.fbin -o i.pfm $SIZE --slurm --workdir "$WD" \
+    --worker "$(wrapper slow 0.6)" --slab-rows 1 >/dev/null 2>logi
+sl_until 40 sh -c "ls i.pfm.franja-job/rows-* 2>/dev/null | wc -l | grep -qv '^[0-2]$'"
+pid=$(pgrep -f "render scene.fbin -o i.pfm" | while read -r p; do
+    [ "$(cat /proc/"$p"/comm 2>/dev/null)" = franja ] && echo "$p"; done | head -n 1)
+kill -INT "$pid"
+sl_until 30 sh -c "! kill -0 $pid 2>/dev/null"
+check "franja stops on SIGINT" sh -c "! kill -0 $pid 2>/dev/null"
+wait "$SL_BG"
+rc=$?
+SL_BG=
+check "and exits 130 ($rc)" test $rc -eq 130
+check "Ctrl-C leaves no step and no worker running ($(sl_steps) $(sl_pids))" no_leftovers
+check "the slabs done so far are kept" test -n "$(ls i.pfm.franja-job/rows-* 2>/dev/null)"
 
 # scancel mid-render: every step goes, franja stops and keeps its slabs;
 # --resume in a second allocation (a batch job) finishes the same image.
