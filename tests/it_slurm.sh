@@ -52,6 +52,24 @@ check "it shows the salloc line" grep -q "salloc .*franja render scene.fbin -o x
 check "it shows the sbatch line" grep -q "sbatch " "$T/err"
 check "and renders nothing" test ! -e x.pfm
 
+# The allocation as the environment describes it, checked before any node
+# is asked anything.
+fake() { env SLURM_JOB_ID=77 SLURM_JOB_NODELIST='n[1-3]' SLURM_JOB_CPUS_PER_NODE="$1" ${2:+SLURM_STEP_ID=$2} \
+    "$FRANJA" hosts list --slurm; }
+fake '4,2(x2)' >list.out 2>&1
+check "hosts list --slurm reads the CPUs per node ($(cat list.out))" \
+    sh -c "grep -Eq '^n1 .* 4 ' list.out && grep -Eq '^n2 .* 2 ' list.out && grep -Eq '^n3 .* 2 ' list.out"
+expect_error "too few CPU counts" "describes 2 nodes, SLURM_JOB_NODELIST has 3" fake '2(x2)'
+expect_error "too many CPU counts" "more than the 3 nodes" fake '2(x4)'
+expect_error "a bad CPU list" "offset 1" fake '2x3'
+expect_error "an unclosed repeat" "expected ')'" fake '2(x3'
+expect_error "zero CPUs" "not in 1..4096" fake '0,2,2'
+expect_error "a huge CPU count" "not in 1..4096" fake '99999999999999999999(x3)'
+expect_error "a job step" "inside job step 77.0" fake '2(x3)' 0
+expect_error "--slurm with --hosts" "exclude each other" "$FRANJA" render scene.fbin -o x.pfm --slurm --hosts /dev/null
+expect_error "--workdir without --slurm" "applies to --slurm only" "$FRANJA" render scene.fbin -o x.pfm --workdir /tmp/x
+expect_error "a relative --workdir" "not an absolute path" "$FRANJA" render scene.fbin -o x.pfm --slurm --workdir x
+
 # hosts check --slurm: every node, its CPUs, its worker.
 sl_alloc 60 -N3 -n6 "$FRANJA" hosts check --slurm >check.out 2>check.err
 check "hosts check --slurm succeeds ($(cat check.err))" test $? -eq 0
@@ -69,6 +87,11 @@ render log2 -N2 -n3 "$FRANJA" render scene.fbin -o n2.pfm $SIZE --slurm --workdi
 check "2 nodes (2 + 1 CPUs) give the same bytes" cmp -s n2.pfm ref.pfm
 check "the second render finds the scene cached" grep -q "already there" log2
 check "a 1-CPU node runs one worker" grep -Eq "^  n2 +1 " log2
+
+# A shared work directory: the scene is copied there, once, no sbcast.
+render logs -N3 -n6 "$FRANJA" render scene.fbin -o sh.pfm $SIZE --slurm --shared-workdir "$T/shared"
+check "a shared work directory gives the same bytes" cmp -s sh.pfm ref.pfm
+check "the scene is in the shared directory" test "$(ls "$T/shared/scenes" | grep -c '\.fbin$')" -eq 1
 
 # A node whose worker is another version is dropped, by name.
 render logv -N3 -n6 "$FRANJA" render scene.fbin -o v.pfm $SIZE --slurm --workdir "$WD" --worker "$(wrapper version n2)"
