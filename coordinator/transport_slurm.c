@@ -299,9 +299,13 @@ static int upload_shared(slurm_host *s, const char *local_path, const char *remo
     return rc ? fr_fail(err, "%s: copying to the shared work directory: %s", s->label, err->msg) : 0;
 }
 
-/* `sh -c HOLD sh DIR`: creates the directory, says which step holds the
- * node, and waits to be cancelled. */
-static const char HOLD[] = "mkdir -p -- \"$1\" && echo \"step $SLURM_JOB_ID.$SLURM_STEP_ID\" && exec sleep 3600";
+/* `sh -c HOLD sh DIR`: creates the directory (which must be this user's,
+ * and so its parent: /tmp is everyone's), says which step holds the node,
+ * and waits to be cancelled. */
+static const char HOLD[] =
+    "mkdir -p -- \"$1\" || exit 1; "
+    "if [ ! -O \"$1\" ] || [ ! -O \"${1%/*}\" ]; then echo \"$1: not this user's directory\" >&2; exit 1; fi; "
+    "echo \"step $SLURM_JOB_ID.$SLURM_STEP_ID\" && exec sleep 3600";
 
 /* `sh -c PLACE sh TMP DEST MODE`: puts the broadcast copy in place. */
 static const char PLACE[] = "chmod \"$3\" \"$1\" && mv -f -- \"$1\" \"$2\" && wc -c < \"$2\"";
