@@ -53,8 +53,8 @@ typedef struct {
     "                       runs in (salloc, sbatch): one per allocated CPU\n"           \
     "  --worker PATH        (--slurm) the worker program on the nodes (default: the\n"   \
     "                       franja-worker beside this franja)\n"                         \
-    "  --workdir DIR        (--slurm) scene cache on each node's own disk (default\n"    \
-    "                       /tmp/franja-USER); scenes are sent there with sbcast\n"      \
+    "  --workdir DIR        (--slurm) scene cache on each node's own disk, filled\n"     \
+    "                       with sbcast (default /tmp/franja-USER)\n"                    \
     "  --shared-workdir DIR (--slurm) a directory that this machine and every node\n"    \
     "                       share: scenes are copied there once, no sbcast\n"
 

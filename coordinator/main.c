@@ -7,16 +7,17 @@
 #include "protocol.h"
 
 static const char usage[] =
-    "usage: franja render SCENE -o OUT [--hosts FILE] [-j N] [--spp N] [--size WxH]\n"
-    "                     [--exposure E] [--resume] [--accept-new-hosts] ...\n"
+    "usage: franja render SCENE -o OUT [--hosts FILE | --slurm] [-j N] [--spp N]\n"
+    "                     [--size WxH] [--exposure E] [--resume] [--accept-new-hosts] ...\n"
     "       franja compile ...\n"
-    "       franja hosts check|list --hosts FILE\n"
+    "       franja hosts check|list --hosts FILE | --slurm\n"
     "       franja deploy --hosts FILE [--dist DIR]\n"
     "       franja --help | --version\n"
     "\n"
-    "Franja renders a scene with a path tracer, on this machine's cores or on a\n"
-    "cluster over SSH.  `franja COMMAND --help` describes each command; the\n"
-    "manual pages are franja(1), franja-worker(1) and franja-hosts(5).\n";
+    "Franja renders a scene with a path tracer, on this machine's cores, on a\n"
+    "cluster over SSH, or on the CPUs of a Slurm allocation.  `franja COMMAND\n"
+    "--help` describes each command; the manual pages are franja(1),\n"
+    "franja-worker(1) and franja-hosts(5).\n";
 
 int main(int argc, char **argv)
 {
