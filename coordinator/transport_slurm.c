@@ -1,7 +1,8 @@
 /* transport_slurm.c -- worker processes as Slurm job steps in the
  * allocation franja runs in (slurm.h), one step per process:
  *
- *     srun --jobid=J --exclusive -N1 -n1 -c1 --mem=0 -w NODE -Q ARGV...
+ *     srun --jobid J --exclusive --nodes=1 --ntasks=1 --cpus-per-task=1
+ *          --mem=0 --quiet --nodelist NODE ARGV...
  *
  * A step per process rather than one step per node feeding several workers:
  * a slab stays one process, as on the other backends, so the scheduler's
@@ -12,8 +13,8 @@
  * slabs of seconds; tests/bench/coord_slurm.sh) and one srun process per
  * running worker on this machine (about 8 MB), which is fine for hundreds
  * of slots.  `--mem=0` lets a step use the job's memory on its node without
- * taking it from the other steps; -c1 overrides a --cpus-per-task of the
- * job.
+ * taking it from the other steps; --cpus-per-task=1 overrides one the job
+ * was given.
  *
  * Stopping: an srun that gets SIGTERM cancels its step (the task is gone
  * within ~40 ms) and exits; SIGKILL would leave the step running, so it is
