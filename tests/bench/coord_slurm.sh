@@ -3,6 +3,11 @@
 # real Slurm cluster on this machine (tests/slurm/cluster.sh: one node per
 # core, one CPU each) against local worker processes with the same number
 # of slots, alternated inside one allocation.  ratio = T(slurm) / T(local).
+# Each job step runs in a session of its own, which Linux's autogroup
+# scheduling treats as a group of its own: on a machine busy with other
+# work, steps would get more CPU than local workers sharing franja's
+# session.  So the local workers start through `setsid` too (a host table
+# whose worker is a wrapper), and both sides compete alike.
 # Also measured: the launch latency of one job step (srun of `true` on a
 # node, against starting `true` here), and the scene broadcast (a first
 # render that sbcasts the scene to every node, against a second one that
@@ -47,10 +52,13 @@ echo "scene broadcast ($(($(wc -c <"$BIG") / 1024)) KB to each of $N nodes at on
     "with sbcast, $B2 s when the scene is cached (probe and check): $(calc "$B1 - $B2") s for the broadcast"
 
 # The render, alternated in one allocation.
+printf '#!/bin/sh\nexec setsid %s "$@"\n' "$ROOT/bin/franja-worker" >"$T/setsid-worker"
+chmod +x "$T/setsid-worker"
+echo "here local - $N worker=$T/setsid-worker" >"$T/local.hosts"
 cat >"$T/compare.sh" <<SH
 . tests/coord/bench_common.sh
 RUNS=${RUNS:-3}
-compare "bin/franja render $SCENE -o $T/l.pfm $ARGS -j $N" \
+compare "bin/franja render $SCENE -o $T/l.pfm $ARGS --hosts $T/local.hosts" \
     "bin/franja render $SCENE -o $T/s.pfm $ARGS --slurm --workdir $T/work" || exit 1
 cmp -s "$T/l.pfm" "$T/s.pfm" || { echo "Slurm and local images differ"; exit 1; }
 echo "local $N slots: \$TA s, $N Slurm nodes x 1 CPU: \$TB s; ratio \$(calc "\$TB / \$TA") (overhead \$(calc "(\$TB - \$TA) * 100 / \$TA") %, \$(calc "\$TB - \$TA") s)"
