@@ -1,23 +1,34 @@
 #include "freeze_light.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fmath.h"
 
-static float prim_area(const fr_builder *b, const fr_prim *p)
+/* |a x b| in double: edges of coordinates up to 1e18 (jsonval.h) have
+ * cross products whose squared length overflows a float. */
+static double cross_len(vec3 a, vec3 b)
+{
+    double x = (double)a.y * b.z - (double)a.z * b.y, y = (double)a.z * b.x - (double)a.x * b.z,
+           z = (double)a.x * b.y - (double)a.y * b.x;
+    return sqrt(x * x + y * y + z * z);
+}
+
+static double prim_area(const fr_builder *b, const fr_prim *p)
 {
     if (p->kind == FR_PRIM_SPHERE) {
-        float r = ((const fr_sphere *)b->spheres.data)[p->index].radius;
-        return 4.0f * FM_PI * r * r;
+        double r = ((const fr_sphere *)b->spheres.data)[p->index].radius;
+        return 4.0 * FM_PI * r * r;
     }
     if (p->kind == FR_PRIM_RECT) {
         const fr_rect *q = &((const fr_rect *)b->rects.data)[p->index];
-        return v3_len(v3_cross(q->edge_u, q->edge_v));
+        return cross_len(q->edge_u, q->edge_v);
     }
     const fr_triangle *t = &((const fr_triangle *)b->triangles.data)[p->index];
     const vec3 *pos = b->positions.data;
-    return 0.5f * v3_len(v3_cross(v3_sub(pos[t->v[1]], pos[t->v[0]]), v3_sub(pos[t->v[2]], pos[t->v[0]])));
+    return 0.5 * cross_len(v3_sub(pos[t->v[1]], pos[t->v[0]]), v3_sub(pos[t->v[2]], pos[t->v[0]]));
 }
 
 /* The bounding sphere of everything bounded, and of the planes' points. */
@@ -164,7 +175,8 @@ double frz_light_power(const fr_builder *b, const fr_light *l)
     case FR_LIGHT_PRIM: {
         const fr_prim *p = (const fr_prim *)b->prims.data + l->prim;
         const fr_material *m = (const fr_material *)b->materials.data + p->material;
-        return FM_PI * v3_luma(m->emission) * l->area * (m->two_sided ? 2.0 : 1.0);
+        /* In double: emission and area may each be near the float limit. */
+        return FM_PI * (double)v3_luma(m->emission) * l->area * (m->two_sided ? 2.0 : 1.0);
     }
     default:
         return 0.0;
@@ -210,7 +222,10 @@ int frz_lights(fr_builder *b, fr_error *err)
         memset(&l, 0, sizeof l);
         l.kind = FR_LIGHT_PRIM;
         l.prim = i;
-        l.area = prim_area(b, &prims[i]);
+        double area = prim_area(b, &prims[i]);
+        if (!(area <= FLT_MAX))
+            return fr_fail(err, "primitive %u: an emitter of area %g, too large for single precision", i, area);
+        l.area = (float)area;
         uint32_t li = bld_push(&b->lights, &l);
         if (li == FR_NONE)
             return fr_fail(err, "out of memory for lights");

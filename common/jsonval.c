@@ -6,6 +6,13 @@
 
 #define PATHLEN 160
 
+/* A JSON number the renderer can use: finite, and small enough that its
+ * square, and sums of a few squares, stay finite in single precision. */
+static int usable(const cJSON *v)
+{
+    return cJSON_IsNumber(v) && isfinite(v->valuedouble) && fabs(v->valuedouble) <= JV_MAX;
+}
+
 int jv_number(const cJSON *obj, const char *key, const char *where, int required, float def, float *out,
               fr_error *err)
 {
@@ -16,8 +23,8 @@ int jv_number(const cJSON *obj, const char *key, const char *where, int required
         *out = def;
         return 0;
     }
-    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || fabs(v->valuedouble) > 3.0e38)
-        return fr_fail(err, "%s.%s: expected a finite number", where, key);
+    if (!usable(v))
+        return fr_fail(err, "%s.%s: expected a finite number (of magnitude at most %g)", where, key, JV_MAX);
     *out = (float)v->valuedouble;
     return 0;
 }
@@ -46,8 +53,8 @@ int jv_vec3_value(const cJSON *v, const char *path, vec3 *out, fr_error *err)
     float c[3];
     for (int i = 0; i < 3; i++) {
         const cJSON *e = cJSON_GetArrayItem(v, i);
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 3.0e38)
-            return fr_fail(err, "%s[%d]: expected a finite number", path, i);
+        if (!usable(e))
+            return fr_fail(err, "%s[%d]: expected a finite number (of magnitude at most %g)", path, i, JV_MAX);
         c[i] = (float)e->valuedouble;
     }
     *out = v3(c[0], c[1], c[2]);
@@ -83,10 +90,9 @@ int jv_vec2(const cJSON *obj, const char *key, const char *where, vec2 def, vec2
         return 0;
     }
     const cJSON *e0 = cJSON_GetArrayItem(v, 0), *e1 = cJSON_GetArrayItem(v, 1);
-    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2 || !cJSON_IsNumber(e0) || !cJSON_IsNumber(e1) ||
-        !isfinite(e0->valuedouble) || !isfinite(e1->valuedouble) || fabs(e0->valuedouble) > 3e38 ||
-        fabs(e1->valuedouble) > 3e38)
-        return fr_fail(err, "%s.%s: expected a finite number or [u, v]", where, key);
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2 || !usable(e0) || !usable(e1))
+        return fr_fail(err, "%s.%s: expected a finite number or [u, v] (of magnitude at most %g)", where, key,
+                       JV_MAX);
     *out = (vec2){(float)e0->valuedouble, (float)e1->valuedouble};
     return 0;
 }

@@ -5,7 +5,10 @@
  *
  * `obj` is a JSON object, `key` one of its members and `where` the object's
  * path (used in messages).  A member that is absent takes `def` unless it is
- * `required`.  Numbers must be finite and fit a float.  Every function
+ * `required`.  Numbers must be finite and at most JV_MAX in magnitude, so
+ * that squares (a radius, a length) and sums of a few of them stay finite
+ * in single precision (a sphere of radius 3e38 would vanish, an emission
+ * of 3e38 overflow the light's power).  Every function
  * returns 0, or -1 with *err set.  Compile time only (the scene readers and
  * the coordinator's mesh hook); nothing here allocates.
  */
@@ -18,6 +21,9 @@
 
 #include "error.h"
 #include "vec.h"
+
+/** The largest magnitude a number of a scene may have. */
+#define JV_MAX 1e18
 
 /** Member `key` as a finite float. */
 int jv_number(const cJSON *obj, const char *key, const char *where, int required, float def, float *out,

@@ -102,17 +102,13 @@ static int check_texture(const scn_appear *a, const cJSON *t, const char *where,
         snprintf(p, sizeof p, "%s.colors", where);
         vec3 col[2];
         for (int i = 0; i < 2; i++) {
-            const cJSON *e = cJSON_GetArrayItem(c, i);
-            if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 3)
-                return fr_fail(err, "%s[%d]: expected [r, g, b]", p, i);
-            float v[3];
-            for (int k = 0; k < 3; k++) {
-                const cJSON *n = cJSON_GetArrayItem(e, k);
-                if (!cJSON_IsNumber(n) || !isfinite(n->valuedouble) || n->valuedouble < 0 || n->valuedouble > 3e38)
-                    return fr_fail(err, "%s[%d][%d]: expected a finite number >= 0", p, i, k);
-                v[k] = (float)n->valuedouble;
-            }
-            col[i] = v3(v[0], v[1], v[2]);
+            char pi[PATHLEN + 16];
+            snprintf(pi, sizeof pi, "%s[%d]", p, i);
+            if (jv_vec3_value(cJSON_GetArrayItem(c, i), pi, &col[i], err) < 0)
+                return -1;
+            for (int k = 0; k < 3; k++)
+                if (v3_get(col[i], k) < 0.0f)
+                    return fr_fail(err, "%s[%d]: expected a finite number >= 0", pi, k);
         }
         tex->color0 = col[0];
         tex->color1 = col[1];

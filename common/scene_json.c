@@ -301,6 +301,8 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
 int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, fr_builder *b, fr_error *err)
 {
     fr_error e;
+    if (!text[strspn(text, " \t\r\n")])
+        return fr_fail(err, "%s: empty file (expected a JSON object)", file);
     cJSON *root = cJSON_Parse(text);
     if (!root) {
         /* cJSON tells where it stopped; turn that into a line number. */

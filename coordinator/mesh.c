@@ -190,7 +190,7 @@ static int read_xform(const cJSON *o, const char *where, xform *x, float *det, f
         float v[16];
         for (int i = 0; i < 16; i++) {
             const cJSON *e = cJSON_GetArrayItem(mx, i);
-            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1.0e30)
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > JV_MAX)
                 return fr_fail(err, "%s.matrix[%d]: expected a finite number", where, i);
             v[i] = (float)e->valuedouble;
         }

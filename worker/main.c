@@ -40,7 +40,12 @@ static int load_scene(const char *path, fr_scene *s, fr_error *err)
     unsigned char magic[2] = {0, 0};
     size_t n = fread(magic, 1, 2, f);
     fclose(f);
-    if (n == 2 && magic[0] == 0x89 && magic[1] == 'F')
+    if (n == 0)
+        return fr_fail(err, "%s: empty file (expected a binary scene from `franja compile`, or a JSON scene)", path);
+    /* A binary scene by its first bytes, or by its name (so that a damaged
+     * one is reported as such, not as bad JSON). */
+    size_t len = strlen(path);
+    if ((n == 2 && magic[0] == 0x89 && magic[1] == 'F') || (len >= 5 && !strcmp(path + len - 5, ".fbin")))
         return fbin_load(path, s, err);
 #ifdef FRANJA_NO_JSON
     return fr_fail(err, "%s: this worker reads binary scenes only; run `franja compile` first", path);
