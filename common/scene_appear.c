@@ -134,9 +134,7 @@ static int check_texture(const scn_appear *a, const cJSON *t, const char *where,
     return 0;
 }
 
-/* Append a decoded image's texels to the builder as texture *tex:
- * channels 1 or 2 (grey, alpha dropped) give 1, 3 or 4 give 3. */
-static int store_image(fr_builder *b, const scn_image *img, int from_srgb, fr_texture *tex, const char *where,
+int scn_store_image(fr_builder *b, const scn_image *img, int from_srgb, fr_texture *tex, const char *where,
                        fr_error *err)
 {
     if (img->width == 0 || img->height == 0 || img->channels == 0 || img->channels > 4)
@@ -206,7 +204,7 @@ static int texture_ref(scn_appear *a, const char *name, int as_colour, const cha
         }
         char iw[PATHLEN + 4096];
         snprintf(iw, sizeof iw, "%s.file '%s'", tw, path);
-        int rc = store_image(a->b, &img, from_srgb, &tex, iw, err);
+        int rc = scn_store_image(a->b, &img, from_srgb, &tex, iw, err);
         free(img.pixels);
         if (rc < 0)
             return -1;

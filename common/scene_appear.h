@@ -48,6 +48,14 @@ void scn_appear_free(scn_appear *a);
 int scn_colour(scn_appear *a, const cJSON *obj, const char *key, const char *where, int required, vec3 def,
                vec3 *tint, uint32_t *tex, fr_error *err);
 
+/** Append a decoded image's texels to the builder and fill tex's image
+ * fields (width, height, channels, first): 1 or 2 channels (grey; alpha
+ * dropped) give 1, 3 or 4 give 3; `from_srgb` decodes the sRGB curve.
+ * Fails (naming `where`) on an empty image, non-finite texels, or when the
+ * scene's texels would pass 2^29 values. */
+int scn_store_image(fr_builder *b, const scn_image *img, int from_srgb, fr_texture *tex, const char *where,
+                    fr_error *err);
+
 /** The material members this module owns: "bump", "normal_map" and
  * "medium"; and the type "interface" (when is_interface). */
 int scn_material_appearance(scn_appear *a, const cJSON *obj, const char *where, int is_interface, fr_material *m,

@@ -31,6 +31,15 @@ typedef struct {
      * into *img; on failure return -1 and say why (unreadable,
      * unsupported, corrupt). */
     int (*texture)(const char *path, scn_image *img, fr_error *err);
+    /** Decode an image held in memory (`len` bytes; `mime` such as
+     * "image/png", or "" when unknown), as `texture` does a file.  May be
+     * NULL: images embedded in glTF files are then not decoded (a warning
+     * says so). */
+    int (*image_mem)(const void *data, size_t len, const char *mime, scn_image *img, fr_error *err);
+    /** Report a warning (a feature of an input file that is not supported
+     * and was ignored, named once); `user` is passed back.  May be NULL. */
+    void (*warn)(void *user, const char *msg);
+    void *user;
 } scn_hooks;
 
 #endif

@@ -1,25 +1,37 @@
-/* cmd_compile.c -- `franja compile`: a JSON scene into a binary scene. */
+/* cmd_compile.c -- `franja compile`: a JSON or glTF scene into a binary scene. */
 #include "cmd.h"
 
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include "clock.h"
 #include "compile.h"
 #include "fbin.h"
 
 static const char usage[] =
-    "usage: franja compile SCENE.json [-o SCENE.fbin]\n"
+    "usage: franja compile SCENE(.json|.gltf|.glb) [-o SCENE.fbin] [--camera NAME]\n"
     "\n"
     "Reads a JSON scene and the meshes it names (OBJ with MTL; PLY, STL, glTF\n"
-    "and other formats through Assimp), builds the BVH and writes the binary\n"
-    "scene that workers map and render (format: common/FORMAT.md).  The output\n"
-    "defaults to the scene's name with .fbin for .json.  Prints the content hash\n"
-    "that names the scene, its size and what it holds.\n";
+    "and other formats through Assimp), or a whole glTF 2.0 scene, builds the\n"
+    "BVH and writes the binary scene that workers map and render (format:\n"
+    "common/FORMAT.md).  The output defaults to the scene's name with .fbin for\n"
+    "its extension.  Prints the content hash that names the scene, its size and\n"
+    "what it holds.  Features of a glTF file that are not supported are named\n"
+    "in warnings.\n"
+    "\n"
+    "  -o FILE         the binary scene to write\n"
+    "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
+    "                  name (default: the first in the scene)\n";
+
+static void print_warning(void *user, const char *msg)
+{
+    fprintf(stderr, "%s: warning: %s\n", (const char *)user, msg);
+}
 
 int cmd_compile(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL;
+    const char *in = NULL, *out = NULL, *camera = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             fputs(usage, stdout);
@@ -30,6 +42,12 @@ int cmd_compile(int argc, char **argv)
                 return 2;
             }
             out = argv[++i];
+        } else if (!strcmp(argv[i], "--camera")) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "franja compile: --camera needs a name\n");
+                return 2;
+            }
+            camera = argv[++i];
         } else if (argv[i][0] == '-' && argv[i][1]) {
             fprintf(stderr, "franja compile: unknown option '%s' (see franja compile --help)\n", argv[i]);
             return 2;
@@ -47,8 +65,9 @@ int cmd_compile(int argc, char **argv)
     char def[4096];
     if (!out) {
         size_t n = strlen(in);
-        if (n > 5 && !strcmp(in + n - 5, ".json"))
-            n -= 5;
+        const char *dot = strrchr(in, '.'), *slash = strrchr(in, '/');
+        if (dot && (!slash || dot > slash) && (!strcasecmp(dot, ".json") || compile_is_gltf(in)))
+            n = (size_t)(dot - in);
         if (snprintf(def, sizeof def, "%.*s.fbin", (int)n, in) >= (int)sizeof def) {
             fprintf(stderr, "franja compile: %s: name too long\n", in);
             return 2;
@@ -58,7 +77,8 @@ int cmd_compile(int argc, char **argv)
     fr_scene s;
     fr_error err;
     double t0 = clk_now();
-    if (compile_json(in, &s, &err) < 0) {
+    compile_opts co = {camera, print_warning, (void *)"franja compile"};
+    if (compile_scene(in, &co, &s, &err) < 0) {
         fprintf(stderr, "franja compile: %s\n", err.msg);
         return 1;
     }

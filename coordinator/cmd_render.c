@@ -24,7 +24,7 @@
 #include "tonemap.h"
 
 static const char usage[] =
-    "usage: franja render SCENE(.json|.fbin) -o OUT [options]\n"
+    "usage: franja render SCENE(.json|.gltf|.glb|.fbin) -o OUT [options]\n"
     "\n"
     "Renders SCENE on this machine's cores, on the hosts of a host table over SSH,\n"
     "or on the CPUs of a Slurm allocation, and writes OUT (.png .exr .tif .jpg .hdr\n"
@@ -36,6 +36,8 @@ static const char usage[] =
     "                       with --hosts or --slurm: at most N per host)\n"
     "  --spp N              samples per pixel (default: the scene's)\n"
     "  --size WxH           image size (default: the scene's)\n"
+    "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
+    "                       own name (default: the first in the scene)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
     "                       (default: the scene's tonemap; HDR outputs .exr\n"
     "                       .hdr .pfm keep linear radiance)\n"
@@ -62,7 +64,7 @@ static int ends_with(const char *s, const char *suffix)
 }
 
 typedef struct {
-    const char *scene, *out, *hosts, *jobdir;
+    const char *scene, *out, *hosts, *jobdir, *camera;
     uint32_t jobs, spp, width, height, slab_rows, retries;
     float exposure;
     int exposure_set;          /* --exposure given: overrides the scene's */
@@ -105,7 +107,7 @@ static int parse(int argc, char **argv, render_args *a)
             continue;
         }
         static const char *valued[] = {"-o", "-j", "--spp", "--size", "--exposure", "--job", "--slab-rows",
-                                       "--retries", "--tonemap"};
+                                       "--retries", "--tonemap", "--camera"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(s, valued[k]);
@@ -123,6 +125,8 @@ static int parse(int argc, char **argv, render_args *a)
             a->out = v;
         else if (!strcmp(s, "--job"))
             a->jobdir = v;
+        else if (!strcmp(s, "--camera"))
+            a->camera = v;
         else if (!strcmp(s, "--tonemap")) {
             uint32_t c;
             a->curve = v;
@@ -158,12 +162,19 @@ static int parse(int argc, char **argv, render_args *a)
     return cli_slurm_check("render", &a->slurm, a->hosts) ? 2 : 0;
 }
 
+static void print_warning(void *user, const char *msg)
+{
+    fprintf(stderr, "%s: warning: %s\n", (const char *)user, msg);
+}
+
 /* Gets the binary scene: loads an .fbin, or compiles a JSON scene into the
  * job directory.  *path receives the .fbin to ship. */
 static int scene_binary(const render_args *a, const char *jobdir, char *path, size_t cap, fr_scene *sc,
                         fr_error *err)
 {
-    if (!ends_with(a->scene, ".json")) {
+    if (!ends_with(a->scene, ".json") && !compile_is_gltf(a->scene)) {
+        if (a->camera)
+            return fr_fail(err, "%s: --camera applies to glTF scenes (a compiled scene has its camera)", a->scene);
         snprintf(path, cap, "%s", a->scene);
         return fbin_load(path, sc, err);
     }
@@ -171,7 +182,8 @@ static int scene_binary(const render_args *a, const char *jobdir, char *path, si
         return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
     snprintf(path, cap, "%s/scene.fbin", jobdir);
     fr_scene compiled;
-    if (compile_json(a->scene, &compiled, err))
+    compile_opts co = {a->camera, print_warning, (void *)"franja"};
+    if (compile_scene(a->scene, &co, &compiled, err))
         return -1;
     int rc = fbin_write(&compiled, path, err);
     scn_free(&compiled);

@@ -1,7 +1,11 @@
 /* compile.c -- the scene compiler: the JSON reader with the mesh and
- * texture hooks of the coordinator (see compile.h). */
+ * texture hooks of the coordinator, and the glTF reader (see compile.h). */
 #include "compile.h"
 
+#include <string.h>
+#include <strings.h>
+
+#include "gltf_scene.h"
 #include "imageio.h"
 #include "mesh.h"
 #include "scene_json.h"
@@ -12,8 +16,29 @@ static int texture_load(const char *path, scn_image *img, fr_error *err)
     return iio_read(path, &img->pixels, &img->width, &img->height, &img->channels, err);
 }
 
+/* Images embedded in glTF files, likewise. */
+static int image_load(const void *data, size_t len, const char *mime, scn_image *img, fr_error *err)
+{
+    return iio_read_mem(data, len, mime, &img->pixels, &img->width, &img->height, &img->channels, err);
+}
+
+int compile_is_gltf(const char *path)
+{
+    size_t n = strlen(path);
+    return (n > 5 && !strcasecmp(path + n - 5, ".gltf")) || (n > 4 && !strcasecmp(path + n - 4, ".glb"));
+}
+
+int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err)
+{
+    scn_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL};
+    if (compile_is_gltf(path))
+        return gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
+    if (o && o->camera)
+        return fr_fail(err, "%s: --camera names a camera of a glTF scene; a JSON scene has its own", path);
+    return scn_load_json(path, &hooks, out, err);
+}
+
 int compile_json(const char *json_path, fr_scene *out, fr_error *err)
 {
-    const scn_hooks hooks = {mesh_add, texture_load};
-    return scn_load_json(json_path, &hooks, out, err);
+    return compile_scene(json_path, NULL, out, err);
 }

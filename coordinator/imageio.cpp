@@ -1,8 +1,10 @@
 // imageio.cpp -- OpenImageIO behind a C header (imageio.h).  Nothing else
 // in the coordinator is C++, and no C++ exception crosses into C.
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -38,35 +40,80 @@ extern "C" int iio_write(const char *path, const void *pixels, iio_type type, ui
     }
 }
 
+// Reads the first image of an opened input into *pixels (see iio_read).
+static int read_open(ImageInput *in, const char *name, float **pixels, uint32_t *width, uint32_t *height,
+                     uint32_t *channels, fr_error *err)
+{
+    const ImageSpec &spec = in->spec();
+    uint64_t n = (uint64_t)spec.width * (uint64_t)spec.height * (uint64_t)spec.nchannels;
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1 || n > (1u << 29))
+        return fr_fail(err, "%s: %d x %d x %d pixels, %d channels: not a 2D image of at most 2^29 values", name,
+                       spec.width, spec.height, spec.depth, spec.nchannels);
+    float *px = (float *)malloc(n * sizeof(float));
+    if (!px)
+        return fr_fail(err, "%s: out of memory for %llu values", name, (unsigned long long)n);
+    bool ok;
+    try {
+        ok = in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, px);
+    } catch (...) {
+        free(px);
+        throw;
+    }
+    if (!ok) {
+        free(px);
+        return fr_fail(err, "%s: %s", name, in->geterror().c_str());
+    }
+    *pixels = px;
+    *width = (uint32_t)spec.width;
+    *height = (uint32_t)spec.height;
+    *channels = (uint32_t)spec.nchannels;
+    return 0;
+}
+
 extern "C" int iio_read(const char *path, float **pixels, uint32_t *width, uint32_t *height, uint32_t *channels,
                         fr_error *err)
 {
     *pixels = nullptr;
-    float *px = nullptr;
     try {
         std::unique_ptr<ImageInput> in = ImageInput::open(path);
         if (!in)
             return fr_fail(err, "%s: %s", path, OIIO::geterror().c_str());
-        const ImageSpec &spec = in->spec();
-        uint64_t n = (uint64_t)spec.width * (uint64_t)spec.height * (uint64_t)spec.nchannels;
-        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1 || n > (1u << 29))
-            return fr_fail(err, "%s: %d x %d x %d pixels, %d channels: not a 2D image of at most 2^29 values", path,
-                           spec.width, spec.height, spec.depth, spec.nchannels);
-        px = (float *)malloc(n * sizeof(float));
-        if (!px)
-            return fr_fail(err, "%s: out of memory for %llu values", path, (unsigned long long)n);
-        if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, px)) {
-            free(px);
-            return fr_fail(err, "%s: %s", path, in->geterror().c_str());
-        }
-        *pixels = px;
-        *width = (uint32_t)spec.width;
-        *height = (uint32_t)spec.height;
-        *channels = (uint32_t)spec.nchannels;
-        return 0;
+        return read_open(in.get(), path, pixels, width, height, channels, err);
     } catch (const std::exception &e) {
-        free(px);
+        free(*pixels);
+        *pixels = nullptr;
         return fr_fail(err, "%s: %s", path, e.what());
+    }
+}
+
+extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, float **pixels, uint32_t *width,
+                            uint32_t *height, uint32_t *channels, fr_error *err)
+{
+    *pixels = nullptr;
+    // The format by its signature first (a MIME type may be wrong), then
+    // by the MIME type.
+    const unsigned char *b = (const unsigned char *)data;
+    const char *name = nullptr;
+    if (len >= 8 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8))
+        name = "embedded.png";
+    else if (len >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff)
+        name = "embedded.jpg";
+    else if (mime && !strcmp(mime, "image/png"))
+        name = "embedded.png";
+    else if (mime && !strcmp(mime, "image/jpeg"))
+        name = "embedded.jpg";
+    if (!name)
+        return fr_fail(err, "embedded image: neither PNG nor JPEG (MIME type '%s')", mime ? mime : "");
+    try {
+        Filesystem::IOMemReader mem(data, len);
+        std::unique_ptr<ImageInput> in = ImageInput::open(name, nullptr, &mem);
+        if (!in)
+            return fr_fail(err, "embedded %s image: %s", name + 9, OIIO::geterror().c_str());
+        return read_open(in.get(), "embedded image", pixels, width, height, channels, err);
+    } catch (const std::exception &e) {
+        free(*pixels);
+        *pixels = nullptr;
+        return fr_fail(err, "embedded image: %s", e.what());
     }
 }
 

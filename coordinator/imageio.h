@@ -5,6 +5,7 @@
 #ifndef FRANJA_IMAGEIO_H
 #define FRANJA_IMAGEIO_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "error.h"
@@ -25,6 +26,12 @@ int iio_write(const char *path, const void *pixels, iio_type type, uint32_t widt
  * and for images over 2^29 values. */
 int iio_read(const char *path, float **pixels, uint32_t *width, uint32_t *height, uint32_t *channels,
              fr_error *err);
+
+/** Reads an image held in memory (`len` bytes of a PNG or JPEG file, told
+ * apart by their signatures, else by `mime`) as iio_read does a file.
+ * Fails for other formats and for undecodable bytes. */
+int iio_read_mem(const void *data, size_t len, const char *mime, float **pixels, uint32_t *width, uint32_t *height,
+                 uint32_t *channels, fr_error *err);
 
 /** Returns 1 if OpenImageIO has a writer for the file name's extension. */
 int iio_can_write(const char *path);

@@ -7,7 +7,7 @@ apt-get update
 apt-get install -y --no-install-recommends \
     build-essential pkg-config \
     libcjson-dev libxxhash-dev libassimp-dev libembree-dev clang libclang-rt-14-dev \
-    libssh-dev libopenimageio-dev openimageio-tools \
+    libssh-dev libopenimageio-dev openimageio-tools assimp-testmodels \
     openssh-server openssh-client iproute2 procps doxygen \
     slurmctld slurmd slurm-client munge \
     docker.io debootstrap qemu-user-static \

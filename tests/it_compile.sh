@@ -15,7 +15,7 @@ triangles() {
 }
 
 # --- the command line ---
-$F compile --help | grep -q 'franja compile SCENE.json' && ok || bad "compile --help"
+$F compile --help | grep -q 'franja compile SCENE' && ok || bad "compile --help"
 expect_error "no scene" "usage: franja compile" $F compile
 expect_error "unknown option" "unknown option '--fast'" $F compile --fast scenes/cornell.json
 expect_error "two scenes" "one scene at a time" $F compile scenes/cornell.json scenes/spheres.json

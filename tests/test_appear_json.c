@@ -20,7 +20,7 @@ static int fake_image(const char *path, scn_image *img, fr_error *err)
     img->pixels = calloc(12, sizeof(float));
     return 0;
 }
-static const scn_hooks hooks = {NULL, fake_image};
+static const scn_hooks hooks = {.texture = fake_image};
 
 /* Parse a scene made of the fixed parts plus `extra` top-level members and
  * material `mat`; return the error message ("" on success). */

@@ -44,7 +44,7 @@ static int synthetic(const char *path, scn_image *img, fr_error *err)
     return 0;
 }
 
-static const scn_hooks hooks = {NULL, synthetic};
+static const scn_hooks hooks = {.texture = synthetic};
 static char dir[64];
 
 /* Parse a scene whose image files live in dir (they exist, empty, so the
