@@ -251,6 +251,8 @@ int gdoc_uri_path(const gltf_doc *d, const char *uri, const char *ptr, char *out
     if (s > 0 && uri[s] == ':')
         return gdoc_fail(d, err, ptr, "uri '%.*s...': only relative file names and data: URIs are supported",
                          (int)(s + 1), uri);
+    if (!d->dir[0])
+        return gdoc_fail(d, err, ptr, "uri '%s': external files are not read for a document held in memory", uri);
     if (uri[0] == '/' || uri[0] == 0)
         return gdoc_fail(d, err, ptr, "uri '%s': expected a file name relative to the glTF file", uri);
     char name[4096];
@@ -332,8 +334,11 @@ static int collect(gltf_doc *d, const cJSON *parent, const char *key, const char
     if ((a->v = malloc((size_t)n * sizeof *a->v)) == NULL)
         return gdoc_fail(d, err, ptr, "out of memory");
     for (const cJSON *e = v->child; e; e = e->next) {
-        if (!cJSON_IsObject(e))
+        if (!cJSON_IsObject(e)) {
+            free(a->v);
+            a->v = NULL;
             return gdoc_fail(d, err, ptr, "element %u: expected an object", a->n);
+        }
         a->v[a->n++] = e;
     }
     return 0;

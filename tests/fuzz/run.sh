@@ -5,8 +5,9 @@
 # and any crashing input go to build/fuzz/run/.  Exit status 1 if a target
 # crashed, leaked, hit undefined behaviour or timed out.
 #
-# Seeds: tests/fuzz/corpus/json and tests/fuzz/corpus/obj (inputs starting
-# with 'M' are MTL files); the binary-scene seeds are compiled now, so that
+# Seeds: tests/fuzz/corpus/json, tests/fuzz/corpus/gltf (written by
+# tests/tools/gengltf) and tests/fuzz/corpus/obj (inputs starting with 'M'
+# are MTL files); the binary-scene seeds are compiled now, so that
 # they are always the current format, from the example scenes without
 # meshes and from tests/fuzz/corpus/fbin/*.json (small scenes with image
 # textures, bump and normal maps and a mesh).  The fuzzer reads at most
@@ -32,7 +33,7 @@ for s in scenes/*.json tests/fuzz/corpus/fbin/*.json; do
 done
 echo "== fuzz: ${SECS} s per target, clang $(clang --version | sed -n 's/.*version \([0-9.]*\).*/\1/p;q'), ASan + UBSan"
 rc=0
-for t in fbin json obj; do
+for t in fbin json obj gltf; do
     seeds=tests/fuzz/corpus/$t
     [ "$t" = fbin ] && seeds=$W/seed-fbin
     mkdir -p "$W/corpus-$t"

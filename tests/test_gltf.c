@@ -1,0 +1,327 @@
+/* The glTF reader in memory (common/gltf_doc.c, gltf_scene.c, gltf_mat.c):
+ * base64 data URIs, accessors of every component type (normalized,
+ * strided, sparse), strips and fans, node transforms and the camera,
+ * JSON-pointer errors, bounds on instancing, warnings once each. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "gltf_doc.h"
+#include "gltf_scene.h"
+
+/* A check that prints its own condition when it fails. */
+#define T(c) CHECK(c, "%s", #c)
+
+/* ---- writing little documents ---------------------------------------- */
+
+static void b64(const unsigned char *p, size_t n, char *out)
+{
+    static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        unsigned v = (unsigned)p[i] << 16 | (i + 1 < n ? (unsigned)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+        out[o++] = a[v >> 18 & 63];
+        out[o++] = a[v >> 12 & 63];
+        out[o++] = i + 1 < n ? a[v >> 6 & 63] : '=';
+        out[o++] = i + 2 < n ? a[v & 63] : '=';
+    }
+    out[o] = 0;
+}
+
+static char doc_text[65536];
+
+/* A document whose one buffer holds `bin`, with `body` (JSON members
+ * after "asset" and "buffers"). */
+static const char *docf(const void *bin, size_t n, const char *body)
+{
+    static char enc[40000];
+    b64(bin, n, enc);
+    snprintf(doc_text, sizeof doc_text,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}]%s%s}",
+             n, enc, body[0] ? "," : "", body);
+    return doc_text;
+}
+
+static int n_warnings;
+static char last_warning[800];
+static void on_warn(void *user, const char *msg)
+{
+    (void)user;
+    n_warnings++;
+    snprintf(last_warning, sizeof last_warning, "%s", msg);
+}
+static const scn_hooks warn_hooks = {.warn = on_warn};
+
+/* Imports text into a fresh builder; returns the import's status. */
+static int import(const char *text, fr_builder *b, gltf_options *o, fr_error *err)
+{
+    gltf_result r;
+    bld_init(b);
+    n_warnings = 0;
+    return gltf_import_mem(text, strlen(text), "t.gltf", &warn_hooks, o, b, &r, err);
+}
+
+static int contains(const char *s, const char *frag)
+{
+    if (strstr(s, frag))
+        return 1;
+    printf("  message: %s\n  lacks:   %s\n", s, frag);
+    return 0;
+}
+
+/* ---- tests ------------------------------------------------------------ */
+
+static void test_data_uri(void)
+{
+    unsigned char *out;
+    size_t n;
+    char mime[32];
+    fr_error e;
+    T(gdoc_data_uri("data:image/png;base64,AAECAw==", &out, &n, mime, sizeof mime, &e) == 0);
+    T(n == 4 && out[0] == 0 && out[1] == 1 && out[2] == 2 && out[3] == 3);
+    T(!strcmp(mime, "image/png"));
+    free(out);
+    T(gdoc_data_uri("data:;base64,/w", &out, &n, NULL, 0, &e) == 0 && n == 1 && out[0] == 255);
+    free(out);
+    T(gdoc_data_uri("data:text/plain,hello", &out, &n, NULL, 0, &e) < 0 && contains(e.msg, "base64"));
+    T(gdoc_data_uri("data:;base64,AA!A", &out, &n, NULL, 0, &e) < 0 && contains(e.msg, "byte 2"));
+    T(gdoc_data_uri("data:;base64,A", &out, &n, NULL, 0, &e) < 0);
+}
+
+static void test_accessors(void)
+{
+    /* bytes 0-3: u8 normalized 0, 255, 51, 0; 4-7: i16 normalized -32768,
+     * 32767; 8-19: three f32; 20-21: sparse index 1 (u16); 24-27: value. */
+    unsigned char bin[28] = {0, 255, 51, 0, 0x00, 0x80, 0xff, 0x7f};
+    float f[3] = {1.5f, -2.0f, 3.25f}, sv = 7.0f;
+    memcpy(bin + 8, f, sizeof f);
+    bin[20] = 1;
+    memcpy(bin + 24, &sv, 4);
+    const char *t = docf(bin, sizeof bin,
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":4},{\"buffer\":0,\"byteOffset\":4,\"byteLength\":4},"
+        "{\"buffer\":0,\"byteOffset\":8,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":20,\"byteLength\":2},"
+        "{\"buffer\":0,\"byteOffset\":24,\"byteLength\":4},{\"buffer\":0,\"byteOffset\":8,\"byteLength\":12,\"byteStride\":8}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5121,\"normalized\":true,\"count\":4,\"type\":\"SCALAR\"},"
+        "{\"bufferView\":1,\"componentType\":5122,\"normalized\":true,\"count\":2,\"type\":\"SCALAR\"},"
+        "{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\","
+        " \"sparse\":{\"count\":1,\"indices\":{\"bufferView\":3,\"componentType\":5123},\"values\":{\"bufferView\":4}}},"
+        "{\"bufferView\":5,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"},"
+        "{\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"},"
+        "{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"SCALAR\"},"
+        "{\"bufferView\":0,\"componentType\":5126,\"normalized\":true,\"count\":1,\"type\":\"SCALAR\"}]");
+    gltf_doc d;
+    fr_error e;
+    gdoc_acc a;
+    T(gdoc_open_mem(&d, t, strlen(t), "t.gltf", NULL, &e) == 0);
+    T(gdoc_accessor(&d, 0, "/x", 1, NULL, &a, &e) == 0);
+    T(gdoc_get(&a, 0, 0) == 0.0 && gdoc_get(&a, 1, 0) == 1.0 && fabs(gdoc_get(&a, 2, 0) - 0.2) < 1e-12);
+    T(gdoc_accessor(&d, 1, "/x", 1, NULL, &a, &e) == 0);
+    T(gdoc_get(&a, 0, 0) == -1.0 && gdoc_get(&a, 1, 0) == 1.0);
+    T(gdoc_accessor(&d, 2, "/x", 1, NULL, &a, &e) == 0);
+    T(gdoc_get(&a, 0, 0) == 1.5 && gdoc_get(&a, 1, 0) == 7.0 && gdoc_get(&a, 2, 0) == 3.25);
+    T(gdoc_accessor(&d, 3, "/x", 1, NULL, &a, &e) == 0); /* stride 8: elements 0 and 2 of the floats */
+    T(gdoc_get(&a, 0, 0) == 1.5 && gdoc_get(&a, 1, 0) == 3.25);
+    T(gdoc_accessor(&d, 4, "/x", 3, NULL, &a, &e) == 0 && gdoc_get(&a, 1, 2) == 0.0); /* no view: zeros */
+    T(gdoc_accessor(&d, 4, "/here", 2, NULL, &a, &e) < 0 && contains(e.msg, "/here: accessor 4 has type VEC3"));
+    T(gdoc_accessor(&d, 5, "/x", 1, NULL, &a, &e) < 0 &&
+          contains(e.msg, "t.gltf: /accessors/5: 4 elements from byte 0 need 16 bytes; bufferView 2 has 12"));
+    T(gdoc_accessor(&d, 6, "/x", 1, NULL, &a, &e) < 0 && contains(e.msg, "/accessors/6: normalized"));
+    T(gdoc_accessor(&d, 7, "/x", 1, NULL, &a, &e) < 0 && contains(e.msg, "accessor 7 does not exist"));
+    gdoc_free(&d);
+}
+
+/* A mesh from positions (float VEC3) with indices (u16) in `mode`. */
+static const char *mesh_doc(const float *p, int nv, const unsigned short *idx, int ni, int mode, const char *nodes)
+{
+    static unsigned char bin[4096];
+    size_t pb = (size_t)nv * 12, ib = (size_t)ni * 2;
+    memcpy(bin, p, pb);
+    memcpy(bin + pb, idx, ib);
+    static char body[8192];
+    snprintf(body, sizeof body,
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":%d,\"type\":\"SCALAR\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"mode\":%d}]}],"
+             "\"nodes\":%s,\"scenes\":[{\"nodes\":[0]}]",
+             pb, pb, ib, nv, ni, mode, nodes);
+    return docf(bin, pb + ib, body);
+}
+
+static const float square[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+
+static void test_modes(void)
+{
+    fr_builder b;
+    fr_error e;
+    gltf_options o;
+    gltf_options_default(&o);
+    const unsigned short strip[4] = {0, 1, 3, 2}, fan[4] = {0, 1, 2, 3};
+    T(import(mesh_doc(square, 4, strip, 4, 5, "[{\"mesh\":0}]"), &b, &o, &e) == 0);
+    T(b.triangles.count == 2);
+    /* every triangle of the strip faces +z (counter-clockwise) */
+    const vec3 *p = b.positions.data;
+    for (uint32_t i = 0; i < b.triangles.count; i++) {
+        const fr_triangle *t = (const fr_triangle *)b.triangles.data + i;
+        vec3 n = v3_cross(v3_sub(p[t->v[1]], p[t->v[0]]), v3_sub(p[t->v[2]], p[t->v[0]]));
+        T(n.z > 0);
+    }
+    bld_free(&b);
+    T(import(mesh_doc(square, 4, fan, 4, 6, "[{\"mesh\":0}]"), &b, &o, &e) == 0);
+    T(b.triangles.count == 2);
+    bld_free(&b);
+    T(import(mesh_doc(square, 4, fan, 4, 1, "[{\"mesh\":0}]"), &b, &o, &e) == 0); /* lines */
+    T(b.triangles.count == 0 && n_warnings == 1 && contains(last_warning, "points and lines are not rendered"));
+    bld_free(&b);
+    const unsigned short bad[3] = {0, 1, 4};
+    T(import(mesh_doc(square, 4, bad, 3, 4, "[{\"mesh\":0}]"), &b, &o, &e) < 0 &&
+          contains(e.msg, "t.gltf: /meshes/0/primitives/0: indices: accessor 1 element 2 is 4, not below the vertex count 4"));
+    bld_free(&b);
+}
+
+static int close3(vec3 a, double x, double y, double z)
+{
+    return fabs(a.x - x) < 1e-5 && fabs(a.y - y) < 1e-5 && fabs(a.z - z) < 1e-5;
+}
+
+static void test_transforms(void)
+{
+    fr_builder b;
+    fr_error e;
+    gltf_options o;
+    gltf_options_default(&o);
+    const unsigned short tri[6] = {0, 1, 2, 0, 2, 3};
+    /* parent: translate (10, 0, 0), rotate 90 degrees about z; child:
+     * scale 2 then a matrix translating by (0, 0, 5): vertex (1, 0, 0)
+     * -> (2, 0, 0) +(0,0,5) -> rotate: (0, 2, 5) -> (10, 2, 5). */
+    char nodes[512];
+    snprintf(nodes, sizeof nodes,
+             "[{\"children\":[1],\"translation\":[10,0,0],\"rotation\":[0,0,%.17g,%.17g]},"
+             "{\"children\":[2],\"matrix\":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,5,1]},{\"mesh\":0,\"scale\":[2,2,2]}]",
+             sqrt(0.5), sqrt(0.5));
+    const char *t = mesh_doc(square, 4, tri, 6, 4, nodes);
+    /* the scene lists node 0 only; nodes 1 and 2 come through children */
+    T(import(t, &b, &o, &e) == 0);
+    const vec3 *p = b.positions.data;
+    T(b.positions.count == 4 && close3(p[1], 10, 2, 5) && close3(p[0], 10, 0, 5) && close3(p[3], 8, 0, 5));
+    bld_free(&b);
+    /* a placement multiplies from the left */
+    o.place[0][3] = 1.0;
+    T(import(t, &b, &o, &e) == 0 && close3(((const vec3 *)b.positions.data)[1], 11, 2, 5));
+    bld_free(&b);
+    gltf_options_default(&o);
+    /* forests only */
+    T(import(mesh_doc(square, 4, tri, 6, 4, "[{\"children\":[0]}]"), &b, &o, &e) < 0 &&
+          contains(e.msg, "/nodes/0/children: node 0 is its own child"));
+    bld_free(&b);
+    T(import(mesh_doc(square, 4, tri, 6, 4, "[{\"children\":[2]},{\"children\":[2]},{\"mesh\":0}]"), &b, &o, &e) < 0 &&
+          contains(e.msg, "/nodes/1/children: node 2 has two parents"));
+    bld_free(&b);
+    T(import(mesh_doc(square, 4, tri, 6, 4, "[{\"mesh\":0,\"matrix\":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1],"
+                                                 "\"scale\":[1,1,1]}]"), &b, &o, &e) < 0 &&
+          contains(e.msg, "/nodes/0: both matrix and translation/rotation/scale"));
+    bld_free(&b);
+    T(import(mesh_doc(square, 4, tri, 6, 4, "[{\"mesh\":0,\"matrix\":[1,0,0,1,0,1,0,0,0,0,1,0,0,0,0,1]}]"), &b, &o,
+                 &e) < 0 && contains(e.msg, "the last row must be 0 0 0 1"));
+    bld_free(&b);
+    /* instancing is bounded */
+    char many[8192];
+    size_t n = (size_t)snprintf(many, sizeof many, "[{\"children\":[");
+    for (int i = 1; i <= 300; i++)
+        n += (size_t)snprintf(many + n, sizeof many - n, "%s%d", i > 1 ? "," : "", i);
+    n += (size_t)snprintf(many + n, sizeof many - n, "]}");
+    for (int i = 1; i <= 300; i++)
+        n += (size_t)snprintf(many + n, sizeof many - n, ",{\"mesh\":0}");
+    snprintf(many + n, sizeof many - n, "]");
+    o.max_triangles = 500;
+    T(import(mesh_doc(square, 4, tri, 6, 4, many), &b, &o, &e) < 0 &&
+          contains(e.msg, "more than 500 triangles"));
+    bld_free(&b);
+}
+
+static void test_camera(void)
+{
+    fr_builder b;
+    fr_error e;
+    gltf_options o;
+    gltf_options_default(&o);
+    const unsigned short tri[6] = {0, 1, 2, 0, 2, 3};
+    /* a camera turned 90 degrees about y looks along -x; yfov 0.5 */
+    char nodes[512];
+    snprintf(nodes, sizeof nodes,
+             "[{\"mesh\":0},{\"camera\":0,\"name\":\"side\",\"translation\":[1,2,3],\"rotation\":[0,%.17g,0,%.17g]}]",
+             sqrt(0.5), sqrt(0.5));
+    char text[65536];
+    snprintf(text, sizeof text, "%s", mesh_doc(square, 4, tri, 6, 4, nodes));
+    char *end = strrchr(text, '}');
+    snprintf(end, sizeof text - (size_t)(end - text),
+             ",\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"aspectRatio\":1.5,\"znear\":0.1}}]}");
+    /* the camera node is not in the scene: no camera */
+    T(import(text, &b, &o, &e) == 0 && b.camera.vfov == 0.0f);
+    bld_free(&b);
+    char *s = strstr(text, "\"scenes\":[{\"nodes\":[0]}]");
+    T(s != NULL);
+    if (s)
+        s[20] = '1';
+    gltf_result r;
+    bld_init(&b);
+    T(gltf_import_mem(text, strlen(text), "t.gltf", NULL, &o, &b, &r, &e) == 0 && r.camera_found);
+    T(close3(b.camera.position, 1, 2, 3) && close3(b.camera.forward, -1, 0, 0) && close3(b.camera.upv, 0, 1, 0));
+    T(b.camera.vfov == 0.5f && fabsf(r.aspect - 1.5f) < 1e-7f);
+    bld_free(&b);
+    o.camera = "front";
+    bld_init(&b);
+    T(gltf_import_mem(text, strlen(text), "t.gltf", NULL, &o, &b, &r, &e) < 0 &&
+          contains(e.msg, "no perspective camera named 'front' in the scene (camera nodes: 'side')"));
+    bld_free(&b);
+    o.camera = "side";
+    bld_init(&b);
+    T(gltf_import_mem(text, strlen(text), "t.gltf", NULL, &o, &b, &r, &e) == 0 && r.camera_found);
+    bld_free(&b);
+}
+
+static void test_documents(void)
+{
+    fr_builder b;
+    fr_error e;
+    gltf_options o;
+    gltf_options_default(&o);
+    T(import("{\"asset\":{}}", &b, &o, &e) < 0 && contains(e.msg, "t.gltf: /asset/version: missing"));
+    bld_free(&b);
+    T(import("[1]", &b, &o, &e) < 0 && contains(e.msg, "(top level): expected an object"));
+    bld_free(&b);
+    T(import("{\"asset\":{\"version\":\"2.0\"},\"extensionsRequired\":[\"EXT_meshopt_compression\"]}", &b, &o,
+                 &e) < 0 && contains(e.msg, "requires extension EXT_meshopt_compression"));
+    bld_free(&b);
+    T(import("{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":10,\"uri\":\"/etc/passwd\"}]}", &b, &o,
+                 &e) < 0 && contains(e.msg, "/buffers/0: uri '/etc/passwd'"));
+    bld_free(&b);
+    T(import("{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":10,\"uri\":\"http://x/y.bin\"}]}", &b,
+                 &o, &e) < 0 && contains(e.msg, "only relative file names and data: URIs"));
+    bld_free(&b);
+    T(import("{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":1000,"
+                 "\"uri\":\"data:application/octet-stream;base64,AAAA\"}]}", &b, &o, &e) < 0 &&
+          contains(e.msg, "/buffers/0: byteLength 1000, but its data: URI holds 3 bytes"));
+    bld_free(&b);
+    /* warnings: one per feature, however often it occurs */
+    const unsigned short tri[6] = {0, 1, 2, 0, 2, 3};
+    T(import(mesh_doc(square, 4, tri, 6, 4, "[{\"mesh\":0,\"skin\":0,\"children\":[1]},{\"mesh\":0,\"skin\":0}],"
+                                                 "\"animations\":[{}],\"extensionsUsed\":[\"EXT_made_up\"]"),
+                 &b, &o, &e) == 0);
+    T(n_warnings == 3 && b.triangles.count == 4);
+    bld_free(&b);
+}
+
+int main(void)
+{
+    test_data_uri();
+    test_accessors();
+    test_modes();
+    test_transforms();
+    test_camera();
+    test_documents();
+    return check_done();
+}
