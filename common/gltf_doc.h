@@ -79,7 +79,7 @@ void gdoc_warn(gltf_doc *d, const char *key, const char *fmt, ...) __attribute__
  * `known` (NULL-terminated). */
 void gdoc_warn_extensions(gltf_doc *d, const char *const *known);
 
-/* ---- JSON values, with JSON-pointer errors ("/nodes/3/mesh: ..."). ---- */
+/** @name JSON values, with JSON-pointer errors ("/nodes/3/mesh: ...") */
 
 /** Member `key` of object o (at pointer `ptr`) as an integer in [0, max]:
  * absent gives `def` (or fails when def < 0). */
@@ -103,7 +103,7 @@ int gdoc_object(const gltf_doc *d, const cJSON *o, const char *ptr, const char *
 int gdoc_fail(const gltf_doc *d, fr_error *err, const char *ptr, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
-/* ---- accessors ---------------------------------------------------------- */
+/** @name Accessors */
 
 /** Component types (glTF's numbers). */
 enum {
@@ -119,8 +119,7 @@ typedef struct {
     int normalized;
     const unsigned char *base; /**< element 0, or NULL: all zeros (no bufferView) */
     size_t stride;             /**< bytes from one element to the next */
-    /* sparse substitution: n_sparse sorted indices and their values */
-    uint32_t n_sparse;
+    uint32_t n_sparse;         /**< sparse substitution: n_sparse sorted indices and their values */
     const unsigned char *sp_index, *sp_value;
     uint32_t sp_itype;         /**< component type of the sparse indices */
 } gdoc_acc;
