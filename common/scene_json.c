@@ -12,6 +12,7 @@
 #include "jsonval.h"
 #include "proto_limits.h"
 #include "scene_appear.h"
+#include "scene_gltf.h"
 #include "scene_light.h"
 
 #define PATHLEN 160
@@ -22,6 +23,7 @@ typedef struct {
     const scn_hooks *hooks;
     fr_builder *b;
     const cJSON *materials;    /* the "materials" object, for name lookup */
+    int gltf_camera;           /* the camera comes from a gltf shape */
     fr_error *err;
     scn_appear *look;          /* textures, media (scene_appear.h) */
 } ctx;
@@ -74,6 +76,16 @@ static int parse_camera(ctx *c, const cJSON *o)
     if (!(cam->focus > 0.0f))
         return fr_fail(c->err, "camera.focus: expected a positive distance");
     return 0;
+}
+
+/* The top-level camera, or (without one) the camera of a gltf shape. */
+static int camera(ctx *c, const cJSON *root)
+{
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (cam)
+        return parse_camera(c, cam);
+    c->gltf_camera = 1;
+    return scn_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->err);
 }
 
 static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material *m)
@@ -223,11 +235,12 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         return fr_fail(c->err, "%s: expected an object", where);
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
-        return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle, box or mesh)", where);
+        return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle, box, mesh or gltf)", where);
     const char *type = t->valuestring;
-    /* Meshes may take their materials from their own files. */
+    /* Meshes and glTF files may take their materials from their own files. */
     uint32_t mat = FR_NONE;
-    if (strcmp(type, "mesh") != 0 || cJSON_GetObjectItemCaseSensitive(o, "material"))
+    int own_materials = !strcmp(type, "mesh") || !strcmp(type, "gltf");
+    if (!own_materials || cJSON_GetObjectItemCaseSensitive(o, "material"))
         if (material_ref(c, o, where, &mat) < 0)
             return -1;
     const fr_material *m = mat == FR_NONE ? NULL : (const fr_material *)c->b->materials.data + mat;
@@ -292,8 +305,13 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         fr_error e;
         if (c->hooks->mesh(c->b, o, where, c->dir, mat, &e) < 0)
             return fr_fail(c->err, "%s", e.msg);
+    } else if (!strcmp(type, "gltf")) {
+        if (scn_gltf_shape(c->b, o, where, c->dir, c->hooks, mat, c->gltf_camera, c->err) < 0)
+            return -1;
+        c->gltf_camera = 0;            /* taken by the first that asks */
     } else {
-        return fr_fail(c->err, "%s.type: '%s' is not sphere, plane, rect, quad, triangle, box or mesh", where, type);
+        return fr_fail(c->err, "%s.type: '%s' is not sphere, plane, rect, quad, triangle, box, mesh or gltf", where,
+                       type);
     }
     return r == FR_NONE ? fr_fail(c->err, "%s: out of memory", where) : 0;
 }
@@ -316,7 +334,7 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
     file_dir(file, dir, sizeof dir);
     scn_appear look;
     memset(&look, 0, sizeof look);
-    ctx c = {file, dir, hooks, b, NULL, &e, &look};
+    ctx c = {file, dir, hooks, b, NULL, 0, &e, &look};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
                                       "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
@@ -324,7 +342,7 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
         fr_fail(&e, "(top level): expected an object");
     } else if (jv_only_fields(root, "(top level)", top, &e) == 0 &&
                parse_image(&c, cJSON_GetObjectItemCaseSensitive(root, "image")) == 0 &&
-               parse_camera(&c, cJSON_GetObjectItemCaseSensitive(root, "camera")) == 0 &&
+               camera(&c, root) == 0 &&
                scn_appear_begin(&look, root, dir, hooks, b, &e) == 0 &&
                parse_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials")) == 0 &&
                scn_lights(&look, cJSON_GetObjectItemCaseSensitive(root, "lights"), &e) == 0 &&

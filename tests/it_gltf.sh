@@ -84,6 +84,44 @@ $F compile "$T/uvxf.gltf" -o "$T/uvxf.fbin" >/dev/null &&
     $W --scene "$T/uvxf.fbin" --rows 0:32 --size 32x32 --spp 1 -o "$T/uvxf.pfm" || bad "uvxf.gltf"
 for xy in "8 8" "24 8" "8 24" "24 24"; do pixel_is "$T/uvxf.pfm" $xy 0 1 0; done
 
+# --- a glTF file as a shape of a JSON scene ---
+cat >"$T/inc.json" <<EOF
+{"image": {"width": 640, "height": 480, "spp": 64, "max_depth": 8},
+ "camera": {"position": [0, 1, 4], "target": [0, 1, 3], "up": [0, 1, 0], "fov": 40},
+ "materials": {}, "shapes": [{"type": "gltf", "file": "scene.gltf"}]}
+EOF
+$F compile "$T/inc.json" -o "$T/inc.fbin" >"$T/inc.out" 2>&1 || bad "inc.json: $(cat "$T/inc.out")"
+[ "$(hash_of "$T/inc.out")" = "$(hash_of "$T/a.out")" ] && ok ||
+    bad "a JSON scene holding scene.gltf with the same camera differs from scene.gltf"
+# the file's camera through the JSON scene
+cat >"$T/incam.json" <<EOF
+{"image": {"width": 64, "height": 32}, "materials": {},
+ "shapes": [{"type": "gltf", "file": "frame.gltf", "camera": true}]}
+EOF
+$F compile "$T/incam.json" -o "$T/incam.fbin" >/dev/null 2>"$T/err" || bad "incam.json: $(cat "$T/err")"
+$W --scene "$T/incam.fbin" --rows 0:32 --size 64x32 --spp 4 -o "$T/incam.pfm" &&
+    [ "$(tail -c 24576 "$T/incam.pfm" | cksum)" = "$(tail -c 24576 "$T/frame.pfm" | cksum)" ] && ok || bad "the glTF camera taken through JSON frames differently"
+# the shape's transform places the file
+cat >"$T/move.json" <<EOF
+{"image": {"width": 64, "height": 32}, "materials": {},
+ "camera": {"position": [0, 0, 0], "target": [0, 0, -1], "fov": 53.1301024},
+ "shapes": [{"type": "gltf", "file": "frame.gltf", "translate": [0.5, 0, 0], "rotate": [0, 0, 90]}]}
+EOF
+$F compile "$T/move.json" -o "$T/move.fbin" >/dev/null 2>"$T/err" || bad "move.json: $(cat "$T/err")"
+$W --scene "$T/move.fbin" --rows 0:32 --size 64x32 --spp 4 -o "$T/move.pfm" || bad "render move.json"
+# the square, turned a quarter about z (no change) and moved 0.5 right: columns 32 to 48
+for xy in "34 16" "46 16"; do pixel_is "$T/move.pfm" $xy 1 1 1; done
+for xy in "28 16" "50 16"; do pixel_is "$T/move.pfm" $xy 0 0 0; done
+sed 's/"camera": true/"camera": true, "translate": [0, 0, -2]/; s/"height": 32}/"height": 32}, "camera": {"position": [0, 0, 0], "target": [0, 0, -1], "fov": 50}/' \
+    "$T/incam.json" >"$T/twocams.json"
+expect_error "two cameras" "shapes[0].camera: the scene has a camera of its own" $F compile "$T/twocams.json" -o "$T/x.fbin"
+sed 's/frame.gltf/nothere.gltf/' "$T/incam.json" >"$T/nofile.json"
+expect_error "missing glTF file" "shapes[0].camera: $T/nothere.gltf: No such file" $F compile "$T/nofile.json" -o "$T/x.fbin"
+sed 's/"camera": true/"camera": true, "scale": 0/' "$T/incam.json" >"$T/zero.json"
+expect_error "singular placement" "shapes[0]: the transform is singular" $F compile "$T/zero.json" -o "$T/x.fbin"
+sed 's/"camera": true/"camera": true, "lod": 2/' "$T/incam.json" >"$T/field.json"
+expect_error "unknown field" "shapes[0].lod: unknown field" $F compile "$T/field.json" -o "$T/x.fbin"
+
 # --- --camera NAME ---
 M=/usr/share/assimp/models/glTF2
 if [ -d $M ]; then

@@ -12,7 +12,7 @@
  *   gengltf uv      DIR PNG   uv.gltf (PNG in a data: URI), uv.glb (PNG in a
  *                             bufferView), uvxf.gltf (KHR_texture_transform):
  *                             a square filling the view, emitting the PNG
- *   gengltf example DIR       example.glb: the example scene of scenes/
+ *   gengltf example DIR       courtyard.glb: the example scene of scenes/
  *
  * Everything is written with fprintf from fixed numbers, so the files are
  * the same on every run. */
@@ -72,6 +72,7 @@ typedef struct {
     str roots;                 /* the scene's node list */
     str images, textures, samplers, cameras, lights;
     const char *used;          /* extensionsUsed, JSON array text, or NULL */
+    char last_attrs[128];      /* the last mesh's primitive, less its material */
 } doc;
 
 static void sep(str *t, int n) { if (n) addf(t, ","); }
@@ -135,16 +136,24 @@ static int mesh(doc *d, const float *pos, int nv, const float *uv, const float *
     int p = floats(d, pos, nv, 3);
     int t = uv ? floats(d, uv, nv, 2) : -1, n = nrm ? floats(d, nrm, nv, 3) : -1;
     int i = idx ? indices16(d, idx, ni) : -1;
-    sep(&d->meshes, d->n_meshes);
-    addf(&d->meshes, "{\"primitives\":[{\"attributes\":{\"POSITION\":%d", p);
+    int o = snprintf(d->last_attrs, sizeof d->last_attrs, "\"attributes\":{\"POSITION\":%d", p);
     if (t >= 0)
-        addf(&d->meshes, ",\"TEXCOORD_0\":%d", t);
+        o += snprintf(d->last_attrs + o, sizeof d->last_attrs - (size_t)o, ",\"TEXCOORD_0\":%d", t);
     if (n >= 0)
-        addf(&d->meshes, ",\"NORMAL\":%d", n);
-    addf(&d->meshes, "}");
+        o += snprintf(d->last_attrs + o, sizeof d->last_attrs - (size_t)o, ",\"NORMAL\":%d", n);
+    o += snprintf(d->last_attrs + o, sizeof d->last_attrs - (size_t)o, "}");
     if (i >= 0)
-        addf(&d->meshes, ",\"indices\":%d", i);
-    addf(&d->meshes, ",\"material\":%d}]}", mat);
+        snprintf(d->last_attrs + o, sizeof d->last_attrs - (size_t)o, ",\"indices\":%d", i);
+    sep(&d->meshes, d->n_meshes);
+    addf(&d->meshes, "{\"primitives\":[{%s,\"material\":%d}]}", d->last_attrs, mat);
+    return d->n_meshes++;
+}
+
+/* Another mesh with the last mesh's accessors and material `mat`. */
+static int mesh_again(doc *d, int mat)
+{
+    sep(&d->meshes, d->n_meshes);
+    addf(&d->meshes, "{\"primitives\":[{%s,\"material\":%d}]}", d->last_attrs, mat);
     return d->n_meshes++;
 }
 
@@ -453,8 +462,8 @@ static void gen_example(const char *dir)
     const float gn[12] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
     const uint16_t gi[6] = {0, 1, 2, 0, 2, 3};
     int mg = mesh(&d, g, 4, NULL, gn, gi, 6, ground);
-    /* a UV sphere with normals, 24 x 12 */
-    enum { SU = 24, SV = 12 };
+    /* a UV sphere with normals, 48 x 24 */
+    enum { SU = 48, SV = 24 };
     static float sp[(SU + 1) * (SV + 1) * 3], sn[(SU + 1) * (SV + 1) * 3];
     static uint16_t si[SU * SV * 6];
     int k = 0;
@@ -476,8 +485,8 @@ static void gen_example(const char *dir)
             q += 6;
         }
     int ms = mesh(&d, sp, k, NULL, sn, si, q, clay);
-    int ms2 = mesh(&d, sp, k, NULL, sn, si, q, teal);
-    int ml = mesh(&d, sp, k, NULL, sn, si, q, lamp);
+    int ms2 = mesh_again(&d, teal);
+    int ml = mesh_again(&d, lamp);
     /* a box, as a cube mesh with flat faces (no normals) */
     const float cb[24] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
     const uint16_t ci[36] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
@@ -499,7 +508,7 @@ static void gen_example(const char *dir)
     addf(&d.lights, "{\"type\":\"point\",\"color\":[1,0.95,0.9],\"intensity\":40}");
     node(&d, 1, "\"name\":\"key light\",\"translation\":[-2.5,4,3],\"extensions\":{\"KHR_lights_punctual\":"
                 "{\"light\":0}}");
-    write_doc(&d, dir, "example.glb", 1);
+    write_doc(&d, dir, "courtyard.glb", 1);
 }
 
 int main(int argc, char **argv)
