@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "builder_light.h"
 #include "freeze.h"
 #include "gltf_doc.h"
 #include "gltf_mat.h"
@@ -373,24 +374,38 @@ static int light(imp *c, uint32_t n, const cJSON *ext, const affine *w, fr_error
         return gdoc_fail(d, err, ptr, "color and intensity must be >= 0");
     if (cJSON_GetObjectItemCaseSensitive(o, "range"))
         gdoc_warn(d, "range", "%s/range: light ranges are not used (lights fall off with the inverse square)", ptr);
-    if (strcmp(type->valuestring, "point") != 0) {
-        gdoc_warn(d, type->valuestring, "%s: %s lights are not supported yet: ignored", ptr, type->valuestring);
+    /* Candela and lux over 683 lm/W: the watts of Blender's exporter
+     * (builder_light.h, scenes/README.md). */
+    vec3 power = v3((float)(col[0] * intensity / 683.0), (float)(col[1] * intensity / 683.0),
+                    (float)(col[2] * intensity / 683.0));
+    if (v3_is_zero(power))
         return 0;
-    }
-    fr_light l;
-    memset(&l, 0, sizeof l);
-    l.kind = FR_LIGHT_POINT;
-    l.prim = FR_NONE;
-    const double o0[3] = {0, 0, 0};
-    double p[3];
+    const double o0[3] = {0, 0, 0}, fw[3] = {0, 0, -1};
+    double p[3], f[3];
     af_apply(w, o0, 1.0, p);
-    l.position = v3((float)p[0], (float)p[1], (float)p[2]);
-    /* Candela taken as Franja's units of intensity (scenes/README.md). */
-    l.intensity = v3((float)(col[0] * intensity), (float)(col[1] * intensity), (float)(col[2] * intensity));
-    if (v3_is_zero(l.intensity))
-        return 0;
-    if (bld_push(&c->b->lights, &l) == FR_NONE)
-        return gdoc_fail(d, err, ptr, "out of memory");
+    af_apply(w, fw, 0.0, f);
+    vec3 pos = v3((float)p[0], (float)p[1], (float)p[2]), dir = v3((float)f[0], (float)f[1], (float)f[2]);
+    fr_error e;
+    int rc;
+    if (!strcmp(type->valuestring, "point")) {
+        rc = bld_point_light(c->b, pos, power, &e);
+    } else if (!strcmp(type->valuestring, "spot")) {
+        const cJSON *sp;
+        char sptr[80];
+        double inner = 0.0, outer = FM_PI / 4.0;
+        snprintf(sptr, sizeof sptr, "%s/spot", ptr);
+        if (gdoc_object(d, o, ptr, "spot", &sp, err) < 0 ||
+            (sp && (gdoc_number(d, sp, sptr, "innerConeAngle", 0.0, &inner, err) < 0 ||
+                    gdoc_number(d, sp, sptr, "outerConeAngle", FM_PI / 4.0, &outer, err) < 0)))
+            return -1;
+        rc = bld_spot_light(c->b, pos, dir, power, (float)inner, (float)outer, &e);
+    } else if (!strcmp(type->valuestring, "directional")) {
+        rc = bld_sun_light(c->b, dir, power, 0.0f, &e);
+    } else {
+        return gdoc_fail(d, err, ptr, "type: '%s' is not point, spot or directional", type->valuestring);
+    }
+    if (rc < 0)
+        return gdoc_fail(d, err, ptr, "%s", e.msg);
     c->r->lights++;
     return 0;
 }
@@ -702,18 +717,10 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scn_
     for (uint32_t k = 0; k < b->prims.count && !emissive; k++)
         emissive = !v3_is_zero(m[((const fr_prim *)b->prims.data)[k].material].emission);
     if (b->lights.count == 0 && !emissive) {
-        warn(hooks, path, "no lights in the scene: a point light at the camera lights it");
-        float dist = v3_len(v3_sub(v3_scale(v3_add(lo, hi), 0.5f), b->camera.position));
-        fr_light l;
-        memset(&l, 0, sizeof l);
-        l.kind = FR_LIGHT_POINT;
-        l.prim = FR_NONE;
-        l.position = b->camera.position;
-        /* A white Lambert surface facing the camera at the scene's centre
-         * then has radiance 1. */
-        l.intensity = v3s(FM_PI * (dist > 0.0f ? dist * dist : 1.0f));
-        if (bld_push(&b->lights, &l) == FR_NONE)
-            return fr_fail(err, "%s: out of memory", path);
+        warn(hooks, path, "no lights in the scene: a white environment of radiance 1 lights it");
+        fr_error e;
+        if (bld_environment(b, v3s(1.0f), FR_NONE, 0.0f, &e) < 0)
+            return fr_fail(err, "%s: %s", path, e.msg);
     }
     return 0;
 }

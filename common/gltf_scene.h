@@ -60,7 +60,8 @@ int gltf_import_mem(const void *bytes, size_t len, const char *name, const scn_h
  * the height from the camera's aspect ratio, else 480; 64 samples, 8
  * bounces), the file's camera `camera` (or its first; with none, one
  * framing the scene's bounds from +Z, with a warning) and its lights (with
- * none and nothing emissive, a point light at the camera, with a warning),
+ * none and nothing emissive, a white environment of radiance 1, with a
+ * warning),
  * frozen into *out (freeze.h).  Returns 0, or -1 with err set. */
 int gltf_load_scene(const char *path, const scn_hooks *hooks, const char *camera, fr_scene *out, fr_error *err);
 

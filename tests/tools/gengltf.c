@@ -335,7 +335,8 @@ static void gen_scene(const char *dir)
     node(&d, 1, "\"name\":\"prism\",\"mesh\":%d", m2);
     camera(&d, fov40(), 0);
     node(&d, 1, "\"name\":\"cam\",\"camera\":0,\"translation\":[0,1,4]");
-    addf(&d.lights, "{\"type\":\"point\",\"color\":[1,1,1],\"intensity\":20}");
+    /* 20 W/sr: 20 x 683 candela (scenes/README.md) */
+    addf(&d.lights, "{\"type\":\"point\",\"color\":[1,1,1],\"intensity\":13660}");
     node(&d, 1, "\"name\":\"lamp\",\"translation\":[0,3,2],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}");
     write_doc(&d, dir, "scene.gltf", 0);
     write_doc(&d, dir, "scene.glb", 1);
@@ -505,7 +506,7 @@ static void gen_example(const char *dir)
     double a = -17.0 * M_PI / 360.0;
     node(&d, 1, "\"name\":\"camera\",\"camera\":0,\"translation\":[0,1.9,4.6],\"rotation\":[%.9g,0,0,%.9g]",
          sin(a), cos(a));
-    addf(&d.lights, "{\"type\":\"point\",\"color\":[1,0.95,0.9],\"intensity\":40}");
+    addf(&d.lights, "{\"type\":\"point\",\"color\":[1,0.95,0.9],\"intensity\":27320}");
     node(&d, 1, "\"name\":\"key light\",\"translation\":[-2.5,4,3],\"extensions\":{\"KHR_lights_punctual\":"
                 "{\"light\":0}}");
     write_doc(&d, dir, "courtyard.glb", 1);
