@@ -47,6 +47,6 @@ static inline int pfm_hook(const char *path, scn_image *img, fr_error *err)
     return ok ? 0 : fr_fail(err, "%s: short PFM", path);
 }
 
-static const scn_hooks pfm_hooks = {NULL, pfm_hook};
+static const scn_hooks pfm_hooks = {.texture = pfm_hook};
 
 #endif
