@@ -315,6 +315,41 @@ static void test_documents(void)
     bld_free(&b);
 }
 
+/* KHR_lights_punctual: point, spot and directional lights, candela and lux
+ * over 683, placed and aimed by their nodes (-z of the node). */
+static void test_lights(void)
+{
+    fr_builder b;
+    fr_error e;
+    gltf_options o;
+    gltf_options_default(&o);
+    const unsigned short tri[6] = {0, 1, 2, 0, 2, 3};
+    char nodes[1024];
+    snprintf(nodes, sizeof nodes,
+             "[{\"mesh\":0,\"children\":[1,2,3]},"
+             "{\"translation\":[1,2,3],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+             "{\"translation\":[0,5,0],\"rotation\":[%.17g,0,0,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}},"
+             "{\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}}],"
+             "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
+             "{\"type\":\"point\",\"color\":[1,0.5,0],\"intensity\":1366},"
+             "{\"type\":\"spot\",\"intensity\":683,\"spot\":{\"innerConeAngle\":0.2,\"outerConeAngle\":0.5}},"
+             "{\"type\":\"directional\",\"intensity\":6830}]}}",
+             -sqrt(0.5), sqrt(0.5)); /* the spot turned to look down -y */
+    T(import(mesh_doc(square, 4, tri, 6, 4, nodes), &b, &o, &e) == 0);
+    const fr_light *l = b.lights.data;
+    T(b.lights.count == 3);
+    if (b.lights.count == 3) {
+        T(l[0].kind == FR_LIGHT_POINT && close3(l[0].position, 1, 2, 3) && close3(l[0].intensity, 2, 1, 0));
+        T(l[1].kind == FR_LIGHT_SPOT && close3(l[1].position, 0, 5, 0) && close3(l[1].intensity, 1, 1, 1) &&
+          close3(l[1].axis, 0, -1, 0));
+        T(l[2].kind == FR_LIGHT_SUN && close3(l[2].axis, 0, 0, 1) && close3(l[2].intensity, 10, 10, 10));
+    }
+    bld_free(&b);
+    o.take_lights = 0;
+    T(import(mesh_doc(square, 4, tri, 6, 4, nodes), &b, &o, &e) == 0 && b.lights.count == 0);
+    bld_free(&b);
+}
+
 int main(void)
 {
     test_data_uri();
@@ -323,5 +358,6 @@ int main(void)
     test_transforms();
     test_camera();
     test_documents();
+    test_lights();
     return check_done();
 }
