@@ -17,6 +17,7 @@
 #include "compile.h"
 #include "fbin.h"
 #include "jobdir.h"
+#include "joblock.h"
 #include "output.h"
 #include "protocol.h"
 #include "quick.h"
@@ -43,8 +44,10 @@ static const char usage[] =
     "                       .hdr .pfm keep linear radiance)\n"
     "  --tonemap CURVE      none or filmic (default: the scene's, else none)\n"
     "  --resume             keep the finished slabs of an interrupted render\n"
+    "  --fresh              discard the finished slabs of an earlier render\n"
     "  --job DIR            job directory (default OUT.franja-job)\n"
     "  --keep-job           keep the job directory after success\n"
+    "  --no-lock            use a job directory on a file system without locks\n"
     "  --slab-rows N        rows per slab (default: about 4 slabs per slot)\n"
     "  --retries N          attempts per slab before giving up (default 5)\n"
     CLI_SLURM_HELP;
@@ -69,7 +72,7 @@ typedef struct {
     float exposure;
     int exposure_set;          /* --exposure given: overrides the scene's */
     const char *curve;         /* --tonemap, or NULL for the scene's */
-    int resume, keep_job;
+    int resume, keep_job, fresh, no_lock;
     tr_options tr;
     cli_slurm slurm;
 } render_args;
@@ -96,6 +99,14 @@ static int parse(int argc, char **argv, render_args *a)
         }
         if (!strcmp(s, "--keep-job")) {
             a->keep_job = 1;
+            continue;
+        }
+        if (!strcmp(s, "--fresh")) {
+            a->fresh = 1;
+            continue;
+        }
+        if (!strcmp(s, "--no-lock")) {
+            a->no_lock = 1;
             continue;
         }
         if (s[0] != '-') {
@@ -157,6 +168,10 @@ static int parse(int argc, char **argv, render_args *a)
     if (!a->scene || !a->out) {
         fprintf(stderr, "franja render: %s is required (see franja render --help)\n",
                 a->scene ? "-o OUT" : "a SCENE");
+        return 2;
+    }
+    if (a->resume && a->fresh) {
+        fprintf(stderr, "franja render: --resume and --fresh exclude each other\n");
         return 2;
     }
     return cli_slurm_check("render", &a->slurm, a->hosts) ? 2 : 0;
@@ -266,6 +281,19 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     return rc;
 }
 
+/* After a failure: a job directory with no finished slab holds nothing
+ * worth keeping (a compiled scene at most), so it goes; one with slabs
+ * stays for --resume.  Then the lock is given up.  Returns rc. */
+static int unlock_with(job_lock *lk, int rc)
+{
+    if (lk->fd >= 0 && job_rows_present(lk->dir) == 0) {
+        job_remove(lk->dir);
+        jlk_release(lk, 1);
+    }
+    jlk_release(lk, 0);
+    return rc;
+}
+
 int cmd_render(int argc, char **argv)
 {
     render_args a;
@@ -283,6 +311,31 @@ int cmd_render(int argc, char **argv)
     else
         snprintf(jobdir, sizeof jobdir, "%s.franja-job", a.out);
 
+    /* One writer per job directory, before anything is read or written
+     * there (joblock.h). */
+    char cmdline[4096];
+    size_t cl = (size_t)snprintf(cmdline, sizeof cmdline, "franja");
+    for (int i = 0; i < argc && cl < sizeof cmdline; i++)
+        cl += (size_t)snprintf(cmdline + cl, sizeof cmdline - cl, " %s", argv[i]);
+    job_lock lk;
+    int lr = jlk_acquire(jobdir, a.out, cmdline, a.no_lock, &lk, &err);
+    if (lr) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return lr == JLK_BUSY || lr == JLK_NOLOCKS ? 2 : 1;
+    }
+    if (lk.unlocked)
+        fprintf(stderr, "franja render: warning: %s is not locked (--no-lock): nothing keeps another render "
+                "of %s out of it\n", jobdir, a.out);
+    if (!a.resume && !a.fresh) {
+        int rows = job_rows_present(jobdir);
+        if (rows > 0) {
+            fprintf(stderr, "franja render: %s holds %d finished rows of an earlier render of %s; rerun with "
+                    "--resume to finish it, or with --fresh to discard them\n", jobdir, rows, a.out);
+            jlk_release(&lk, 0);
+            return 2;
+        }
+    }
+
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -293,22 +346,22 @@ int cmd_render(int argc, char **argv)
     uint32_t probe = UINT32_MAX;
     if (quick_spp(&probe, &err) < 0) {
         fprintf(stderr, "franja render: %s\n", err.msg);
-        return 2;
+        return unlock_with(&lk, 2);
     }
     hosts_table table;
     slurm_alloc alloc;
     memset(&alloc, 0, sizeof alloc);
     if (a.slurm.on) {
         if (cli_slurm_hosts("render", &a.slurm, argc, argv, &a.tr, &alloc, &table))
-            return 2;
+            return unlock_with(&lk, 2);
     } else if (a.hosts) {
         if (cli_load_hosts("render", a.hosts, &table))
-            return 2;
+            return unlock_with(&lk, 2);
     } else {
         table.n = 1;
         table.v = calloc(1, sizeof *table.v);
         if (!table.v)
-            return 1;
+            return unlock_with(&lk, 1);
         snprintf(table.path, sizeof table.path, "(this machine)");
         strcpy(table.v[0].name, "local");
         strcpy(table.v[0].address, "local");
@@ -320,7 +373,7 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         hosts_free(&table);
         slurm_close(&alloc);
-        return 1;
+        return unlock_with(&lk, 1);
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
                      a.spp ? a.spp : sc.settings.spp};
@@ -366,10 +419,13 @@ int cmd_render(int argc, char **argv)
     }
     if (!a.keep_job)
         job_remove(jobdir);
+    jlk_release(&lk, !a.keep_job);
     fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, spec.width, spec.height, spec.spp,
             clk_now() - t0);
     rc = 0;
 done:
+    if (rc)
+        unlock_with(&lk, rc);
     if (rc && stop_flag)
         rc = 130;
     free(have);

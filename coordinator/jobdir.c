@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "file.h"
+#include "protocol.h"
 
 int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
                       uint32_t y1, fr_error *err)
@@ -198,6 +199,43 @@ int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf
     char path[4200];
     snprintf(path, sizeof path, "%s/rows-%05u-%05u.pf", dir, y0, y1);
     return write_file(path, buf, len, err);
+}
+
+static int mark_rows(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *ctx)
+{
+    (void)dir, (void)name;
+    unsigned char *seen = ctx;
+    for (uint32_t y = y0; y < y1 && y < PROTO_MAX_SIZE; y++)
+        seen[y] = 1;
+    return 0;
+}
+
+int job_rows_present(const char *dir)
+{
+    unsigned char *seen = calloc(PROTO_MAX_SIZE, 1);
+    if (!seen)
+        return 0;
+    fr_error ignore;
+    int rows = 0;
+    if (each_slab(dir, mark_rows, seen, &ignore) == 0)
+        for (uint32_t y = 0; y < PROTO_MAX_SIZE; y++)
+            rows += seen[y];
+    free(seen);
+    return rows;
+}
+
+void job_kept_note(const char *dir, char *out, size_t cap)
+{
+    struct stat st;
+    if (lstat(dir, &st) || !S_ISDIR(st.st_mode)) {
+        snprintf(out, cap, "the job directory %s was removed by another process; nothing was kept", dir);
+        return;
+    }
+    int rows = job_rows_present(dir);
+    if (rows == 0)
+        snprintf(out, cap, "no slab had finished, so nothing was kept");
+    else
+        snprintf(out, cap, "%d finished rows are kept in %s; rerun with --resume", rows, dir);
 }
 
 void job_missing_rows(const unsigned char *have, uint32_t height, char *out, size_t cap)

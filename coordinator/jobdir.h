@@ -49,6 +49,16 @@ int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf
  * Fails, naming the missing rows, unless every row is covered. */
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, fr_error *err);
 
+/** Counts the rows that slab files in dir cover, whatever render they
+ * belong to (by their names only; nothing is read or removed).  0 when dir
+ * does not exist. */
+int job_rows_present(const char *dir);
+
+/** Says truthfully what a failed render leaves in dir, checked now: "N rows
+ * are kept in DIR; rerun with --resume", that nothing finished, or that the
+ * directory was removed by another process.  Written to out[cap]. */
+void job_kept_note(const char *dir, char *out, size_t cap);
+
 /** Deletes the job directory and what franja put in it. */
 void job_remove(const char *dir);
 

@@ -446,8 +446,9 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         char missing[400], why[sizeof err->msg];
         snprintf(why, sizeof why, "%s", err->msg);
         missing_text(&s, missing, sizeof missing);
-        fr_fail(err, "%s; rows %s not rendered (finished slabs are kept in %s; rerun with --resume)",
-                why, missing, p->jobdir);
+        char kept[4400];
+        job_kept_note(p->jobdir, kept, sizeof kept);
+        fr_fail(err, "%s; rows %s not rendered (%s)", why, missing, kept);
     }
     st->wall_s = clk_now() - s.t0;
     free(s.slabs);
