@@ -123,9 +123,10 @@ static int nodes_from(const char *list, int timeout_s, slurm_alloc *a, fr_error 
         char *e = strchr(l, '\n');
         size_t len = e ? (size_t)(e - l) : strlen(l);
         if (!good_node(l, len)) {
+            fr_fail(err, "SLURM_JOB_NODELIST='%s': unexpected node name '%.*s' from scontrol", list,
+                    (int)(len < 80 ? len : 80), l);
             free(text);
-            return fr_fail(err, "SLURM_JOB_NODELIST='%s': unexpected node name '%.*s' from scontrol", list,
-                           (int)(len < 80 ? len : 80), l);
+            return -1;
         }
         memcpy(a->node[k++], l, len);
         l += len + (e != NULL);
