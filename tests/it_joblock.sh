@@ -19,7 +19,17 @@ printf 'here local - 1 worker=%s\n' "$(fh_wrapper slow slow)" >t_slow
 SLOW="--hosts t_slow --slab-rows 4"
 
 # Two renders of one output: the second refuses at once, the first finishes.
-"$FRANJA" render scene.fbin -o same.pfm $SIZE --hosts t_slow --slab-rows 1 2>logA &
+# The first one's workers wait for the file "go", so it holds its lock for
+# as long as the checks take, however slow the machine.
+cat >held.sh <<SH
+#!/bin/sh
+case " \$* " in *" --rows "*) ;; *) exec "$WORKER" "\$@" ;; esac
+while [ ! -e "$FH/go" ]; do sleep 0.1; done
+exec "$WORKER" "\$@"
+SH
+chmod +x held.sh
+printf 'here local - 2 worker=%s\n' "$FH/held.sh" >t_held
+"$FRANJA" render scene.fbin -o same.pfm $SIZE --hosts t_held --slab-rows 4 2>logA &
 A=$!
 fh_until test -s same.pfm.franja-job/lock
 "$FRANJA" render scene.fbin -o same.pfm $SIZE 2>logB
@@ -31,6 +41,7 @@ check "--resume is refused too (status 2)" test $? -eq 2
 "$FRANJA" render scene.fbin -o same.pfm $SIZE --fresh 2>logB3
 check "--fresh is refused while the lock is held (status 2)" test $? -eq 2
 check "--fresh names the holder" grep -q "being rendered by another franja (pid $A" logB3
+touch go
 wait $A
 rc=$?
 check "the first render finishes (status $rc)" test $rc -eq 0
