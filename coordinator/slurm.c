@@ -201,6 +201,21 @@ int slurm_job_ended(slurm_alloc *a, int ask)
     return ended;
 }
 
+int slurm_sharing(slurm_alloc *a)
+{
+    pthread_mutex_lock(&a->lock);
+    int v = a->sharing;
+    pthread_mutex_unlock(&a->lock);
+    return v;
+}
+
+void slurm_share(slurm_alloc *a)
+{
+    pthread_mutex_lock(&a->lock);
+    a->sharing = 1;
+    pthread_mutex_unlock(&a->lock);
+}
+
 void slurm_close(slurm_alloc *a)
 {
     free(a->node);

@@ -37,6 +37,7 @@ typedef struct {
     int timeout_s;             /**< longest wait for a Slurm command that should be quick */
     pthread_mutex_t lock;      /**< guards what follows */
     int ended;                 /**< the job was seen to have ended */
+    int sharing;               /**< new steps share the job's CPUs (srun --overlap) */
     char copied[8][1024];      /**< shared workdir: files already copied this run */
     int ncopied;
 } slurm_alloc;
@@ -56,6 +57,13 @@ int slurm_open(slurm_alloc *a, const char *worker, int timeout_s, fr_error *err)
  * ended job; without, only says what is known.  A job the controller
  * cannot be asked about is taken as still running. */
 int slurm_job_ended(slurm_alloc *a, int ask);
+
+/** Whether new steps are to share the job's CPUs (srun --overlap) rather
+ * than take their own, and slurm_share to make it so: for a job where
+ * Slurm no longer hands out CPUs that ended steps used (transport_slurm.c
+ * says when). */
+int slurm_sharing(slurm_alloc *a);
+void slurm_share(slurm_alloc *a);
 
 /** Frees what slurm_open allocated.  Safe on a zeroed struct. */
 void slurm_close(slurm_alloc *a);

@@ -51,6 +51,15 @@
 #include "clock.h"
 #include "slurm.h"
 
+/* What is needed to start a process's step again (see wait_or_share). */
+typedef struct {
+    tr_proc *p;
+    char **argv;               /* the command after srun's options (owned) */
+    double since;              /* when its srun started */
+    int shared;                /* started with --overlap */
+    int started;               /* its task has started (MARK seen) */
+} step_rec;
+
 typedef struct {
     slurm_alloc *a;
     tr_host *h;
@@ -59,10 +68,18 @@ typedef struct {
     pid_t leaving[64];         /* sruns told to stop, not yet reaped */
     int nleaving;
     int lost;
+    step_rec *rec;
+    int nrec, caprec;
 } slurm_host;
 
 /* The srun options of every step; the node and the command follow. */
-#define STEP_OPTS(job) "--jobid", (job), "--exclusive", "--nodes=1", "--ntasks=1", "--cpus-per-task=1", "--mem=0", "--quiet"
+#define STEP_OPTS(job) "--jobid", (job), "--nodes=1", "--ntasks=1", "--cpus-per-task=1", "--mem=0", "--quiet"
+
+/* Every command runs as `sh -c START sh COMMAND...`: the task says on
+ * stderr that it has started, then becomes the command (exec), so signals
+ * reach it.  srun itself says nothing of a step that waits to be created. */
+#define MARK "franja-step-started"
+static const char START[] = "printf '" MARK "\\n' >&2; exec \"$@\"";
 
 static int slurm_connect(tr_host *h, void **impl, tr_place *place, fr_error *err)
 {
@@ -89,12 +106,12 @@ static int slurm_connect(tr_host *h, void **impl, tr_place *place, fr_error *err
     return 0;
 }
 
-static int slurm_spawn(void *impl, tr_proc *p, const char *const *argv, fr_error *err)
+/* Starts argv as a step on the node: CPUs of its own (--exclusive), or
+ * sharing the job's (--overlap). */
+static int start_step(slurm_host *s, tr_proc *p, char *const *argv, int shared, fr_error *err)
 {
-    slurm_host *s = impl;
-    if (s->lost)
-        return fr_fail(err, "%s: the node has left the allocation", s->label);
-    const char *full[96] = {"srun", STEP_OPTS(s->a->job), "--nodelist", s->node};
+    const char *full[96] = {"srun", STEP_OPTS(s->a->job), shared ? "--overlap" : "--exclusive", "--nodelist", s->node,
+                            "sh", "-c", START, "sh"};
     size_t n = 0;
     while (full[n])
         n++;
@@ -107,6 +124,54 @@ static int slurm_spawn(void *impl, tr_proc *p, const char *const *argv, fr_error
     if (tr_pipe_spawn(p, full, err))
         return fr_fail(err, "%s: %s", s->label, err->msg);
     return 0;
+}
+
+static void free_argv(char **argv)
+{
+    for (size_t i = 0; argv && argv[i]; i++)
+        free(argv[i]);
+    free(argv);
+}
+
+static int slurm_spawn(void *impl, tr_proc *p, const char *const *argv, fr_error *err)
+{
+    slurm_host *s = impl;
+    if (s->lost)
+        return fr_fail(err, "%s: the node has left the allocation", s->label);
+    if (s->nrec == s->caprec) {
+        int cap = s->caprec ? 2 * s->caprec : 8;
+        step_rec *r = realloc(s->rec, (size_t)cap * sizeof *r);
+        if (!r)
+            return fr_fail(err, "%s: out of memory", s->label);
+        s->rec = r;
+        s->caprec = cap;
+    }
+    size_t n = 0;
+    while (argv[n])
+        n++;
+    char **copy = calloc(n + 1, sizeof *copy);
+    for (size_t i = 0; copy && i < n; i++)
+        if (!(copy[i] = strdup(argv[i]))) {
+            free_argv(copy);
+            copy = NULL;
+        }
+    if (!copy)
+        return fr_fail(err, "%s: out of memory", s->label);
+    int shared = slurm_sharing(s->a);
+    if (start_step(s, p, copy, shared, err)) {
+        free_argv(copy);
+        return -1;
+    }
+    s->rec[s->nrec++] = (step_rec){p, copy, clk_now(), shared, 0};
+    return 0;
+}
+
+static step_rec *rec_of(slurm_host *s, const tr_proc *p)
+{
+    for (int i = 0; i < s->nrec; i++)
+        if (s->rec[i].p == p)
+            return &s->rec[i];
+    return NULL;
 }
 
 static int slurm_pollfds(void *impl, tr_proc *procs, struct pollfd *pfd, int max)
@@ -149,11 +214,65 @@ static int lost(slurm_host *s, tr_proc *procs, fr_error *err, const char *fmt, c
     return -1;
 }
 
+/* Sends an srun SIGTERM and keeps it to be reaped, without waiting long. */
+static void let_go(slurm_host *s, tr_proc *p);
+
+/* Notes the steps whose task has started, taking the mark out of what
+ * their stderr says. */
+static void see_starts(slurm_host *s, tr_proc *procs)
+{
+    for (tr_proc *p = procs; p; p = p->next) {
+        step_rec *r = rec_of(s, p);
+        char *m = r && !r->started ? strstr(p->err, MARK) : NULL;
+        if (!m)
+            continue;
+        r->started = 1;
+        size_t len = strlen(MARK);
+        if (m[len] == ' ' || m[len] == '\n')
+            len++;
+        memmove(m, m + len, strlen(m + len) + 1);
+        p->err_len = strlen(p->err);
+    }
+}
+
+/* Slurm 22.05 keeps, in a job that lost a node (--no-kill), the CPUs of
+ * the steps that were running while the node was taken out: they stay
+ * counted as used after those steps end, so new --exclusive steps wait
+ * for them for ever, silently.  franja never runs more workers on a node
+ * than the job has CPUs there, so a step not started after the time-out
+ * is such a one: it is started again with --overlap (sharing the job's
+ * CPUs instead of taking its own), and so is every step after it.  The
+ * waiting step never ran its command, so nothing is lost or run twice. */
+static void wait_or_share(slurm_host *s, tr_proc *procs)
+{
+    double now = clk_now();
+    for (tr_proc *p = procs; p; p = p->next) {
+        step_rec *r = p->state == TR_RUNNING ? rec_of(s, p) : NULL;
+        if (!r || r->started || r->shared || now - r->since < s->a->timeout_s)
+            continue;
+        if (!slurm_sharing(s->a)) {
+            slurm_share(s->a);
+            tr_note(s->h, "Slurm job %s starts no new step on CPUs of its own after %d s (it lost a node, "
+                          "and keeps the CPUs of steps that ran then); from now on steps share the job's "
+                          "CPUs (srun --overlap)", s->a->job, s->a->timeout_s);
+        }
+        let_go(s, p);
+        p->err_len = 0;
+        p->err[0] = 0;
+        fr_error e;
+        r->since = now;
+        r->shared = 1;
+        if (start_step(s, p, r->argv, 1, &e))
+            tr_proc_fail(p, "%s", e.msg);
+    }
+}
+
 static int slurm_service(void *impl, tr_proc *procs, fr_error *err)
 {
     slurm_host *s = impl;
     reap(s);
     tr_pipe_service(procs);
+    see_starts(s, procs);
     if (slurm_job_ended(s->a, 0))
         return lost(s, procs, err, "%s: %s", "the Slurm job has ended (cancelled, or out of time)");
     /* Processes that ended by themselves (those killed here are TR_FAILED):
@@ -162,10 +281,11 @@ static int slurm_service(void *impl, tr_proc *procs, fr_error *err)
         if (p->state != TR_EXITED || !p->impl)
             continue;
         if (says(p->err, NODE_GONE))
-            return lost(s, procs, err, "%s: the node is lost to the job (srun: %s)", p->err);
+            return lost(s, procs, err, "%s: the node is lost to the job (%s)", p->err);
         if ((says(p->err, JOB_GONE) || strstr(p->err, "CANCELLED")) && slurm_job_ended(s->a, 1))
             return lost(s, procs, err, "%s: %s", "the Slurm job has ended (cancelled, or out of time)");
     }
+    wait_or_share(s, procs);
     return 0;
 }
 
@@ -175,11 +295,8 @@ static void slurm_kill(void *impl, tr_proc *p)
     tr_pipe_signal(p, SIGTERM);
 }
 
-static void slurm_release(void *impl, tr_proc *p)
+static void let_go(slurm_host *s, tr_proc *p)
 {
-    slurm_host *s = impl;
-    if (!p->impl)
-        return;
     tr_pipe_signal(p, SIGTERM);
     pid_t pid = tr_pipe_detach(p);
     if (pid <= 0)
@@ -199,6 +316,18 @@ static void slurm_release(void *impl, tr_proc *p)
     waitpid(pid, NULL, 0);
 }
 
+static void slurm_release(void *impl, tr_proc *p)
+{
+    slurm_host *s = impl;
+    step_rec *r = rec_of(s, p);
+    if (r) {
+        free_argv(r->argv);
+        *r = s->rec[--s->nrec];
+    }
+    if (p->impl)
+        let_go(s, p);
+}
+
 static void slurm_host_close(void *impl)
 {
     slurm_host *s = impl;
@@ -212,6 +341,9 @@ static void slurm_host_close(void *impl)
         kill(s->leaving[i], SIGKILL);
         waitpid(s->leaving[i], NULL, 0);
     }
+    for (int i = 0; i < s->nrec; i++)
+        free_argv(s->rec[i].argv);
+    free(s->rec);
     free(s);
 }
 

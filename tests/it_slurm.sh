@@ -3,7 +3,8 @@
 # cluster of three nodes on this machine (tests/slurm/cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process
 # render whatever the node count; the scene is broadcast once per node;
-# a node killed mid-render loses only its slabs; Ctrl-C and scancel
+# a node killed or set down mid-render loses only its slabs, a drained one
+# goes on; Ctrl-C and scancel
 # mid-render leave no step and no worker running; --resume finishes in a
 # second allocation (a batch job from hosts/franja.sbatch);
 # a node whose worker is another version is dropped, by name; outside an
@@ -98,6 +99,30 @@ render logv -N3 -n6 "$FRANJA" render scene.fbin -o v.pfm $SIZE --slurm --workdir
 check "a wrong worker version on n2 does not stop the render" cmp -s v.pfm ref.pfm
 check "the message names n2 and its version" grep -q "n2.*0.0.1" logv
 check "n2 rendered nothing" sh -c "! grep -Eq '^  n2 +[0-9]+ +[1-9]' logv"
+
+sl_alloc 60 -N3 -n6 "$FRANJA" hosts check --slurm --worker "$T/worker-version" >checkv.out 2>&1
+check "hosts check --slurm fails for a node with another worker version" test $? -eq 1
+check "and names it ($(cat checkv.out))" grep -Eq "^n2 +FAIL .*0\.0\.1" checkv.out
+
+# An administrator sets n2 down and drains n1 mid-render: n2's steps fail
+# and it is dropped at once, its slabs going elsewhere; a drained node
+# keeps the steps of running jobs, so n1 goes on rendering.
+sl_alloc_bg 90 -N3 -n6 --no-kill "$FRANJA" render scene.fbin -o d.pfm $SIZE --slurm --workdir "$WD" \
+    --worker "$(wrapper slow 0.6)" --slab-rows 1 --job djob --timeout 3 >/dev/null 2>logd
+sl_until 40 sh -c "ls djob/rows-* 2>/dev/null | wc -l | grep -qv '^[0-2]$'"
+sl_q scontrol update nodename=n2 state=down reason=franja-test
+sl_q scontrol update nodename=n1 state=drain reason=franja-test
+wait "$SL_BG"
+rc=$?
+SL_BG=
+check "a render that lost n2 and had n1 drained succeeds (status $rc: $(tail -n 3 logd))" test $rc -eq 0
+check "and is byte-identical" cmp -s d.pfm ref.pfm
+check "n2 is dropped as lost to the job" grep -q "dropping host n2: .*lost to the job" logd
+check "the drained n1 is not dropped and renders" grep -Eq "^  n1 +2 +[0-9]+ +[0-9]+ .* ok$" logd
+sl_q scontrol update nodename=n1 state=resume
+sl_q scontrol update nodename=n2 state=resume 2>/dev/null # (already back by itself: ReturnToService=2)
+check "n1 and n2 are back" sl_until 20 sh -c \
+    "test \"\$(timeout 5 sinfo -h -N -t idle -o %N </dev/null | sort -u | tr '\n' ' ')\" = 'n1 n2 n3 '"
 
 # A node killed mid-render (slurmd, its slurmstepd and its workers): its
 # slabs go to the others and the image is the same.
