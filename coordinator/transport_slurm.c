@@ -25,7 +25,7 @@
  * A lost node: srun reports it ("Node failure on", a failed task launch,
  * or a step that cannot be created on the node any more); service() then
  * says the host is lost, so its slabs go elsewhere without counting
- * against them.  A node that dies silently keeps its sruns waiting until
+ * against them.  What that does to the job's other CPUs: wait_or_share.  A node that dies silently keeps its sruns waiting until
  * the controller notices (SlurmdTimeout); meanwhile the scheduler's
  * straggler copies finish its slabs elsewhere.
  *
