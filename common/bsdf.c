@@ -1,6 +1,7 @@
 #include "bsdf.h"
 
 #include "fmath.h"
+#include "microfacet.h"
 
 int bsdf_has_smooth(const fr_material *m) { return m->p_lobe[1] > 0.0f; }
 
@@ -18,12 +19,7 @@ void bsdf_lobe_probs(fr_material *m)
         m->p_lobe[3] = 1.0f;
 }
 
-vec3 bsdf_sample_cosine(float u1, float u2)
-{
-    float r = sqrtf(u1), s, c;
-    fm_sincosf(2.0f * FM_PI * u2, &s, &c);
-    return v3(r * c, r * s, sqrtf(fmaxf(0.0f, 1.0f - u1)));
-}
+vec3 bsdf_sample_cosine(float u1, float u2) { return mf_sample_cosine(u1, u2); }
 
 vec3 bsdf_sample_phong(float exponent, float u1, float u2)
 {
@@ -41,19 +37,7 @@ float bsdf_phong_pdf(float exponent, float cos_alpha)
     return (exponent + 1.0f) * FM_INV_2PI * fm_powf(cos_alpha, exponent);
 }
 
-float bsdf_fresnel(float cos_i, float eta, float *cos_t)
-{
-    float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= 1.0f) {
-        *cos_t = 0.0f;
-        return 1.0f;
-    }
-    float ct = sqrtf(1.0f - sin2_t);
-    float rs = (cos_i - eta * ct) / (cos_i + eta * ct);
-    float rp = (eta * cos_i - ct) / (eta * cos_i + ct);
-    *cos_t = ct;
-    return 0.5f * (rs * rs + rp * rp);
-}
+float bsdf_fresnel(float cos_i, float eta, float *cos_t) { return mf_fresnel_dielectric(cos_i, eta, cos_t); }
 
 /* Shading normal turned to wo's side of the geometric surface. */
 static vec3 facing_normal(const fr_surface *sf, vec3 wo)

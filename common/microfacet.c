@@ -3,7 +3,6 @@
  * lobes (see microfacet.h for conventions). */
 #include "microfacet.h"
 
-#include "bsdf.h"
 #include "fmath.h"
 #include "microfacet_table.h"
 
@@ -96,6 +95,27 @@ float mf_pdf_visible(mf_alpha a, vec3 wo, vec3 m)
 }
 
 /* ---- Fresnel ------------------------------------------------------------ */
+
+float mf_fresnel_dielectric(float cos_i, float eta, float *cos_t)
+{
+    float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
+    if (sin2_t >= 1.0f) {
+        *cos_t = 0.0f;
+        return 1.0f;
+    }
+    float ct = sqrtf(1.0f - sin2_t);
+    float rs = (cos_i - eta * ct) / (cos_i + eta * ct);
+    float rp = (eta * cos_i - ct) / (eta * cos_i + ct);
+    *cos_t = ct;
+    return 0.5f * (rs * rs + rp * rp);
+}
+
+vec3 mf_sample_cosine(float u1, float u2)
+{
+    float r = sqrtf(u1), s, c;
+    fm_sincosf(2.0f * FM_PI * u2, &s, &c);
+    return v3(r * c, r * s, sqrtf(fmaxf(0.0f, 1.0f - u1)));
+}
 
 static inline float pow5(float x) { float x2 = x * x; return x2 * x2 * x; }
 
@@ -282,12 +302,12 @@ vec3 mf_dielectric_eval(const mf_dielectric *d, float eta, vec3 wo, vec3 wi, flo
         return v3s(0.0f);
     float unused, fmacro = 0.0f;
     if (d->fresnel_at == MF_DIELECTRIC_MACRO)
-        fmacro = bsdf_fresnel(wo.z, eta, &unused);
+        fmacro = mf_fresnel_dielectric(wo.z, eta, &unused);
     vec3 f;
     if (wi.z > 0.0f) {
         vec3 h = v3_norm(v3_add(wo, wi));
         float oh = v3_dot(wo, h);
-        float fr = d->fresnel_at == MF_DIELECTRIC_MACRO ? fmacro : bsdf_fresnel(oh, eta, &unused);
+        float fr = d->fresnel_at == MF_DIELECTRIC_MACRO ? fmacro : mf_fresnel_dielectric(oh, eta, &unused);
         float dh = mf_D(d->alpha, h);
         f = v3_scale(d->reflect_tint, fr * dh * mf_G2(d->alpha, d->masking, wo, wi) / (4.0f * wo.z * wi.z));
         *pdf = fr * mf_G1(d->alpha, wo) * dh / (4.0f * wo.z);
@@ -304,7 +324,7 @@ vec3 mf_dielectric_eval(const mf_dielectric *d, float eta, vec3 wo, vec3 wi, flo
         float oh = v3_dot(wo, h), ih = v3_dot(wi, h);
         if (oh <= 0.0f || ih >= 0.0f)
             return v3s(0.0f);
-        float ft = d->fresnel_at == MF_DIELECTRIC_MACRO ? fmacro : bsdf_fresnel(oh, eta, &unused);
+        float ft = d->fresnel_at == MF_DIELECTRIC_MACRO ? fmacro : mf_fresnel_dielectric(oh, eta, &unused);
         float den = oh + eta * ih, den2 = den * den;
         if (!(den2 > 0.0f) || ft >= 1.0f)
             return v3s(0.0f);
@@ -329,8 +349,8 @@ int mf_dielectric_sample(const mf_dielectric *d, float eta, vec3 wo, float uc, f
     float c = v3_dot(wo, m), cos_t, unused;
     if (c <= 0.0f)
         return 0;
-    float fm = bsdf_fresnel(c, eta, &cos_t);
-    float fr = d->fresnel_at == MF_DIELECTRIC_MACRO ? bsdf_fresnel(wo.z, eta, &unused) : fm;
+    float fm = mf_fresnel_dielectric(c, eta, &cos_t);
+    float fr = d->fresnel_at == MF_DIELECTRIC_MACRO ? mf_fresnel_dielectric(wo.z, eta, &unused) : fm;
     if (uc < fr) {
         s->wi = reflect_about(wo, m);
         if (s->wi.z <= 0.0f)
@@ -451,7 +471,7 @@ int mf_principled_sample(const mf_principled *p, float eta, vec3 wo, float uc, f
         if (s->wi.z <= 0.0f)
             return 0;
     } else if (u < c.spec + c.cosine) {
-        s->wi = bsdf_sample_cosine(u1, u2);
+        s->wi = mf_sample_cosine(u1, u2);
     } else {
         mf_dielectric dl = principled_dielectric(p);
         mf_sample t;

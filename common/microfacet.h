@@ -1,7 +1,8 @@
-/**
- * @file microfacet.h
- * @brief Rough surfaces: the GGX (Trowbridge-Reitz) microfacet model and the
- * conductor, dielectric and glTF metallic-roughness lobes built on it.
+/** @file microfacet.h
+ * Rough surfaces: the GGX (Trowbridge-Reitz) microfacet model and the
+ * conductor, dielectric and glTF metallic-roughness lobes built on it, with
+ * the Fresnel factors and the cosine-weighted hemisphere they use (bsdf.c
+ * builds its materials from these).
  *
  * Everything works in a local shading frame: z is the shading normal, x and
  * y the tangent directions that anisotropic roughness refers to.  Directions
@@ -108,6 +109,16 @@ float mf_pdf_visible(mf_alpha a, vec3 wo, vec3 m);
 /** Schlick's approximation F0 + (1 - F0)(1 - cos)^5 per channel; @p cos_i
  *  clamped to [0, 1]. */
 vec3 mf_fresnel_schlick(vec3 f0, float cos_i);
+
+/** Unpolarized Fresnel reflectance of a smooth dielectric boundary for
+ *  light arriving at cos_i (> 0) from the side of index 1 onto relative
+ *  index @p eta, both polarizations exact.  *cos_t receives the cosine of
+ *  the refracted direction, 0 on total internal reflection (F = 1). */
+float mf_fresnel_dielectric(float cos_i, float eta, float *cos_t);
+
+/** A direction of the hemisphere around +z with density cos(theta) / pi,
+ *  from two uniform numbers (Malley's method). */
+vec3 mf_sample_cosine(float u1, float u2);
 
 /** F0 of a dielectric boundary of relative index @p eta:
  *  ((eta - 1) / (eta + 1))^2. */

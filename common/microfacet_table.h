@@ -1,6 +1,5 @@
-/**
- * @file microfacet_table.h
- * @brief The grids of the compiled albedo tables that energy compensation
+/** @file microfacet_table.h
+ * The grids of the compiled albedo tables that energy compensation
  * and the principled material's layering read (microfacet_table.c, written
  * by tests/tools/genmftab.c; regenerate it with
  * `bin/tools/genmftab > common/microfacet_table.c`).

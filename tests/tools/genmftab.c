@@ -18,7 +18,6 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "bsdf.h"
 #include "microfacet.h"
 #include "microfacet_table.h"
 
@@ -61,7 +60,7 @@ static double albedo_dielectric(float roughness, uint32_t masking, float eta, do
             float c = v3_dot(wo, m), ct;
             if (c <= 0.0f)
                 continue;
-            float f = bsdf_fresnel(c, eta, &ct);
+            float f = mf_fresnel_dielectric(c, eta, &ct);
             vec3 r = v3_sub(v3_scale(m, 2.0f * c), wo);
             if (r.z > 0.0f)
                 acc += f * mf_G2(a, masking, wo, r) / g1;
