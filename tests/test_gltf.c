@@ -350,6 +350,72 @@ static void test_lights(void)
     bld_free(&b);
 }
 
+/* An image decoder for tests: any bytes give a 2x2 RGB image of 0.5. */
+static int fake_image(const void *data, size_t len, const char *mime, scn_image *img, fr_error *err)
+{
+    (void)data;
+    (void)len;
+    (void)mime;
+    (void)err;
+    img->width = img->height = 2;
+    img->channels = 3;
+    img->pixels = malloc(12 * sizeof(float));
+    for (int i = 0; img->pixels && i < 12; i++)
+        img->pixels[i] = 0.5f;
+    return img->pixels ? 0 : -1;
+}
+
+/* Materials: emission with KHR_materials_emissive_strength, transmission
+ * with KHR_materials_ior, a base colour texture (sRGB-decoded) with its
+ * sampler and KHR_texture_transform rewritten for Franja's flipped v. */
+static void test_materials(void)
+{
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const char *t = docf(tri, sizeof tri,
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0},"
+        "{\"attributes\":{\"POSITION\":0},\"material\":1}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+        "\"materials\":[{\"emissiveFactor\":[1,0.5,0],\"doubleSided\":true,"
+        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4}}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"baseColorTexture\":{\"index\":0,"
+        "\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.25,0.5],\"scale\":[2,4]}}}},"
+        "\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":0.75},"
+        "\"KHR_materials_ior\":{\"ior\":1.3}}}],"
+        "\"textures\":[{\"source\":0,\"sampler\":0}],"
+        "\"samplers\":[{\"magFilter\":9728,\"wrapS\":33071,\"wrapT\":33071}],"
+        "\"images\":[{\"uri\":\"data:image/png;base64,AAAA\"}]");
+    scn_hooks h = {.image_mem = fake_image, .warn = on_warn};
+    gltf_options o;
+    gltf_options_default(&o);
+    fr_builder b;
+    gltf_result r;
+    fr_error e;
+    bld_init(&b);
+    T(gltf_import_mem(t, strlen(t), "t.gltf", &h, &o, &b, &r, &e) == 0);
+    T(b.materials.count == 2 && b.textures.count == 1);
+    if (b.materials.count == 2 && b.textures.count == 1) {
+        const fr_material *m = b.materials.data;
+        T(close3(m[0].emission, 4, 2, 0) && m[0].two_sided == 1 && close3(m[0].diffuse, 1, 1, 1)); /* glTF's default base colour */
+        T(close3(m[1].diffuse, 0.125, 0.125, 0.125) && close3(m[1].transmit, 0.375, 0.375, 0.375));
+        T(m[1].ior == 1.3f && m[1].tex_diffuse == 0 && m[1].tex_transmit == 0 && v3_is_zero(m[1].emission));
+        const fr_texture *x = b.textures.data;
+        T(x->kind == FR_TEX_IMAGE && x->width == 2 && x->channels == 3);
+        T(x->filter == FR_FILTER_NEAREST && x->wrap == FR_WRAP_CLAMP);
+        /* v' = 4 v' + (1 - 4 - 0.5) */
+        T(x->scale.u == 2.0f && x->scale.v == 4.0f && x->offset.u == 0.25f && x->offset.v == -3.5f);
+        T(fabsf(((const float *)b.texels.data)[x->first] - 0.2140411f) < 1e-4f); /* 0.5 sRGB-decoded */
+    }
+    bld_free(&b);
+    /* without a decoder, the texture is dropped with a warning */
+    bld_init(&b);
+    n_warnings = 0;
+    T(gltf_import_mem(t, strlen(t), "t.gltf", &warn_hooks, &o, &b, &r, &e) == 0 && b.textures.count == 0 &&
+      n_warnings == 1 && contains(last_warning, "images are not decoded"));
+    bld_free(&b);
+}
+
 int main(void)
 {
     test_data_uri();
@@ -359,5 +425,6 @@ int main(void)
     test_camera();
     test_documents();
     test_lights();
+    test_materials();
     return check_done();
 }
