@@ -19,11 +19,13 @@ int gmat_begin(gmat_ctx *c, gltf_doc *d, const scn_hooks *hooks, fr_builder *b, 
     c->b = b;
     uint32_t n = d->materials.n + 1, ni = d->images.n ? d->images.n : 1;
     c->mat_of = malloc(n * sizeof *c->mat_of);
+    c->uvxf = malloc(n * sizeof *c->uvxf);
+    c->has_uvxf = calloc(n, 1);
     for (int k = 0; k < 2; k++) {
         c->img[k] = calloc(ni, sizeof *c->img[k]);
         c->img_done[k] = calloc(ni, 1);
     }
-    if (!c->mat_of || !c->img[0] || !c->img[1] || !c->img_done[0] || !c->img_done[1]) {
+    if (!c->mat_of || !c->uvxf || !c->has_uvxf || !c->img[0] || !c->img[1] || !c->img_done[0] || !c->img_done[1]) {
         gmat_end(c);
         return gdoc_fail(d, err, NULL, "out of memory");
     }
@@ -35,6 +37,8 @@ int gmat_begin(gmat_ctx *c, gltf_doc *d, const scn_hooks *hooks, fr_builder *b, 
 void gmat_end(gmat_ctx *c)
 {
     free(c->mat_of);
+    free(c->uvxf);
+    free(c->has_uvxf);
     for (int k = 0; k < 2; k++) {
         free(c->img[k]);
         free(c->img_done[k]);
@@ -208,9 +212,16 @@ static int texture_info(gmat_ctx *c, const cJSON *o, const char *ptr, const char
             gdoc_numbers(d, tt, ep, "scale", 2, sc, &has, err) < 0 || gdoc_number(d, tt, ep, "rotation", 0, &rot, err) < 0 ||
             gdoc_uint(d, tt, ep, "texCoord", texcoord, 255, &texcoord, err) < 0)
             return -1;
-        if (rot != 0.0)
-            gdoc_warn(d, "rotation", "%s: KHR_texture_transform rotation is not supported: ignored", ep);
     }
+    /* The material's textures' transforms: one with a rotation is applied
+     * to the vertices' UVs instead, if they all share it (gmat_material). */
+    const double xf[5] = {off[0], off[1], sc[0], sc[1], rot};
+    if (!c->xf_seen)
+        memcpy(c->xf, xf, sizeof xf);
+    else if (memcmp(c->xf, xf, sizeof xf) != 0)
+        c->xf_mixed = 1;
+    c->xf_seen = 1;
+    c->xf_rot |= rot != 0.0;
     if (texcoord != 0)
         gdoc_warn(d, "texcoord", "%s: texCoord %llu: only TEXCOORD_0 is used", p, (unsigned long long)texcoord);
     tex.scale = (vec2){(float)sc[0], (float)sc[1]};
@@ -344,18 +355,45 @@ void gmat_to_franja(gmat_ctx *c, const gmat_values *v, fr_material *m)
     bsdf_lobe_probs(m);
 }
 
-int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, fr_error *err)
+int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, const double **uvxf, fr_error *err)
 {
     uint32_t slot = index == UINT32_MAX ? c->doc->materials.n : index;
     if (c->mat_of[slot] == FR_NONE) {
         gmat_values v;
         fr_material m;
+        uint32_t first_tex = c->b->textures.count;
+        c->xf_seen = c->xf_mixed = c->xf_rot = 0;
         if (gmat_read(c, index, &v, err) < 0)
             return -1;
+        if (c->xf_rot) {
+            if (c->xf_mixed) {
+                gdoc_warn(c->doc, "rotation", "/materials/%u: KHR_texture_transform rotation is not supported when "
+                          "a material's textures have different transforms: ignored", index);
+            } else {
+                /* u' = ou + cos(r) su u + sin(r) sv v, v' = ov - sin(r) su u + cos(r) sv v:
+                 * the extension's translation x rotation x scale, its rotation
+                 * matrix written in rows (cos, sin; -sin, cos): counter-
+                 * clockwise in glTF's UV space, whose v runs down the image. */
+                double sn = sin(c->xf[4]), cs = cos(c->xf[4]), *x = c->uvxf[slot];
+                x[0] = cs * c->xf[2];
+                x[1] = sn * c->xf[3];
+                x[2] = c->xf[0];
+                x[3] = -sn * c->xf[2];
+                x[4] = cs * c->xf[3];
+                x[5] = c->xf[1];
+                c->has_uvxf[slot] = 1;
+                fr_texture *t = c->b->textures.data;
+                for (uint32_t k = first_tex; k < c->b->textures.count; k++) {
+                    t[k].scale = (vec2){1.0f, 1.0f};
+                    t[k].offset = (vec2){0.0f, 0.0f};
+                }
+            }
+        }
         gmat_to_franja(c, &v, &m);
         if ((c->mat_of[slot] = bld_push(&c->b->materials, &m)) == FR_NONE)
             return gdoc_fail(c->doc, err, NULL, "out of memory");
     }
     *out = c->mat_of[slot];
+    *uvxf = c->has_uvxf[slot] ? c->uvxf[slot] : NULL;
     return 0;
 }

@@ -49,6 +49,11 @@ typedef struct {
     uint32_t *mat_of;          /**< builder material per glTF material (last: the default), FR_NONE until made */
     fr_texture *img[2];        /**< decoded images' fields, [linear, sRGB] per image */
     uint8_t *img_done[2];
+    double (*uvxf)[6];         /**< per material slot: the UV transform its vertices take (see gmat_material) */
+    uint8_t *has_uvxf;
+    /* while a material is read: the KHR_texture_transform of its textures */
+    int xf_seen, xf_mixed, xf_rot; /**< a transform seen; two different ones; one with a rotation */
+    double xf[5];              /**< offset u, v, scale u, v, rotation (glTF's UV space) */
 } gmat_ctx;
 
 /** Prepares the conversion of d's materials into b.  Returns 0, or -1 when
@@ -57,8 +62,12 @@ int gmat_begin(gmat_ctx *c, gltf_doc *d, const scn_hooks *hooks, fr_builder *b, 
 void gmat_end(gmat_ctx *c);
 
 /** The builder material for glTF material `index` (UINT32_MAX: glTF's
- * default material), converting it on first use. */
-int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, fr_error *err);
+ * default material), converting it on first use.  When the material's
+ * textures share one KHR_texture_transform with a rotation (which Franja's
+ * textures cannot express), the textures are left untransformed and *uvxf
+ * receives the row-major 2x3 matrix to apply to the vertices' glTF UVs
+ * instead (before v is flipped); otherwise *uvxf is NULL. */
+int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, const double **uvxf, fr_error *err);
 
 /** Reads glTF material `index` (UINT32_MAX: the default) into *v, making
  * the textures it uses. */

@@ -201,7 +201,8 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
                              iidx, i, v, nv);
     }
     uint32_t mat = c->o->material;
-    if (mat == FR_NONE && gmat_material(&c->mat, imat, &mat, err) < 0)
+    const double *uvxf = NULL;
+    if (mat == FR_NONE && gmat_material(&c->mat, imat, &mat, &uvxf, err) < 0)
         return -1;
 
     double det = af_det(w), cof[3][3];
@@ -229,6 +230,11 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
         }
         if (use_uv) {
             double u = gdoc_get(&uv, i, 0), v = gdoc_get(&uv, i, 1);
+            if (uvxf) {
+                double tu = uvxf[0] * u + uvxf[1] * v + uvxf[2];
+                v = uvxf[3] * u + uvxf[4] * v + uvxf[5];
+                u = tu;
+            }
             vec2 t = {(float)u, (float)(1.0 - v)};
             if (!isfinite(t.u) || !isfinite(t.v))
                 t = (vec2){0, 0};

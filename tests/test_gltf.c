@@ -416,6 +416,56 @@ static void test_materials(void)
     bld_free(&b);
 }
 
+/* A KHR_texture_transform with a rotation, shared by a material's
+ * textures, moves the vertices' UVs (rotation counter-clockwise in glTF's
+ * UV space: (1, 0) -> (0, -1) for a quarter turn), then v is flipped. */
+static void test_uv_rotation(void)
+{
+    float bin[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, /* UVs: */ 0, 0, 1, 0, 0, 1};
+    char body[2048];
+    for (int mixed = 0; mixed < 2; mixed++) {
+        snprintf(body, sizeof body,
+            "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24}],"
+            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+            "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}],"
+            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]}],"
+            "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+            "\"materials\":[{\"emissiveFactor\":[1,1,1],\"emissiveTexture\":{\"index\":0%s},"
+            "\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,"
+            "\"extensions\":{\"KHR_texture_transform\":{\"rotation\":1.5707963267948966,\"offset\":[0,0.5]}}}}}],"
+            "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,AAAA\"}]",
+            mixed ? "" : ",\"extensions\":{\"KHR_texture_transform\":{\"rotation\":1.5707963267948966,\"offset\":[0,0.5]}}");
+        const char *t = docf(bin, sizeof bin, body);
+        scn_hooks h = {.image_mem = fake_image, .warn = on_warn};
+        gltf_options o;
+        gltf_options_default(&o);
+        fr_builder b;
+        gltf_result r;
+        fr_error e;
+        bld_init(&b);
+        n_warnings = 0;
+        T(gltf_import_mem(t, strlen(t), "t.gltf", &h, &o, &b, &r, &e) == 0 && b.uvs.count == 3);
+        if (b.uvs.count == 3 && b.textures.count == 2) {
+            const vec2 *uv = b.uvs.data;
+            const fr_texture *x = b.textures.data;
+            if (!mixed) {
+                /* (0,0) -> (0,0.5) -> (0,0.5); (1,0) -> (0,-0.5) -> (0,1.5); (0,1) -> (1,0.5) -> (1,0.5) */
+                T(fabsf(uv[0].u) < 1e-6f && fabsf(uv[0].v - 0.5f) < 1e-6f);
+                T(fabsf(uv[1].u) < 1e-6f && fabsf(uv[1].v - 1.5f) < 1e-6f);
+                T(fabsf(uv[2].u - 1.0f) < 1e-6f && fabsf(uv[2].v - 0.5f) < 1e-6f);
+                T(x[0].scale.u == 1.0f && x[0].scale.v == 1.0f && x[0].offset.u == 0.0f && x[0].offset.v == 0.0f);
+                T(x[1].scale.v == 1.0f && x[1].offset.v == 0.0f && n_warnings == 0);
+            } else {
+                /* different transforms: UVs as in the file (v flipped), rotation warned */
+                T(uv[1].u == 1.0f && uv[1].v == 1.0f && n_warnings == 1 && contains(last_warning, "rotation"));
+            }
+        } else {
+            T(0);
+        }
+        bld_free(&b);
+    }
+}
+
 int main(void)
 {
     test_data_uri();
@@ -426,5 +476,6 @@ int main(void)
     test_documents();
     test_lights();
     test_materials();
+    test_uv_rotation();
     return check_done();
 }
