@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "bsdf.h"
+#include "fmath.h"
 #include "scene_appear.h"
 
 enum { WRAP_CLAMP = 33071, WRAP_MIRROR = 33648, WRAP_REPEAT = 10497, FILTER_NEAREST = 9728 };
@@ -374,7 +375,9 @@ int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, const double **uvx
                  * the extension's translation x rotation x scale, its rotation
                  * matrix written in rows (cos, sin; -sin, cos): counter-
                  * clockwise in glTF's UV space, whose v runs down the image. */
-                double sn = sin(c->xf[4]), cs = cos(c->xf[4]), *x = c->uvxf[slot];
+                float snf, csf;        /* fmath: the worker links this module (JSON scenes) */
+                fm_sincosf((float)c->xf[4], &snf, &csf);
+                double sn = snf, cs = csf, *x = c->uvxf[slot];
                 x[0] = cs * c->xf[2];
                 x[1] = sn * c->xf[3];
                 x[2] = c->xf[0];

@@ -51,9 +51,9 @@ typedef struct {
     uint8_t *img_done[2];
     double (*uvxf)[6];         /**< per material slot: the UV transform its vertices take (see gmat_material) */
     uint8_t *has_uvxf;
-    /* while a material is read: the KHR_texture_transform of its textures */
-    int xf_seen, xf_mixed, xf_rot; /**< a transform seen; two different ones; one with a rotation */
-    double xf[5];              /**< offset u, v, scale u, v, rotation (glTF's UV space) */
+    int xf_seen, xf_mixed, xf_rot; /**< while a material is read, its textures' KHR_texture_transform: one
+                                        seen; two different ones; one with a rotation */
+    double xf[5];              /**< the first seen: offset u, v, scale u, v, rotation (glTF's UV space) */
 } gmat_ctx;
 
 /** Prepares the conversion of d's materials into b.  Returns 0, or -1 when
