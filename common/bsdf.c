@@ -77,6 +77,22 @@ vec3 bsdf_eval(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi, flo
     return smooth_eval(m, facing_normal(sf, wo), wo, wi, pdf);
 }
 
+float bsdf_pdf(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi)
+{
+    float pdf;
+    bsdf_eval(m, sf, wo, wi, &pdf);
+    return pdf;
+}
+
+float bsdf_adjoint_scale(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi)
+{
+    float side = v3_dot(wo, sf->ng);
+    if (side * v3_dot(wi, sf->ng) >= 0.0f)
+        return 1.0f;
+    float eta = side >= 0.0f ? m->ior : 1.0f / m->ior;  /* index on wi's side / index on wo's side */
+    return eta * eta;
+}
+
 int bsdf_sample(const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe, float u1, float u2,
                 fr_bsdf_sample *out)
 {

@@ -29,6 +29,21 @@ typedef struct {
  * and in *pdf the solid-angle pdf with which bsdf_sample would pick wi. */
 vec3 bsdf_eval(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi, float *pdf);
 
+/** The solid-angle pdf with which bsdf_sample, given wo, picks wi (its
+ * smooth lobes; 0 for a direction only a delta lobe reaches).  The pdf of
+ * the reverse step, wo given wi, is bsdf_pdf(m, sf, wi, wo): bidirectional
+ * integrators ask for both. */
+float bsdf_pdf(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi);
+
+/** The factor that turns a sample weight or a value of bsdf_eval for the
+ * step wo -> wi, which carry radiance (from wi toward wo), into the adjoint
+ * BSDF's that carries importance the other way (light subpaths): 1 for a
+ * reflection, (n_wi / n_wo)^2 for a transmission (indices of refraction on
+ * wi's and wo's side), since radiance is compressed by refraction and
+ * importance is not (Veach 1997, section 5.2).  Shading normals need a
+ * correction of their own (the caller's: it involves the geometry). */
+float bsdf_adjoint_scale(const fr_material *m, const fr_surface *sf, vec3 wo, vec3 wi);
+
 /** Sample wi given wo from three uniform numbers (lobe choice, direction).
  * Returns 0 when the path ends here (absorbed, or a void sample). */
 int bsdf_sample(const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe, float u1, float u2,

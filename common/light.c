@@ -182,20 +182,29 @@ static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u
 }
 
 /* A point uniform by area on primitive `pr` from (u1, u2): its position,
- * unit geometric normal, and the coordinates trace_surface takes. */
-static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2, vec3 *p, vec3 *n, float *ua, float *ub)
+ * unit geometric normal, the coordinates trace_surface takes, and when err
+ * is not NULL a bound on the point's error per coordinate (the
+ * geo_*_point functions give the bound; the point is computed here as
+ * light sampling always has). */
+static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2, vec3 *p, vec3 *n, float *ua, float *ub,
+                       vec3 *err)
 {
+    vec3 unused;
+    if (!err)
+        err = &unused;
     if (pr->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[pr->index];
         float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
         fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
         *n = v3(r * cs, r * sn, z);
         *p = v3_madd(sp->center, *n, sp->radius);
+        geo_sphere_point(sp, *n, err);
         *ua = *ub = 0.0f;
     } else if (pr->kind == FR_PRIM_RECT) {
         const fr_rect *q = &s->rects[pr->index];
         *p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, u1), v3_scale(q->edge_v, u2)));
         *n = v3_norm(q->normal);
+        geo_rect_point(q, u1, u2, err);
         *ua = u1;
         *ub = u2;
     } else {
@@ -206,6 +215,7 @@ static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2,
         *n = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
         *ua = b1;
         *ub = 1.0f - b0 - b1;
+        geo_triangle_point(p0, p1, p2, *ua, *ub, err);
     }
 }
 
@@ -245,7 +255,7 @@ int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr
     }
     /* Uniform by area (a sphere seen from inside: over its whole surface). */
     float ua, ub;
-    prim_point(s, pr, u1, u2, &out->p, &out->n, &ua, &ub);
+    prim_point(s, pr, u1, u2, &out->p, &out->n, &ua, &ub, NULL);
     float d2 = aim(out, from);
     if (!(d2 > 0.0f))
         return 0;
@@ -288,6 +298,7 @@ int lgt_sample_emit(const fr_scene *s, float upick, float u1, float u2, float u3
     const fr_light *l = &s->lights[li];
     out->light = li;
     out->prim = FR_NONE;
+    out->perr = v3s(0.0f);
     out->delta_pos = out->delta_dir = out->distant = 0;
     if (l->kind == FR_LIGHT_POINT || l->kind == FR_LIGHT_SPOT) {
         out->delta_pos = 1;
@@ -335,7 +346,7 @@ int lgt_sample_emit(const fr_scene *s, float upick, float u1, float u2, float u3
     const fr_material *m = &s->materials[pr->material];
     float ua, ub;
     vec3 p, n;
-    prim_point(s, pr, u1, u2, &p, &n, &ua, &ub);
+    prim_point(s, pr, u1, u2, &p, &n, &ua, &ub, &out->perr);
     float side_pdf = 1.0f;
     if (m->two_sided) {
         side_pdf = 0.5f;

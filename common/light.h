@@ -77,6 +77,8 @@ float lgt_spot_falloff(const fr_light *l, float c);
 typedef struct {
     fr_ray ray;                /**< origin on the light, unit direction; for distant lights the origin lies on
                                     a disk of the world's radius, facing the scene from outside its bounds */
+    vec3 perr;                 /**< area lights: a bound on the origin's error per coordinate (geom.h), for
+                                    geo_offset; 0 for the other kinds */
     vec3 n;                    /**< the surface normal at the origin (area lights, on the side emitted into);
                                     ray.d for the other kinds */
     vec3 Le;                   /**< radiance along the ray (area, sun disk, environment), intensity toward

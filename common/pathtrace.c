@@ -1,6 +1,6 @@
 #include "pathtrace.h"
 
-#include "fmath.h"
+#include "camera.h"
 #include "texture.h"
 #include "vertex.h"
 
@@ -30,23 +30,10 @@ fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float 
     vec3 d = v3_add(c->forward, v3_add(v3_scale(c->right, sx), v3_scale(c->upv, sy)));
     fr_ray r = {c->position, d};
     if (c->aperture > 0.0f) {
-        /* Uniform point on the lens disk (concentric mapping keeps the
-         * stratification of lx, ly); aim at the point of the focal plane the
-         * pinhole ray reaches, `focus` along the view axis. */
-        float a = 2.0f * lx - 1.0f, b = 2.0f * ly - 1.0f, rad, phi;
-        if (a == 0.0f && b == 0.0f) {
-            rad = 0.0f; phi = 0.0f;
-        } else if (fabsf(a) > fabsf(b)) {
-            rad = a; phi = 0.25f * FM_PI * (b / a);
-        } else {
-            rad = b; phi = 0.5f * FM_PI - 0.25f * FM_PI * (a / b);
-        }
-        float sn, cs;
-        fm_sincosf(phi, &sn, &cs);
-        rad *= c->aperture;
-        vec3 lens = v3_add(v3_scale(c->right, rad * cs), v3_scale(c->upv, rad * sn));
+        /* A point on the lens disk (camera.h), aimed at the point of the
+         * focal plane the pinhole ray reaches, `focus` along the view axis. */
         vec3 focus = v3_madd(c->position, d, c->focus);
-        r.o = v3_add(c->position, lens);
+        r.o = v3_add(c->position, cam_lens(c, lx, ly));
         r.d = v3_sub(focus, r.o);
     }
     r.d = v3_norm(r.d);

@@ -1,0 +1,601 @@
+#include "bdpt.h"
+
+#include <stdlib.h>
+
+#include "bsdf.h"
+#include "camera.h"
+#include "fmath.h"
+#include "light.h"
+#include "pathtrace.h"
+#include "sampler.h"
+#include "splat.h"
+#include "texture.h"
+
+/* Bounces before Russian roulette may end a subpath (as in pathtrace.c). */
+#define RR_DEPTH 4
+/* First dimension pair of a light subpath's numbers (bdpt.h). */
+#define LIGHT_DIM 65536u
+
+enum { BD_CAMERA, BD_LIGHT, BD_SURFACE };
+
+/* A subpath vertex.  pdf_fwd is the area density with which its own
+ * subpath reached it, pdf_rev the one with which the other direction
+ * would (from the next vertex of its subpath).  A step through a delta
+ * lobe has density 1 both ways: the delta factor is the same for every
+ * strategy that can make the path, so it cancels from their ratios.  A
+ * genuine 0 (a direction that the BSDF never samples though it reflects
+ * light there, as below the shading hemisphere) stays 0, so the strategy
+ * that would need it does not count. */
+typedef struct {
+    int type;                  /* BD_* */
+    int delta;                 /* surface: the subpath left it by a delta lobe */
+    int delta_light;           /* light: no path can hit it (point, spot, a sun without a disk) */
+    int distant;               /* light: the sun and environment, a direction rather than a point */
+    int connectible;           /* a connection may end here (camera, light, a smooth lobe) */
+    vec3 p;                    /* position (not for distant lights) */
+    vec3 ng, ns;               /* geometric and shading normal; 0 off surfaces (camera, point light) */
+    vec3 wo;                   /* surface: unit direction to the previous vertex of its subpath;
+                                  distant light: unit direction from the scene toward it */
+    vec3 beta;                 /* subpath throughput up to here */
+    float pdf_fwd, pdf_rev;
+    uint32_t light;            /* light: index into lights; surface: its area light or FR_NONE */
+    float u[3];                /* camera subpath: light pick and point for s = 1; light subpath: lens point */
+    fr_surface sf;
+    fr_material m;             /* as textured at sf */
+} vert;
+
+struct bd_work {
+    uint32_t cap;
+    vert *cam, *lgt;
+};
+
+int bd_supported(const fr_scene *s, fr_error *err)
+{
+    if (s->n_media)
+        return fr_fail(err, "the scene has participating media (fog or a medium inside a shape), which the "
+                            "bidirectional integrator does not support; render it with the path integrator");
+    return 0;
+}
+
+bd_work *bd_work_new(const fr_scene *s)
+{
+    bd_work *w = malloc(sizeof *w);
+    if (!w)
+        return NULL;
+    w->cap = s->settings.max_depth + 2;
+    w->cam = malloc(sizeof(vert) * w->cap);
+    w->lgt = malloc(sizeof(vert) * w->cap);
+    if (!w->cam || !w->lgt) {
+        bd_work_free(w);
+        return NULL;
+    }
+    return w;
+}
+
+void bd_work_free(bd_work *w)
+{
+    if (!w)
+        return;
+    free(w->cam);
+    free(w->lgt);
+    free(w);
+}
+
+static int on_surface(const vert *v) { return !v3_is_zero(v->ng); }
+
+/* A density to divide by: 0 (a grazing step, rounding) as 1. */
+static float remap0(float f) { return f != 0.0f ? f : 1.0f; }
+
+/* Density of a distant light's ray origin on the disk it starts from (the
+ * world's cross-section): directions stand for distant light vertices, so
+ * the vertex after one is reached with this density times its cosine. */
+static float disk_pdf(const fr_scene *s) { return 1.0f / (FM_PI * s->world.radius * s->world.radius); }
+
+/* The density of the step from vertex `from` to vertex `to`, given as a
+ * solid-angle pdf at `from`, in the measure of `to`: area (times the
+ * cosine at `to` over the squared distance), or solid angle when `to` is
+ * a distant light; after a distant light, the disk's density times the
+ * cosine at `to` (pdf unused). */
+static float to_area(const fr_scene *s, float pdf, const vert *from, const vert *to)
+{
+    if (to->distant)
+        return pdf;
+    if (from->distant)
+        return disk_pdf(s) * (on_surface(to) ? fabsf(v3_dot(to->ng, from->wo)) : 1.0f);
+    vec3 d = v3_sub(to->p, from->p);
+    float d2 = v3_len2(d);
+    if (!(d2 > 0.0f))
+        return 0.0f;
+    float inv = 1.0f / d2;
+    if (on_surface(to))
+        pdf *= fabsf(v3_dot(to->ng, d)) * sqrtf(inv);
+    return pdf * inv;
+}
+
+/* Unit direction from vertex a toward vertex b (toward the light for a
+ * distant b, away from it for a distant a). */
+static vec3 dir_to(const vert *a, const vert *b)
+{
+    if (b->distant)
+        return b->wo;
+    if (a->distant)
+        return v3_neg(a->wo);
+    return v3_norm(v3_sub(b->p, a->p));
+}
+
+/* Veach's adjoint correction for shading normals, for importance carried
+ * from wo to wi (1 when the shading normal is the geometric one). */
+static float shading_fix(const fr_surface *sf, vec3 wo, vec3 wi)
+{
+    float num = fabsf(v3_dot(wo, sf->ns)) * fabsf(v3_dot(wi, sf->ng));
+    float den = fabsf(v3_dot(wo, sf->ng)) * fabsf(v3_dot(wi, sf->ns));
+    return den > 0.0f ? num / den : 0.0f;
+}
+
+/* The BSDF at surface vertex v for light between its subpath's previous
+ * vertex and direction w, always as radiance flows (toward the camera
+ * side: bsdf.h's wo is the camera side), so that both subpaths weigh a
+ * path alike even where a BSDF is not symmetric (below the shading
+ * hemisphere, Lambert is 0 for wi only).  On a light subpath it is
+ * f(w, wo) with Veach's shading-normal correction. */
+static vec3 vert_f(const vert *v, vec3 w, int importance)
+{
+    float pdf;
+    if (!importance)
+        return bsdf_eval(&v->m, &v->sf, v->wo, w, &pdf);
+    vec3 f = bsdf_eval(&v->m, &v->sf, w, v->wo, &pdf);
+    return v3_is_zero(f) ? f : v3_scale(f, shading_fix(&v->sf, v->wo, w));
+}
+
+/* The density with which the light subpath would start at emitter vertex
+ * v: by area on its light (with the pick), for a distant light the
+ * density of its direction, summed over the distant lights (with their
+ * picks; any of them may shine from that direction). */
+static float emit_pdf_origin(const fr_scene *s, const vert *v)
+{
+    if (v->distant) {
+        float sum = 0.0f, pdf;
+        for (uint32_t i = 0, n = lgt_n_distant(s); i < n; i++) {
+            lgt_distant(s, i, v->wo, &pdf);
+            sum += pdf;
+        }
+        return sum;
+    }
+    float pos, dir;
+    lgt_pdf_emit(s, v->light, v->p, v->ng, v->ng, &pos, &dir);
+    return pos;
+}
+
+/* Solid-angle density of light leaving local emitter vertex v along w. */
+static float emit_pdf_dir(const fr_scene *s, const vert *v, vec3 w)
+{
+    float pos, dir;
+    lgt_pdf_emit(s, v->light, v->p, v->ng, w, &pos, &dir);
+    return dir;
+}
+
+/* Density at `next` (to_area's measure) of the step from v to next, given
+ * that the path came to v from prev (unused at the camera and at lights). */
+static float vert_pdf(const fr_scene *s, const vert *v, const vert *prev, const vert *next)
+{
+    float pdf;
+    if (v->distant)
+        pdf = 0.0f;    /* the disk's density: to_area's */
+    else if (v->type == BD_CAMERA)
+        cam_importance(s, v->p, dir_to(v, next), &pdf, NULL, NULL);
+    else if (v->type == BD_LIGHT)
+        pdf = emit_pdf_dir(s, v, dir_to(v, next));
+    else
+        pdf = bsdf_pdf(&v->m, &v->sf, dir_to(v, prev), dir_to(v, next));
+    return to_area(s, pdf, v, next);
+}
+
+/* Russian roulette on a subpath whose throughput went from beta0 to *beta
+ * (the ratio is what its scattering kept).  Returns 0 when it ends. */
+static int roulette(fr_sampler *smp, uint32_t depth, vec3 beta0, vec3 *beta)
+{
+    if (depth < RR_DEPTH)
+        return 1;
+    float r = v3_max(*beta) / v3_max(beta0), q = r < 0.95f ? r : 0.95f;
+    if (!(smp_random(smp) < q))
+        return 0;
+    *beta = v3_scale(*beta, 1.0f / q);
+    return 1;
+}
+
+/* Extend the subpath path[0] along ray (throughput beta, leaving path[0]
+ * with solid-angle density pdf_dir) to at most maxv vertices in all;
+ * importance: a light subpath.  A camera subpath that leaves the scene
+ * ends on a distant light vertex when the scene has distant lights.
+ * Returns the number of vertices. */
+static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float pdf_dir, int importance, vert *path,
+                int maxv)
+{
+    vec3 beta0 = beta;
+    int n = 1, delta_in = 0;
+    for (uint32_t depth = 0; n < maxv; depth++) {
+        fr_hit hit;
+        vert *v = &path[n], *prev = &path[n - 1];
+        if (!trace_closest(s, &ray, INFINITY, &hit)) {
+            if (!importance && lgt_n_distant(s)) {
+                v->type = BD_LIGHT;
+                v->delta = v->delta_light = 0;
+                v->distant = 1;
+                v->connectible = 0;    /* only for s = 0 */
+                v->ng = v->ns = v->p = v3s(0.0f);
+                v->wo = ray.d;
+                v->beta = beta;
+                v->light = FR_NONE;
+                v->pdf_fwd = delta_in ? 1.0f : pdf_dir;
+                v->pdf_rev = 0.0f;
+                n++;
+            }
+            break;
+        }
+        trace_surface(s, &ray, &hit, &v->sf);
+        v->m = *tex_material(s, &s->materials[v->sf.material], &v->sf, &v->m);
+        v->type = BD_SURFACE;
+        v->delta = v->delta_light = v->distant = 0;
+        v->connectible = bsdf_has_smooth(&v->m);
+        v->p = v->sf.p;
+        v->ng = v->sf.ng;
+        v->ns = v->sf.ns;
+        v->wo = v3_neg(ray.d);
+        v->beta = beta;
+        v->light = v->sf.light;
+        v->pdf_fwd = delta_in ? 1.0f : to_area(s, pdf_dir, prev, v);
+        v->pdf_rev = 0.0f;
+        n++;
+        /* Three pairs per vertex: camera side (light pick, lobe), light
+         * point, direction; light side (lobe, -), direction, lens point. */
+        float ulobe, unused, u1, u2, a, b;
+        if (importance) {
+            smp_2d(smp, &ulobe, &unused);
+            smp_2d(smp, &u1, &u2);
+            smp_2d(smp, &a, &b);
+            v->u[0] = a;
+            v->u[1] = b;
+        } else {
+            smp_2d(smp, &v->u[0], &ulobe);
+            smp_2d(smp, &v->u[1], &v->u[2]);
+            smp_2d(smp, &u1, &u2);
+        }
+        if (n >= maxv)
+            break;
+        fr_bsdf_sample bs;
+        if (!bsdf_sample(&v->m, &v->sf, v->wo, ulobe, u1, u2, &bs))
+            break;
+        vec3 weight = bs.weight;
+        if (importance) {
+            /* A light subpath: the BSDF as radiance flows back along it,
+             * f(wi, wo), and the adjoint corrections; a delta lobe cannot
+             * be evaluated, so its radiance weight is rescaled. */
+            float fix = shading_fix(&v->sf, v->wo, bs.wi);
+            if (bs.delta) {
+                weight = v3_scale(weight, bsdf_adjoint_scale(&v->m, &v->sf, v->wo, bs.wi) * fix);
+            } else {
+                float unused_pdf;
+                vec3 f = bsdf_eval(&v->m, &v->sf, bs.wi, v->wo, &unused_pdf);
+                weight = v3_scale(f, fabsf(v3_dot(bs.wi, v->sf.ns)) * fix / bs.pdf);
+            }
+        }
+        beta = v3_mul(beta, weight);
+        v->delta = delta_in = bs.delta;
+        pdf_dir = bs.pdf;
+        prev->pdf_rev = bs.delta ? 1.0f : to_area(s, bsdf_pdf(&v->m, &v->sf, bs.wi, v->wo), v, prev);
+        ray.o = geo_offset(v->p, v->sf.perr, v->ng, bs.wi);
+        ray.d = bs.wi;
+        if (v3_is_zero(beta) || !roulette(smp, depth, beta0, &beta))
+            break;
+    }
+    return n;
+}
+
+static int camera_subpath(const fr_scene *s, fr_sampler *smp, uint32_t x, uint32_t y, vert *cam, int maxv)
+{
+    float px, py, lx, ly, pdf_dir;
+    smp_2d(smp, &px, &py);
+    smp_2d(smp, &lx, &ly);
+    fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
+    cam_importance(s, ray.o, ray.d, &pdf_dir, NULL, NULL);
+    vert *c = &cam[0];
+    c->type = BD_CAMERA;
+    c->delta = c->delta_light = c->distant = 0;
+    c->connectible = 1;
+    c->p = ray.o;
+    c->ng = c->ns = c->wo = v3s(0.0f);
+    c->beta = v3s(1.0f);
+    c->pdf_fwd = c->pdf_rev = 0.0f;
+    c->light = FR_NONE;
+    return walk(s, smp, ray, c->beta, pdf_dir, 0, cam, maxv);
+}
+
+static int light_subpath(const fr_scene *s, fr_sampler *smp, vert *lgt, int maxv)
+{
+    float upick, unused, u1, u2, u3, u4;
+    smp_2d(smp, &upick, &unused);
+    smp_2d(smp, &u1, &u2);
+    smp_2d(smp, &u3, &u4);
+    fr_light_emit e;
+    if (!lgt_sample_emit(s, upick, u1, u2, u3, u4, &e))
+        return 0;
+    vert *l = &lgt[0];
+    int local = !e.distant && !e.delta_pos;   /* an area light: a point on a surface */
+    l->type = BD_LIGHT;
+    l->delta = 0;
+    l->delta_light = e.delta_pos || e.delta_dir;
+    l->distant = e.distant;
+    l->connectible = 1;
+    l->p = e.ray.o;
+    l->ng = l->ns = local ? e.n : v3s(0.0f);
+    l->wo = e.distant ? v3_neg(e.ray.d) : v3s(0.0f);
+    l->sf.perr = e.perr;
+    l->beta = v3_scale(e.Le, 1.0f / e.pdf_pos);
+    l->light = e.light;
+    l->pdf_rev = 0.0f;
+    /* A distant light's vertex is its direction: its density is that of
+     * the direction (emit_pdf_origin), and the disk's goes to the next
+     * vertex (to_area). */
+    l->pdf_fwd = e.distant ? emit_pdf_origin(s, l) : e.pdf_pos;
+    float cosl = local ? fabsf(v3_dot(e.n, e.ray.d)) : 1.0f;
+    vec3 beta = v3_scale(e.Le, cosl / (e.pdf_pos * e.pdf_dir));
+    fr_ray ray = {local ? geo_offset(e.ray.o, e.perr, e.n, e.ray.d) : e.ray.o, e.ray.d};
+    return walk(s, smp, ray, beta, e.pdf_dir, 1, lgt, maxv);
+}
+
+/* 1 if nothing blocks the segment from surface vertex a to surface
+ * vertex b.  The segment leaves a pushed off its surface (geo_offset) and
+ * ends short of b by a bound on how far the rounding of a hit distance can
+ * put b's own surface in front of b (a few dozen ulps of the coordinates
+ * involved), so that b's surface does not hide b. */
+static int visible(const fr_scene *s, const vert *a, const vert *b)
+{
+    vec3 o = geo_offset(a->p, a->sf.perr, a->ng, v3_sub(b->p, a->p)), d = v3_sub(b->p, o);
+    float len = v3_len(d);
+    float margin = (v3_max(v3_abs(o)) + v3_max(v3_abs(b->p)) + v3_max(b->sf.perr)) * GEO_GAMMA(32);
+    if (!(len > margin))
+        return 1;
+    fr_ray r = {o, v3_scale(d, 1.0f / len)};
+    return !trace_occluded(s, &r, len - margin, FR_NONE);
+}
+
+/* Power-heuristic weight of strategy (s_, t) for the path it made, by the
+ * ratios of each neighbouring strategy's density to this one's (pbrt-v3's
+ * MISWeight with squared ratios).  `sampled` is the vertex the strategy
+ * sampled itself (s_ = 1: a light point, t = 1: a lens point). */
+static float mis_weight(const fr_scene *s, vert *cam, vert *lgt, const vert *sampled, int s_, int t)
+{
+    if (s_ + t == 2)
+        return 1.0f;
+    vert *qs = s_ > 0 ? &lgt[s_ - 1] : NULL, *pt = &cam[t - 1];
+    vert *qs_m = s_ > 1 ? &lgt[s_ - 2] : NULL, *pt_m = t > 1 ? &cam[t - 2] : NULL;
+    /* The strategy's own view of its end vertices, swapped in and out. */
+    vert saved;
+    vert *slot = s_ == 1 ? qs : t == 1 ? pt : NULL;
+    if (slot) {
+        saved = *slot;
+        *slot = *sampled;
+    }
+    int pt_delta = pt->delta, qs_delta = qs ? qs->delta : 0;
+    float pt_rev = pt->pdf_rev, pt_m_rev = pt_m ? pt_m->pdf_rev : 0.0f;
+    float qs_rev = qs ? qs->pdf_rev : 0.0f, qs_m_rev = qs_m ? qs_m->pdf_rev : 0.0f;
+    pt->delta = 0;
+    if (qs)
+        qs->delta = 0;
+    pt->pdf_rev = s_ > 0 ? vert_pdf(s, qs, qs_m, pt) : emit_pdf_origin(s, pt);
+    if (pt_m) {
+        if (s_ > 0)
+            pt_m->pdf_rev = vert_pdf(s, pt, qs, pt_m);
+        else    /* pt is an emitter the camera subpath found: as a light subpath's start */
+            pt_m->pdf_rev = to_area(s, pt->distant ? 0.0f : emit_pdf_dir(s, pt, dir_to(pt, pt_m)), pt, pt_m);
+    }
+    if (qs)
+        qs->pdf_rev = vert_pdf(s, pt, pt_m, qs);
+    if (qs_m)
+        qs_m->pdf_rev = vert_pdf(s, qs, pt, qs_m);
+
+    float sum = 0.0f, r = 1.0f;
+    for (int i = t - 1; i > 0; i--) {
+        r *= cam[i].pdf_rev / remap0(cam[i].pdf_fwd);
+        if (!cam[i].delta && !cam[i - 1].delta)
+            sum += r * r;
+    }
+    r = 1.0f;
+    for (int i = s_ - 1; i >= 0; i--) {
+        r *= lgt[i].pdf_rev / remap0(lgt[i].pdf_fwd);
+        int delta_before = i > 0 ? lgt[i - 1].delta : lgt[0].delta_light;
+        if (!lgt[i].delta && !delta_before)
+            sum += r * r;
+    }
+
+    pt->delta = pt_delta;
+    pt->pdf_rev = pt_rev;
+    if (pt_m)
+        pt_m->pdf_rev = pt_m_rev;
+    if (qs) {
+        qs->delta = qs_delta;
+        qs->pdf_rev = qs_rev;
+    }
+    if (qs_m)
+        qs_m->pdf_rev = qs_m_rev;
+    if (slot)
+        *slot = saved;
+    return 1.0f / (1.0f + sum);
+}
+
+
+/* The unweighted contribution of strategy (s_, t), 0 when it makes no
+ * path; *sampled receives the vertex it sampled (s_ = 1 or t = 1) and, for
+ * t = 1, *rx, *ry the raster position. */
+static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled, float *rx, float *ry)
+{
+    const vec3 zero = v3s(0.0f);
+    if (s_ == 0) {
+        const vert *pt = &w->cam[t - 1];
+        if (pt->distant) {
+            vec3 le = zero;
+            float pdf;
+            for (uint32_t i = 0, n = lgt_n_distant(s); i < n; i++)
+                le = v3_add(le, lgt_distant(s, i, pt->wo, &pdf));
+            return v3_mul(pt->beta, le);
+        }
+        if (pt->type != BD_SURFACE || pt->light == FR_NONE)
+            return zero;
+        return v3_mul(pt->beta, lgt_emitted(&pt->m, pt->ng, pt->wo));
+    }
+    if (t == 1) {
+        const vert *qs = &w->lgt[s_ - 1];
+        if (!qs->connectible)
+            return zero;
+        const fr_camera *c = &s->camera;
+        vec3 lens = v3_add(c->position, cam_lens(c, qs->u[0], qs->u[1]));
+        vec3 d = v3_sub(qs->p, lens);
+        float d2 = v3_len2(d);
+        if (!(d2 > 0.0f))
+            return zero;
+        float dist = sqrtf(d2), pdf_dir;
+        vec3 wc = v3_scale(d, 1.0f / dist), wi = v3_neg(wc);
+        float we = cam_importance(s, lens, wc, &pdf_dir, rx, ry);
+        if (!(we > 0.0f))
+            return zero;
+        /* The lens point was sampled by area: the solid-angle density at
+         * qs is d^2 / (cos lens_area). */
+        float g = we * v3_dot(wc, c->forward) * cam_lens_area(c) / d2;
+        vec3 L = v3_scale(v3_mul(qs->beta, vert_f(qs, wi, 1)), fabsf(v3_dot(wi, qs->ns)) * g);
+        if (v3_is_zero(L))
+            return zero;
+        fr_ray r = {geo_offset(qs->p, qs->sf.perr, qs->ng, wi), wi};
+        if (trace_occluded(s, &r, v3_len(v3_sub(lens, r.o)), FR_NONE))
+            return zero;
+        sampled->type = BD_CAMERA;
+        sampled->delta = sampled->delta_light = sampled->distant = 0;
+        sampled->connectible = 1;
+        sampled->p = lens;
+        sampled->ng = sampled->ns = sampled->wo = zero;
+        sampled->light = FR_NONE;
+        sampled->pdf_fwd = sampled->pdf_rev = 0.0f;
+        return L;
+    }
+    vert *pt = &w->cam[t - 1];
+    if (!pt->connectible)
+        return zero;
+    if (s_ == 1) {
+        fr_light_sample ls;
+        if (!lgt_sample(s, pt->p, pt->u[0], pt->u[1], pt->u[2], &ls))
+            return zero;
+        vec3 L = v3_mul(v3_mul(pt->beta, vert_f(pt, ls.wi, 0)), ls.radiance);
+        L = v3_scale(L, fabsf(v3_dot(ls.wi, pt->ns)) / ls.pdf);
+        if (v3_is_zero(L))
+            return zero;
+        fr_ray r = {geo_offset(pt->p, pt->sf.perr, pt->ng, ls.wi), ls.wi};
+        float tmax = ls.distant ? INFINITY : v3_dot(v3_sub(ls.p, r.o), ls.wi);
+        if (!(tmax > 0.0f) || trace_occluded(s, &r, tmax, ls.prim))
+            return zero;
+        int area = !ls.distant && ls.prim != FR_NONE;
+        sampled->type = BD_LIGHT;
+        sampled->delta = 0;
+        sampled->delta_light = ls.delta;
+        sampled->distant = ls.distant;
+        sampled->connectible = 1;
+        sampled->p = ls.p;
+        sampled->ng = sampled->ns = area ? ls.n : zero;
+        sampled->wo = ls.distant ? ls.wi : zero;
+        sampled->light = ls.light;
+        sampled->pdf_fwd = emit_pdf_origin(s, sampled);
+        sampled->pdf_rev = 0.0f;
+        return L;
+    }
+    const vert *qs = &w->lgt[s_ - 1];
+    if (!qs->connectible)
+        return zero;
+    vec3 d = v3_sub(pt->p, qs->p);
+    float d2 = v3_len2(d);
+    if (!(d2 > 0.0f))
+        return zero;
+    vec3 wq = v3_scale(d, 1.0f / sqrtf(d2));   /* from qs toward pt */
+    vec3 fq = vert_f(qs, wq, 1), fp = vert_f(pt, v3_neg(wq), 0);
+    float g = fabsf(v3_dot(wq, qs->ns)) * fabsf(v3_dot(wq, pt->ns)) / d2;
+    vec3 L = v3_scale(v3_mul(v3_mul(qs->beta, fq), v3_mul(fp, pt->beta)), g);
+    if (v3_is_zero(L) || !visible(s, qs, pt))
+        return zero;
+    return L;
+}
+
+static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
+               bd_splat_fn splat, void *ctx)
+{
+    fr_sampler cs, ls;
+    smp_start(&cs, x, y, index, s->settings.seed);
+    ls = cs;
+    ls.dim = LIGHT_DIM;
+    int maxd = (int)s->settings.max_depth;
+    int nc = camera_subpath(s, &cs, x, y, w->cam, maxd + 2);
+    int nl = light_subpath(s, &ls, w->lgt, maxd + 1);
+    /* s = 1 samples its own light point: possible even when the light
+     * subpath could not start. */
+    int smax = nl > 0 ? nl : s->n_lights > 0;
+    int use_mis = st->s < 0;
+    vec3 L = v3s(0.0f);
+    for (int t = 1; t <= nc; t++)
+        for (int s_ = 0; s_ <= smax; s_++) {
+            int depth = s_ + t - 2;
+            if ((s_ == 1 && t == 1) || depth < 0 || depth > maxd)
+                continue;
+            if (use_mis ? (st->depth >= 0 && depth != st->depth) : (s_ != st->s || t != st->t))
+                continue;
+            vert sampled;
+            float rx = 0.0f, ry = 0.0f;
+            vec3 c = connect(s, w, s_, t, &sampled, &rx, &ry);
+            if (v3_is_zero(c))
+                continue;
+            if (use_mis)
+                c = v3_scale(c, mis_weight(s, w->cam, w->lgt, &sampled, s_, t));
+            if (t > 1)
+                L = v3_add(L, c);
+            else if (finite3(c))
+                splat(ctx, (uint32_t)rx, (uint32_t)ry, c.x, c.y, c.z);
+        }
+    return finite3(L) ? L : v3s(0.0f);
+}
+
+typedef struct {
+    uint64_t *buf;
+    uint32_t width;
+} fixed_splats;
+
+static void add_fixed(void *ctx, uint32_t x, uint32_t y, float r, float g, float b)
+{
+    fixed_splats *f = ctx;
+    uint64_t *p = f->buf + ((size_t)y * f->width + x) * 3;
+    spl_add(&p[0], spl_fixed(r));
+    spl_add(&p[1], spl_fixed(g));
+    spl_add(&p[2], spl_fixed(b));
+}
+
+int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err)
+{
+    if (bd_supported(s, err) < 0)
+        return -1;
+    bd_work *w = bd_work_new(s);
+    if (!w)
+        return fr_fail(err, "out of memory for the bidirectional subpaths");
+    const bd_strategy all = {-1, -1, -1};
+    fixed_splats f = {splat, s->settings.width};
+    uint32_t width = s->settings.width, spp = s->settings.spp;
+    for (uint32_t y = y0; y < y1; y++)
+        for (uint32_t x = 0; x < width; x++) {
+            double acc[3] = {0, 0, 0};
+            for (uint32_t i = 0; i < spp; i++) {
+                vec3 c = bd_sample(s, w, &all, x, y, i, add_fixed, &f);
+                acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
+            }
+            float *px = rgb + ((size_t)(y - y0) * width + x) * 3;
+            px[0] = (float)(acc[0] / spp);
+            px[1] = (float)(acc[1] / spp);
+            px[2] = (float)(acc[2] / spp);
+        }
+    bd_work_free(w);
+    return 0;
+}

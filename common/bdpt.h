@@ -1,0 +1,82 @@
+/** @file bdpt.h
+ * Bidirectional path tracing (Veach 1997, ch. 10; in the formulation of
+ * pbrt-v3, ch. 16.3).
+ *
+ * Each pixel sample traces a camera subpath x0 (a lens point) x1 x2 ...
+ * and a light subpath y0 (a point on a light) y1 y2 ..., and forms every
+ * path of at most max_depth bounces by joining the first s light vertices
+ * to the first t camera vertices (a strategy (s, t)): s = 0 is the camera
+ * subpath hitting an emitter, s = 1 samples a light point for a camera
+ * vertex (next-event estimation), t = 1 joins a light vertex to a point
+ * sampled on the lens (light tracing: its light lands on another pixel, a
+ * splat), the others join two subpath vertices by a shadow ray.  Every
+ * strategy is weighted by the power heuristic against all the others that
+ * could have made the same path, with the pdfs of both directions kept at
+ * each vertex in area measure and the ratios of neighbouring strategies
+ * multiplied out (no pdf is recomputed beyond the two vertices at each end
+ * of the connection).  (1, 1), a light point joined to a lens point, is
+ * left out: the camera subpath hitting the light (0, 2) covers it.
+ *
+ * Vertices reached by a delta lobe (mirror, smooth glass) are never
+ * connection ends.  Light subpaths carry importance: refraction does not
+ * scale it by eta^2 as it does radiance, and shading normals get Veach's
+ * adjoint correction |wo.ns||wi.ng| / (|wo.ng||wi.ns|).
+ *
+ * Random numbers: the camera subpath of sample i of pixel (x, y) uses the
+ * pixel's sampler from dimension 0 in path tracing's order (pathtrace.h),
+ * the light subpath the same pixel sample's numbers from dimension pair
+ * 65536 on: light pick and side, light point, direction, then per vertex
+ * the lobe, the direction, the lens point for its light-tracing splat, and
+ * Russian roulette.  So each light subpath belongs to one pixel sample, and
+ * a split of the image into rows traces every light subpath once.
+ *
+ * Scenes with participating media are refused (bd_supported).
+ */
+#ifndef FRANJA_BDPT_H
+#define FRANJA_BDPT_H
+
+#include "error.h"
+#include "scene.h"
+
+/** Which strategies to use.  {-1, -1, -1}: all of them with MIS weights
+ * (what images use).  s, t >= 0: that strategy alone with weight 1, an
+ * unbiased estimator of the paths of depth s + t - 2 (tests).  depth >= 0
+ * (with s = t = -1): only paths of that many bounces, MIS-weighted. */
+typedef struct {
+    int s, t;
+    int depth;
+} bd_strategy;
+
+/** Where light tracing sends its splats: called with a pixel of the image
+ * and the radiance to add to its sum (the pixel's value gains L / spp). */
+typedef void (*bd_splat_fn)(void *ctx, uint32_t x, uint32_t y, float r, float g, float b);
+
+/** Working memory for one thread: the two subpaths. */
+typedef struct bd_work bd_work;
+
+/** 0 when bidirectional path tracing can render scene s; otherwise -1
+ * with err saying why (participating media). */
+int bd_supported(const fr_scene *s, fr_error *err);
+
+/** Allocate working memory for scene s (subpaths of max_depth + 2
+ * vertices); NULL when out of memory.  Free with bd_work_free. */
+bd_work *bd_work_new(const fr_scene *s);
+void bd_work_free(bd_work *w);
+
+/** Sample `index` of pixel (x, y): returns the radiance of the strategies
+ * with t >= 2 (their light arrives at this pixel) and sends each t = 1
+ * contribution to splat(ctx, ...).  Non-finite results are dropped (0, no
+ * splat) the same way everywhere.  The scene must pass bd_supported. */
+vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
+               bd_splat_fn splat, void *ctx);
+
+/** Render rows [y0, y1) of s->settings' size and spp with all strategies:
+ * rgb (3 floats per pixel, row y0 first, width*(y1-y0)*3) receives the
+ * mean of the samples' own radiance, and splat (3 sums per pixel of the
+ * whole image, caller-owned and zeroed, width*height*3) the fixed-point
+ * sums of their light-tracing splats (splat.h).  The finished rows are
+ * rgb plus spl_resolve of the splats of every slab.  Returns -1 with err
+ * set when the scene is not supported or memory runs out. */
+int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err);
+
+#endif
