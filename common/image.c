@@ -1,6 +1,7 @@
 #include "image.h"
 
 #include <errno.h>
+#include <float.h>
 #include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
@@ -115,7 +116,17 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
         for (size_t i = 0; i < (size_t)w * 3; i++) {
             uint32_t bits = (uint32_t)src[i * 4] | (uint32_t)src[i * 4 + 1] << 8 | (uint32_t)src[i * 4 + 2] << 16 |
                             (uint32_t)src[i * 4 + 3] << 24;
-            memcpy(&out[r * w * 3 + i], &bits, 4);
+            float v;
+            memcpy(&v, &bits, 4);
+            /* Radiance is finite and not negative: anything else is a
+             * broken or hostile worker, never stitched. */
+            if (!(v >= 0.0f && v <= FLT_MAX)) {
+                free(out);
+                return fr_fail(err, "byte %zu: pixel (%zu, %zu) is %s (%g)", (size_t)(src - buf) + i * 4,
+                               i / 3, y0 + r, v < 0.0f ? "negative" : "not finite",
+                               (double)v);
+            }
+            out[r * w * 3 + i] = v;
         }
     }
     info->scene = scene;

@@ -34,8 +34,9 @@ typedef struct {
 int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, fr_error *err);
 
 /** Parse a PF partial image held in buf[0..len).  Checks the magic, the
- * header comment, that the pixel rows match rows and width, and that the
- * data length is exact.  On success *rgb is a malloc'd array (caller
+ * header comment, that the pixel rows match rows and width, that the
+ * data length is exact, and that every float is finite and >= 0 (a NaN,
+ * infinity or negative value is refused, naming the pixel).  On success *rgb is a malloc'd array (caller
  * frees) of width*(y1-y0)*3 floats, top row first.  Errors give the byte
  * offset. */
 int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *info, float **rgb, fr_error *err);

@@ -39,4 +39,25 @@ check "stderr line then exit: render succeeds" test $rc -eq 0
 check "stderr line then exit: byte-identical" cmp -s oom.pfm ref.pfm
 check "stderr line then exit: the worker's message is reported" grep -q "cannot allocate memory" logo
 
+# A worker whose partial image is well formed but holds a NaN (or a
+# negative value): refused, the host blamed, the rows rendered elsewhere.
+poison() {
+    f="$FH/$1/p"
+    printf '"%s" "$@" >"%s.$$" || exit 1\n' "$WORKER" "$f"
+    printf 'printf %s | dd of="%s.$$" bs=1 seek=$(($(stat -c %%s "%s.$$") - %s)) conv=notrunc 2>/dev/null\n' "'$2'" "$f" "$f" "$3"
+    printf 'cat "%s.$$"; rm -f "%s.$$"\n' "$f" "$f"
+}
+: >hosts
+fh_start nan 6 2 "$(hostile nan "$(poison nan '\000\000\300\177' 4)")"
+fh_start neg 7 2 "$(hostile neg "$(poison neg '\000\000\200\277' 8)")"
+fh_start good2 8 1
+timeout 60 env -u SSH_AUTH_SOCK "$FRANJA" render scene.fbin --known-hosts "$FH/known_hosts" \
+    --no-ssh-config --timeout 3 -o nan.pfm --hosts hosts $SIZE 2>logn
+rc=$?
+check "NaN/negative pixels: render succeeds" test $rc -eq 0
+check "NaN/negative pixels: byte-identical" cmp -s nan.pfm ref.pfm
+check "NaN pixel: partial refused" grep -q "failed on nan .*bad partial image.*not finite" logn
+check "negative pixel: partial refused" grep -q "failed on neg .*bad partial image.*negative" logn
+check "NaN/negative pixels: hosts blamed and dropped" sh -c 'grep -q "dropping host nan" logn && grep -q "dropping host neg" logn'
+
 summary
