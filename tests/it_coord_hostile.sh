@@ -60,4 +60,36 @@ check "NaN pixel: partial refused" grep -q "failed on nan .*bad partial image.*n
 check "negative pixel: partial refused" grep -q "failed on neg .*bad partial image.*negative" logn
 check "NaN/negative pixels: hosts blamed and dropped" sh -c 'grep -q "dropping host nan" logn && grep -q "dropping host neg" logn'
 
+# Workers that write without end: on slabs (stdout), and on --version
+# (the probe).  Each stream is capped at its expected size, so the
+# process fails at once, the render ends on the healthy host and the
+# coordinator stays small (its peak resident size is sampled while it runs).
+endless() {
+    name=$1 w="$FH/$1/worker.sh"
+    mkdir -p "$FH/$1"
+    printf '#!/bin/sh\ncase " $* " in *" %s "*) exec cat /dev/zero ;; esac\nexec "%s" "$@"\n' "$2" "$WORKER" >"$w"
+    chmod +x "$w"
+    echo "$w"
+}
+: >hosts
+fh_start flood 9 2 "$(endless flood --rows)"
+fh_start chatty 10 2 "$(endless chatty --version)"
+fh_start good3 11 1
+env -u SSH_AUTH_SOCK timeout 60 "$FRANJA" render scene.fbin --known-hosts "$FH/known_hosts" \
+    --no-ssh-config --timeout 3 -o flood.pfm --hosts hosts $SIZE 2>logf &
+pid=$!
+peak=0
+while kill -0 $pid 2>/dev/null; do
+    kb=$(awk '/^VmRSS/ {print $2}' /proc/$pid/status 2>/dev/null)
+    [ -n "$kb" ] && [ "$kb" -gt "$peak" ] && peak=$kb
+    sleep 0.05
+done
+wait $pid
+rc=$?
+check "endless output: render succeeds" test $rc -eq 0
+check "endless output: byte-identical" cmp -s flood.pfm ref.pfm
+check "endless slab output: refused at its size" grep -q "failed on flood .*more than the .* bytes expected" logf
+check "endless --version output: host not used" grep -q "host chatty is not used" logf
+check "endless output: coordinator under 200 MB resident (peak ${peak} KB)" test "$peak" -lt 204800
+
 summary
