@@ -87,7 +87,7 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
                        vec3 beta, vtx_mis mis, float upick, float u1, float u2, vtx_direct *out);
 
 /** Next-event estimation at medium vertex v (in `medium`), as
- * vtx_direct_surface with the phase function for the BSDF.  A point light
+ * vtx_direct_surface with the phase function for the BSDF.  A point or spot light
  * is weighted against the equiangular sampling of v's segment when
  * mis.equiangular.  Returns 1 when a light was sampled (out->L may still
  * be 0: blocked), 0 when none was. */
