@@ -266,6 +266,28 @@ static void furnace(void)
     scn_free(&s);
 }
 
+/* From inside a box of absorbing medium the environment is seen through
+ * it: a narrow camera at the centre of a cube of side 2 looking at a face
+ * sees L e^(-sigma_a) (the ray leaves through the face, distance 1). */
+static void through_medium(void)
+{
+    static const char json[] =
+        "{\"image\": {\"width\": 1, \"height\": 1, \"spp\": 1, \"max_depth\": 4},"
+        " \"camera\": {\"position\": [0, 0, 0], \"target\": [0, 0, 1], \"fov\": 0.01},"
+        " \"environment\": {\"color\": [0.5, 1.0, 2.0]},"
+        " \"media\": {\"ink\": {\"sigma_a\": [0.5, 1.0, 2.0]}},"
+        " \"materials\": {\"ink\": {\"type\": \"interface\", \"medium\": \"ink\"}},"
+        " \"shapes\": [{\"type\": \"box\", \"min\": [-1, -1, -1], \"max\": [1, 1, 1], \"material\": \"ink\"}]}";
+    fr_scene s;
+    test_scene(json, &s);
+    vec3 L = pt_sample(&s, PT_MIS, 0, 0, 0);
+    double e[3] = {0.5 * exp(-0.5), 1.0 * exp(-1.0), 2.0 * exp(-2.0)};
+    CHECK(fabs(L.x - e[0]) < 1e-4 && fabs(L.y - e[1]) < 1e-4 && fabs(L.z - e[2]) < 1e-4,
+          "environment through an absorbing box: %g %g %g, expected %g %g %g", (double)L.x, (double)L.y, (double)L.z,
+          e[0], e[1], e[2]);
+    scn_free(&s);
+}
+
 /* Light-only, BSDF-only and MIS estimate the same image of a map-lit
  * scene with a glossy floor. */
 static void mis_agree(void)
@@ -365,6 +387,7 @@ int main(void)
     pdf_follows_radiance("nearest");
     pdf_follows_radiance("bilinear");
     furnace();
+    through_medium();
     mis_agree();
     orientation();
     char cmd[300];
