@@ -17,6 +17,7 @@
 
 #include "error.h"
 #include "hosts.h"
+#include "transport.h"
 
 /** Longest node name kept (Slurm's own limit is lower). */
 #define SLURM_NODE_MAX 64
@@ -76,6 +77,16 @@ int slurm_parse_cpus(const char *s, int n, int *cpus, fr_error *err);
 /** A host table with one entry per node (name and address: the node name;
  * cores: its CPUs; worker and workdir from a).  t is freed with hosts_free. */
 int slurm_hosts(const slurm_alloc *a, hosts_table *t, fr_error *err);
+
+/** Copies local_path to `remote` (absolute, as the nodes name it) with
+ * permission bits `mode` on node `node` of the job, for host h of the
+ * Slurm backend (slurm_copy.c says how): by sbcast to that node alone,
+ * through a temporary name renamed into place, creating the directory;
+ * or, with a shared work directory, by copying it here once per run.
+ * Checks the size that arrived.  May be called from several threads, one
+ * per host. */
+int slurm_copy(tr_host *h, slurm_alloc *a, const char *node, const char *local_path, const char *remote, int mode,
+               fr_error *err);
 
 /** Writes into out[cap] the lines that show how to run the command argv
  * (as typed) inside an allocation: with salloc, and with sbatch. */

@@ -1,8 +1,8 @@
 /* transport_slurm.c -- worker processes as Slurm job steps in the
  * allocation franja runs in (slurm.h), one step per process:
  *
- *     srun --jobid J --exclusive --nodes=1 --ntasks=1 --cpus-per-task=1
- *          --mem=0 --quiet --nodelist NODE ARGV...
+ *     srun --jobid J --nodes=1 --ntasks=1 --cpus-per-task=1 --mem=0 --quiet
+ *          --exclusive --nodelist NODE sh -c START sh ARGV...
  *
  * A step per process rather than one step per node feeding several workers:
  * a slab stays one process, as on the other backends, so the scheduler's
@@ -25,26 +25,20 @@
  * A lost node: srun reports it ("Node failure on", a failed task launch,
  * or a step that cannot be created on the node any more); service() then
  * says the host is lost, so its slabs go elsewhere without counting
- * against them.  What that does to the job's other CPUs: wait_or_share.  A node that dies silently keeps its sruns waiting until
+ * against them.  A node that dies silently keeps its sruns waiting until
  * the controller notices (SlurmdTimeout); meanwhile the scheduler's
- * straggler copies finish its slabs elsewhere.
+ * straggler copies finish its slabs elsewhere.  What a lost node does to
+ * the job's other CPUs, and the way around it: wait_or_share.
  *
- * Scenes: with a node-local work directory, one upload is one sbcast to
- * that node alone, through a step held on it (sbcast -j JOB.STEP): the
- * holder creates the directory, sbcast writes a private temporary file,
- * and a last step renames it into place and reports its size.  With a
- * shared work directory the file is copied here, once per run, and every
- * node reads it. */
+ * Uploads (scenes) are slurm_copy.c's: sbcast to the node, or a copy into
+ * a shared work directory. */
 #include "transport_backend.h"
 
 #include <errno.h>
-#include <fcntl.h>
-#include <limits.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -347,176 +341,10 @@ static void slurm_host_close(void *impl)
     free(s);
 }
 
-/* Runs a step on the node to completion: its stdout into out[cap]. */
-static int step(slurm_host *s, const char *const *argv, char *out, size_t cap, fr_error *err)
-{
-    tr_proc *p;
-    if (tr_run(s->h, argv, 65536, 3 * s->a->timeout_s, &p, err))
-        return -1;
-    int rc = 0;
-    if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0)
-        rc = fr_fail(err, "%s: %s failed: %s", s->label, argv[0], tr_proc_reason(p));
-    else if (out) {
-        size_t len;
-        const unsigned char *o = tr_proc_output(p, &len);
-        if (len >= cap)
-            len = cap - 1;
-        memcpy(out, o, len);
-        out[len] = 0;
-    }
-    tr_proc_free(p);
-    return rc;
-}
-
-/* Copies src to dst here, through a private temporary name. */
-static int copy_local(const char *src, const char *dst, int mode, fr_error *err)
-{
-    char dir[PATH_MAX], tmp[PATH_MAX + 64];
-    snprintf(dir, sizeof dir, "%s", dst);
-    char *slash = strrchr(dir, '/');
-    if (!slash || slash == dir)
-        return fr_fail(err, "%s: not an absolute path", dst);
-    *slash = 0;
-    for (char *c = dir + 1; *c; c++)
-        if (*c == '/') {
-            *c = 0;
-            if (mkdir(dir, 0755) && errno != EEXIST)
-                return fr_fail(err, "%s: %s", dir, strerror(errno));
-            *c = '/';
-        }
-    if (mkdir(dir, 0755) && errno != EEXIST)
-        return fr_fail(err, "%s: %s", dir, strerror(errno));
-    snprintf(tmp, sizeof tmp, "%s/.%s.%ld.tmp", dir, slash + 1, (long)getpid());
-    int in = open(src, O_RDONLY | O_CLOEXEC);
-    if (in < 0)
-        return fr_fail(err, "%s: %s", src, strerror(errno));
-    int out = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, mode);
-    if (out < 0) {
-        close(in);
-        return fr_fail(err, "%s: %s", tmp, strerror(errno));
-    }
-    char buf[1 << 16];
-    ssize_t n;
-    int rc = 0;
-    while ((n = read(in, buf, sizeof buf)) > 0)
-        if (write(out, buf, (size_t)n) != n) {
-            rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
-            break;
-        }
-    if (n < 0 && !rc)
-        rc = fr_fail(err, "%s: %s", src, strerror(errno));
-    if ((fchmod(out, (mode_t)mode) || fsync(out)) && !rc)
-        rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
-    if (close(out) && !rc)
-        rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
-    close(in);
-    if (!rc && rename(tmp, dst))
-        rc = fr_fail(err, "%s: %s", dst, strerror(errno));
-    if (rc)
-        unlink(tmp);
-    return rc;
-}
-
-/* The shared work directory: the first node to need the file copies it. */
-static int upload_shared(slurm_host *s, const char *local_path, const char *remote, int mode, fr_error *err)
-{
-    slurm_alloc *a = s->a;
-    pthread_mutex_lock(&a->lock);
-    int done = 0;
-    for (int i = 0; i < a->ncopied; i++)
-        done |= !strcmp(a->copied[i], remote);
-    int rc = done ? 0 : copy_local(local_path, remote, mode, err);
-    if (!done && !rc && a->ncopied < (int)(sizeof a->copied / sizeof *a->copied))
-        snprintf(a->copied[a->ncopied++], sizeof a->copied[0], "%s", remote);
-    pthread_mutex_unlock(&a->lock);
-    return rc ? fr_fail(err, "%s: copying to the shared work directory: %s", s->label, err->msg) : 0;
-}
-
-/* `sh -c HOLD sh DIR`: creates the directory (which must be this user's,
- * and so its parent: /tmp is everyone's), says which step holds the node,
- * and waits to be cancelled. */
-static const char HOLD[] =
-    "mkdir -p -- \"$1\" || exit 1; "
-    "if [ ! -O \"$1\" ] || [ ! -O \"${1%/*}\" ]; then echo \"$1: not this user's directory\" >&2; exit 1; fi; "
-    "echo \"step $SLURM_JOB_ID.$SLURM_STEP_ID\" && exec sleep 3600";
-
-/* `sh -c PLACE sh TMP DEST MODE`: puts the broadcast copy in place. */
-static const char PLACE[] = "chmod \"$3\" \"$1\" && mv -f -- \"$1\" \"$2\" && wc -c < \"$2\"";
-
-/* Waits until the holder printed its step, or ended. */
-static int held_step(slurm_host *s, tr_proc *p, char *stepid, size_t cap, fr_error *err)
-{
-    double end = clk_now() + 3 * s->a->timeout_s;
-    for (;;) {
-        size_t len;
-        const char *o = (const char *)tr_proc_output(p, &len);
-        const char *nl = len ? memchr(o, '\n', len) : NULL;
-        if (nl) {
-            unsigned long j, st;
-            char extra;
-            char line[128];
-            snprintf(line, sizeof line, "%.*s", (int)(nl - o), o);
-            if (sscanf(line, "step %lu.%lu%c", &j, &st, &extra) != 2)
-                return fr_fail(err, "%s: unexpected answer from the holding step: %s", s->label, line);
-            snprintf(stepid, cap, "%lu.%lu", j, st);
-            return 0;
-        }
-        if (tr_proc_state(p) != TR_RUNNING)
-            return fr_fail(err, "%s: cannot hold a step on the node: %s", s->label, tr_proc_reason(p));
-        if (clk_now() > end)
-            return fr_fail(err, "%s: no step could be started on the node within %d s", s->label,
-                           3 * s->a->timeout_s);
-        struct pollfd pfd[16];
-        int n = tr_pollfds(s->h, pfd, 16);
-        poll(pfd, (nfds_t)n, 20);
-        fr_error e2;
-        if (tr_service(s->h, &e2))
-            return fr_fail(err, "%s", e2.msg);
-    }
-}
-
 static int slurm_upload(void *impl, const char *local_path, const char *remote, int mode, fr_error *err)
 {
     slurm_host *s = impl;
-    if (s->a->shared)
-        return upload_shared(s, local_path, remote, mode, err);
-    struct stat st;
-    if (stat(local_path, &st))
-        return fr_fail(err, "%s: %s", local_path, strerror(errno));
-    char dir[1024], tmp[1200], stepid[64], modes[16], got[64];
-    snprintf(dir, sizeof dir, "%s", remote);
-    char *slash = strrchr(dir, '/');
-    if (!slash || remote[0] != '/')
-        return fr_fail(err, "%s: %s: the work directory on the nodes must be an absolute path", s->label, remote);
-    *slash = 0;
-    snprintf(tmp, sizeof tmp, "%s/.%s.%s.%ld.tmp", dir, slash + 1, s->node, (long)getpid());
-    snprintf(modes, sizeof modes, "%o", mode & 07777);
-    const char *hold[] = {"sh", "-c", HOLD, "sh", dir, NULL};
-    tr_proc *holder;
-    if (tr_spawn(s->h, hold, 4096, &holder, err))
-        return -1;
-    int rc = held_step(s, holder, stepid, sizeof stepid, err);
-    if (rc == 0) {
-        char to[16];
-        snprintf(to, sizeof to, "%d", s->a->timeout_s);
-        const char *bcast[] = {"sbcast", "--force", "--timeout", to, "--jobid", stepid, local_path, tmp, NULL};
-        /* As long as the copy takes: a big scene on a slow link is no hang. */
-        rc = tr_pipe_run(bcast, 3600, err);
-        if (rc)
-            fr_fail(err, "%s: sbcast to the node failed: %s", s->label, err->msg);
-    }
-    tr_proc_free(holder); /* ends the holding step */
-    if (rc)
-        return -1;
-    const char *place[] = {"sh", "-c", PLACE, "sh", tmp, remote, modes, NULL};
-    if (step(s, place, got, sizeof got, err))
-        return -1;
-    char *end;
-    unsigned long long size = strtoull(got, &end, 10);
-    if (end == got || (*end && *end != '\n') || size != (unsigned long long)st.st_size)
-        return fr_fail(err, "%s: %s arrived with %s bytes instead of %lld", s->label, remote, got,
-                       (long long)st.st_size);
-    return 0;
+    return slurm_copy(s->h, s->a, s->node, local_path, remote, mode, err);
 }
 
 const tr_backend tr_slurm_backend = {
