@@ -104,8 +104,9 @@ static int nodes_from(const char *list, int timeout_s, slurm_alloc *a, fr_error 
 {
     const char *argv[] = {"scontrol", "show", "hostnames", list, NULL};
     char *text;
-    if (capture(argv, timeout_s, &text, err))
-        return fr_fail(err, "cannot expand SLURM_JOB_NODELIST='%s': %s", list, err->msg);
+    fr_error e;
+    if (capture(argv, timeout_s, &text, &e))
+        return fr_fail(err, "cannot expand SLURM_JOB_NODELIST='%s': %s", list, e.msg);
     int n = 0;
     for (const char *c = text; *c; c++)
         n += *c == '\n';

@@ -105,11 +105,12 @@ static int copy_shared(tr_host *h, slurm_alloc *a, const char *local_path, const
     int done = 0;
     for (int i = 0; i < a->ncopied; i++)
         done |= !strcmp(a->copied[i], remote);
-    int rc = done ? 0 : copy_local(local_path, remote, mode, err);
+    fr_error e;
+    int rc = done ? 0 : copy_local(local_path, remote, mode, &e);
     if (!done && !rc && a->ncopied < (int)(sizeof a->copied / sizeof *a->copied))
         snprintf(a->copied[a->ncopied++], sizeof a->copied[0], "%s", remote);
     pthread_mutex_unlock(&a->lock);
-    return rc ? fr_fail(err, "%s: copying to the shared work directory: %s", tr_host_label(h), err->msg) : 0;
+    return rc ? fr_fail(err, "%s: copying to the shared work directory: %s", tr_host_label(h), e.msg) : 0;
 }
 
 /* `sh -c HOLD sh DIR`: creates the directory (which must be this user's,
@@ -182,9 +183,10 @@ int slurm_copy(tr_host *h, slurm_alloc *a, const char *node, const char *local_p
         snprintf(to, sizeof to, "%d", a->timeout_s);
         const char *bcast[] = {"sbcast", "--force", "--timeout", to, "--jobid", stepid, local_path, tmp, NULL};
         /* As long as the copy takes: a big scene on a slow link is no hang. */
-        rc = tr_pipe_run(bcast, 3600, err);
+        fr_error e;
+        rc = tr_pipe_run(bcast, 3600, &e);
         if (rc)
-            fr_fail(err, "%s: sbcast to the node failed: %s", tr_host_label(h), err->msg);
+            fr_fail(err, "%s: sbcast to the node failed: %s", tr_host_label(h), e.msg);
     }
     tr_proc_free(holder); /* ends the holding step */
     if (rc)

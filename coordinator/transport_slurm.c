@@ -115,8 +115,9 @@ static int start_step(slurm_host *s, tr_proc *p, char *const *argv, int shared, 
         full[n++] = argv[i];
     }
     full[n] = NULL;
-    if (tr_pipe_spawn(p, full, err))
-        return fr_fail(err, "%s: %s", s->label, err->msg);
+    fr_error e;
+    if (tr_pipe_spawn(p, full, &e))
+        return fr_fail(err, "%s: %s", s->label, e.msg);
     return 0;
 }
 
