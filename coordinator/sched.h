@@ -50,7 +50,7 @@ typedef struct {
     int slab_rows;             /**< rows per slab; 0 = about 4 slabs per slot */
     int max_attempts;          /**< failed attempts per slab before giving up */
     int max_host_failures;     /**< failures in a row before a host is dropped */
-    int tty;                   /**< live progress line instead of log lines */
+    int tty;                   /**< a live progress line; else a plain line every 10 s */
     volatile sig_atomic_t *stop; /**< set asynchronously (SIGINT): stop and keep what is done */
 } sched_params;
 
