@@ -306,6 +306,10 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         if (c->hooks->mesh(c->b, o, where, c->dir, mat, &e) < 0)
             return fr_fail(c->err, "%s", e.msg);
     } else if (!strcmp(type, "gltf")) {
+        /* Without the compiler's image decoder its textures would be lost. */
+        if (!c->hooks || !c->hooks->image_mem || !c->hooks->texture)
+            return fr_fail(c->err, "%s: glTF files need the scene compiler: run `franja compile` and render the .fbin",
+                           where);
         if (scn_gltf_shape(c->b, o, where, c->dir, c->hooks, mat, c->gltf_camera, c->err) < 0)
             return -1;
         c->gltf_camera = 0;            /* taken by the first that asks */

@@ -115,6 +115,8 @@ for xy in "28 16" "50 16"; do pixel_is "$T/move.pfm" $xy 0 0 0; done
 sed 's/"camera": true/"camera": true, "translate": [0, 0, -2]/; s/"height": 32}/"height": 32}, "camera": {"position": [0, 0, 0], "target": [0, 0, -1], "fov": 50}/' \
     "$T/incam.json" >"$T/twocams.json"
 expect_error "two cameras" "shapes[0].camera: the scene has a camera of its own" $F compile "$T/twocams.json" -o "$T/x.fbin"
+expect_error "worker and a gltf shape" "shapes[0]: glTF files need the scene compiler" \
+    $W --scene "$T/incam.json" --rows 0:1 -o "$T/x.pfm"
 sed 's/frame.gltf/nothere.gltf/' "$T/incam.json" >"$T/nofile.json"
 expect_error "missing glTF file" "shapes[0].camera: $T/nothere.gltf: No such file" $F compile "$T/nofile.json" -o "$T/x.fbin"
 sed 's/"camera": true/"camera": true, "scale": 0/' "$T/incam.json" >"$T/zero.json"
