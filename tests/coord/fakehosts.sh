@@ -13,7 +13,8 @@
 #                             FH_SSHD_EXTRA: lines that override sshd_config;
 #                             FH_ADDR: another address; FH_NETNS: run sshd
 #                             in that network namespace)
-#   fh_pids NAME              PIDs of the host: sshd, its sessions, its workers
+#   fh_pids NAME [WORD]       PIDs of the host: sshd, its sessions, its workers
+#                             (only those whose arguments include WORD)
 #   fh_kill NAME / fh_stop NAME / fh_cont NAME
 #   fh_wrapper NAME MODE      a worker wrapper that misbehaves once (MODE:
 #                             kill, truncate, extra, slow, hang) and prints its path
@@ -89,20 +90,29 @@ CFG
     FH_HOSTS="$FH_HOSTS $name"
 }
 
-# The PID and every descendant of a process.
+# The PID and every descendant of a process, from one snapshot of the
+# process table (a walk with one ps per process takes long enough on a busy
+# machine for short-lived workers to come and go unseen); with a second
+# argument, only those whose command line contains that word.
 fh_tree() {
-    echo "$1"
-    for c in $(ps -o pid= --ppid "$1" 2>/dev/null); do
-        fh_tree "$c"
-    done
+    ps -e -o pid=,ppid=,args= | awk -v root="$1" -v word="${2:-}" '
+        { kids[$2] = kids[$2] " " $1; args[$1] = " " $0 " " }
+        END {
+            n = 1; q[1] = root
+            for (i = 1; i <= n; i++) {
+                if (word == "" || index(args[q[i]], " " word " ")) print q[i]
+                m = split(kids[q[i]], k, " ")
+                for (j = 1; j <= m; j++) q[++n] = k[j]
+            }
+        }'
 }
 
 fh_pids() {
     pidfile="$FH/$1/sshd.pid"
-    [ -s "$pidfile" ] && fh_tree "$(cat "$pidfile")"
+    [ -s "$pidfile" ] && fh_tree "$(cat "$pidfile")" "${2:-}"
 }
 
-fh_busy() { fh_pids "$1" | xargs -r ps -o args= -p 2>/dev/null | grep -q -- "--rows"; }
+fh_busy() { [ -n "$(fh_pids "$1" --rows)" ]; }
 
 fh_slabs() { ls "$1" 2>/dev/null | grep -c '^rows-.*\.pf$'; }
 
