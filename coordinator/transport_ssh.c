@@ -379,11 +379,19 @@ static int ssh_spawn(void *impl, tr_proc *p, const char *const *argv, fr_error *
     ssh_proc *sp = calloc(1, sizeof *sp);
     if (!sp)
         return fr_fail(err, "%s: out of memory", h->label);
+    double t0 = clk_now();
     sp->ch = ssh_channel_new(h->s);
-    if (!sp->ch || ssh_channel_open_session(sp->ch) != SSH_OK ||
-        ssh_channel_request_exec(sp->ch, cmd) != SSH_OK) {
-        fr_fail(err, "%s: cannot start a process: %s (a host running more than ~9 workers needs "
-                "MaxSessions raised in its sshd_config)", h->label, ssh_get_error(h->s));
+    int ok = sp->ch && ssh_channel_open_session(sp->ch) == SSH_OK && ssh_channel_request_exec(sp->ch, cmd) == SSH_OK;
+    /* The request waited for this host's answer: a silence meanwhile is
+     * the host's, and counts toward losing it (ssh_service). */
+    h->service_t = clk_now();
+    if (!ok) {
+        const char *why = ssh_get_error(h->s);
+        if (!why[0] || h->service_t - t0 >= 0.9 * (h->opt->timeout_s > 0 ? h->opt->timeout_s : 10))
+            fr_fail(err, "%s: cannot start a process: no answer within %.0f s", h->label, h->service_t - t0);
+        else
+            fr_fail(err, "%s: cannot start a process: %s (a host running more than ~9 workers needs "
+                    "MaxSessions raised in its sshd_config)", h->label, why);
         if (sp->ch)
             ssh_channel_free(sp->ch);
         free(sp);
