@@ -124,7 +124,7 @@ $(FUZZ_COORD_LIB): $(FUZZ_COORD_OBJ)
 bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	@mkdir -p bin/fuzz
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -Icoordinator -fsanitize=fuzzer,address,undefined -o $@ $< $(FUZZ_COORD_LIB) \
-	    $(FUZZ_OBJ) $(CJSON_LIBS) -lm
+	    $(FUZZ_OBJ) $(CJSON_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) -lm
 
 fuzz: bin/franja $(FUZZ_BIN)
 	sh tests/fuzz/run.sh $(FUZZ_SECONDS)

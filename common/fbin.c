@@ -1,6 +1,7 @@
 #include "fbin.h"
 
 #include "bvh.h"
+#include "file.h"
 #include "proto_limits.h"
 
 #include <errno.h>
@@ -409,15 +410,11 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
 
 int fbin_load(const char *path, fr_scene *out, fr_error *err)
 {
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return fr_fail(err, "%s: %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) < 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
-        return fr_fail(err, "%s: not a regular file", path);
-    }
-    size_t size = (size_t)st.st_size;
+    /* Mapped, not read: any size the address space holds. */
+    int fd;
+    size_t size;
+    if (file_open_regular(path, SIZE_MAX, &fd, &size, err) < 0)
+        return -1;
     /* MAP_POPULATE: validation reads every page anyway; faulting them in
      * one call is several times cheaper than page by page. */
     void *m = size ? mmap(NULL, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0) : MAP_FAILED;

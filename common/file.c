@@ -2,16 +2,70 @@
 #include "file.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+static const char *kind(mode_t m)
+{
+    return S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device" : S_ISBLK(m) ? "a block device"
+         : S_ISDIR(m) ? "a directory" : S_ISSOCK(m) ? "a socket" : "not a plain file";
+}
+
+int file_open_regular(const char *path, size_t max, int *fd, size_t *size, fr_error *err)
+{
+    *fd = -1;
+    *size = 0;
+    int d = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (d < 0)
+        return fr_fail(err, "%s: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(d, &st) < 0) {
+        int e = errno;
+        close(d);
+        return fr_fail(err, "%s: %s", path, strerror(e));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        close(d);
+        return fr_fail(err, "%s: not a regular file (%s)", path, kind(st.st_mode));
+    }
+    if (st.st_size < 0 || (uintmax_t)st.st_size > max) {
+        close(d);
+        return fr_fail(err, "%s: %jd bytes, more than the %zu this reader takes", path, (intmax_t)st.st_size, max);
+    }
+    *fd = d;
+    *size = (size_t)st.st_size;
+    return 0;
+}
+
+int file_check_regular(const char *path, size_t max, size_t *size, fr_error *err)
+{
+    int fd;
+    size_t n;
+    if (file_open_regular(path, max, &fd, &n, err) < 0)
+        return -1;
+    close(fd);
+    if (size)
+        *size = n;
+    return 0;
+}
 
 int file_read(const char *path, char **text, size_t *len, fr_error *err)
 {
-    FILE *f = fopen(path, "rb");
+    int fd;
+    size_t size;
+    *text = NULL;
+    *len = 0;
+    if (file_open_regular(path, FILE_READ_MAX, &fd, &size, err) < 0)
+        return -1;
+    FILE *f = fdopen(fd, "rb");
     if (!f) {
-        *text = NULL;
-        return fr_fail(err, "%s: %s", path, strerror(errno));
+        int e = errno;
+        close(fd);
+        return fr_fail(err, "%s: %s", path, strerror(e));
     }
     return file_read_stream(f, path, text, len, err);
 }
@@ -22,30 +76,36 @@ int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_err
     *len = 0;
     /* A regular file's size is known: room for it, its NUL, and one byte
      * more so that the read that finds the end needs no bigger buffer.  A
-     * pipe or a /proc file (size 0) grows as it is read. */
+     * pipe or a /proc file (size 0) grows as it is read, up to one byte
+     * past the limit (which shows that the limit was passed). */
     struct stat st;
-    size_t cap = 4096;
-    if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && (size_t)st.st_size + 2 > cap)
-        cap = (size_t)st.st_size + 2;
+    size_t cap = 4096, top = FILE_READ_MAX + 2;
+    if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && (uintmax_t)st.st_size + 2 > cap)
+        cap = (uintmax_t)st.st_size + 2 < top ? (size_t)st.st_size + 2 : top;
     size_t n = 0;
     char *buf = malloc(cap);
-    while (buf) {
+    while (buf && n <= FILE_READ_MAX) {
         size_t got = fread(buf + n, 1, cap - n - 1, f);
         n += got;
         if (got == 0)
             break;
-        if (n + 1 == cap) {
-            char *bigger = realloc(buf, cap * 2);
+        if (n + 1 == cap && cap < top) {
+            size_t bigger_cap = cap < top / 2 ? cap * 2 : top;
+            char *bigger = realloc(buf, bigger_cap);
             if (!bigger)
                 free(buf);
             buf = bigger;
-            cap *= 2;
+            cap = bigger_cap;
         }
     }
     int bad = ferror(f), why = errno;
     fclose(f);
     if (!buf)
         return fr_fail(err, "%s: out of memory", path);
+    if (n > FILE_READ_MAX) {
+        free(buf);
+        return fr_fail(err, "%s: more than the %zu bytes this reader takes", path, FILE_READ_MAX);
+    }
     if (bad) {
         free(buf);
         return fr_fail(err, "%s: read error: %s", path, strerror(why));

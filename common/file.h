@@ -2,7 +2,11 @@
  * Whole files into memory, and the directory a file is in.
  *
  * For the readers that parse a file as one buffer (scene JSON, OBJ/MTL, host
- * tables, job directories).  Errors name the path (error.h).
+ * tables, job directories), and a check for files that libraries open by
+ * name.  Inputs must be regular files: a FIFO, a device (/dev/zero) or a
+ * directory, directly or through a symbolic link, is refused at once
+ * instead of blocking the open or filling memory, and so is a file larger
+ * than the reader's limit.  Errors name the path (error.h).
  */
 #ifndef FRANJA_FILE_H
 #define FRANJA_FILE_H
@@ -12,16 +16,32 @@
 
 #include "error.h"
 
-/** Read the whole file at path into a new malloc'd buffer with a NUL after
- * its *len bytes (the file may hold NULs of its own).  The caller frees
- * *text.  Fails with "PATH: <system error>" when the file cannot be opened,
- * "PATH: read error: <system error>" or "PATH: out of memory"; *text is then
- * NULL. */
+/** The largest file file_read and file_read_stream read: 1 GiB. */
+#define FILE_READ_MAX ((size_t)1 << 30)
+
+/** Open path for reading if it is a regular file of at most max bytes: the
+ * open does not block (O_NONBLOCK, so a FIFO without a writer cannot hang
+ * it), then the file's type and size are checked on the open descriptor.
+ * *fd receives the descriptor (the caller closes it) and *size the file's
+ * size.  Fails with "PATH: <system error>", "PATH: not a regular file (a
+ * FIFO)" (a character device, a directory ...) or "PATH: N bytes, more than
+ * the M this reader takes"; *fd is then -1. */
+int file_open_regular(const char *path, size_t max, int *fd, size_t *size, fr_error *err);
+
+/** file_open_regular, then close: for files a library opens by name
+ * (images, Assimp meshes).  *size (may be NULL) receives the size. */
+int file_check_regular(const char *path, size_t max, size_t *size, fr_error *err);
+
+/** Read the whole regular file at path (file_open_regular with
+ * FILE_READ_MAX) into a new malloc'd buffer with a NUL after its *len bytes
+ * (the file may hold NULs of its own).  The caller frees *text.  Fails with
+ * file_open_regular's errors, "PATH: read error: <system error>" or "PATH:
+ * out of memory"; *text is then NULL. */
 int file_read(const char *path, char **text, size_t *len, fr_error *err);
 
 /** The same for a stream the caller opened (to word its own open error):
- * reads f to its end and closes it, whatever happens; path names it in
- * errors. */
+ * reads f to its end, at most FILE_READ_MAX bytes, and closes it, whatever
+ * happens; path names it in errors. */
 int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_error *err);
 
 /** Write the directory part of path (all before its last '/') into dir[cap],

@@ -7,9 +7,14 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "file.h"
 #include "geom.h"
 #include "jsonval.h"
 #include "texture.h"
+
+/* The largest image file a texture may come from (a 16k x 8k float RGBA
+ * image is 2 GiB). */
+#define IMAGE_MAX_BYTES ((size_t)4 << 30)
 
 #define PATHLEN 200
 
@@ -129,8 +134,11 @@ static int check_texture(const scn_appear *a, const cJSON *t, const char *where,
     if (image_format(path) < 0)
         return fr_fail(err, "%s.file: '%s': unsupported image format (expected png, jpg, exr, tif, hdr, bmp, tga, "
                        "ppm, pgm or pfm)", where, f->valuestring);
-    if (access(path, R_OK) != 0)
-        return fr_fail(err, "%s.file: cannot read '%s': %s", where, path, strerror(errno));
+    /* OpenImageIO opens the file by name: make sure first that it is a
+     * regular file (a FIFO would block it, a device feed it forever). */
+    fr_error e;
+    if (file_check_regular(path, IMAGE_MAX_BYTES, NULL, &e) < 0)
+        return fr_fail(err, "%s.file: cannot read %s", where, e.msg);
     return 0;
 }
 

@@ -6,10 +6,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "file.h"
 
 #define HOSTS_MAX_LINE 4096
+#define HOSTS_MAX_BYTES ((size_t)16 << 20)   /* a host table larger than 16 MiB is not one */
 
 /* Copies src into a fixed field, refusing what would not fit rather than
  * silently cutting a path or a name. */
@@ -227,9 +229,20 @@ int hosts_parse(const char *text, const char *path, hosts_table *t, fr_error *er
 int hosts_load(const char *path, hosts_table *t, fr_error *err)
 {
     memset(t, 0, sizeof *t);
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    int fd;
+    size_t size;
+    fr_error e;
+    if (file_open_regular(path, HOSTS_MAX_BYTES, &fd, &size, &e) < 0) {
+        /* e.msg is "PATH: why" (file.h): say what the file was for. */
+        size_t n = strlen(path);
+        const char *why = strncmp(e.msg, path, n) == 0 && e.msg[n] == ':' ? e.msg + n + 2 : e.msg;
+        return fr_fail(err, "%s: cannot open host table: %s", path, why);
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
         return fr_fail(err, "%s: cannot open host table: %s", path, strerror(errno));
+    }
     char *text;
     size_t n;
     if (file_read_stream(f, path, &text, &n, err))

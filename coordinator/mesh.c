@@ -1,9 +1,5 @@
 #include "mesh.h"
 
-#include <assimp/cimport.h>
-#include <assimp/material.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,146 +8,19 @@
 
 #include "fmath.h"
 #include "jsonval.h"
+#include "mesh_import.h"
 
 enum { LOD_MAX = 16 };
 #define LOD_DENSITY 0.25f      /* default triangles per pixel of projected area */
 
 /* ---- reading files ---- */
 
-static int grow_mesh(obj_mesh *m, uint32_t nv, uint32_t nt, int normals, int uvs)
-{
-    if ((m->pos = realloc(m->pos, (size_t)nv * sizeof *m->pos)) == NULL ||
-        (m->tri = realloc(m->tri, (size_t)nt * sizeof *m->tri)) == NULL ||
-        (m->tri_flags = realloc(m->tri_flags, nt ? nt : 1)) == NULL ||
-        (m->tri_mat = realloc(m->tri_mat, (size_t)nt * sizeof *m->tri_mat)) == NULL)
-        return -1;
-    if (normals && (m->nrm = realloc(m->nrm, (size_t)nv * sizeof *m->nrm)) == NULL)
-        return -1;
-    if (uvs && (m->uv = realloc(m->uv, (size_t)nv * sizeof *m->uv)) == NULL)
-        return -1;
-    return 0;
-}
-
-static void assimp_material(const struct aiMaterial *am, obj_material *o)
-{
-    struct aiColor4D c;
-    float f;
-    unsigned int one = 1;
-    memset(o, 0, sizeof *o);
-    o->kd = v3s(0.8f);
-    o->tf = v3s(1.0f);
-    o->ni = 1.5f;
-    o->d = 1.0f;
-    o->illum = 1;
-    o->defined = 1;
-    if (!am)
-        return;
-    if (aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS)
-        o->kd = v3(c.r, c.g, c.b);
-    if (aiGetMaterialColor(am, AI_MATKEY_COLOR_SPECULAR, &c) == aiReturn_SUCCESS)
-        o->ks = v3(c.r, c.g, c.b);
-    if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS)
-        o->ke = v3(c.r, c.g, c.b);
-    if (aiGetMaterialFloatArray(am, AI_MATKEY_SHININESS, &f, &one) == aiReturn_SUCCESS)
-        o->ns = f;
-    one = 1;
-    if (aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &f, &one) == aiReturn_SUCCESS)
-        o->ni = f;
-    /* Negative or non-finite values from a file are not colours. */
-    vec3 *cols[] = {&o->kd, &o->ks, &o->ke};
-    for (int i = 0; i < 3; i++)
-        if (!(cols[i]->x >= 0.0f && cols[i]->y >= 0.0f && cols[i]->z >= 0.0f) || !isfinite(v3_max(*cols[i])))
-            *cols[i] = v3s(0.0f);
-    if (!(o->ns >= 0.0f && o->ns <= 1.0e6f))
-        o->ns = 0.0f;
-    if (!isfinite(o->ni))
-        o->ni = 1.5f;
-    o->illum = v3_is_zero(o->ks) ? 1 : 2;
-}
-
-/* Any format Assimp knows, flattened (node transforms applied) into one
- * indexed mesh; points and lines are dropped. */
-static int read_assimp(const char *path, obj_mesh *m, fr_error *err)
-{
-    memset(m, 0, sizeof *m);
-    const struct aiScene *sc = aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                                      aiProcess_PreTransformVertices | aiProcess_SortByPType);
-    if (!sc)
-        return fr_fail(err, "%s: %s", path, aiGetErrorString());
-    int rc = 0;
-    uint32_t nv = 0, nt = 0;
-    int normals = 0, uvs = 0;
-    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
-        const struct aiMesh *am = sc->mMeshes[i];
-        if ((uint64_t)nv + am->mNumVertices > 0x7fffffffu || (uint64_t)nt + am->mNumFaces > 0x7fffffffu) {
-            rc = fr_fail(err, "%s: too many vertices or faces", path);
-            break;
-        }
-        nv += am->mNumVertices;
-        nt += am->mNumFaces;
-        normals |= am->mNormals != NULL;
-        uvs |= am->mTextureCoords[0] != NULL;
-    }
-    m->n_mats = sc->mNumMaterials ? sc->mNumMaterials : 1;
-    if (rc == 0 && ((m->mats = calloc(m->n_mats, sizeof *m->mats)) == NULL ||
-                    grow_mesh(m, nv ? nv : 1, nt ? nt : 1, normals, uvs) < 0))
-        rc = fr_fail(err, "%s: out of memory", path);
-    for (unsigned i = 0; rc == 0 && i < m->n_mats; i++) {
-        if (i < sc->mNumMaterials)
-            assimp_material(sc->mMaterials[i], &m->mats[i]);
-        else
-            assimp_material(NULL, &m->mats[i]);
-        struct aiString name;
-        if (i < sc->mNumMaterials && aiGetMaterialString(sc->mMaterials[i], AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
-            snprintf(m->mats[i].name, sizeof m->mats[i].name, "%s", name.data);
-    }
-    for (unsigned i = 0; rc == 0 && i < sc->mNumMeshes; i++) {
-        const struct aiMesh *am = sc->mMeshes[i];
-        uint32_t base = m->n_vert;
-        for (unsigned v = 0; v < am->mNumVertices; v++) {
-            const struct aiVector3D *p = &am->mVertices[v];
-            m->pos[base + v] = v3(p->x, p->y, p->z);
-            if (normals)
-                m->nrm[base + v] = am->mNormals ? v3(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z)
-                                                : v3s(0.0f);
-            if (uvs)
-                m->uv[base + v] = am->mTextureCoords[0]
-                                      ? (vec2){am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y}
-                                      : (vec2){0.0f, 0.0f};
-            if (!isfinite(m->pos[base + v].x) || !isfinite(m->pos[base + v].y) || !isfinite(m->pos[base + v].z))
-                rc = fr_fail(err, "%s: mesh %u vertex %u is not finite", path, i, v);
-        }
-        m->n_vert += am->mNumVertices;
-        for (unsigned f = 0; rc == 0 && f < am->mNumFaces; f++) {
-            const struct aiFace *fc = &am->mFaces[f];
-            if (fc->mNumIndices != 3)
-                continue;
-            uint32_t t = m->n_tri++;
-            for (int k = 0; k < 3; k++) {
-                if (fc->mIndices[k] >= am->mNumVertices) {
-                    rc = fr_fail(err, "%s: mesh %u face %u: index out of range", path, i, f);
-                    break;
-                }
-                m->tri[t][k] = base + fc->mIndices[k];
-            }
-            m->tri_flags[t] = (uint8_t)((am->mNormals ? FR_TRI_NORMALS : 0) | (am->mTextureCoords[0] ? FR_TRI_UVS : 0));
-            m->tri_mat[t] = am->mMaterialIndex < m->n_mats ? am->mMaterialIndex : 0;
-        }
-    }
-    aiReleaseImport(sc);
-    if (rc == 0 && m->n_tri == 0)
-        rc = fr_fail(err, "%s: no triangles", path);
-    if (rc < 0)
-        obj_free(m);
-    return rc;
-}
-
 int mesh_read(const char *path, obj_mesh *m, fr_error *err)
 {
     const char *dot = strrchr(path, '.');
     if (dot && !strcasecmp(dot, ".obj"))
         return obj_read(path, m, err);
-    return read_assimp(path, m, err);
+    return mesh_import(path, m, err);
 }
 
 /* ---- placement ---- */

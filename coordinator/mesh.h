@@ -4,7 +4,8 @@
  * added to a builder.
  *
  * OBJ files go through our reader (obj.h, exact file:line errors); any
- * other extension (ply, stl, gltf, glb, dae, fbx, 3ds ...) through Assimp.
+ * other extension (ply, stl, gltf, glb, dae, fbx, 3ds ...) through Assimp,
+ * in a child process with limits (mesh_import.h).
  * MTL (or Assimp) materials become Franja materials as scenes/README.md
  * describes, unless the shape names a material that overrides them all.
  */
@@ -23,8 +24,8 @@
 int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
              fr_error *err);
 
-/** Reads a mesh file by its extension: OBJ by obj_read, others by Assimp
- * into the same structure (free with obj_free). */
+/** Reads a mesh file by its extension: OBJ by obj_read, others by
+ * mesh_import into the same structure (free with obj_free). */
 int mesh_read(const char *path, obj_mesh *m, fr_error *err);
 
 #endif

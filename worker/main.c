@@ -1,12 +1,14 @@
 /* franja-worker -- render rows [y0, y1) of a scene and write them as a
  * partial image of the PPM family (see franja-worker(1)). */
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "fbin.h"
+#include "file.h"
 #include "image.h"
 #include "pathtrace.h"
 #include "protocol.h"
@@ -34,13 +36,14 @@ static const char usage[] =
 
 static int load_scene(const char *path, fr_scene *s, fr_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return fr_fail(err, "%s: %s", path, strerror(errno));
+    int fd;
+    size_t size;
+    if (file_open_regular(path, SIZE_MAX, &fd, &size, err) < 0)
+        return -1;
     unsigned char magic[2] = {0, 0};
-    size_t n = fread(magic, 1, 2, f);
-    fclose(f);
-    if (n == 0)
+    ssize_t n = read(fd, magic, 2);
+    close(fd);
+    if (n <= 0)
         return fr_fail(err, "%s: empty file (expected a binary scene from `franja compile`, or a JSON scene)", path);
     /* A binary scene by its first bytes, or by its name (so that a damaged
      * one is reported as such, not as bad JSON). */

@@ -1,0 +1,114 @@
+#!/bin/sh
+# Inputs that are not plain files, or that promise more than they hold: a
+# FIFO as scene, mesh, MTL, texture or host table; /dev/zero (directly or
+# through a symbolic link) as scene or mtllib; a directory; an ASCII PLY
+# declaring 10^8 faces; PLY files that make Assimp abort or crash.  Each is
+# refused within seconds, with bounded memory, naming the file; nothing
+# hangs, nothing dies.  Every command runs under a time limit and an
+# address-space limit, so that a failure of this test cannot take the
+# machine down with it.
+cd "$(dirname "$0")/.." || exit 1
+. tests/lib.sh
+need mkfifo timeout
+F=$PWD/bin/franja W=$PWD/bin/franja-worker
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+
+# bounded SECONDS CMD...: CMD under a 3 GiB address-space limit and a time
+# limit; its status (124: timed out).
+bounded() {
+    secs=$1
+    shift
+    (ulimit -v 3000000; exec timeout -s KILL "$secs" "$@")
+}
+
+# refused WHAT FRAGMENT CMD...: CMD fails within 60 s, not by a signal,
+# with FRAGMENT on stderr.
+refused() {
+    what=$1 frag=$2
+    shift 2
+    bounded 60 "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+    if [ $rc -eq 0 ]; then
+        bad "$what: exit status 0"
+    elif [ $rc -eq 124 ] || [ $rc -eq 137 ]; then
+        bad "$what: still running after 60 s (killed)"
+    elif [ $rc -gt 128 ]; then
+        bad "$what: died of signal $((rc - 128)): $(tail -c 300 "$T/err")"
+    elif ! grep -qF -- "$frag" "$T/err"; then
+        bad "$what: stderr lacks '$frag': $(tail -c 300 "$T/err")"
+    else
+        ok
+    fi
+}
+
+mkfifo "$T/fifo.json" "$T/fifo.fbin" "$T/fifo.obj" "$T/fifo.mtl" "$T/fifo.png" "$T/fifo.ply" "$T/fifo.hosts"
+ln -s /dev/zero "$T/zero.json"
+ln -s /dev/zero "$T/zero.mtl"
+ln -s /dev/zero "$T/zero.png"
+mkdir "$T/dir.json"
+
+# --- scenes ---
+refused "FIFO as scene (worker)" "fifo.json: not a regular file (a FIFO)" $W --scene "$T/fifo.json" --rows 0:1 -o "$T/x"
+refused "FIFO as .fbin (worker)" "fifo.fbin: not a regular file (a FIFO)" $W --scene "$T/fifo.fbin" --rows 0:1 -o "$T/x"
+refused "FIFO as scene (compile)" "fifo.json: not a regular file (a FIFO)" $F compile "$T/fifo.json" -o "$T/x.fbin"
+refused "FIFO as .fbin (render)" "fifo.fbin: not a regular file (a FIFO)" $F render "$T/fifo.fbin" -o "$T/x.png"
+refused "/dev/zero as scene (worker)" "/dev/zero: not a regular file (a character device)" $W --scene /dev/zero --rows 0:1 -o "$T/x"
+refused "symlink to /dev/zero as scene (worker)" "zero.json: not a regular file (a character device)" $W --scene "$T/zero.json" --rows 0:1 -o "$T/x"
+refused "symlink to /dev/zero as scene (compile)" "zero.json: not a regular file (a character device)" $F compile "$T/zero.json" -o "$T/x.fbin"
+refused "directory as scene (compile)" "dir.json: not a regular file (a directory)" $F compile "$T/dir.json" -o "$T/x.fbin"
+refused "FIFO as host table" "fifo.hosts: cannot open host table: not a regular file (a FIFO)" $F hosts list --hosts "$T/fifo.hosts"
+
+# --- meshes, MTL files and textures, named by a scene ---
+scene() { # scene FILE SHAPES
+    cat >"$1" <<JSON
+{"image": {"width": 8, "height": 8, "spp": 1},
+ "camera": {"position": [0, 0, -5], "target": [0, 0, 0], "fov": 40},
+ "materials": {"m": {"type": "lambert", "albedo": [0.5, 0.5, 0.5]}},
+ "lights": [{"type": "point", "position": [0, 3, -3], "intensity": [10, 10, 10]}],
+ "shapes": [$2]}
+JSON
+}
+mesh() { scene "$T/$1.json" "{\"type\": \"mesh\", \"file\": \"$2\"${3:+, \"material\": \"$3\"}}"; }
+mesh fifo-obj fifo.obj m
+refused "FIFO as OBJ mesh" "fifo.obj: not a regular file (a FIFO)" $F compile "$T/fifo-obj.json" -o "$T/x.fbin"
+mesh fifo-ply fifo.ply m
+refused "FIFO as PLY mesh" "fifo.ply: not a regular file (a FIFO)" $F compile "$T/fifo-ply.json" -o "$T/x.fbin"
+printf 'mtllib fifo.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/a.obj"
+printf 'mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/b.obj"
+mesh mtl-fifo a.obj
+refused "FIFO as mtllib" "fifo.mtl: not a regular file (a FIFO)" $F compile "$T/mtl-fifo.json" -o "$T/x.fbin"
+mesh mtl-zero b.obj
+refused "/dev/zero as mtllib" "zero.mtl: not a regular file (a character device)" $F compile "$T/mtl-zero.json" -o "$T/x.fbin"
+cat >"$T/tex-fifo.json" <<'JSON'
+{"image": {"width": 8, "height": 8, "spp": 1},
+ "camera": {"position": [0, 0, -5], "target": [0, 0, 0], "fov": 40},
+ "textures": {"i": {"type": "image", "file": "fifo.png"}},
+ "materials": {"t": {"type": "lambert", "albedo": "i"}},
+ "lights": [{"type": "point", "position": [0, 3, -3], "intensity": [10, 10, 10]}],
+ "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "t"}]}
+JSON
+sed 's/fifo.png/zero.png/' "$T/tex-fifo.json" >"$T/tex-zero.json"
+refused "FIFO as texture" "textures.i.file: cannot read $T/fifo.png: not a regular file (a FIFO)" $F compile "$T/tex-fifo.json" -o "$T/x.fbin"
+refused "symlink to /dev/zero as texture" "zero.png: not a regular file (a character device)" $F compile "$T/tex-zero.json" -o "$T/x.fbin"
+
+# --- Assimp: a header that promises 10^8 faces, files that abort or crash it ---
+H='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n'
+printf "${H}element face 100000000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" >"$T/huge.ply"
+printf "${H}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0\n" >"$T/abort.ply"
+printf "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\001\002" >"$T/crash.ply"
+printf "${H}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" >"$T/good.ply"
+mesh huge huge.ply m
+start=$(date +%s)
+refused "PLY declaring 10^8 faces" "huge.ply: the mesh importer (Assimp) ran out of its" $F compile "$T/huge.json" -o "$T/x.fbin"
+[ $(($(date +%s) - start)) -lt 30 ] && ok || bad "PLY declaring 10^8 faces: refused after $(($(date +%s) - start)) s"
+mesh abort abort.ply m
+refused "PLY that makes Assimp abort" "abort.ply: the mesh importer (Assimp) crashed (signal 6" $F compile "$T/abort.json" -o "$T/x.fbin"
+mesh crash crash.ply m
+refused "truncated binary PLY that crashes Assimp" "crash.ply: the mesh importer (Assimp) crashed (signal 11" $F compile "$T/crash.json" -o "$T/x.fbin"
+# ... while a good one still arrives.
+mesh good good.ply m
+bounded 60 $F compile "$T/good.json" -o "$T/good.fbin" >"$T/out" 2>&1 && grep -q '1 primitives (1 triangles)' "$T/out" &&
+    ok || bad "a good PLY: $(cat "$T/out")"
+
+summary
