@@ -105,7 +105,7 @@ extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, floa
     if (!name)
         return fr_fail(err, "embedded image: neither PNG nor JPEG (MIME type '%s')", mime ? mime : "");
     try {
-        Filesystem::IOMemReader mem(data, len);
+        Filesystem::IOMemReader mem(const_cast<void *>(data), len); // OIIO 2.2 takes a non-const pointer; it only reads
         std::unique_ptr<ImageInput> in = ImageInput::open(name, nullptr, &mem);
         if (!in)
             return fr_fail(err, "embedded %s image: %s", name + 9, OIIO::geterror().c_str());
