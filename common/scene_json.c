@@ -9,6 +9,7 @@
 #include "file.h"
 #include "fmath.h"
 #include "freeze.h"
+#include "jsoncheck.h"
 #include "jsonval.h"
 #include "proto_limits.h"
 #include "scene_appear.h"
@@ -325,15 +326,14 @@ int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, f
     fr_error e;
     if (!text[strspn(text, " \t\r\n")])
         return fr_fail(err, "%s: empty file (expected a JSON object)", file);
-    cJSON *root = cJSON_Parse(text);
-    if (!root) {
-        /* cJSON tells where it stopped; turn that into a line number. */
-        const char *at = cJSON_GetErrorPtr();
-        int line = 1;
-        for (const char *p = text; at && p < at && *p; p++)
-            line += *p == '\n';
-        return fr_fail(err, "%s:%d: invalid JSON", file, line);
-    }
+    /* Strict syntax first, with line and column: cJSON would take the first
+     * of two members of the same name, ignore text after the scene and
+     * say little about where it stopped. */
+    if (jc_check(text, strlen(text), file, err) < 0)
+        return -1;
+    cJSON *root = cJSON_ParseWithOpts(text, NULL, 1);
+    if (!root)
+        return fr_fail(err, "%s: the JSON reader failed (out of memory?)", file);
     char dir[4096];
     file_dir(file, dir, sizeof dir);
     scn_appear look;
@@ -389,6 +389,11 @@ int scn_load_json(const char *path, const scn_hooks *hooks, fr_scene *out, fr_er
     size_t len;
     if (file_read(path, &text, &len, err))
         return -1;
+    /* A NUL byte would end the text early: say where it is. */
+    if (memchr(text, 0, len) && jc_check(text, len, path, err) < 0) {
+        free(text);
+        return -1;
+    }
     fr_builder b;
     bld_init(&b);
     int rc = scn_parse_json(text, path, hooks, &b, err);

@@ -16,8 +16,11 @@
 #include "scene_hooks.h"
 
 /** Parse the JSON text `text` (from file `file`, used in messages) into b,
- * with `hooks` (may be NULL).  Returns 0, or -1 with *err naming the file
- * and the JSON path (or line, for invalid JSON). */
+ * with `hooks` (may be NULL).  The text must be strict JSON
+ * (jsoncheck.h: no duplicate member names, so no two materials of one
+ * name, nothing after the scene's closing brace).  Returns 0, or -1 with
+ * *err naming the file and the JSON path, or the line and column of a
+ * syntax error. */
 int scn_parse_json(const char *text, const char *file, const scn_hooks *hooks, fr_builder *b, fr_error *err);
 
 /** Read file `path`, parse it and freeze the scene into *out (freeze.h;

@@ -44,7 +44,7 @@ scene_error "image.width: missing" "{\"image\": {\"height\": 4}, \"camera\": {},
 scene_error "materials.m: lobe albedos sum to" "{$base, \"materials\": {\"m\": {\"type\": \"mix\", \"diffuse\": [0.7,0.7,0.7], \"specular\": [0.5,0.5,0.5]}}, \"shapes\": []}"
 scene_error "shapes[0].center[1]: expected a finite number" "{$base, $mats, \"shapes\": [{\"type\": \"sphere\", \"center\": [0,1e999,0], \"radius\": 1, \"material\": \"m\"}]}"
 scene_error "shapes[0].radiu: unknown field" "{$base, $mats, \"shapes\": [{\"type\": \"sphere\", \"center\": [0,0,0], \"radiu\": 1, \"material\": \"m\"}]}"
-scene_error "bad.json:3: invalid JSON" "{$base,
+scene_error "bad.json:3:12: expected a value" "{$base,
 $mats,
 \"shapes\": [}"
 
