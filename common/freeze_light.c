@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "texture.h"
 
 /* |a x b| in double: edges of coordinates up to 1e18 (jsonval.h) have
  * cross products whose squared length overflows a float. */
@@ -158,6 +159,54 @@ static int env_tables(fr_builder *b, double *integral, fr_error *err)
     return rc;
 }
 
+/* Luminance of material m's emission at texture coordinates uv. */
+static double emission_at(const fr_scene *view, const fr_material *m, vec2 uv)
+{
+    return v3_luma(tex_emission(view, m, uv));
+}
+
+/* Mean luminance of the emission of primitive p (material m) for its
+ * power: the emission colour, times its texture's mean over a few points
+ * of the primitive (the corners, edge midpoints and centre of a triangle,
+ * a 3 x 3 grid on a rectangle), blended with a tenth of the texture's
+ * mean over its whole square so that no textured light gets no power. */
+static double emission_luma(const fr_builder *b, const fr_prim *p, const fr_material *m)
+{
+    if (m->tex_emission == FR_NONE)
+        return v3_luma(m->emission);
+    fr_scene view;
+    memset(&view, 0, sizeof view);
+    view.textures = b->textures.data;
+    view.n_textures = b->textures.count;
+    view.texels = b->texels.data;
+    view.n_texels = b->texels.count;
+    double global = 0.0, local = 0.0;
+    for (int j = 0; j < 8; j++)
+        for (int i = 0; i < 8; i++)
+            global += emission_at(&view, m, (vec2){((float)i + 0.5f) / 8.0f, ((float)j + 0.5f) / 8.0f}) / 64.0;
+    if (p->kind == FR_PRIM_TRIANGLE) {
+        /* Barycentric points (b1, b2); uv as trace_surface computes it. */
+        static const float pts[7][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5f, 0}, {0, 0.5f}, {0.5f, 0.5f}, {1.0f / 3, 1.0f / 3}};
+        const fr_triangle *t = (const fr_triangle *)b->triangles.data + p->index;
+        const vec2 *uvs = b->uvs.data;
+        for (int k = 0; k < 7; k++) {
+            float b1 = pts[k][0], b2 = pts[k][1], b0 = 1.0f - b1 - b2;
+            vec2 uv = {b1, b2};
+            if (t->flags & FR_TRI_UVS)
+                uv = (vec2){b0 * uvs[t->v[0]].u + b1 * uvs[t->v[1]].u + b2 * uvs[t->v[2]].u,
+                            b0 * uvs[t->v[0]].v + b1 * uvs[t->v[1]].v + b2 * uvs[t->v[2]].v};
+            local += emission_at(&view, m, uv) / 7.0;
+        }
+    } else if (p->kind == FR_PRIM_RECT) {
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < 3; i++)
+                local += emission_at(&view, m, (vec2){((float)i + 0.5f) / 3.0f, ((float)j + 0.5f) / 3.0f}) / 9.0;
+    } else {
+        local = global;
+    }
+    return 0.9 * local + 0.1 * global;
+}
+
 double frz_light_power(const fr_builder *b, const fr_light *l)
 {
     double r2 = (double)b->world.radius * b->world.radius, y = v3_luma(l->intensity);
@@ -176,7 +225,7 @@ double frz_light_power(const fr_builder *b, const fr_light *l)
         const fr_prim *p = (const fr_prim *)b->prims.data + l->prim;
         const fr_material *m = (const fr_material *)b->materials.data + p->material;
         /* In double: emission and area may each be near the float limit. */
-        return FM_PI * (double)v3_luma(m->emission) * l->area * (m->two_sided ? 2.0 : 1.0);
+        return FM_PI * emission_luma(b, p, m) * l->area * (m->two_sided ? 2.0 : 1.0);
     }
     default:
         return 0.0;

@@ -19,7 +19,10 @@
 int frz_lights(fr_builder *b, fr_error *err);
 
 /** Power (W, as the light's units make it) that frz_lights gives light l
- * for its pick probability, for lights other than the environment. */
+ * for its pick probability, for lights other than the environment.  An
+ * area light with an emission texture counts the texture's mean over a
+ * few points of its primitive (nine tenths) and over the whole texture
+ * (one tenth), so every emitter keeps some chance of being picked. */
 double frz_light_power(const fr_builder *b, const fr_light *l);
 
 #endif

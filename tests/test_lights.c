@@ -257,6 +257,76 @@ static void many_area_lights(void)
     bld_free(&b);
 }
 
+/* Area lights with an emission texture: their power follows the texture
+ * on them (a triangle on a black square of a checkerboard gets a twentieth
+ * of the chance of one on a white square, never none), and light-only,
+ * BSDF-only and MIS estimates of a floor lit by such a panel agree. */
+static void textured_area_lights(void)
+{
+    fr_builder b;
+    bld_init(&b);
+    b.settings = (fr_settings){8, 8, 1, 2, 0, {0, 0, 0}};
+    b.camera.position = v3(0, 0, -5);
+    b.camera.target = v3(0, 0, 0);
+    b.camera.up = v3(0, 1, 0);
+    b.camera.vfov = 0.7f;
+    b.camera.focus = 5;
+    fr_texture t;
+    memset(&t, 0, sizeof t);
+    t.kind = FR_TEX_CHECKER;
+    t.color0 = v3s(1.0f);
+    t.color1 = v3s(0.0f);
+    t.scale = (vec2){4, 4};
+    bld_push(&b.textures, &t);
+    fr_material m;
+    bld_material_init(&m);
+    m.emission = v3s(2.0f);
+    m.tex_emission = 0;
+    bld_push(&b.materials, &m);
+    /* uv squares of 1/4: [0, 1/4)^2 is colour0 (white), [1/4, 1/2) x [0, 1/4) black. */
+    const vec3 p[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const vec2 white[3] = {{0.05f, 0.05f}, {0.2f, 0.05f}, {0.05f, 0.2f}};
+    const vec2 black[3] = {{0.3f, 0.05f}, {0.45f, 0.05f}, {0.3f, 0.2f}};
+    bld_triangle_uv(&b, p, white, 0);
+    const vec3 q[3] = {{2, 0, 0}, {3, 0, 0}, {2, 1, 0}};
+    bld_triangle_uv(&b, q, black, 0);
+    fr_scene s;
+    fr_error err;
+    int rc = frz_scene(&b, &s, &err);
+    CHECK(rc == 0, "freeze: %s", rc ? err.msg : "");
+    if (rc == 0) {
+        const fr_light *lw = &s.lights[0], *lb = &s.lights[1];
+        if (s.prims[lw->prim].material == 0 && s.triangles[s.prims[lw->prim].index].v[0] != 0) {
+            const fr_light *x = lw;
+            lw = lb;
+            lb = x;
+        }
+        double ratio = lw->pick / lb->pick;
+        CHECK(s.n_lights == 2 && ratio > 15 && ratio < 25, "white / black pick ratio %.2f, expected about 19", ratio);
+        scn_free(&s);
+    }
+    bld_free(&b);
+    static const char json[] =
+        "{\"image\": {\"width\": 1, \"height\": 1, \"spp\": 1, \"max_depth\": 1},"
+        " \"camera\": {\"position\": [0.5, 5, 2.001], \"target\": [0.5, 0, 2], \"up\": [0, 0, 1], \"fov\": 0.01},"
+        " \"textures\": {\"checks\": {\"type\": \"checker\", \"colors\": [[1, 1, 1], [0, 0, 0]], \"scale\": 3}},"
+        " \"materials\": {\"floor\": {\"type\": \"lambert\", \"albedo\": [0.6, 0.6, 0.6]},"
+        "   \"screen\": {\"type\": \"emitter\", \"emission\": {\"texture\": \"checks\", \"factor\": [5, 5, 5]}}},"
+        " \"shapes\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"floor\"},"
+        "   {\"type\": \"quad\", \"vertices\": [[-1, 1, -1], [1, 1, -1], [1, 1, 1], [-1, 1, 1]], \"material\": \"screen\"},"
+        "   {\"type\": \"quad\", \"vertices\": [[1.5, 0.5, -1], [2.5, 0.5, -1], [2.5, 0.5, 1], [1.5, 0.5, 1]],"
+        "    \"material\": \"screen\"}]}";
+    test_scene(json, &s);
+    estimate mis = pixel(&s, PT_MIS, 20000), light = pixel(&s, PT_LIGHT_ONLY, 20000), bsdf = pixel(&s, PT_BSDF_ONLY, 80000);
+    double d1 = fabs(mis.mean - light.mean), s1 = hypot(mis.se, light.se);
+    double d2 = fabs(mis.mean - bsdf.mean), s2 = hypot(mis.se, bsdf.se);
+    printf("textured panels: MIS %.5f +- %.5f, light %.5f +- %.5f, BSDF %.5f +- %.5f\n", mis.mean, mis.se, light.mean, light.se,
+           bsdf.mean, bsdf.se);
+    CHECK(mis.mean > 0 && d1 < 4 * s1 && d2 < 4 * s2, "textured panels: MIS %.5f, light %.5f, BSDF %.5f (+- %.5f %.5f %.5f)",
+          mis.mean, light.mean, bsdf.mean, mis.se, light.se, bsdf.se);
+    scn_free(&s);
+}
+
 /* Bad light definitions: an error naming the place, never a crash. */
 static void json_errors(void)
 {
@@ -337,6 +407,7 @@ int main(void)
     spot_falloff();
     emission();
     many_area_lights();
+    textured_area_lights();
     json_errors();
     return check_done();
 }
