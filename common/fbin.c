@@ -431,20 +431,7 @@ int fbin_load(const char *path, fr_scene *out, fr_error *err)
 
 int fbin_write(const fr_scene *s, const char *path, fr_error *err)
 {
-    char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof tmp)
-        return fr_fail(err, "%s: path too long", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
-        return fr_fail(err, "%s: %s", tmp, strerror(errno));
-    int ok = fwrite(s->blob, 1, s->blob_size, f) == s->blob_size;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, path) < 0) {
-        int e = errno;
-        unlink(tmp);
-        return fr_fail(err, "%s: %s", path, strerror(e));
-    }
-    return 0;
+    return file_write_atomic(path, s->blob, s->blob_size, err);
 }
 
 void scn_free(fr_scene *s)

@@ -1,4 +1,4 @@
-/* file.c -- whole files into memory (see file.h). */
+/* file.c -- whole files into memory, and written atomically (see file.h). */
 #include "file.h"
 
 #include <errno.h>
@@ -123,4 +123,84 @@ void file_dir(const char *path, char *dir, size_t cap)
         snprintf(dir, cap, ".");
     else
         snprintf(dir, cap, "%.*s", (int)(slash - path), path);
+}
+
+int file_out_open(const char *path, file_out *o, fr_error *err)
+{
+    static unsigned counter;
+    o->fd = -1;
+    o->tmp[0] = 0;
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash - path + 1) : 0;
+    const char *base = path + dirlen;
+    const char *dot = strrchr(base, '.');
+    const char *ext = dot && dot != base ? dot : "";
+    for (int tries = 0; tries < 100; tries++) {
+        unsigned n = __atomic_fetch_add(&counter, 1, __ATOMIC_RELAXED);
+        if (snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.tmp-%ld-%u%s", dirlen, path, base, (long)getpid(), n, ext) >=
+            (int)sizeof o->tmp)
+            return fr_fail(err, "%s: path too long", path);
+        o->fd = open(o->tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (o->fd >= 0)
+            return 0;
+        if (errno != EEXIST)
+            break;
+    }
+    int e = errno;
+    fr_fail(err, "%s: cannot create a temporary file beside it: %s", path, strerror(e));
+    o->tmp[0] = 0;
+    return -1;
+}
+
+int file_out_write(file_out *o, const void *data, size_t n, fr_error *err)
+{
+    const char *p = data;
+    while (n) {
+        ssize_t k = write(o->fd, p, n);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            return fr_fail(err, "%s: write failed: %s", o->tmp, k < 0 ? strerror(errno) : "no progress");
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+int file_out_commit(file_out *o, const char *path, fr_error *err)
+{
+    int rc = 0;
+    if (fsync(o->fd))
+        rc = fr_fail(err, "%s: fsync failed: %s", o->tmp, strerror(errno));
+    if (close(o->fd) && rc == 0)
+        rc = fr_fail(err, "%s: close failed: %s", o->tmp, strerror(errno));
+    o->fd = -1;
+    if (rc == 0 && rename(o->tmp, path))
+        rc = fr_fail(err, "%s: %s", path, strerror(errno));
+    if (rc)
+        unlink(o->tmp);
+    o->tmp[0] = 0;
+    return rc;
+}
+
+void file_out_abort(file_out *o)
+{
+    if (o->fd >= 0)
+        close(o->fd);
+    if (o->tmp[0])
+        unlink(o->tmp);
+    o->fd = -1;
+    o->tmp[0] = 0;
+}
+
+int file_write_atomic(const char *path, const void *data, size_t len, fr_error *err)
+{
+    file_out o;
+    if (file_out_open(path, &o, err))
+        return -1;
+    if (file_out_write(&o, data, len, err)) {
+        file_out_abort(&o);
+        return -1;
+    }
+    return file_out_commit(&o, path, err);
 }

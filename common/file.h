@@ -1,12 +1,15 @@
 /** @file file.h
- * Whole files into memory, and the directory a file is in.
+ * Whole files into memory, files written atomically, and the directory a
+ * file is in.
  *
  * For the readers that parse a file as one buffer (scene JSON, OBJ/MTL, host
- * tables, job directories), and a check for files that libraries open by
- * name.  Inputs must be regular files: a FIFO, a device (/dev/zero) or a
- * directory, directly or through a symbolic link, is refused at once
- * instead of blocking the open or filling memory, and so is a file larger
- * than the reader's limit.  Errors name the path (error.h).
+ * tables, job directories) and for every file Franja writes whole (binary
+ * scenes, finished slabs, final images), and a check for files that
+ * libraries open by name.  Inputs must be regular files: a FIFO, a device
+ * (/dev/zero) or a directory, directly or through a symbolic link, is
+ * refused at once instead of blocking the open or filling memory, and so
+ * is a file larger than the reader's limit.  Errors name the path
+ * (error.h).
  */
 #ifndef FRANJA_FILE_H
 #define FRANJA_FILE_H
@@ -43,6 +46,35 @@ int file_read(const char *path, char **text, size_t *len, fr_error *err);
  * reads f to its end, at most FILE_READ_MAX bytes, and closes it, whatever
  * happens; path names it in errors. */
 int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_error *err);
+
+/** An output file being written: a private temporary file in the target's
+ * directory, which file_out_commit renames over the target, so that the
+ * target is always either the old file or the complete new one. */
+typedef struct {
+    int fd;                    /**< open for writing; -1 once committed or aborted */
+    char tmp[4400];            /**< the temporary file's name */
+} file_out;
+
+/** Creates the temporary file for path: DIR/.BASE.tmp-PID-N.EXT (it keeps
+ * path's extension, for writers that choose a format by it and write by
+ * name), with O_CREAT|O_EXCL|O_NOFOLLOW (never an existing file or a
+ * link), mode 0666 less the umask.  Fails with "PATH: cannot create a
+ * temporary file beside it: <system error>". */
+int file_out_open(const char *path, file_out *o, fr_error *err);
+
+/** Writes all n bytes to the temporary file (short writes and EINTR
+ * retried).  On failure the caller still calls file_out_abort. */
+int file_out_write(file_out *o, const void *data, size_t n, fr_error *err);
+
+/** Puts the file in place: fsync, close and rename over path, each
+ * checked.  On failure the temporary file is removed and path untouched. */
+int file_out_commit(file_out *o, const char *path, fr_error *err);
+
+/** Closes and removes the temporary file; nothing once committed. */
+void file_out_abort(file_out *o);
+
+/** Writes data[0..len) to path atomically (open, write, commit). */
+int file_write_atomic(const char *path, const void *data, size_t len, fr_error *err);
 
 /** Write the directory part of path (all before its last '/') into dir[cap],
  * or "." when path has no '/', for resolving names relative to a file. */

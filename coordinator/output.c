@@ -12,6 +12,7 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include "file.h"
 #include "image.h"
 #include "imageio.h"
 
@@ -32,43 +33,43 @@ int out_check(const char *path, fr_error *err)
                    "or .pfm", path, extension(path));
 }
 
-/* dir/.name.tmp-PID.ext: same directory (rename stays atomic), same
- * extension (OpenImageIO picks the format by it). */
-static void temp_name(const char *path, char *out, size_t cap)
+static int write_pfm(file_out *o, const float *rgb, const job_spec *spec, fr_error *err)
 {
-    const char *slash = strrchr(path, '/');
-    int dirlen = slash ? (int)(slash - path + 1) : 0;
-    const char *base = path + dirlen;
-    snprintf(out, cap, "%.*s.%s.tmp-%ld.%s", dirlen, path, base, (long)getpid(), extension(path));
-}
-
-static int write_pfm(const char *tmp, const float *rgb, const job_spec *spec, fr_error *err)
-{
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
-        return fr_fail(err, "%s: %s", tmp, strerror(errno));
+    int fd = dup(o->fd);
+    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    if (!f) {
+        if (fd >= 0)
+            close(fd);
+        return fr_fail(err, "%s: %s", o->tmp, strerror(errno));
+    }
     img_partial_info info = {spec->hash, 0, spec->height, spec->spp, spec->width, spec->height};
     int rc = img_write(f, IMG_PF, &info, rgb, err);
     if (fclose(f) && rc == 0)
-        rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
+        rc = fr_fail(err, "%s: %s", o->tmp, strerror(errno));
     return rc;
 }
 
 int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err)
 {
-    char tmp[4200];
-    temp_name(path, tmp, sizeof tmp);
+    /* OpenImageIO writes by name: into the temporary file file_out_open
+     * made (same extension, so the same format), which the commit renames. */
+    file_out o;
+    if (file_out_open(path, &o, err))
+        return -1;
+    const char *tmp = o.tmp;
     size_t n = (size_t)spec->width * spec->height * 3;
     int rc;
     if (is_ext(path, "pfm")) {
-        rc = write_pfm(tmp, rgb, spec, err);
+        rc = write_pfm(&o, rgb, spec, err);
     } else if (is_ext(path, "exr") || is_ext(path, "hdr")) {
         rc = iio_write(tmp, rgb, IIO_F32, spec->width, spec->height, err);
     } else {
         int wide = is_ext(path, "tif") || is_ext(path, "tiff");
         void *px = malloc(n * (wide ? 2 : 1));
-        if (!px)
+        if (!px) {
+            file_out_abort(&o);
             return fr_fail(err, "out of memory for the final image");
+        }
         for (size_t i = 0; i < n; i++) {
             float v = tm_display(tm, rgb[i]);
             if (wide)
@@ -79,9 +80,9 @@ int out_write(const char *path, const float *rgb, const job_spec *spec, const fr
         rc = iio_write(tmp, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, err);
         free(px);
     }
-    if (rc == 0 && rename(tmp, path))
-        rc = fr_fail(err, "%s: %s", path, strerror(errno));
-    if (rc)
-        unlink(tmp);
-    return rc;
+    if (rc) {
+        file_out_abort(&o);
+        return rc;
+    }
+    return file_out_commit(&o, path, err);
 }
