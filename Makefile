@@ -75,6 +75,8 @@ $(COORD_LIB): $(COORD_LIB_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && $(AR) rcs $@ $^
 
+$(TESTSUP_OBJ): CSTD += -Icoordinator -Itests
+
 $(TESTSUP_LIB): $(TESTSUP_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && $(AR) rcs $@ $^

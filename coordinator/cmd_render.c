@@ -224,6 +224,85 @@ static void summary(const sched_host *hs, int n, const job_spec *spec, const sch
     }
 }
 
+/* The scheduler's reports on stderr.  Progress: on a terminal a live line
+ * four times a second; otherwise (a batch job's log) a plain line every
+ * LOG_EVERY seconds and one at the end.  Events are log lines, except
+ * accepted slabs (the progress shows them) and, on a terminal, second
+ * copies. */
+enum { LOG_EVERY = 10 };
+
+typedef struct {
+    int tty;
+    const sched_host *hosts;
+    int nhosts;
+    const job_spec *spec;
+    double last_draw;
+    double t;                  /* the latest progress report */
+    int done, total;
+    int drawn;                 /* a live line is on screen */
+} reporter;
+
+static void clear_line(reporter *r)
+{
+    if (r->drawn) {
+        fputs("\r\033[K", stderr);
+        r->drawn = 0;
+    }
+}
+
+static void on_event(void *ctx, const sched_event *ev)
+{
+    reporter *r = ctx;
+    if (ev->kind == SCHED_SLAB_DONE || (r->tty && ev->kind == SCHED_COPY))
+        return;
+    clear_line(r);
+    fprintf(stderr, "franja: [%6.1fs] %s\n", ev->t, ev->text);
+}
+
+/* "rows 120/512 (23%)  ETA 40s  1.20 Msamples/s  alpha:8/8 3.1r/s ..." */
+static void progress_text(const reporter *r, char *line, size_t cap)
+{
+    double t = r->t, rate = t > 0 ? r->done / t : 0;
+    int n = snprintf(line, cap, "rows %d/%d (%3.0f%%)", r->done, r->total,
+                     r->total ? 100.0 * r->done / r->total : 100.0);
+    if (rate > 0 && r->done < r->total)
+        n += snprintf(line + n, cap - (size_t)n, "  ETA %.0fs", (r->total - r->done) / rate);
+    n += snprintf(line + n, cap - (size_t)n, "  %.2f Msamples/s ", rate * r->spec->width * r->spec->spp / 1e6);
+    for (int i = 0; i < r->nhosts && n < (int)cap - 40; i++) {
+        const sched_host *h = &r->hosts[i];
+        if (h->dropped)
+            n += snprintf(line + n, cap - (size_t)n, " %s:down", h->name);
+        else
+            n += snprintf(line + n, cap - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
+                          t > 0 ? h->rows / t : 0.0);
+    }
+}
+
+static void draw(reporter *r, int force)
+{
+    if (!force && r->t - r->last_draw < (r->tty ? 0.25 : LOG_EVERY))
+        return;
+    r->last_draw = r->t;
+    char line[1024];
+    progress_text(r, line, sizeof line);
+    if (r->tty) {
+        fprintf(stderr, "\r\033[K%s", line);
+        fflush(stderr);
+        r->drawn = 1;
+    } else {
+        fprintf(stderr, "franja: [%6.1fs] %s\n", r->t, line);
+    }
+}
+
+static void on_progress(void *ctx, double t, int done, int total)
+{
+    reporter *r = ctx;
+    r->t = t;
+    r->done = done;
+    r->total = total;
+    draw(r, 0);
+}
+
 /* Connects the hosts and runs the slabs not yet in the job directory. */
 static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
                      const char *jobdir, const unsigned char *have, int rows_missing, fr_error *err)
@@ -269,10 +348,21 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     else
         rc = cl_check_versions(cl, n, err);
     if (rc == 0) {
-        sched_params p = {*spec, jobdir, have, (int)a->slab_rows, (int)a->retries, 3, isatty(2), &stop_flag};
+        reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = ns, .spec = spec};
+        sched_params p = {.spec = *spec,
+                          .jobdir = jobdir,
+                          .have = have,
+                          .slab_rows = (int)a->slab_rows,
+                          .max_attempts = (int)a->retries,
+                          .max_host_failures = 3,
+                          .stop = &stop_flag,
+                          .hooks = {.event = on_event, .progress = on_progress, .ctx = &rep}};
         sched_stats st;
         double t0 = clk_now();
         rc = sched_run(&p, sh, ns, &st, err);
+        draw(&rep, 1);
+        if (rep.drawn)
+            fputc('\n', stderr);
         summary(sh, ns, spec, &st, rows_missing, clk_now() - t0);
     }
     cl_close(cl, n);
@@ -401,7 +491,7 @@ int cmd_render(int argc, char **argv)
     }
     int rows_have = 0;
     if (a.resume) {
-        rows_have = job_scan(jobdir, &spec, have, &err);
+        rows_have = job_scan(jobdir, &spec, have, &a.tr.notes, &err);
         if (rows_have < 0) {
             fprintf(stderr, "franja render: %s\n", err.msg);
             goto done;
@@ -413,7 +503,7 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (job_stitch(jobdir, &spec, rgb, &err) || out_write(a.out, rgb, &spec, &tm, &err)) {
+    if (job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err) || out_write(a.out, rgb, &spec, &tm, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }

@@ -3,7 +3,6 @@
 
 #include <dirent.h>
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,36 +33,6 @@ int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec
     return 0;
 }
 
-static int write_file(const char *path, const void *data, size_t len, fr_error *err)
-{
-    char tmp[4200];
-    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0)
-        return fr_fail(err, "%s: %s", tmp, strerror(errno));
-    const char *p = data;
-    size_t left = len;
-    while (left) {
-        ssize_t n = write(fd, p, left);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0) {
-            int e = errno;
-            close(fd);
-            unlink(tmp);
-            return fr_fail(err, "%s: write failed: %s", tmp, strerror(e));
-        }
-        p += n;
-        left -= (size_t)n;
-    }
-    if (close(fd) || rename(tmp, path)) {
-        int e = errno;
-        unlink(tmp);
-        return fr_fail(err, "%s: %s", path, strerror(e));
-    }
-    return 0;
-}
-
 static void spec_text(const job_spec *s, char *out, size_t cap)
 {
     snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n", (unsigned long long)s->hash,
@@ -91,7 +60,8 @@ static int each_slab(const char *dir, int (*fn)(const char *dir, const char *nam
     return rc;
 }
 
-/* A slab file half-written when a coordinator died: never used, removed. */
+/* A file half-written when a coordinator died (file_out_open's
+ * ".NAME.tmp-..."): never used, removed. */
 static void remove_temporaries(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -100,7 +70,7 @@ static void remove_temporaries(const char *dir)
     struct dirent *e;
     char path[4200];
     while ((e = readdir(d)))
-        if (!strncmp(e->d_name, "rows-", 5) && strstr(e->d_name, ".pf.tmp-")) {
+        if (e->d_name[0] == '.' && strstr(e->d_name, ".tmp-")) {
             snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
             unlink(path);
         }
@@ -140,7 +110,7 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
         fr_error ignore;
         each_slab(dir, remove_one, NULL, &ignore);
     }
-    return write_file(path, want, strlen(want), err);
+    return file_write_atomic(path, want, strlen(want), err);
 }
 
 typedef struct {
@@ -148,6 +118,7 @@ typedef struct {
     unsigned char *have;
     float *rgb;                /* job_stitch only */
     int rows;
+    const note_sink *notes;
 } scan_ctx;
 
 static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
@@ -174,7 +145,7 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
         free(text);
     }
     if (bad) {
-        fprintf(stderr, "franja: %s: discarded (%s)\n", path, e.msg);
+        note_say(c->notes, "%s: discarded (%s)", path, e.msg);
         unlink(path);
         return 0;
     }
@@ -185,9 +156,9 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     return 0;
 }
 
-int job_scan(const char *dir, const job_spec *spec, unsigned char *have, fr_error *err)
+int job_scan(const char *dir, const job_spec *spec, unsigned char *have, const note_sink *notes, fr_error *err)
 {
-    scan_ctx c = {spec, have, NULL, 0};
+    scan_ctx c = {spec, have, NULL, 0, notes};
     memset(have, 0, spec->height);
     if (each_slab(dir, scan_one, &c, err))
         return -1;
@@ -198,7 +169,7 @@ int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf
 {
     char path[4200];
     snprintf(path, sizeof path, "%s/rows-%05u-%05u.pf", dir, y0, y1);
-    return write_file(path, buf, len, err);
+    return file_write_atomic(path, buf, len, err);
 }
 
 static int mark_rows(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *ctx)
@@ -260,12 +231,12 @@ void job_missing_rows(const unsigned char *have, uint32_t height, char *out, siz
     }
 }
 
-int job_stitch(const char *dir, const job_spec *spec, float *rgb, fr_error *err)
+int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err)
 {
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, rgb, 0};
+    scan_ctx c = {spec, have, rgb, 0, notes};
     int rc = each_slab(dir, scan_one, &c, err);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];

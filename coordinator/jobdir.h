@@ -7,8 +7,9 @@
  *     DIR/scene.fbin           the compiled scene, for JSON inputs
  *     DIR/rows-Y0-Y1.pf        one checked partial image per finished slab
  *
- * Every slab file is written to a temporary name and renamed, so a crash
- * leaves either the whole slab or nothing.
+ * Every file is written atomically (file_write_atomic), so a crash leaves
+ * either the whole slab or nothing; temporaries a crash left are removed
+ * by job_open and job_remove.
  */
 #ifndef FRANJA_JOBDIR_H
 #define FRANJA_JOBDIR_H
@@ -18,6 +19,7 @@
 
 #include "error.h"
 #include "image.h"
+#include "note.h"
 
 /** What a render produces: every partial must match it exactly. */
 typedef struct {
@@ -38,16 +40,17 @@ int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec
 int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err);
 
 /** Marks in have[0..height) the rows that finished slab files in dir
- * cover.  Files that do not check out are deleted, with a message on
- * stderr.  Returns the number of rows covered, or -1. */
-int job_scan(const char *dir, const job_spec *spec, unsigned char *have, fr_error *err);
+ * cover.  Files that do not check out are deleted, each with a line to
+ * notes.  Returns the number of rows covered, or -1. */
+int job_scan(const char *dir, const job_spec *spec, unsigned char *have, const note_sink *notes, fr_error *err);
 
 /** Stores a checked slab (the worker's bytes as they came). */
 int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf, size_t len, fr_error *err);
 
-/** Reads every slab into rgb (width*height*3 floats, top row first).
- * Fails, naming the missing rows, unless every row is covered. */
-int job_stitch(const char *dir, const job_spec *spec, float *rgb, fr_error *err);
+/** Reads every slab into rgb (width*height*3 floats, top row first); slab
+ * files that no longer check out are deleted with a line to notes, as in
+ * job_scan.  Fails, naming the missing rows, unless every row is covered. */
+int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err);
 
 /** Counts the rows that slab files in dir cover, whatever render they
  * belong to (by their names only; nothing is read or removed).  0 when dir

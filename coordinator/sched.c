@@ -15,6 +15,7 @@ typedef struct {
     int done;
     int attempts;              /* failed attempts so far */
     int copies;                /* processes running it now */
+    int failed_on;             /* host of the last failed attempt, -1 if none */
     char last_error[300];
 } slab;
 
@@ -34,66 +35,37 @@ typedef struct {
     int nrun, caprun;
     int rows_total, rows_done;
     sched_stats *st;
-    double t0, last_draw;
-    int drawn;                 /* a progress line is on screen */
+    double t0;
 } sched;
 
-/* Messages go to stderr, after clearing the live line if one is shown. */
-static void say(sched *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void say(sched *s, const char *fmt, ...)
+static double now(const sched *s)
 {
-    if (s->drawn) {
-        fputs("\r\033[K", stderr);
-        s->drawn = 0;
-    }
+    const sched_hooks *k = &s->p->hooks;
+    return k->now ? k->now(k->ctx) : clk_now();
+}
+
+/* Reports an event with a one-line text (printf-style). */
+static void emit(sched *s, sched_event_kind kind, int host, const slab *sl, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+static void emit(sched *s, sched_event_kind kind, int host, const slab *sl, const char *fmt, ...)
+{
+    const sched_hooks *k = &s->p->hooks;
+    if (!k->event)
+        return;
+    char text[1024];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "franja: [%6.1fs] ", clk_now() - s->t0);
-    vfprintf(stderr, fmt, ap);
+    vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
-    fputc('\n', stderr);
+    sched_event ev = {kind, now(s) - s->t0, host, sl ? sl->y0 : 0, sl ? sl->y1 : 0, text};
+    k->event(k->ctx, &ev);
 }
 
-/* "rows 120/512 (23%)  ETA 40s  1.20 Msamples/s  alpha:8/8 3.1r/s ..." */
-static void progress_text(sched *s, double t, char *line, size_t cap)
+static void progress(sched *s)
 {
-    double el = t - s->t0;
-    double rate = el > 0 ? s->rows_done / el : 0;
-    int n = snprintf(line, cap, "rows %d/%d (%3.0f%%)", s->rows_done, s->rows_total,
-                     s->rows_total ? 100.0 * s->rows_done / s->rows_total : 100.0);
-    if (rate > 0 && s->rows_done < s->rows_total)
-        n += snprintf(line + n, cap - (size_t)n, "  ETA %.0fs", (s->rows_total - s->rows_done) / rate);
-    n += snprintf(line + n, cap - (size_t)n, "  %.2f Msamples/s ", rate * s->p->spec.width * s->p->spec.spp / 1e6);
-    for (int i = 0; i < s->nhosts && n < (int)cap - 40; i++) {
-        sched_host *h = &s->hosts[i];
-        if (h->dropped)
-            n += snprintf(line + n, cap - (size_t)n, " %s:down", h->name);
-        else
-            n += snprintf(line + n, cap - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
-                          el > 0 ? h->rows / el : 0.0);
-    }
-}
-
-/* Progress: a live line on a terminal (4 times a second); otherwise (a
- * batch job's log) a plain line every LOG_EVERY seconds and at the end. */
-enum { LOG_EVERY = 10 };
-
-static void draw(sched *s, int force)
-{
-    double t = clk_now();
-    double every = s->p->tty ? 0.25 : LOG_EVERY;
-    if (!force && t - s->last_draw < every)
-        return;
-    s->last_draw = t;
-    char line[1024];
-    progress_text(s, t, line, sizeof line);
-    if (!s->p->tty) {
-        say(s, "%s", line);
-        return;
-    }
-    fprintf(stderr, "\r\033[K%s", line);
-    fflush(stderr);
-    s->drawn = 1;
+    const sched_hooks *k = &s->p->hooks;
+    if (k->progress)
+        k->progress(k->ctx, now(s) - s->t0, s->rows_done, s->rows_total);
 }
 
 static int make_slabs(sched *s)
@@ -124,7 +96,7 @@ static int make_slabs(sched *s)
         uint32_t end = y;
         while (end < p->spec.height && !(p->have && p->have[end]) && end - y < per)
             end++;
-        s->slabs[s->nslabs++] = (slab){.y0 = y, .y1 = end};
+        s->slabs[s->nslabs++] = (slab){.y0 = y, .y1 = end, .failed_on = -1};
         y = end;
     }
     s->rows_total = (int)missing;
@@ -139,25 +111,48 @@ static int running_on(sched *s, int slab_i, int host_i)
     return 0;
 }
 
-/* The next queued slab, else the longest-running slab with one copy (a
- * straggler), preferring those not already running on this host. */
+/* 1 if a live host other than host_i could run a slab. */
+static int other_host_alive(const sched *s, int host_i)
+{
+    for (int i = 0; i < s->nhosts; i++)
+        if (i != host_i && !s->hosts[i].dropped)
+            return 1;
+    return 0;
+}
+
+/* Most processes one slab runs at once (its first and two copies). */
+enum { MAX_COPIES = 3 };
+
+/* What host_i should run next: the first queued slab, passing over those
+ * that last failed on this host while another host is alive to take them;
+ * else a second copy of a straggler: a slab that is not running here, with
+ * the fewest copies, the one that has run longest; else, only when no slab
+ * runs elsewhere, a second copy here of this host's own oldest slab (a
+ * stuck process is overtaken even on a single host).  -1 if nothing. */
 static int pick(sched *s, int host_i)
 {
     while (s->next < s->nslabs && (s->slabs[s->next].done || s->slabs[s->next].copies))
         s->next++;
-    for (int i = s->next; i < s->nslabs; i++)
-        if (!s->slabs[i].done && !s->slabs[i].copies)
+    int others = other_host_alive(s, host_i);
+    for (int i = s->next; i < s->nslabs; i++) {
+        const slab *sl = &s->slabs[i];
+        if (!sl->done && !sl->copies && !(others && sl->failed_on == host_i))
             return i;
-    int best = -1, best_here = 1;
+    }
+    int best = -1, best_here = 1, best_copies = MAX_COPIES;
     double best_t = 0;
     for (int r = 0; r < s->nrun; r++) {
         int si = s->run[r].slab;
-        if (s->slabs[si].done || s->slabs[si].copies != 1)
-            continue;
+        const slab *sl = &s->slabs[si];
         int here = running_on(s, si, host_i);
-        if (best < 0 || here < best_here || (here == best_here && s->run[r].start < best_t)) {
+        if (sl->done || sl->copies >= MAX_COPIES || (here && sl->copies != 1))
+            continue;
+        int better = best < 0 || here < best_here || (here == best_here && sl->copies < best_copies) ||
+                     (here == best_here && sl->copies == best_copies && s->run[r].start < best_t);
+        if (better) {
             best = si;
             best_here = here;
+            best_copies = sl->copies;
             best_t = s->run[r].start;
         }
     }
@@ -194,10 +189,10 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     if (sl->copies) {
         s->st->duplicates++;
         h->duplicates++;
-        if (!s->p->tty)
-            say(s, "rows %u:%u still running; starting a second copy on %s", sl->y0, sl->y1, h->name);
+        emit(s, SCHED_COPY, host_i, sl, "rows %u:%u still running; starting a second copy on %s", sl->y0, sl->y1,
+             h->name);
     }
-    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, clk_now()};
+    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now(s)};
     sl->copies++;
     h->running++;
     return 0;
@@ -221,7 +216,7 @@ static void drop_host(sched *s, int host_i, const char *why)
         return;
     h->dropped = 1;
     snprintf(h->drop_reason, sizeof h->drop_reason, "%s", why);
-    say(s, "dropping host %s: %s", h->name, why);
+    emit(s, SCHED_HOST_DROPPED, host_i, NULL, "dropping host %s: %s", h->name, why);
     for (int r = s->nrun - 1; r >= 0; r--)
         if (s->run[r].host == host_i) {
             tr_proc_kill(s->run[r].proc);
@@ -238,12 +233,13 @@ static int fail_attempt(sched *s, int r, const char *why, fr_error *err)
     if (sl->done)
         return 0; /* another copy already won; this one does not matter */
     sl->attempts++;
+    sl->failed_on = a.host;
     h->failures++;
     h->streak++;
     s->st->retries++;
     snprintf(sl->last_error, sizeof sl->last_error, "%s: %s", h->name, why);
-    say(s, "rows %u:%u failed on %s (attempt %d of %d): %s", sl->y0, sl->y1, h->name, sl->attempts,
-        s->p->max_attempts, why);
+    emit(s, SCHED_SLAB_FAILED, a.host, sl, "rows %u:%u failed on %s (attempt %d of %d): %s", sl->y0, sl->y1,
+         h->name, sl->attempts, s->p->max_attempts, why);
     if (sl->attempts >= s->p->max_attempts && !sl->copies)
         return fr_fail(err, "rows %u:%u failed %d times, last on %s", sl->y0, sl->y1, sl->attempts,
                        sl->last_error);
@@ -275,7 +271,7 @@ static int accept_attempt(sched *s, int r, fr_error *err)
     }
     if (job_save(s->p->jobdir, sl->y0, sl->y1, out, len, err))
         return -1;
-    double dt = clk_now() - a.start;
+    double dt = now(s) - a.start;
     sl->done = 1;
     h->slabs++;
     h->rows += (int)(sl->y1 - sl->y0);
@@ -288,6 +284,8 @@ static int accept_attempt(sched *s, int r, fr_error *err)
             tr_proc_kill(s->run[k].proc);
             finish(s, k);
         }
+    emit(s, SCHED_SLAB_DONE, a.host, sl, "rows %u:%u from %s in %.2f s (%d/%d rows)", sl->y0, sl->y1, h->name, dt,
+         s->rows_done, s->rows_total);
     return 0;
 }
 
@@ -348,13 +346,13 @@ static int loop(sched *s, fr_error *err)
     int cap_pfd = 0;
     int rc = 0;
     while (s->rows_done < s->rows_total) {
-        if (*s->p->stop) {
+        if (s->p->stop && *s->p->stop) {
             rc = fr_fail(err, "interrupted");
             break;
         }
         for (int i = 0; i < s->nhosts; i++) {
             sched_host *h = &s->hosts[i];
-            while (!h->dropped && h->running < h->slots && clk_now() >= h->retry_at) {
+            while (!h->dropped && h->running < h->slots && now(s) >= h->retry_at) {
                 int si = pick(s, i);
                 if (si < 0)
                     break;
@@ -366,8 +364,8 @@ static int loop(sched *s, fr_error *err)
                 if (h->running > 0) {
                     /* The host takes fewer processes than it has cores (sshd's
                      * MaxSessions, a process limit): use what it takes. */
-                    say(s, "host %s: cannot start more than %d workers (%s); using %d slots", h->name,
-                        h->running, e2.msg, h->running);
+                    emit(s, SCHED_HOST_SHRUNK, i, NULL, "host %s: cannot start more than %d workers (%s); using %d slots",
+                         h->name, h->running, e2.msg, h->running);
                     h->slots = h->running;
                 } else if (++h->start_streak >= s->p->max_host_failures) {
                     h->failures++;
@@ -376,15 +374,15 @@ static int loop(sched *s, fr_error *err)
                     /* The server may still be tearing down the channels of
                      * the set-up (probe, SFTP): try again a little later. */
                     h->failures++;
-                    h->retry_at = clk_now() + 0.5 * h->start_streak;
-                    say(s, "host %s: %s; trying again", h->name, e2.msg);
+                    h->retry_at = now(s) + 0.5 * h->start_streak;
+                    emit(s, SCHED_HOST_RETRY, i, NULL, "host %s: %s; trying again", h->name, e2.msg);
                 }
                 break;
             }
         }
         int waiting = 0;
         for (int i = 0; i < s->nhosts; i++)
-            waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > clk_now();
+            waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > now(s);
         if (s->nrun == 0 && !waiting) {
             rc = fr_fail(err, alive_hosts(s) ? "nothing left to run" : "no host left to render on");
             break;
@@ -405,7 +403,10 @@ static int loop(sched *s, fr_error *err)
         for (int i = 0; i < s->nhosts; i++)
             if (!s->hosts[i].dropped)
                 n += tr_pollfds(s->hosts[i].tr, pfd + n, cap_pfd - n);
-        poll(pfd, (nfds_t)n, 100);
+        if (s->p->hooks.wait)
+            s->p->hooks.wait(s->p->hooks.ctx, pfd, n, 100);
+        else
+            poll(pfd, (nfds_t)n, 100);
         for (int i = 0; i < s->nhosts; i++) {
             fr_error e2;
             if (!s->hosts[i].dropped && tr_service(s->hosts[i].tr, &e2))
@@ -415,7 +416,7 @@ static int loop(sched *s, fr_error *err)
             rc = -1;
             break;
         }
-        draw(s, 0);
+        progress(s);
     }
     free(pfd);
     return rc;
@@ -430,7 +431,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
     s.hosts = hosts;
     s.nhosts = nhosts;
     s.st = st;
-    s.t0 = s.last_draw = clk_now();
+    s.t0 = now(&s);
     if (make_slabs(&s))
         return fr_fail(err, "out of memory");
     st->slabs = s.nslabs;
@@ -439,9 +440,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         tr_proc_kill(s.run[r].proc);
         finish(&s, r);
     }
-    draw(&s, 1);
-    if (s.drawn)
-        fputc('\n', stderr);
+    progress(&s);
     if (rc) {
         char missing[400], why[sizeof err->msg];
         snprintf(why, sizeof why, "%s", err->msg);
@@ -450,7 +449,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         job_kept_note(p->jobdir, kept, sizeof kept);
         fr_fail(err, "%s; rows %s not rendered (%s)", why, missing, kept);
     }
-    st->wall_s = clk_now() - s.t0;
+    st->wall_s = now(&s) - s.t0;
     free(s.slabs);
     free(s.run);
     return rc;

@@ -5,18 +5,30 @@
  * - More slabs than slots, from one queue, so faster hosts take more.
  * - A slab whose worker fails, dies, or returns a partial that does not
  *   check out (size, header, scene hash, rows, spp) goes back to the queue,
- *   at most `max_attempts` times.
+ *   at most `max_attempts` times.  Its next attempt goes to another host
+ *   when one is alive: a host takes back a slab that failed on it only when
+ *   no other host is left.
  * - A host with `max_host_failures` failures in a row, or whose connection
- *   is lost, is dropped with a message; its slabs go back to the queue.
+ *   is lost, is dropped; its slabs go back to the queue (a lost connection
+ *   does not count against them).
+ * - A host that refuses to start a worker while it runs others (sshd's
+ *   MaxSessions, a process limit) keeps the number of slots it runs.  One
+ *   that refuses while running nothing is tried again after a pause, and
+ *   dropped after `max_host_failures` refusals in a row.
  * - When the queue is empty and a slot is idle, the slab that has been
- *   running longest is started again (elsewhere when possible); the first
- *   valid copy wins and the others are killed.  Slabs are bit-identical
- *   wherever they run, so this is safe.
+ *   running longest with a single copy is started again, on another host
+ *   when possible; the first valid copy wins and the others are killed.
+ *   Slabs are bit-identical wherever they run, so this is safe.
  * - Each accepted slab is saved in the job directory at once.
+ *
+ * Nothing here prints: what happens is reported through sched_hooks, and
+ * the clock and the wait for activity can be replaced (tests drive the
+ * scheduler with a fake backend and a virtual clock).
  */
 #ifndef FRANJA_SCHED_H
 #define FRANJA_SCHED_H
 
+#include <poll.h>
 #include <signal.h>
 
 #include "jobdir.h"
@@ -28,30 +40,63 @@ typedef struct {
     tr_host *tr;               /**< connected transport (owned by the caller) */
     const char *name;
     char scene[1024];          /**< path of the binary scene on the host */
-    int slots;                 /**< worker processes at once */
+    int slots;                 /**< worker processes at once (lowered when the host refuses more) */
     /* statistics */
-    int running;
+    int running;               /**< processes running now */
     int slabs, rows;           /**< accepted from this host */
-    int failures;              /**< failed attempts */
+    int failures;              /**< failed attempts and refused starts */
     int duplicates;            /**< straggler copies started here */
     int streak;                /**< failures in a row */
     int dropped;
-    int start_streak;          /**< failed process starts in a row */
-    double retry_at;           /**< no new process before this time (after a failed start) */
+    int start_streak;          /**< refused starts in a row */
+    double retry_at;           /**< no new process before this time (after a refused start) */
     char drop_reason[300];
     double busy_s;             /**< sum of the run time of accepted slabs */
 } sched_host;
+
+/** What happened (sched_event.kind). */
+typedef enum {
+    SCHED_SLAB_DONE,           /**< a slab was accepted and saved */
+    SCHED_SLAB_FAILED,         /**< an attempt failed; the slab goes back to the queue */
+    SCHED_COPY,                /**< a second copy of a straggler was started */
+    SCHED_HOST_DROPPED,        /**< a host was dropped */
+    SCHED_HOST_SHRUNK,         /**< a host refused a worker: its slots went down */
+    SCHED_HOST_RETRY           /**< a host refused a worker while running none: later */
+} sched_event_kind;
+
+/** One event of a run. */
+typedef struct {
+    sched_event_kind kind;
+    double t;                  /**< seconds since sched_run began */
+    int host;                  /**< index into the hosts array */
+    uint32_t y0, y1;           /**< the slab (SLAB_*, COPY); 0 and 0 otherwise */
+    const char *text;          /**< one line saying what happened, for a log */
+} sched_event;
+
+/** How the scheduler reports and keeps time.  Every member may be NULL. */
+typedef struct {
+    /** Called for every event, from sched_run's thread. */
+    void (*event)(void *ctx, const sched_event *ev);
+    /** Called after every turn of the loop (about every 100 ms) and once at
+     * the end: rows done of the total; the hosts' statistics are current. */
+    void (*progress)(void *ctx, double t, int rows_done, int rows_total);
+    /** The clock in seconds; NULL = clk_now (clock.h). */
+    double (*now)(void *ctx);
+    /** Waits up to ms milliseconds for activity on pfd[0..n); NULL = poll. */
+    int (*wait)(void *ctx, struct pollfd *pfd, int n, int ms);
+    void *ctx;
+} sched_hooks;
 
 /** What to render and how. */
 typedef struct {
     job_spec spec;
     const char *jobdir;
-    const unsigned char *have; /**< rows already finished (resume), height entries */
+    const unsigned char *have; /**< rows already finished (resume), height entries; NULL = none */
     int slab_rows;             /**< rows per slab; 0 = about 4 slabs per slot */
     int max_attempts;          /**< failed attempts per slab before giving up */
     int max_host_failures;     /**< failures in a row before a host is dropped */
-    int tty;                   /**< a live progress line; else a plain line every 10 s */
-    volatile sig_atomic_t *stop; /**< set asynchronously (SIGINT): stop and keep what is done */
+    volatile sig_atomic_t *stop; /**< set asynchronously (SIGINT): stop and keep what is done; may be NULL */
+    sched_hooks hooks;
 } sched_params;
 
 /** Totals of a run. */
@@ -62,9 +107,11 @@ typedef struct {
     double wall_s;
 } sched_stats;
 
-/** Renders every row not in p->have.  Returns 0 when all rows are saved in
- * the job directory; otherwise -1 with err naming the missing rows and the
- * reason (no host left, a slab failed too often, interrupted). */
+/** Renders every row not in p->have on hosts[0..nhosts).  Returns 0 when
+ * all rows are saved in the job directory; otherwise -1 with err naming
+ * the missing rows and the reason (no host left, a slab failed too often,
+ * interrupted, the job directory cannot be written).  Every process it
+ * started is gone when it returns. */
 int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats *st, fr_error *err);
 
 #endif
