@@ -21,10 +21,9 @@ typedef struct {
     int uploaded;              /**< the scene was sent during this run */
     double ready_s;            /**< seconds it took */
     fr_error err;              /**< why the host is not usable (tr == NULL) */
-    /* private: remarks collected while the threads run */
-    char notes[2048];
-    size_t notes_len;
-    const note_sink *forward;
+    char notes[2048];          /**< private: remarks collected while the threads run */
+    size_t notes_len;          /**< private: bytes used in notes */
+    const note_sink *forward;  /**< private: where remarks go once the threads are done */
 } cl_host;
 
 /** A step run on host i once it is connected, in the host's own thread; on
