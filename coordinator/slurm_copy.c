@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "clock.h"
+#include "file.h"
 #include "transport_backend.h"
 
 /* Runs a step on the node to completion: its stdout into out[cap]. */
@@ -51,7 +52,7 @@ static int step(tr_host *h, int timeout_s, const char *const *argv, char *out, s
 /* Copies src to dst here, through a private temporary name. */
 static int copy_local(const char *src, const char *dst, int mode, fr_error *err)
 {
-    char dir[PATH_MAX], tmp[PATH_MAX + 64];
+    char dir[PATH_MAX];
     snprintf(dir, sizeof dir, "%s", dst);
     char *slash = strrchr(dir, '/');
     if (!slash || slash == dir)
@@ -66,35 +67,30 @@ static int copy_local(const char *src, const char *dst, int mode, fr_error *err)
         }
     if (mkdir(dir, 0755) && errno != EEXIST)
         return fr_fail(err, "%s: %s", dir, strerror(errno));
-    snprintf(tmp, sizeof tmp, "%s/.%s.%ld.tmp", dir, slash + 1, (long)getpid());
     int in = open(src, O_RDONLY | O_CLOEXEC);
     if (in < 0)
         return fr_fail(err, "%s: %s", src, strerror(errno));
-    int out = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, mode);
-    if (out < 0) {
+    file_out out;
+    if (file_out_open(dst, &out, err)) {
         close(in);
-        return fr_fail(err, "%s: %s", tmp, strerror(errno));
+        return -1;
     }
     char buf[1 << 16];
     ssize_t n;
     int rc = 0;
-    while ((n = read(in, buf, sizeof buf)) > 0)
-        if (write(out, buf, (size_t)n) != n) {
-            rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
-            break;
-        }
-    if (n < 0 && !rc)
-        rc = fr_fail(err, "%s: %s", src, strerror(errno));
-    if ((fchmod(out, (mode_t)mode) || fsync(out)) && !rc)
-        rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
-    if (close(out) && !rc)
-        rc = fr_fail(err, "%s: %s", tmp, strerror(errno));
+    while (!rc && (n = read(in, buf, sizeof buf)) != 0)
+        if (n < 0)
+            rc = errno == EINTR ? 0 : fr_fail(err, "%s: %s", src, strerror(errno));
+        else
+            rc = file_out_write(&out, buf, (size_t)n, err);
+    if (!rc && fchmod(out.fd, (mode_t)mode))
+        rc = fr_fail(err, "%s: %s", out.tmp, strerror(errno));
     close(in);
-    if (!rc && rename(tmp, dst))
-        rc = fr_fail(err, "%s: %s", dst, strerror(errno));
-    if (rc)
-        unlink(tmp);
-    return rc;
+    if (rc) {
+        file_out_abort(&out);
+        return -1;
+    }
+    return file_out_commit(&out, dst, err);
 }
 
 /* The shared work directory: the first node to need the file copies it. */
