@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "stats.h"
 #include "envmap.h"
 #include "fmath.h"
 #include "light.h"
@@ -18,44 +19,6 @@
 #include "scenes.h"
 
 static char dir[] = "/tmp/franja-envXXXXXX";
-
-static double rnd(uint32_t *st)
-{
-    *st = smp_hash(*st + 0x9e3779b9u);
-    uint32_t hi = *st;
-    *st = smp_hash(*st + 0x9e3779b9u);
-    return ((double)(hi >> 8) + (double)(*st >> 8) / 16777216.0) / 16777216.0;
-}
-
-static double chi2_pvalue(double x, int k)
-{
-    double z = (pow(x / k, 1.0 / 3.0) - (1.0 - 2.0 / (9.0 * k))) / sqrt(2.0 / (9.0 * k));
-    return 0.5 * erfc(z / sqrt(2.0));
-}
-
-/* Pearson's statistic over bins with expected counts >= 5 (smaller ones
- * pooled); the p-value, 0 when samples fall where none are expected. */
-static double chi2_test(const double *observed, const double *expected, int n)
-{
-    double stat = 0, pool_o = 0, pool_e = 0;
-    int dof = -1;
-    for (int i = 0; i < n; i++) {
-        if (expected[i] < 5.0) {
-            pool_o += observed[i];
-            pool_e += expected[i];
-            continue;
-        }
-        stat += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-        dof++;
-    }
-    if (pool_e >= 5.0) {
-        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-        dof++;
-    } else if (pool_o > 0 && pool_e < 1e-3) {
-        return 0.0;
-    }
-    return dof > 0 ? chi2_pvalue(stat, dof) : 0.0;
-}
 
 /* The test map, W x H, top row first: a smooth sky, a black band, and a
  * small bright "sun" texel. */
@@ -129,7 +92,7 @@ static void chi_square(const char *filter, float rot)
     for (int k = 0; k < N; k++) {
         float pdf;
         vec3 rad;
-        vec3 d = env_sample(&s, (float)rnd(&st), (float)rnd(&st), &pdf, &rad);
+        vec3 d = env_sample(&s, (float)st_rnd(&st), (float)st_rnd(&st), &pdf, &rad);
         float again = env_pdf(&s, d);
         if (!(pdf > 0.0f) || fabsf(again - pdf) > 1e-3f * pdf + 1e-6f)
             bad_pdf++;
@@ -153,7 +116,7 @@ static void chi_square(const char *filter, float rot)
                     total += e;
                 }
     CHECK(fabs(total - 1.0) < 2e-3, "%s: env_pdf integrates to %.5f over the sphere", filter, total);
-    double pv = chi2_test(obs, expct, NB);
+    double pv = st_chi2_test(obs, expct, NB, 0);
     CHECK(pv > 1e-4, "%s rot %g: chi-square p-value %.2e", filter, (double)rot, pv);
     scn_free(&s);
 }
@@ -170,7 +133,7 @@ static void pdf_follows_radiance(const char *filter)
     double ratio0 = -1, worst = 0;
     int missing = 0;
     for (int k = 0; k < 20000; k++) {
-        double z = 1 - 2 * rnd(&st), r = sqrt(1 - z * z), ph = 2 * M_PI * rnd(&st);
+        double z = 1 - 2 * st_rnd(&st), r = sqrt(1 - z * z), ph = 2 * M_PI * st_rnd(&st);
         vec3 d = v3((float)(r * cos(ph)), (float)z, (float)(r * sin(ph)));
         double y = v3_luma(env_radiance(&s, d)), pdf = env_pdf(&s, d);
         if (y > 0 && !(pdf > 0))
@@ -203,7 +166,7 @@ static void pdf_follows_radiance(const char *filter)
     for (int k = 0; k < N; k++) {
         float pdf;
         vec3 rad;
-        env_sample(&s, (float)rnd(&st), (float)rnd(&st), &pdf, &rad);
+        env_sample(&s, (float)st_rnd(&st), (float)st_rnd(&st), &pdf, &rad);
         double v = pdf > 0 ? v3_luma(rad) / pdf : 0;
         sum += v;
         sum2 += v * v;

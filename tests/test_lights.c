@@ -7,19 +7,12 @@
 
 #include "builder_light.h"
 #include "check.h"
+#include "stats.h"
 #include "freeze.h"
 #include "light.h"
 #include "pathtrace.h"
 #include "sampler.h"
 #include "scenes.h"
-
-static double rnd(uint32_t *st)
-{
-    *st = smp_hash(*st + 0x9e3779b9u);
-    uint32_t hi = *st;
-    *st = smp_hash(*st + 0x9e3779b9u);
-    return ((double)(hi >> 8) + (double)(*st >> 8) / 16777216.0) / 16777216.0;
-}
 
 typedef struct { double mean, se; } estimate;
 
@@ -150,7 +143,7 @@ static void emitted_power(const char *what, const char *lights, const char *extr
         fr_light_emit em;
         float u[5];
         for (int i = 0; i < 5; i++)
-            u[i] = (float)rnd(&st);
+            u[i] = (float)st_rnd(&st);
         double v = 0;
         if (lgt_sample_emit(&s, u[0], u[1], u[2], u[3], u[4], &em)) {
             double c = em.prim != FR_NONE ? fabs(v3_dot(em.n, em.ray.d)) : 1.0;

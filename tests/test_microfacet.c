@@ -10,6 +10,7 @@
 
 #include "bsdf.h"
 #include "check.h"
+#include "stats.h"
 #include "microfacet.h"
 #include "microfacet_table.h"
 #include "sampler.h"
@@ -21,38 +22,6 @@ static float rnd(void)
 {
     rng_state = smp_hash(rng_state + 0x9e3779b9u);
     return (float)(rng_state >> 8) * 0x1p-24f;
-}
-
-/* Upper tail of the chi-square distribution with k degrees of freedom
- * (Wilson-Hilferty). */
-static double chi2_pvalue(double x, int k)
-{
-    double z = (pow(x / k, 1.0 / 3.0) - (1.0 - 2.0 / (9.0 * k))) / sqrt(2.0 / (9.0 * k));
-    return 0.5 * erfc(z / sqrt(2.0));
-}
-
-/* Pearson's statistic over bins with expected counts >= 5, the others
- * pooled; 0 when samples land where the pdf says none can. */
-static double chi2_test(const double *obs, const double *expct, int n)
-{
-    double stat = 0, pool_o = 0, pool_e = 0;
-    int dof = -1;
-    for (int i = 0; i < n; i++) {
-        if (expct[i] < 5.0) {
-            pool_o += obs[i];
-            pool_e += expct[i];
-            continue;
-        }
-        stat += (obs[i] - expct[i]) * (obs[i] - expct[i]) / expct[i];
-        dof++;
-    }
-    if (pool_e >= 5.0) {
-        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-        dof++;
-    } else if (pool_o > 10.0 + 3.0 * pool_e) {
-        return 0.0; /* many samples where the pdf says (almost) none can be */
-    }
-    return dof > 0 ? chi2_pvalue(stat, dof) : 0.0;
 }
 
 /* Deterministic random numbers make each p-value fixed; the threshold is a
@@ -281,7 +250,7 @@ static void chi2_model(const char *name, const model *md, vec3 wo, vec3 axis_up,
     for (int i = 0; i < 2 * NB; i++)
         expct[i] *= nsamples;
     expct[2 * NB] = fmax(0.0, 1.0 - total) * nsamples;
-    double p = chi2_test(obs, expct, 2 * NB + 1);
+    double p = st_chi2_test(obs, expct, 2 * NB + 1, 10.0);
     if (getenv("MF_DEBUG") && p <= P_MIN)
         for (int i = 0; i <= 2 * NB; i++)
             if (fabs(obs[i] - expct[i]) > 4 * sqrt(expct[i] + 1))

@@ -7,50 +7,11 @@
 #include "bsdf.h"
 #include "builder.h"
 #include "check.h"
+#include "stats.h"
 #include "fmath.h"
 #include "sampler.h"
 
 enum { NT = 16, NP = 32, NSAMPLES = 400000 };
-
-static double rnd(uint32_t *st)
-{
-    *st = smp_hash(*st + 0x9e3779b9u);
-    uint32_t hi = *st;
-    *st = smp_hash(*st + 0x9e3779b9u);
-    return ((double)(hi >> 8) + (double)(*st >> 8) / 16777216.0) / 16777216.0;
-}
-
-/* Upper tail probability of the chi-square distribution with k degrees of
- * freedom at x, by the Wilson-Hilferty normal approximation. */
-static double chi2_pvalue(double x, int k)
-{
-    double z = (pow(x / k, 1.0 / 3.0) - (1.0 - 2.0 / (9.0 * k))) / sqrt(2.0 / (9.0 * k));
-    return 0.5 * erfc(z / sqrt(2.0));
-}
-
-/* Pearson's statistic over bins with expected counts >= 5 (smaller ones
- * pooled); returns the p-value. */
-static double chi2_test(const double *observed, const double *expected, int n)
-{
-    double stat = 0, pool_o = 0, pool_e = 0;
-    int dof = -1;
-    for (int i = 0; i < n; i++) {
-        if (expected[i] < 5.0) {
-            pool_o += observed[i];
-            pool_e += expected[i];
-            continue;
-        }
-        stat += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-        dof++;
-    }
-    if (pool_e >= 5.0) {
-        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-        dof++;
-    } else if (pool_o > 0 && pool_e == 0) {
-        return 0.0; /* samples where the pdf says none can be */
-    }
-    return dof > 0 ? chi2_pvalue(stat, dof) : 0.0;
-}
 
 /* Bins over (cos theta in [-1,1], phi) of a local frame with z up. */
 static int bin_of(vec3 d)
@@ -73,13 +34,13 @@ static void chi2_local(const char *name, vec3 (*sample)(float, float, float), fl
     memset(obs, 0, sizeof obs);
     uint32_t st = 12345;
     for (int i = 0; i < NSAMPLES; i++)
-        obs[bin_of(sample(param, (float)rnd(&st), (float)rnd(&st)))]++;
+        obs[bin_of(sample(param, (float)st_rnd(&st), (float)st_rnd(&st)))]++;
     for (int it = 0; it < NT; it++) {
         double c0 = -1.0 + 2.0 * it / NT, c1 = -1.0 + 2.0 * (it + 1) / NT;
         for (int ip = 0; ip < NP; ip++)
             expct[it * NP + ip] = NSAMPLES * (cdf_cos(c1, param) - cdf_cos(c0, param)) / NP;
     }
-    double p = chi2_test(obs, expct, NT * NP);
+    double p = st_chi2_test(obs, expct, NT * NP, 0);
     CHECK(p > 1e-3, "%s: chi-square p-value %.3g", name, p);
     printf("%s: chi-square p = %.3f\n", name, p);
 }
@@ -104,7 +65,7 @@ static void chi2_material(const char *name, const fr_material *m, vec3 wo)
     uint32_t st = 777;
     for (int i = 0; i < NSAMPLES; i++) {
         fr_bsdf_sample bs;
-        if (bsdf_sample(m, &sf, wo, (float)rnd(&st), (float)rnd(&st), (float)rnd(&st), &bs))
+        if (bsdf_sample(m, &sf, wo, (float)st_rnd(&st), (float)st_rnd(&st), (float)st_rnd(&st), &bs))
             obs[bin_of(bs.wi)]++;
         else
             obs[NT * NP]++;
@@ -129,7 +90,7 @@ static void chi2_material(const char *name, const fr_material *m, vec3 wo)
             total += e;
         }
     expct[NT * NP] = (1.0 - total) * NSAMPLES;
-    double p = chi2_test(obs, expct, NT * NP + 1);
+    double p = st_chi2_test(obs, expct, NT * NP + 1, 0);
     CHECK(p > 1e-3, "%s: chi-square p-value %.3g", name, p);
     printf("%s: chi-square p = %.3f (void fraction %.4f)\n", name, p, obs[NT * NP] / NSAMPLES);
 }
@@ -164,8 +125,8 @@ static void test_reciprocity_energy(const fr_material *m, const char *name)
     uint32_t st = 99;
     float worst = 0;
     for (int i = 0; i < 10000; i++) {
-        vec3 a = bsdf_sample_cosine((float)rnd(&st), (float)rnd(&st));
-        vec3 b = bsdf_sample_cosine((float)rnd(&st), (float)rnd(&st));
+        vec3 a = bsdf_sample_cosine((float)st_rnd(&st), (float)st_rnd(&st));
+        vec3 b = bsdf_sample_cosine((float)st_rnd(&st), (float)st_rnd(&st));
         float p;
         vec3 fab = bsdf_eval(m, &sf, a, b, &p), fba = bsdf_eval(m, &sf, b, a, &p);
         float d = fabsf(fab.x - fba.x) / fmaxf(1e-6f, fabsf(fab.x));
@@ -177,7 +138,7 @@ static void test_reciprocity_energy(const fr_material *m, const char *name)
     enum { N = 200000 };
     for (int i = 0; i < N; i++) {
         fr_bsdf_sample bs;
-        if (bsdf_sample(m, &sf, v3(0, 0, 1), (float)rnd(&st), (float)rnd(&st), (float)rnd(&st), &bs))
+        if (bsdf_sample(m, &sf, v3(0, 0, 1), (float)st_rnd(&st), (float)st_rnd(&st), (float)st_rnd(&st), &bs))
             albedo += bs.weight.x;
     }
     albedo /= N;
