@@ -5,7 +5,12 @@
  * path vertex), wi toward the light or the next vertex.  All unit length.
  * A material is a weighted set of lobes (scene.h): Lambert, normalized Phong,
  * perfect mirror and smooth dielectric; one lobe is picked per sample with
- * the material's lobe probabilities.
+ * the material's lobe probabilities.  Or it is one of the microfacet models
+ * of microfacet.h (rough conductor, rough dielectric, glTF
+ * metallic-roughness), evaluated in the shading frame: z along the shading
+ * normal turned to wo's side, x along dpdu when the roughness is
+ * anisotropic.  Their lobes are smooth (not delta), so next-event
+ * estimation and MIS treat them like Phong.
  *
  * The shading normal shades; the geometric normal decides sides: a
  * reflected direction must leave on wo's side of the geometric surface and a
@@ -54,9 +59,15 @@ int bsdf_has_smooth(const fr_material *m);
 
 /** Set m->p_lobe, the cumulative probabilities with which bsdf_sample picks
  * each lobe, from the lobe colours: in proportion to each lobe's brightest
- * channel; all zero for a material without a lobe (it only emits).  Called
- * when a material is made and again when textures change its colours. */
+ * channel; all zero for a material without a lobe (it only emits).  A
+ * microfacet model is one smooth lobe: {0, 1, 1, 1}.  Called when textures
+ * change a material's colours (bsdf_material_finish calls it too). */
 void bsdf_lobe_probs(fr_material *m);
+
+/** Derive what a material's fields imply: p_lobe (bsdf_lobe_probs) and a
+ * conductor's average Fresnel factor.  Call once when a material's fields
+ * are set. */
+void bsdf_material_finish(fr_material *m);
 
 /** Unpolarized Fresnel reflectance of a smooth dielectric boundary for light
  * arriving at cos_i (> 0) from the side of index 1 onto index `eta` (the

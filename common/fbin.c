@@ -176,7 +176,7 @@ static int validate_appearance(const fr_scene *s, const void *base, const uint64
         const fr_material *m = &s->materials[i];
         if (!tex_ref_ok(s, m->tex_diffuse) || !tex_ref_ok(s, m->tex_glossy) || !tex_ref_ok(s, m->tex_specular) ||
             !tex_ref_ok(s, m->tex_transmit) || !tex_ref_ok(s, m->tex_emission) || !tex_ref_ok(s, m->tex_bump) ||
-            !tex_ref_ok(s, m->tex_normal))
+            !tex_ref_ok(s, m->tex_normal) || !tex_ref_ok(s, m->tex_roughness) || !tex_ref_ok(s, m->tex_metallic))
             return fr_fail(err, "section materials, byte %zu: material %u: texture index out of range",
                            AT(&m->tex_diffuse), i);
         if (!isfinite(m->bump_strength) || !isfinite(m->normal_strength) || m->medium > s->n_media ||
@@ -295,6 +295,13 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
         if (!ok || !(m->ior > 0.0f) || !(m->exponent >= 0.0f) || !finite3(m->emission))
             return fr_fail(err, "section materials, byte %zu: material %u: bad lobe probabilities, ior, exponent "
                            "or emission", AT(m), i);
+        if (m->model >= FR_MAT_MODELS || m->mf_flags > FR_MF_ALL || m->fresnel >= FR_FRESNEL_MODES ||
+            !(m->roughness >= 0.0f && m->roughness <= 1.0f) || !(m->anisotropy >= -1.0f && m->anisotropy <= 1.0f) ||
+            !(m->metallic >= 0.0f && m->metallic <= 1.0f) || !(m->transmission >= 0.0f && m->transmission <= 1.0f) ||
+            !finite3(m->eta) || !finite3(m->k) || !finite3(m->fresnel_avg) ||
+            (m->model == FR_MAT_CONDUCTOR && m->fresnel == FR_FRESNEL_EXACT && !(v3_min(m->eta) > 0.0f && v3_min(m->k) >= 0.0f)))
+            return fr_fail(err, "section materials, byte %zu: material %u: bad microfacet model, flags, Fresnel mode, "
+                           "roughness, anisotropy, metallic, transmission or index", AT(&m->model), i);
     }
     if (s->n_prims > 0 && s->n_materials == 0)
         return fr_fail(err, "section materials: primitives but no material");

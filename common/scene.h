@@ -43,12 +43,41 @@ typedef struct {
     float pad;
 } fr_camera;
 
-/** A material is a weighted set of lobes, one of which is picked per
- * scattering event by Russian roulette with probability proportional to
- * its weight.  A plain Lambert material has only `diffuse`; a Phong
- * material `diffuse` and `glossy`; a mirror `specular`; glass `transmit`.
- * Lobe colours are the albedos the lobe contributes: energy is conserved
- * when the per-channel sum of the four is at most 1. */
+/** Material models (fr_material.model). */
+enum {
+    FR_MAT_LOBES = 0,      /**< the weighted lobes below */
+    FR_MAT_CONDUCTOR = 1,  /**< rough conductor: reflectance in `specular` (and tex_specular) */
+    FR_MAT_DIELECTRIC = 2, /**< rough dielectric boundary: tint in `transmit` (and tex_transmit), index `ior` */
+    FR_MAT_PRINCIPLED = 3, /**< glTF metallic-roughness: base colour in `diffuse` (and tex_diffuse), `ior` */
+    FR_MAT_MODELS
+};
+
+/** How a conductor's reflectance depends on the angle (fr_material.fresnel;
+ * the MF_FRESNEL_* of microfacet.h). */
+enum {
+    FR_FRESNEL_SCHLICK = 0, /**< `specular` is F0 of Schlick's approximation */
+    FR_FRESNEL_EXACT = 1,   /**< exact Fresnel of the complex index eta + i k, tinted by `specular` */
+    FR_FRESNEL_NONE = 2,    /**< `specular` at every angle */
+    FR_FRESNEL_MODES
+};
+
+/** Options of the microfacet models (bits of fr_material.mf_flags). */
+enum {
+    FR_MF_SEPARABLE = 1,     /**< separable Smith masking (as Cycles 3.4) instead of height-correlated */
+    FR_MF_COMPENSATE = 2,    /**< multiple-scattering energy compensation */
+    FR_MF_MACRO_FRESNEL = 4, /**< dielectric: Fresnel once with the shading normal (Cycles 3.4's Glass) */
+    FR_MF_GLTF_COUPLING = 8, /**< principled: glTF's fresnel_mix as written instead of albedo coupling */
+    FR_MF_ALL = 15
+};
+
+/** A material is a weighted set of lobes (model FR_MAT_LOBES), one of
+ * which is picked per scattering event by Russian roulette with probability
+ * proportional to its weight, or a microfacet model (microfacet.h).  A
+ * plain Lambert material has only `diffuse`; a Phong material `diffuse` and
+ * `glossy`; a mirror `specular`; smooth glass `transmit`.  Lobe colours are
+ * the albedos the lobe contributes: energy is conserved when the
+ * per-channel sum of the four is at most 1.  The microfacet models keep
+ * their colour in one of the four (see FR_MAT_*) and leave the others 0. */
 typedef struct {
     vec3 diffuse;              /**< Lambert albedo */
     vec3 glossy;               /**< normalized Phong albedo */
@@ -72,6 +101,18 @@ typedef struct {
     float normal_strength;     /**< scales the map's tangential components */
     uint32_t medium;           /**< medium inside the shape: 1 + index into media, 0 = none */
     uint32_t interface;        /**< 1: no surface at all, only a boundary between media */
+    uint32_t model;            /**< FR_MAT_* */
+    uint32_t mf_flags;         /**< microfacet models: FR_MF_* bits */
+    uint32_t fresnel;          /**< conductor: FR_FRESNEL_* */
+    float roughness;           /**< microfacet models: [0, 1], alpha = roughness^2 */
+    float anisotropy;          /**< microfacet models: [-1, 1], 0 isotropic, > 0 rougher along dpdu */
+    float metallic;            /**< principled: [0, 1] */
+    float transmission;        /**< principled: [0, 1], the share of the dielectric that refracts */
+    vec3 eta, k;               /**< conductor, FR_FRESNEL_EXACT: complex index of refraction per channel */
+    vec3 fresnel_avg;          /**< derived (bsdf_material_finish): the exact conductor's cosine-weighted
+                                    average Fresnel factor, untinted */
+    uint32_t tex_roughness;    /**< times roughness: a grey texture, or the G channel of an RGB one (glTF) */
+    uint32_t tex_metallic;     /**< times metallic: a grey texture, or the B channel of an RGB one (glTF) */
 } fr_material;
 
 /** A texture: an image of decoded linear texels stored in the scene, or a

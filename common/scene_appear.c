@@ -335,6 +335,44 @@ int scn_colour(scn_appear *a, const cJSON *obj, const char *key, const char *whe
     return texture_ref(a, name->valuestring, 1, path, tex, err);
 }
 
+int scn_scalar(scn_appear *a, const cJSON *obj, const char *key, const char *where, float def, float lo, float hi,
+               float *value, uint32_t *tex, fr_error *err)
+{
+    static const char *const fields[] = {"texture", "factor", NULL};
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char path[PATHLEN];
+    snprintf(path, sizeof path, "%s.%s", where, key);
+    *tex = FR_NONE;
+    *value = def;
+    if (!v)
+        return 0;
+    const char *bound = path;
+    char fpath[PATHLEN + 8];
+    if (cJSON_IsNumber(v)) {
+        if (jv_number(obj, key, where, 1, def, value, err) < 0)
+            return -1;
+    } else if (cJSON_IsString(v)) {
+        *value = 1.0f;
+        if (texture_ref(a, v->valuestring, 0, path, tex, err) < 0)
+            return -1;
+    } else if (cJSON_IsObject(v)) {
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(v, "texture");
+        if (jv_only_fields(v, path, fields, err) < 0 || jv_number(v, "factor", path, 0, 1.0f, value, err) < 0)
+            return -1;
+        if (!cJSON_IsString(name))
+            return fr_fail(err, "%s.texture: missing (expected a texture name)", path);
+        if (texture_ref(a, name->valuestring, 0, path, tex, err) < 0)
+            return -1;
+        snprintf(fpath, sizeof fpath, "%s.factor", path);
+        bound = fpath;
+    } else {
+        return fr_fail(err, "%s: expected a number, a texture name or {\"texture\": name, \"factor\": f}", path);
+    }
+    if (!(*value >= lo && *value <= hi))
+        return fr_fail(err, "%s: expected a number in [%g, %g]", bound, (double)lo, (double)hi);
+    return 0;
+}
+
 /* "key": name or {"texture": name, "strength": s}: a data texture. */
 static int map_ref(scn_appear *a, const cJSON *obj, const char *key, const char *where, float def_strength,
                    uint32_t *tex, float *strength, fr_error *err)

@@ -56,6 +56,14 @@ int scn_colour(scn_appear *a, const cJSON *obj, const char *key, const char *whe
 int scn_store_image(fr_builder *b, const scn_image *img, int from_srgb, fr_texture *tex, const char *where,
                     fr_error *err);
 
+/** Read number member `key` of obj (at path `where`): a number, a texture
+ * name, or {"texture": name, "factor": f} (a data texture: no sRGB
+ * decoding).  *value receives the number or the factor (1 by default),
+ * which must lie in [lo, hi]; *tex the texture index or FR_NONE.  Absent:
+ * *value = def, *tex = FR_NONE. */
+int scn_scalar(scn_appear *a, const cJSON *obj, const char *key, const char *where, float def, float lo, float hi,
+               float *value, uint32_t *tex, fr_error *err);
+
 /** The material members this module owns: "bump", "normal_map" and
  * "medium"; and the type "interface" (when is_interface). */
 int scn_material_appearance(scn_appear *a, const cJSON *obj, const char *where, int is_interface, fr_material *m,

@@ -15,6 +15,7 @@
 #include "scene_appear.h"
 #include "scene_gltf.h"
 #include "scene_light.h"
+#include "scene_microfacet.h"
 
 #define PATHLEN 160
 
@@ -89,11 +90,17 @@ static int camera(ctx *c, const cJSON *root)
     return scn_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->err);
 }
 
+#define TYPES "lambert, phong, mirror, glass, mix, conductor, principled, emitter or interface"
+
 static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material *m)
 {
-    static const char *const fields[] = {"type", "albedo", "diffuse", "glossy", "specular", "exponent",
-                                         "reflectance", "transmit", "tint", "ior", "emission", "two_sided",
-                                         "bump", "normal_map", "medium", NULL};
+    static const char *const lobe_fields[] = {"type", "albedo", "diffuse", "glossy", "specular", "exponent",
+                                              "reflectance", "transmit", "tint", "ior", "emission", "two_sided",
+                                              "bump", "normal_map", "medium", NULL};
+    enum { N_LOBE = sizeof lobe_fields / sizeof lobe_fields[0] - 1, N_MF = SCN_MICROFACET_NFIELDS };
+    const char *fields[N_LOBE + N_MF + 1];
+    memcpy(fields, lobe_fields, N_LOBE * sizeof *fields);
+    memcpy(fields + N_LOBE, scn_microfacet_fields, (N_MF + 1) * sizeof *fields);
     bld_material_init(m);
     scn_appear *a = c->look;
     if (!cJSON_IsObject(o))
@@ -102,8 +109,7 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
         return -1;
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
-        return fr_fail(c->err, "%s.type: missing (expected lambert, phong, mirror, glass, mix, emitter or interface)",
-                       where);
+        return fr_fail(c->err, "%s.type: missing (expected %s)", where, TYPES);
     const char *type = t->valuestring;
     int rc = 0;
     /* Colours may be textures (scn_colour). */
@@ -125,11 +131,12 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
              scn_colour(a, o, "specular", where, 0, v3s(0), &m->specular, &m->tex_specular, c->err) |
              scn_colour(a, o, "transmit", where, 0, v3s(0), &m->transmit, &m->tex_transmit, c->err) |
              jv_number(o, "ior", where, 0, 1.5f, &m->ior, c->err);
-    } else if (strcmp(type, "emitter") != 0 && strcmp(type, "interface") != 0) {
-        return fr_fail(c->err, "%s.type: '%s' is not lambert, phong, mirror, glass, mix, emitter or interface", where,
-                       type);
+    } else if (strcmp(type, "emitter") != 0 && strcmp(type, "interface") != 0 && strcmp(type, "conductor") != 0 &&
+               strcmp(type, "principled") != 0) {
+        return fr_fail(c->err, "%s.type: '%s' is not %s", where, type, TYPES);
     }
-    if (rc < 0 || scn_colour(a, o, "emission", where, 0, v3s(0), &m->emission, &m->tex_emission, c->err) < 0 ||
+    if (rc < 0 || scn_microfacet(a, o, where, type, m, c->err) < 0 ||
+        scn_colour(a, o, "emission", where, 0, v3s(0), &m->emission, &m->tex_emission, c->err) < 0 ||
         scn_material_appearance(a, o, where, !strcmp(type, "interface"), m, c->err) < 0)
         return -1;
     const cJSON *ts = cJSON_GetObjectItemCaseSensitive(o, "two_sided");
@@ -147,7 +154,7 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
         return fr_fail(c->err, "%s.exponent: expected a number in [0, 1e6]", where);
     if (!(m->ior >= 1.0f / 16.0f && m->ior <= 16.0f) || m->ior == 1.0f)
         return fr_fail(c->err, "%s.ior: expected an index of refraction in [1/16, 16], not 1", where);
-    bsdf_lobe_probs(m);
+    bsdf_material_finish(m);
     return 0;
 }
 

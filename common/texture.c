@@ -111,7 +111,7 @@ float tex_eval1(const fr_scene *s, uint32_t ti, vec2 uv)
 int tex_material_textured(const fr_material *m)
 {
     return (m->tex_diffuse & m->tex_glossy & m->tex_specular & m->tex_transmit & m->tex_emission & m->tex_bump &
-            m->tex_normal) != FR_NONE;
+            m->tex_normal & m->tex_roughness & m->tex_metallic) != FR_NONE;
 }
 
 static vec3 clamp01(vec3 c)
@@ -207,6 +207,12 @@ const fr_material *tex_material(const fr_scene *s, const fr_material *m, fr_surf
         tmp->transmit = v3_mul(m->transmit, clamp01(tex_eval(s, m->tex_transmit, sf->uv))), lobes = 1;
     if (m->tex_emission != FR_NONE)
         tmp->emission = tex_emission(s, m, sf->uv);
+    /* glTF's metallicRoughness texture: roughness in G, metallic in B (a
+     * grey texture has the same value in every channel). */
+    if (m->tex_roughness != FR_NONE)
+        tmp->roughness = m->roughness * clamp01(tex_eval(s, m->tex_roughness, sf->uv)).y;
+    if (m->tex_metallic != FR_NONE)
+        tmp->metallic = m->metallic * clamp01(tex_eval(s, m->tex_metallic, sf->uv)).z;
     if (lobes)
         bsdf_lobe_probs(tmp);
     if (m->tex_bump != FR_NONE)

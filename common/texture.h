@@ -27,7 +27,9 @@ int tex_material_textured(const fr_material *m);
 /** The material as it is at surface point *sf: when m has no texture,
  * returns m unchanged; otherwise copies it into *tmp, replaces each
  * textured colour by tint * texture (reflectances clamped to [0, 1],
- * emission to >= 0), recomputes the lobe probabilities and returns tmp.
+ * emission to >= 0), a textured roughness (metallic) by the factor times
+ * the texture's G (B) channel, clamped to [0, 1], recomputes the lobe
+ * probabilities and returns tmp.
  * Bump and normal maps tilt sf->ns (the shading normal only: sf->ng, which
  * decides on which side of the surface a path is, is left alone, and ns is
  * kept in ng's hemisphere). */

@@ -224,6 +224,24 @@ static void test_contents(void)
     size_t light = section(g, 12), mat = section(g, 3);
     poke("light kind", light, 9, "section lights");
     poke("material texture", mat + 88, 3, "section materials");
+    /* The microfacet fields (offsets as in FORMAT.md); errors name the
+     * material's model field, or its first texture index. */
+    size_t model = mat + 132;
+    poke_at("material model", model, FR_MAT_MODELS, "section materials", model);
+    poke_at("material flags", mat + 136, FR_MF_ALL + 1, "section materials", model);
+    poke_at("material Fresnel mode", mat + 140, FR_FRESNEL_MODES, "section materials", model);
+    float two = 2.0f, minus = -0.5f;
+    memcpy(&u, &two, 4);
+    poke_at("material roughness", mat + 144, u, "section materials", model);
+    poke_at("material anisotropy", mat + 148, u, "section materials", model);
+    memcpy(&u, &minus, 4);
+    poke_at("material metallic", mat + 152, u, "section materials", model);
+    poke_at("material transmission", mat + 156, u, "section materials", model);
+    memcpy(&u, &nan, 4);
+    poke_at("material eta", mat + 160, u, "section materials", model);
+    poke_at("material fresnel_avg", mat + 184, u, "section materials", model);
+    poke_at("material roughness texture", mat + 196, 3, "section materials", mat + 88);
+    poke_at("material metallic texture", mat + 200, 3, "section materials", mat + 88);
     memcpy(&u, &nan, 4);
     poke("camera NaN", section(g, 2), u, "section camera");
     poke("settings width", section(g, 1), 0, "section settings");

@@ -1,12 +1,16 @@
 /* imgcmp -- compare a rendered PFM against a reference PFM.
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
+ *          [--max-block-rel Z [--block N]]
  *
  * IMAGE is box-downsampled to the reference's size when it is an integer
  * multiple of it.  Prints each channel's mean (image and reference) and the
  * RMSE over all channels of the pixels off the light (reference pixels with
- * a channel >= 10 are the light).  With limits, prints the closing
- * "N passed, N failed" line and exits non-zero when one is exceeded. */
+ * a channel >= 10 are the light), and with --max-block-rel the worst
+ * relative difference of the mean (all channels, off the light) over the
+ * N x N blocks of the reference (N = 64 by default).  With limits, prints
+ * the closing "N passed, N failed" line and exits non-zero when one is
+ * exceeded. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,13 +50,21 @@ bad:
 
 int main(int argc, char **argv)
 {
-    double max_rmse = -1, max_rel = -1;
-    if (argc < 3) { fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]\n"); return 2; }
+    double max_rmse = -1, max_rel = -1, max_block = -1;
+    int bs = 64;
+    if (argc < 3) {
+        fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y] "
+                        "[--max-block-rel Z [--block N]]\n");
+        return 2;
+    }
     for (int i = 3; i + 1 < argc; i += 2) {
         if (!strcmp(argv[i], "--max-rmse")) max_rmse = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--max-mean-rel")) max_rel = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--max-block-rel")) max_block = atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--block")) bs = atoi(argv[i + 1]);
         else { fprintf(stderr, "imgcmp: unknown option %s\n", argv[i]); return 2; }
     }
+    if (bs < 1 || bs > 65536) { fprintf(stderr, "imgcmp: bad block size\n"); return 2; }
     image a, r;
     if (read_pfm(argv[1], &a) < 0 || read_pfm(argv[2], &r) < 0) return 2;
     if (a.w % r.w || a.h % r.h || a.w / r.w != a.h / r.h) {
@@ -62,6 +74,9 @@ int main(int argc, char **argv)
     int k = a.w / r.w;
     double mean[3] = {0}, rmean[3] = {0}, se = 0;
     long off = 0;
+    int nbx = (r.w + bs - 1) / bs, nby = (r.h + bs - 1) / bs;
+    double *blk = calloc((size_t)nbx * nby * 2, sizeof(double));
+    if (!blk) return 2;
     for (int y = 0; y < r.h; y++)
         for (int x = 0; x < r.w; x++) {
             const float *q = r.px + ((size_t)y * r.w + x) * 3;
@@ -74,7 +89,12 @@ int main(int argc, char **argv)
                 v /= k * k;
                 mean[ch] += v;
                 rmean[ch] += q[ch];
-                if (!light) se += (v - q[ch]) * (v - q[ch]);
+                if (!light) {
+                    se += (v - q[ch]) * (v - q[ch]);
+                    double *b = blk + ((size_t)(y / bs) * nbx + x / bs) * 2;
+                    b[0] += v;
+                    b[1] += q[ch];
+                }
             }
             off += !light;
         }
@@ -91,10 +111,24 @@ int main(int argc, char **argv)
         }
     }
     printf("rmse %.5f over %ld pixels off the light\n", rmse, off);
+    if (max_block >= 0) {
+        double worst = 0;
+        int wx = 0, wy = 0;
+        for (int by = 0; by < nby; by++)
+            for (int bx = 0; bx < nbx; bx++) {
+                const double *b = blk + ((size_t)by * nbx + bx) * 2;
+                double rel = b[1] > 0 ? fabs(b[0] - b[1]) / b[1] : (b[0] > 0 ? INFINITY : 0);
+                if (rel > worst) { worst = rel; wx = bx; wy = by; }
+            }
+        printf("worst %dx%d block: (%d, %d) from the top left, mean off by %.2f %%\n", bs, bs, wx, wy, 100 * worst);
+        if (worst <= max_block) pass++;
+        else { fail++; printf("FAIL: a block's mean is off by %.2f %% (limit %.2f %%)\n", 100 * worst, 100 * max_block); }
+    }
+    free(blk);
     if (max_rmse >= 0) {
         if (rmse <= max_rmse) pass++;
         else { fail++; printf("FAIL: rmse %.5f above %.5f\n", rmse, max_rmse); }
     }
-    if (max_rmse >= 0 || max_rel >= 0) printf("%d passed, %d failed\n", pass, fail);
+    if (max_rmse >= 0 || max_rel >= 0 || max_block >= 0) printf("%d passed, %d failed\n", pass, fail);
     return fail ? 1 : 0;
 }
