@@ -326,20 +326,20 @@ void gmat_to_franja(gmat_ctx *c, const gmat_values *v, fr_material *m)
 {
     bld_material_init(m);
     m->bump_strength = 1.0f;   /* as the JSON reader leaves a material without bump map */
-    /* Until rough conductors and dielectrics exist, the metallic-roughness
-     * model is drawn as its base colour over a Lambert lobe, and
-     * transmission as smooth glass tinted by the base colour. */
-    if (v->metallic < 1.0f || v->roughness < 1.0f || v->t_metal_rough.tex != FR_NONE)
-        gdoc_warn(c->doc, "pbr", "metallic-roughness materials are drawn as diffuse base colour (no specular lobe yet)");
-    m->diffuse = v3_scale(v->base, 1.0f - v->transmission);
+    /* glTF's metallic-roughness model is Franja's principled material:
+     * the base colour and its texture, the metallic and roughness factors,
+     * the metallicRoughness texture's B and G channels (texture.c reads
+     * them so), KHR_materials_transmission and KHR_materials_ior. */
+    m->model = FR_MAT_PRINCIPLED;
+    m->diffuse = v->base;
     m->tex_diffuse = v->t_base.tex;
-    if (v->transmission > 0.0f) {
-        m->transmit = v3_scale(v->base, v->transmission);
-        m->tex_transmit = v->t_base.tex;
-        m->ior = v->ior;
-        if (v->t_transmission.tex != FR_NONE)
-            gdoc_warn(c->doc, "ttex", "transmissionTexture is not supported: the factor is used");
-    }
+    m->metallic = v->metallic;
+    m->roughness = v->roughness;
+    m->tex_roughness = m->tex_metallic = v->t_metal_rough.tex;
+    m->transmission = v->transmission;
+    m->ior = v->ior;
+    if (v->t_transmission.tex != FR_NONE)
+        gdoc_warn(c->doc, "ttex", "transmissionTexture is not supported: the factor is used");
     m->emission = v->emissive;
     if (!v3_is_zero(v->emissive))
         m->tex_emission = v->t_emissive.tex;
@@ -353,7 +353,7 @@ void gmat_to_franja(gmat_ctx *c, const gmat_values *v, fr_material *m)
             gdoc_warn(c->doc, "normal1", "a normal texture without three channels is ignored");
         }
     }
-    bsdf_lobe_probs(m);
+    bsdf_material_finish(m);
 }
 
 int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, const double **uvxf, fr_error *err)

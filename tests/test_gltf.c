@@ -365,9 +365,12 @@ static int fake_image(const void *data, size_t len, const char *mime, scn_image 
     return img->pixels ? 0 : -1;
 }
 
-/* Materials: emission with KHR_materials_emissive_strength, transmission
- * with KHR_materials_ior, a base colour texture (sRGB-decoded) with its
- * sampler and KHR_texture_transform rewritten for Franja's flipped v. */
+/* Materials, each the principled model: emission with
+ * KHR_materials_emissive_strength, transmission with KHR_materials_ior, a
+ * base colour texture (sRGB-decoded) with its sampler and
+ * KHR_texture_transform rewritten for Franja's flipped v, metallic and
+ * roughness factors with the metallicRoughness texture (linear), glTF's
+ * default material. */
 static void test_materials(void)
 {
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
@@ -375,15 +378,18 @@ static void test_materials(void)
         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0},"
-        "{\"attributes\":{\"POSITION\":0},\"material\":1}]}],"
+        "{\"attributes\":{\"POSITION\":0},\"material\":1},{\"attributes\":{\"POSITION\":0},\"material\":2},"
+        "{\"attributes\":{\"POSITION\":0}}]}],"
         "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
         "\"materials\":[{\"emissiveFactor\":[1,0.5,0],\"doubleSided\":true,"
         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4}}},"
         "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"baseColorTexture\":{\"index\":0,"
         "\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.25,0.5],\"scale\":[2,4]}}}},"
         "\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":0.75},"
-        "\"KHR_materials_ior\":{\"ior\":1.3}}}],"
-        "\"textures\":[{\"source\":0,\"sampler\":0}],"
+        "\"KHR_materials_ior\":{\"ior\":1.3}}},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.6,0.3,1],\"metallicFactor\":0.75,"
+        "\"roughnessFactor\":0.25,\"metallicRoughnessTexture\":{\"index\":1}}}],"
+        "\"textures\":[{\"source\":0,\"sampler\":0},{\"source\":0}],"
         "\"samplers\":[{\"magFilter\":9728,\"wrapS\":33071,\"wrapT\":33071}],"
         "\"images\":[{\"uri\":\"data:image/png;base64,AAAA\"}]");
     scn_hooks h = {.image_mem = fake_image, .warn = on_warn};
@@ -394,18 +400,33 @@ static void test_materials(void)
     fr_error e;
     bld_init(&b);
     T(gltf_import_mem(t, strlen(t), "t.gltf", &h, &o, &b, &r, &e) == 0);
-    T(b.materials.count == 2 && b.textures.count == 1);
-    if (b.materials.count == 2 && b.textures.count == 1) {
+    T(b.materials.count == 4 && b.textures.count == 2);
+    if (b.materials.count == 4 && b.textures.count == 2) {
         const fr_material *m = b.materials.data;
-        T(close3(m[0].emission, 4, 2, 0) && m[0].two_sided == 1 && close3(m[0].diffuse, 1, 1, 1)); /* glTF's default base colour */
-        T(close3(m[1].diffuse, 0.125, 0.125, 0.125) && close3(m[1].transmit, 0.375, 0.375, 0.375));
-        T(m[1].ior == 1.3f && m[1].tex_diffuse == 0 && m[1].tex_transmit == 0 && v3_is_zero(m[1].emission));
+        /* glTF's default material (the last primitive's): white, metallic 1, roughness 1 */
+        for (int i = 0; i < 4; i++)
+            T(m[i].model == FR_MAT_PRINCIPLED && m[i].mf_flags == 0);
+        T(close3(m[0].emission, 4, 2, 0) && m[0].two_sided == 1 && close3(m[0].diffuse, 1, 1, 1) &&
+          m[0].metallic == 1.0f && m[0].roughness == 1.0f);
+        T(close3(m[3].diffuse, 1, 1, 1) && m[3].metallic == 1.0f && m[3].roughness == 1.0f &&
+          v3_is_zero(m[3].emission) && m[3].ior == 1.5f && m[3].transmission == 0.0f);
+        /* transmission and ior: the share of the dielectric that refracts */
+        T(close3(m[1].diffuse, 0.5, 0.5, 0.5) && m[1].transmission == 0.75f && m[1].ior == 1.3f);
+        T(m[1].tex_diffuse == 0 && m[1].tex_roughness == FR_NONE && m[1].tex_metallic == FR_NONE &&
+          v3_is_zero(m[1].emission) && v3_is_zero(m[1].transmit));
+        /* metallicRoughnessTexture: the factors scale its G (roughness) and
+         * B (metallic) channels, read linearly (texture.c) */
+        T(close3(m[2].diffuse, 0.9, 0.6, 0.3) && m[2].metallic == 0.75f && m[2].roughness == 0.25f &&
+          m[2].tex_diffuse == FR_NONE && m[2].tex_roughness == 1 && m[2].tex_metallic == 1 &&
+          m[2].transmission == 0.0f);
         const fr_texture *x = b.textures.data;
         T(x->kind == FR_TEX_IMAGE && x->width == 2 && x->channels == 3);
         T(x->filter == FR_FILTER_NEAREST && x->wrap == FR_WRAP_CLAMP);
         /* v' = 4 v' + (1 - 4 - 0.5) */
         T(x->scale.u == 2.0f && x->scale.v == 4.0f && x->offset.u == 0.25f && x->offset.v == -3.5f);
         T(fabsf(((const float *)b.texels.data)[x->first] - 0.2140411f) < 1e-4f); /* 0.5 sRGB-decoded */
+        T(x[1].wrap == FR_WRAP_REPEAT && x[1].filter == FR_FILTER_BILINEAR && x[1].first != x[0].first);
+        T(((const float *)b.texels.data)[x[1].first] == 0.5f); /* data: not decoded */
     }
     bld_free(&b);
     /* without a decoder, the texture is dropped with a warning */

@@ -322,11 +322,16 @@ static void gen_scene(const char *dir)
         for (int v = 0; v < 3; v++)
             memcpy(prism[i].p + 3 * v, faces[i][v], 3 * sizeof(float));
     doc d = {0};
-    d.used = "[\"KHR_lights_punctual\"]";
+    d.used = "[\"KHR_lights_punctual\",\"KHR_materials_transmission\",\"KHR_materials_ior\"]";
+    /* a rough metal, a dielectric over a diffuse base, a rough glass */
     int grey = material(&d, "\"name\":\"grey\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.6,0.6,0.6,1],"
                             "\"metallicFactor\":1,\"roughnessFactor\":1}");
-    int blue = material(&d, "\"name\":\"blue\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.2,0.3,0.7,1]}");
-    int red = material(&d, "\"name\":\"red\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.7,0.2,0.2,1]}");
+    int blue = material(&d, "\"name\":\"blue\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.2,0.3,0.7,1],"
+                            "\"metallicFactor\":0,\"roughnessFactor\":0.5}");
+    int red = material(&d, "\"name\":\"red\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.7,0.2,0.2,1],"
+                           "\"metallicFactor\":0.25,\"roughnessFactor\":0.3},\"extensions\":{"
+                           "\"KHR_materials_transmission\":{\"transmissionFactor\":0.8},"
+                           "\"KHR_materials_ior\":{\"ior\":1.4}}");
     int m0 = mesh(&d, floor[0].p, 6, NULL, NULL, NULL, 0, grey);
     int m1 = mesh(&d, wall[0].p, 6, NULL, NULL, NULL, 0, blue);
     int m2 = mesh(&d, prism[0].p, 12, NULL, NULL, NULL, 0, red);
@@ -344,9 +349,11 @@ static void gen_scene(const char *dir)
     str j = {0};
     addf(&j, "{\n  \"image\": {\"width\": 640, \"height\": 480, \"spp\": 64, \"max_depth\": 8},\n"
              "  \"camera\": {\"position\": [0, 1, 4], \"target\": [0, 1, 3], \"up\": [0, 1, 0], \"fov\": 40},\n"
-             "  \"materials\": {\"grey\": {\"type\": \"lambert\", \"albedo\": [0.6, 0.6, 0.6]},\n"
-             "                \"blue\": {\"type\": \"lambert\", \"albedo\": [0.2, 0.3, 0.7]},\n"
-             "                \"red\": {\"type\": \"lambert\", \"albedo\": [0.7, 0.2, 0.2]}},\n"
+             "  \"materials\": {\"grey\": {\"type\": \"principled\", \"base_color\": [0.6, 0.6, 0.6]},\n"
+             "                \"blue\": {\"type\": \"principled\", \"base_color\": [0.2, 0.3, 0.7], \"metallic\": 0,"
+             " \"roughness\": 0.5},\n"
+             "                \"red\": {\"type\": \"principled\", \"base_color\": [0.7, 0.2, 0.2], \"metallic\": 0.25,"
+             " \"roughness\": 0.3, \"transmission\": 0.8, \"ior\": 1.4}},\n"
              "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 2], \"intensity\": [20, 20, 20]}],\n"
              "  \"shapes\": [");
     str t = {0};
@@ -453,9 +460,14 @@ static void gen_example(const char *dir)
 {
     doc d = {0};
     d.used = "[\"KHR_lights_punctual\",\"KHR_materials_emissive_strength\"]";
-    int ground = material(&d, "\"name\":\"stone\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.55,0.52,0.48,1]}");
-    int clay = material(&d, "\"name\":\"clay\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.75,0.35,0.2,1]}");
-    int teal = material(&d, "\"name\":\"teal\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.15,0.5,0.5,1]}");
+    /* glTF's factors default to a rough metal: the stone and the clay say
+     * they are not metals; the teal is a rough metal */
+    int ground = material(&d, "\"name\":\"stone\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.55,0.52,0.48,1],"
+                              "\"metallicFactor\":0,\"roughnessFactor\":0.8}");
+    int clay = material(&d, "\"name\":\"clay\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.75,0.35,0.2,1],"
+                            "\"metallicFactor\":0,\"roughnessFactor\":0.45}");
+    int teal = material(&d, "\"name\":\"teal\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.15,0.5,0.5,1],"
+                            "\"metallicFactor\":1,\"roughnessFactor\":0.35}");
     int lamp = material(&d, "\"name\":\"lamp\",\"emissiveFactor\":[1,0.8,0.5],\"extensions\":"
                             "{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":6}}");
     /* ground */
