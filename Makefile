@@ -148,13 +148,14 @@ bench: all $(TOOL_BIN) $(BENCH_BIN)
 render: all
 	bin/franja render scenes/cornell.json -o cornell.png
 
-# The small Cycles renders in tests/data that tests/it_conventions.sh and
-# tests/it_envlight.sh compare against, made again with Debian's blender
-# (apt-get install blender).  The tests read the committed files: only this
-# target needs blender.
+# The small Cycles renders in tests/data that tests/it_conventions.sh,
+# tests/it_envlight.sh and tests/it_cycles_rough.sh compare against, made
+# again with Debian's blender (apt-get install blender).  The tests read the
+# committed files: only this target needs blender.
 refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
+	blender -b --factory-startup --python tests/refs/cycles_rough.py -- tests/data/cycles-rough.json tests/data
 
 # HTML API documentation of the headers, in build/docs/html (Doxygen).
 docs:

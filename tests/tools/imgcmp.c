@@ -1,10 +1,12 @@
 /* imgcmp -- compare a rendered PFM against a reference PFM.
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
- *          [--max-block-rel Z [--block N]]
+ *          [--max-block-rel Z [--block N]] [--down D]
  *
  * IMAGE is box-downsampled to the reference's size when it is an integer
- * multiple of it.  Prints each channel's mean (image and reference) and the
+ * multiple of it; with --down, both are then box-downsampled by D (which
+ * must divide the reference's sides), and everything below is measured on
+ * the smaller images (block sizes in their pixels).  Prints each channel's mean (image and reference) and the
  * RMSE over all channels of the pixels off the light (reference pixels with
  * a channel >= 10 are the light), and with --max-block-rel the worst
  * relative difference of the mean (all channels, off the light) over the
@@ -48,13 +50,30 @@ bad:
     return -1;
 }
 
+/* Box-downsample im by f in place (f divides its sides). */
+static void box_down(image *im, int f)
+{
+    int w = im->w / f, h = im->h / f;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int ch = 0; ch < 3; ch++) {
+                double v = 0;
+                for (int j = 0; j < f; j++)
+                    for (int i = 0; i < f; i++)
+                        v += im->px[((size_t)(y * f + j) * im->w + x * f + i) * 3 + ch];
+                im->px[((size_t)y * w + x) * 3 + ch] = (float)(v / (f * f));
+            }
+    im->w = w;
+    im->h = h;
+}
+
 int main(int argc, char **argv)
 {
     double max_rmse = -1, max_rel = -1, max_block = -1;
-    int bs = 64;
+    int bs = 64, down = 1;
     if (argc < 3) {
         fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y] "
-                        "[--max-block-rel Z [--block N]]\n");
+                        "[--max-block-rel Z [--block N]] [--down D]\n");
         return 2;
     }
     for (int i = 3; i + 1 < argc; i += 2) {
@@ -62,16 +81,24 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--max-mean-rel")) max_rel = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--max-block-rel")) max_block = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--block")) bs = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--down")) down = atoi(argv[i + 1]);
         else { fprintf(stderr, "imgcmp: unknown option %s\n", argv[i]); return 2; }
     }
     if (bs < 1 || bs > 65536) { fprintf(stderr, "imgcmp: bad block size\n"); return 2; }
+    if (down < 1 || down > 65536) { fprintf(stderr, "imgcmp: bad --down\n"); return 2; }
     image a, r;
     if (read_pfm(argv[1], &a) < 0 || read_pfm(argv[2], &r) < 0) return 2;
     if (a.w % r.w || a.h % r.h || a.w / r.w != a.h / r.h) {
         fprintf(stderr, "imgcmp: %dx%d is not a multiple of %dx%d\n", a.w, a.h, r.w, r.h);
         return 2;
     }
-    int k = a.w / r.w;
+    if (r.w % down || r.h % down) {
+        fprintf(stderr, "imgcmp: --down %d does not divide %dx%d\n", down, r.w, r.h);
+        return 2;
+    }
+    box_down(&a, a.w / r.w * down);
+    box_down(&r, down);
+    int k = 1;
     double mean[3] = {0}, rmean[3] = {0}, se = 0;
     long off = 0;
     int nbx = (r.w + bs - 1) / bs, nby = (r.h + bs - 1) / bs;
