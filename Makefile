@@ -5,6 +5,7 @@
 #   make check      build and run every test
 #   make bench      benchmarks (see tests/bench/)
 #   make render     render scenes/cornell.json to cornell.png on this machine
+#   make install    bin/, man pages and bash completion under PREFIX (DESTDIR)
 #   make refs       the Cycles references in tests/data (needs blender)
 
 CC      ?= cc
@@ -52,7 +53,7 @@ LIB         = $(B)/libfranja.a
 WORKER_LIBS = $(CJSON_LIBS) -lm
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm -pthread
 
-.PHONY: all deps check test bench render clean docs fuzz static dist check-cross refs
+.PHONY: all deps check test bench render clean docs fuzz static dist check-cross refs install uninstall
 all: bin/franja-worker bin/franja
 
 $(B)/%.o: %.c
@@ -156,6 +157,29 @@ refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
 	blender -b --factory-startup --python tests/refs/cycles_rough.py -- tests/data/cycles-rough.json tests/data
+
+# make install [PREFIX=/usr/local] [DESTDIR=staging]: the two programs, their
+# manual pages and bash completion; make uninstall removes exactly those files.
+# franja finds the franja-worker installed beside it.
+PREFIX     ?= /usr/local
+BINDIR     ?= $(PREFIX)/bin
+MANDIR     ?= $(PREFIX)/share/man
+BASHCOMPDIR ?= $(PREFIX)/share/bash-completion/completions
+MAN1 = $(wildcard coordinator/man/*.1)
+MAN5 = $(wildcard coordinator/man/*.5)
+INSTALLED = $(BINDIR)/franja $(BINDIR)/franja-worker $(MAN1:coordinator/man/%=$(MANDIR)/man1/%) \
+	    $(MAN5:coordinator/man/%=$(MANDIR)/man5/%) $(BASHCOMPDIR)/franja $(BASHCOMPDIR)/franja-worker
+
+install: all
+	install -d '$(DESTDIR)$(BINDIR)' '$(DESTDIR)$(MANDIR)/man1' '$(DESTDIR)$(MANDIR)/man5' '$(DESTDIR)$(BASHCOMPDIR)'
+	install -m 755 bin/franja bin/franja-worker '$(DESTDIR)$(BINDIR)/'
+	install -m 644 $(MAN1) '$(DESTDIR)$(MANDIR)/man1/'
+	install -m 644 $(MAN5) '$(DESTDIR)$(MANDIR)/man5/'
+	install -m 644 coordinator/completion/franja.bash '$(DESTDIR)$(BASHCOMPDIR)/franja'
+	install -m 644 coordinator/completion/franja.bash '$(DESTDIR)$(BASHCOMPDIR)/franja-worker'
+
+uninstall:
+	rm -f $(INSTALLED:%='$(DESTDIR)%')
 
 # HTML API documentation of the headers, in build/docs/html (Doxygen).
 docs:
