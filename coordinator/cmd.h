@@ -28,4 +28,11 @@ int cmd_deploy(int argc, char **argv);
  * error. */
 int cmd_compile(int argc, char **argv);
 
+/** `franja stitch JOBDIR -o OUT`: writes the image a job directory's
+ * finished slabs make, rows not yet rendered shown as a checkerboard, and
+ * says how many rows are present.  0 when written, 1 when the directory is
+ * not a readable job directory or the image cannot be written, 2 on a
+ * usage error. */
+int cmd_stitch(int argc, char **argv);
+
 #endif

@@ -3,8 +3,8 @@
 
 #include <stdio.h>
 #include <string.h>
-#include <strings.h>
 
+#include "opt.h"
 #include "clock.h"
 #include "compile.h"
 #include "fbin.h"
@@ -15,12 +15,13 @@ static const char usage[] =
     "Reads a JSON scene and the meshes it names (OBJ with MTL; PLY, STL, glTF\n"
     "and other formats through Assimp), or a whole glTF 2.0 scene, builds the\n"
     "BVH and writes the binary scene that workers map and render (format:\n"
-    "common/FORMAT.md).  The output defaults to the scene's name with .fbin for\n"
-    "its extension.  Prints the content hash that names the scene, its size and\n"
+    "common/FORMAT.md).  The output defaults to the scene's file name with .fbin\n"
+    "for its extension, in the current directory.  Prints the content hash that names the scene, its size and\n"
     "what it holds.  Features of a glTF file that are not supported are named\n"
     "in warnings.\n"
     "\n"
-    "  -o FILE         the binary scene to write\n"
+    "  -o FILE         the binary scene to write (without -o: SCENE.fbin in the\n"
+    "                  current directory)\n"
     "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
     "                  name (default: the first in the scene)\n";
 
@@ -64,12 +65,8 @@ int cmd_compile(int argc, char **argv)
     }
     char def[4096];
     if (!out) {
-        size_t n = strlen(in);
-        const char *dot = strrchr(in, '.'), *slash = strrchr(in, '/');
-        if (dot && (!slash || dot > slash) && (!strcasecmp(dot, ".json") || compile_is_gltf(in)))
-            n = (size_t)(dot - in);
-        if (snprintf(def, sizeof def, "%.*s.fbin", (int)n, in) >= (int)sizeof def) {
-            fprintf(stderr, "franja compile: %s: name too long\n", in);
+        if (opt_default_output(in, ".fbin", def, sizeof def)) {
+            fprintf(stderr, "franja compile: %s: cannot make an output name from it; give -o FILE\n", in);
             return 2;
         }
         out = def;

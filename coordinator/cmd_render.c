@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "opt.h"
 #include "clock.h"
 #include "cluster.h"
 #include "compile.h"
@@ -25,13 +26,14 @@
 #include "tonemap.h"
 
 static const char usage[] =
-    "usage: franja render SCENE(.json|.gltf|.glb|.fbin) -o OUT [options]\n"
+    "usage: franja render SCENE(.json|.gltf|.glb|.fbin) [-o OUT] [options]\n"
     "\n"
     "Renders SCENE on this machine's cores, on the hosts of a host table over SSH,\n"
     "or on the CPUs of a Slurm allocation, and writes OUT (.png .exr .tif .jpg .hdr\n"
     ".ppm .bmp .pfm, by extension).\n"
     "\n"
-    "  -o OUT               output image (written atomically, only when complete)\n"
+    "  -o OUT               output image (written atomically, only when complete;\n"
+    "                       without -o, SCENE.png in the current directory)\n"
     "  --hosts FILE         host table (franja-hosts(5)); default: this machine\n"
     "  -j N                 worker processes (local: default one per core;\n"
     "                       with --hosts or --slurm: at most N per host)\n"
@@ -72,6 +74,7 @@ typedef struct {
     float exposure;
     int exposure_set;          /* --exposure given: overrides the scene's */
     const char *curve;         /* --tonemap, or NULL for the scene's */
+    char out_buf[4096];        /* out when -o is omitted */
     int resume, keep_job, fresh, no_lock;
     tr_options tr;
     cli_slurm slurm;
@@ -165,10 +168,16 @@ static int parse(int argc, char **argv, render_args *a)
             return 2;
         }
     }
-    if (!a->scene || !a->out) {
-        fprintf(stderr, "franja render: %s is required (see franja render --help)\n",
-                a->scene ? "-o OUT" : "a SCENE");
+    if (!a->scene) {
+        fprintf(stderr, "franja render: a SCENE is required (see franja render --help)\n");
         return 2;
+    }
+    if (!a->out) {
+        if (opt_default_output(a->scene, ".png", a->out_buf, sizeof a->out_buf)) {
+            fprintf(stderr, "franja render: %s: cannot make an output name from it; give -o OUT\n", a->scene);
+            return 2;
+        }
+        a->out = a->out_buf;
     }
     if (a->resume && a->fresh) {
         fprintf(stderr, "franja render: --resume and --fresh exclude each other\n");

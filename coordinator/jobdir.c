@@ -116,9 +116,11 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
 typedef struct {
     const job_spec *spec;
     unsigned char *have;
-    float *rgb;                /* job_stitch only */
+    float *rgb;                /* job_stitch and job_gather only */
     int rows;
     const note_sink *notes;
+    int keep;                  /* job_gather: skip bad slabs, silently, and keep them */
+    int skipped;
 } scan_ctx;
 
 static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
@@ -144,6 +146,10 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
         }
         free(text);
     }
+    if (bad && c->keep) {
+        c->skipped++;
+        return 0;
+    }
     if (bad) {
         note_say(c->notes, "%s: discarded (%s)", path, e.msg);
         unlink(path);
@@ -158,7 +164,7 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
 
 int job_scan(const char *dir, const job_spec *spec, unsigned char *have, const note_sink *notes, fr_error *err)
 {
-    scan_ctx c = {spec, have, NULL, 0, notes};
+    scan_ctx c = {spec, have, NULL, 0, notes, 0, 0};
     memset(have, 0, spec->height);
     if (each_slab(dir, scan_one, &c, err))
         return -1;
@@ -236,7 +242,7 @@ int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sin
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, rgb, 0, notes};
+    scan_ctx c = {spec, have, rgb, 0, notes, 0, 0};
     int rc = each_slab(dir, scan_one, &c, err);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];
@@ -245,6 +251,47 @@ int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sin
     }
     free(have);
     return rc;
+}
+
+int job_gather(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped,
+               fr_error *err)
+{
+    scan_ctx c = {spec, have, rgb, 0, NULL, 1, 0};
+    memset(have, 0, spec->height);
+    int rc = each_slab(dir, scan_one, &c, err);
+    if (skipped)
+        *skipped = c.skipped;
+    return rc ? -1 : c.rows;
+}
+
+int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
+{
+    char path[4200], *text;
+    size_t len;
+    snprintf(path, sizeof path, "%s/job", dir);
+    if (file_read(path, &text, &len, err))
+        return fr_fail(err, "%s: not a job directory (no readable job file: %s)", dir, err->msg);
+    unsigned long long hash = 0;
+    unsigned w = 0, h = 0, spp = 0;
+    int n = -1;
+    /* Exactly what spec_text writes, and nothing after it. */
+    int ok = len < 200 && memchr(text, 0, len) == NULL;
+    if (ok) {
+        char copy[200];
+        memcpy(copy, text, len);
+        copy[len] = 0;
+        ok = sscanf(copy, "franja job\nscene=%16llx\nsize=%ux%u\nspp=%u\n%n", &hash, &w, &h, &spp, &n) == 4 &&
+             n == (int)len;
+    }
+    free(text);
+    if (!ok || w == 0 || h == 0 || w > PROTO_MAX_SIZE || h > PROTO_MAX_SIZE || spp == 0 || spp > PROTO_MAX_SPP)
+        return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, "
+                       "sizes in 1..%u)", path, PROTO_MAX_SIZE);
+    spec->hash = hash;
+    spec->width = w;
+    spec->height = h;
+    spec->spp = spp;
+    return 0;
 }
 
 void job_remove(const char *dir)

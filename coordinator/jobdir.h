@@ -52,6 +52,21 @@ int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf
  * job_scan.  Fails, naming the missing rows, unless every row is covered. */
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err);
 
+/** Reads what render the job directory dir belongs to (DIR/job) into
+ * *spec.  Fails naming the file and what is wrong when it is missing or
+ * not one that job_open wrote. */
+int job_read_spec(const char *dir, job_spec *spec, fr_error *err);
+
+/** Reads whatever finished slabs dir holds into rgb (width*height*3
+ * floats, top row first) and marks their rows in have[0..height), for an
+ * image of a render in progress or cut short.  Unlike job_scan and
+ * job_stitch it changes nothing in dir: a slab that does not check out is
+ * skipped and counted in *skipped (when not NULL).  Rows not covered are
+ * left as they were in rgb.  Returns the number of rows covered, or -1
+ * when dir cannot be read. */
+int job_gather(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped,
+               fr_error *err);
+
 /** Counts the rows that slab files in dir cover, whatever render they
  * belong to (by their names only; nothing is read or removed).  0 when dir
  * does not exist. */

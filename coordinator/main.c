@@ -7,17 +7,45 @@
 #include "protocol.h"
 
 static const char usage[] =
-    "usage: franja render SCENE -o OUT [--hosts FILE | --slurm] [-j N] [--spp N]\n"
+    "usage: franja render SCENE [-o OUT] [--hosts FILE | --slurm] [-j N] [--spp N]\n"
     "                     [--size WxH] [--exposure E] [--resume] [--accept-new-hosts] ...\n"
-    "       franja compile ...\n"
+    "       franja compile SCENE [-o SCENE.fbin] [--camera NAME]\n"
     "       franja hosts check|list --hosts FILE | --slurm\n"
     "       franja deploy --hosts FILE [--dist DIR]\n"
-    "       franja --help | --version\n"
+    "       franja stitch JOBDIR -o OUT\n"
+    "       franja help [COMMAND]\n"
+    "       franja version | -V | --version\n"
     "\n"
     "Franja renders a scene with a path tracer, on this machine's cores, on a\n"
-    "cluster over SSH, or on the CPUs of a Slurm allocation.  `franja COMMAND\n"
-    "--help` describes each command; the manual pages are franja(1),\n"
-    "franja-worker(1) and franja-hosts(5).\n";
+    "cluster over SSH, or on the CPUs of a Slurm allocation.  `franja help\n"
+    "COMMAND` or `franja COMMAND --help` describes each command; the manual\n"
+    "pages are franja(1), franja-worker(1) and franja-hosts(5).\n";
+
+typedef int (*command_fn)(int argc, char **argv);
+
+/* The subcommand called name, or NULL. */
+static command_fn lookup(const char *name)
+{
+    static const struct {
+        const char *name;
+        command_fn fn;
+    } cmds[] = {{"render", cmd_render}, {"compile", cmd_compile}, {"hosts", cmd_hosts}, {"deploy", cmd_deploy},
+                  {"stitch", cmd_stitch}};
+    for (size_t i = 0; i < sizeof cmds / sizeof *cmds; i++)
+        if (!strcmp(name, cmds[i].name))
+            return cmds[i].fn;
+    return NULL;
+}
+
+static int run(command_fn fn, int argc, char **argv)
+{
+    /* Only the commands that reach hosts need libssh set up; doing it for
+     * every one costs nothing worth avoiding. */
+    ssh_init();
+    int rc = fn(argc, argv);
+    ssh_finalize();
+    return rc;
+}
 
 int main(int argc, char **argv)
 {
@@ -26,27 +54,33 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *cmd = argv[1];
-    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
-        fputs(usage, stdout);
-        return 0;
-    }
-    if (!strcmp(cmd, "--version")) {
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "-V") || !strcmp(cmd, "version")) {
+        if (argc > 2) {
+            fprintf(stderr, "franja %s: takes no arguments\n", cmd);
+            return 2;
+        }
         char line[128];
         proto_version_line("franja", line, sizeof line);
         printf("%s\n", line);
         return 0;
     }
-    if (!strcmp(cmd, "compile"))
-        return cmd_compile(argc - 1, argv + 1);
-    if (!strcmp(cmd, "deploy"))
-        return cmd_deploy(argc - 1, argv + 1);
-    int rc;
-    if (!strcmp(cmd, "render") || !strcmp(cmd, "hosts")) {
-        ssh_init();
-        rc = !strcmp(cmd, "render") ? cmd_render(argc - 1, argv + 1) : cmd_hosts(argc - 1, argv + 1);
-        ssh_finalize();
-        return rc;
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        if (argc == 2) {
+            fputs(usage, stdout);
+            return 0;
+        }
+        command_fn fn = lookup(argv[2]);
+        if (!fn || argc > 3) {
+            fprintf(stderr, "franja help: %s '%s'; the commands are render, compile, hosts, deploy and stitch\n",
+                    fn ? "one command at a time, not" : "no command", argc > 3 && fn ? argv[3] : argv[2]);
+            return 2;
+        }
+        char *args[] = {argv[2], (char *)"--help", NULL};
+        return run(fn, 2, args);
     }
+    command_fn fn = lookup(cmd);
+    if (fn)
+        return run(fn, argc - 1, argv + 1);
     fprintf(stderr, "franja: unknown command '%s'\n\n%s", cmd, usage);
     return 2;
 }

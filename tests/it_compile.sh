@@ -20,7 +20,10 @@ expect_error "no scene" "usage: franja compile" $F compile
 expect_error "unknown option" "unknown option '--fast'" $F compile --fast scenes/cornell.json
 expect_error "two scenes" "one scene at a time" $F compile scenes/cornell.json scenes/spheres.json
 cp scenes/cornell.json "$T/box.json"
-$F compile "$T/box.json" >/dev/null && [ -s "$T/box.fbin" ] && ok || bad "default output name (.json -> .fbin)"
+# Without -o: SCENE.fbin in the current directory, not beside the scene.
+mkdir "$T/here"
+(R=$(pwd) && cd "$T/here" && "$R/$F" compile "$T/box.json" >/dev/null) && [ -s "$T/here/box.fbin" ] && [ ! -e "$T/box.fbin" ] && ok ||
+    bad "default output name (.json -> .fbin in the current directory)"
 
 # --- compiled scenes render the bytes their JSON renders ---
 for s in scenes/*.json; do

@@ -165,7 +165,7 @@ lint() {
         franja | */franja | franja-worker | */franja-worker)
             prog=$(basename "$cmd") sub=""
             if [ "$prog" = franja ]; then
-                case "${1:-}" in render | compile | deploy) sub=$1; shift ;; hosts) sub="hosts ${2:-}"; shift 2 ;; esac
+                case "${1:-}" in render | compile | deploy | stitch) sub=$1; shift ;; hosts) sub="hosts ${2:-}"; shift 2 ;; esac
             fi
             help_of "$prog" $sub >"$T/help"
             for w in "$@"; do

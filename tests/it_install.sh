@@ -65,7 +65,7 @@ hasnt() {
     for w in "$@"; do printf '%s\n' "$list" | grep -qxF -- "$w" && bad "$what: '$w' offered" || ok; done
 }
 c=$(comp franja "")
-has "franja <TAB>" "$c" render compile hosts deploy help version
+has "franja <TAB>" "$c" render compile stitch hosts deploy help version
 c=$(comp franja re)
 [ "$c" = render ] && ok || bad "franja re<TAB> gives '$c', not render"
 c=$(comp franja render --s)
@@ -82,6 +82,9 @@ c=$(comp franja compile "")
 has "franja compile <TAB>" "$c" room.json shot.glb
 hasnt "franja compile <TAB>" "$c" room.fbin notes.txt
 has "franja render --tonemap <TAB>" "$(comp franja render x.json --tonemap "")" none filmic
+c=$(comp franja stitch "")
+has "franja stitch <TAB>" "$c" sub
+hasnt "franja stitch <TAB>" "$c" room.json
 has "franja hosts <TAB>" "$(comp franja hosts "")" check list
 has "franja hosts check --<TAB>" "$(comp franja hosts check --)" --hosts --timeout --slurm
 has "franja-worker --<TAB>" "$(comp franja-worker --)" --scene --rows --format

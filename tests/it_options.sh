@@ -96,7 +96,7 @@ compare_sets() {
 
 # --- franja ---
 : >"$T/f.help"
-for c in render compile hosts deploy; do
+for c in render compile hosts deploy stitch; do
     bin/franja $c --help >"$T/f.$c" 2>&1 || bad "franja $c --help exits non-zero"
     cat "$T/f.$c" >>"$T/f.help"
 done
@@ -113,7 +113,7 @@ done <"$T/dups"
 sort -t "$(printf '\t')" -k1,1 -k2,2r "$T/f.lines" | awk -F '\t' '!seen[$1]++' >"$T/f.opts"
 # What franja --help names must be options of its commands.
 named <"$T/f.top" | while read -r opt; do
-    case "$opt" in --help | --version | -h) continue ;; esac
+    case "$opt" in --help | --version | -h | -V) continue ;; esac
     cat "$T/f.help" | named | grep -qx -- "$opt" || echo "franja --help names $opt, which no command's --help describes"
 done >"$T/top.extra"
 if [ -s "$T/top.extra" ]; then while IFS= read -r l; do bad "$l"; done <"$T/top.extra"; else ok; fi

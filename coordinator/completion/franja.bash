@@ -11,6 +11,7 @@
 #   franja render <TAB>          scene files (.json .gltf .glb .fbin) and directories
 #   franja render --tonemap <TAB>  none filmic
 #   franja hosts <TAB>           check list
+#   franja stitch <TAB>          directories (job directories)
 
 # _franja_opts PROGRAM [WORDS...]: the options that `PROGRAM WORDS --help` lists.
 _franja_opts()
@@ -44,7 +45,7 @@ _franja()
         if [[ $cur == -* ]]; then
             COMPREPLY=($(compgen -W "--help --version -V" -- "$cur"))
         else
-            COMPREPLY=($(compgen -W "render compile hosts deploy help version" -- "$cur"))
+            COMPREPLY=($(compgen -W "render compile stitch hosts deploy help version" -- "$cur"))
         fi
         return 0
     fi
@@ -73,7 +74,8 @@ _franja()
     compile) _franja_files "$cur" '*.@(json|gltf|glb)' ;;
     hosts)
         [ "$i" -eq $((COMP_CWORD - 1)) ] && COMPREPLY=($(compgen -W "check list" -- "$cur")) ;;
-    help) COMPREPLY=($(compgen -W "render compile hosts deploy" -- "$cur")) ;;
+    stitch) COMPREPLY=($(compgen -d -- "$cur")) ;;
+    help) COMPREPLY=($(compgen -W "render compile stitch hosts deploy" -- "$cur")) ;;
     esac
     return 0
 }

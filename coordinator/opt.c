@@ -1,0 +1,219 @@
+/* opt.c -- option parsing for the subcommands (see opt.h). */
+#include "opt.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "protocol.h"
+
+/* A decimal integer in [lo, hi], no sign, nothing after it. */
+static int parse_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    char *end;
+    errno = 0;
+    if (!s || !*s || *s == '-' || *s == '+')
+        return -1;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno || *end || v < lo || v > hi)
+        return -1;
+    *out = (uint32_t)v;
+    return 0;
+}
+
+int opt_default_output(const char *scene, const char *ext, char *buf, size_t cap)
+{
+    const char *slash = strrchr(scene, '/');
+    const char *base = slash ? slash + 1 : scene;
+    size_t n = strlen(base);
+    static const char *const scene_ext[] = {".json", ".gltf", ".glb", ".fbin"};
+    for (size_t i = 0; i < sizeof scene_ext / sizeof *scene_ext; i++) {
+        size_t e = strlen(scene_ext[i]);
+        if (n >= e && !strcasecmp(base + n - e, scene_ext[i])) {
+            n -= e;
+            break;
+        }
+    }
+    if (n == 0 || (n == 1 && base[0] == '.') || (n == 2 && !strncmp(base, "..", 2)))
+        return -1;
+    int len = snprintf(buf, cap, "%.*s%s", (int)n, base, ext);
+    return len < 0 || (size_t)len >= cap ? -1 : 0;
+}
+
+/* Levenshtein distance of a[0..na) and b[0..nb), capped at 32 characters. */
+static int edits(const char *a, size_t na, const char *b, size_t nb)
+{
+    if (na > 32 || nb > 32)
+        return 99;
+    int row[33];
+    for (size_t j = 0; j <= nb; j++)
+        row[j] = (int)j;
+    for (size_t i = 1; i <= na; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= nb; j++) {
+            int up = row[j];
+            int best = diag + (a[i - 1] != b[j - 1]);
+            if (row[j] + 1 < best)
+                best = row[j] + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            diag = up;
+            row[j] = best;
+        }
+    }
+    return row[nb];
+}
+
+int opt_suggest(const char *typed, const char *shortopts, const struct option *longopts, char *buf, size_t cap)
+{
+    /* What people coming from other renderers type, and what franja calls it. */
+    static const char *const synonyms[][2] = {
+        {"samples", "spp"},   {"spp-count", "spp"}, {"resolution", "size"}, {"res", "size"},
+        {"threads", "j"},     {"jobs", "j"},        {"output", "o"},        {"out", "o"},
+        {"host", "hosts"},    {"hostfile", "hosts"}, {"curve", "tonemap"},  {"tone-map", "tonemap"},
+        {"continue", "resume"}, {"ev", "exposure"},
+    };
+    const char *name = typed;
+    while (*name == '-')
+        name++;
+    size_t n = strcspn(name, "=");
+    if (n == 0)
+        return -1;
+    const char *best = NULL;
+    for (size_t i = 0; i < sizeof synonyms / sizeof *synonyms && !best; i++)
+        if (strlen(synonyms[i][0]) == n && !strncmp(name, synonyms[i][0], n))
+            best = synonyms[i][1];
+    if (best) {
+        /* A synonym counts only if the command has what it stands for. */
+        int have = strlen(best) == 1 ? strchr(shortopts, best[0]) != NULL : 0;
+        for (const struct option *o = longopts; o->name && !have; o++)
+            have = !strcmp(o->name, best);
+        if (!have)
+            best = NULL;
+    }
+    /* Otherwise the nearest long option within a few edits (fewer for
+     * short names, where a few edits make anything of anything). */
+    int limit = n <= 3 ? 1 : n <= 6 ? 2 : 3;
+    const char *nearest = NULL;
+    for (const struct option *o = longopts; o->name && !best; o++) {
+        int d = edits(name, n, o->name, strlen(o->name));
+        if (d <= limit) {
+            limit = d - 1;
+            nearest = o->name;
+        }
+    }
+    if (!best)
+        best = nearest;
+    if (!best)
+        return -1;
+    int len = snprintf(buf, cap, strlen(best) == 1 ? "-%s" : "--%s", best);
+    return len < 0 || (size_t)len >= cap ? -1 : 0;
+}
+
+int opt_next(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts)
+{
+    char spec[64];
+    snprintf(spec, sizeof spec, ":%s", shortopts);
+    opterr = 0;
+    int c = getopt_long(argc, argv, spec, longopts, NULL);
+    if (c != '?' && c != ':')
+        return c;
+    /* What was typed: the long option just passed, else the short one. */
+    char typed[80];
+    const char *prev = optind > 0 && optind <= argc ? argv[optind - 1] : "";
+    if (!strncmp(prev, "--", 2))
+        snprintf(typed, sizeof typed, "%.*s", (int)strcspn(prev, "="), prev);
+    else
+        snprintf(typed, sizeof typed, "-%c", optopt ? optopt : '?');
+    if (c == ':') {
+        fprintf(stderr, "franja %s: %s needs a value (see franja %s --help)\n", cmd, typed, cmd);
+        return '?';
+    }
+    if (typed[1] == '-' && strchr(prev, '=')) {
+        /* --flag=value for an option that takes none. */
+        const struct option *match = NULL;
+        int matches = 0;
+        for (const struct option *o = longopts; o->name; o++)
+            if (!strncmp(o->name, typed + 2, strlen(typed + 2))) {
+                matches++;
+                match = o;
+                if (!strcmp(o->name, typed + 2)) {
+                    matches = 1;   /* an exact name wins over longer ones */
+                    break;
+                }
+            }
+        if (matches == 1 && match->has_arg == no_argument) {
+            fprintf(stderr, "franja %s: --%s takes no value\n", cmd, match->name);
+            return '?';
+        }
+    }
+    if (typed[1] == '-') {
+        /* A known prefix of several options is ambiguous, not unknown. */
+        size_t n = strlen(typed + 2), k = 0;
+        char which[256] = "";
+        for (const struct option *o = longopts; o->name; o++)
+            if (n && !strncmp(o->name, typed + 2, n)) {
+                size_t used = strlen(which);
+                snprintf(which + used, sizeof which - used, "%s--%s", k++ ? ", " : "", o->name);
+            }
+        if (k > 1) {
+            fprintf(stderr, "franja %s: %s is ambiguous: %s\n", cmd, typed, which);
+            return '?';
+        }
+    }
+    char near[80];
+    if (opt_suggest(typed, shortopts, longopts, near, sizeof near) == 0)
+        fprintf(stderr, "franja %s: unknown option '%s'; did you mean %s? (see franja %s --help)\n", cmd, typed,
+                near, cmd);
+    else
+        fprintf(stderr, "franja %s: unknown option '%s' (see franja %s --help)\n", cmd, typed, cmd);
+    return '?';
+}
+
+int opt_uint(const char *cmd, const char *opt, const char *v, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    if (parse_uint(v, lo, hi, out) == 0)
+        return 0;
+    fprintf(stderr, "franja %s: %s: '%s' is not an integer in %u..%u\n", cmd, opt, v, lo, hi);
+    return -1;
+}
+
+int opt_float(const char *cmd, const char *opt, const char *v, float lo, float hi, float *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    if (!errno && end != v && !*end && d >= lo && d <= hi) {
+        *out = (float)d;
+        return 0;
+    }
+    fprintf(stderr, "franja %s: %s: '%s' is not a number in %g..%g\n", cmd, opt, v, (double)lo, (double)hi);
+    return -1;
+}
+
+int opt_size(const char *cmd, const char *opt, const char *v, uint32_t *w, uint32_t *h)
+{
+    if (proto_parse_size(v, w, h) == 0)
+        return 0;
+    fprintf(stderr, "franja %s: %s: '%s' is not WxH (width and height in pixels, each in 1..%u, like 640x480)\n",
+            cmd, opt, v, PROTO_MAX_SIZE);
+    return -1;
+}
+
+int opt_choice(const char *cmd, const char *opt, const char *v, const char *const *choices)
+{
+    for (int i = 0; choices[i]; i++)
+        if (!strcmp(v, choices[i]))
+            return i;
+    char list[256] = "";
+    for (int i = 0; choices[i]; i++) {
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", choices[i]);
+    }
+    fprintf(stderr, "franja %s: %s: '%s' is not one of: %s\n", cmd, opt, v, list);
+    return -1;
+}
+

@@ -1,0 +1,58 @@
+/** @file opt.h
+ * Command-line options of the franja subcommands: getopt_long with the
+ * messages franja gives (the nearest option to an unknown one; what a bad
+ * value may be), value parsers that say what is allowed, and the output
+ * name made from a scene's.  Messages go to stderr as "franja CMD: ...";
+ * nothing here exits.
+ */
+#ifndef FRANJA_OPT_H
+#define FRANJA_OPT_H
+
+#include <getopt.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/** The name of an output made from scene in the current directory: the
+ * scene's file name without its directory and without a scene extension
+ * (.json .gltf .glb .fbin, any case), then ext (".png", ".fbin"): so
+ * "scenes/cornell.json" gives "cornell.png".  Returns -1 when that name
+ * does not fit in buf[cap] or would be ext alone (a scene named ".json"). */
+int opt_default_output(const char *scene, const char *ext, char *buf, size_t cap);
+
+/** The next option of a subcommand's argv, by getopt_long(3) (options and
+ * operands in any order, --spp=8 or --spp 8, abbreviations that are
+ * unambiguous, -- ends the options; argv is permuted so that the operands
+ * end up in argv[optind..argc)).  Set optind = 0 before the first call.
+ * shortopts and longopts are getopt_long's (shortopts without a leading
+ * ':').  Returns the option's value, *optarg set when it takes one, or -1
+ * after the last option.  An unknown option (with the nearest known one,
+ * opt_suggest), an ambiguous abbreviation (with its candidates) or a
+ * missing value is reported on stderr as "franja CMD: ..." and returns '?'. */
+int opt_next(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts);
+
+/** The known option nearest to typed (an option as written, "--samples",
+ * "--spp=0", "-x"), for "did you mean": a usual synonym ("--samples" ->
+ * "--spp"), a long option within a few edits, or one that typed is a
+ * prefix of.  Writes "--NAME" or "-C" to buf[cap] and returns 0; -1 when
+ * none is near. */
+int opt_suggest(const char *typed, const char *shortopts, const struct option *longopts, char *buf, size_t cap);
+
+/** Parses an option's value as a decimal integer in [lo, hi]; otherwise
+ * prints "franja CMD: OPT: 'V' is not an integer in LO..HI" and returns
+ * -1. */
+int opt_uint(const char *cmd, const char *opt, const char *v, uint32_t lo, uint32_t hi, uint32_t *out);
+
+/** Parses an option's value as a number in [lo, hi] (strtod); otherwise
+ * prints the range and returns -1. */
+int opt_float(const char *cmd, const char *opt, const char *v, float lo, float hi, float *out);
+
+/** Parses an option's value as WxH (proto_parse_size); otherwise prints
+ * what is expected and returns -1. */
+int opt_size(const char *cmd, const char *opt, const char *v, uint32_t *w, uint32_t *h);
+
+/** Finds v among the NULL-terminated choices and returns its index;
+ * otherwise prints "franja CMD: OPT: 'V' is not one of: A, B" and returns
+ * -1. */
+int opt_choice(const char *cmd, const char *opt, const char *v, const char *const *choices);
+
+#endif
