@@ -76,8 +76,8 @@ check "resume refuses another render's job directory" grep -q "belongs to anothe
 "$FRANJA" render scene.fbin -o x.xyz 2>e1
 check "unknown output type refused (status 2)" test $? -eq 2
 check "unknown output type named" grep -q "unknown image type 'xyz'" e1
-"$FRANJA" render scene.fbin 2>e2
-check "missing -o refused" test $? -eq 2
+"$FRANJA" render -o x.png 2>e2
+check "missing scene refused" test $? -eq 2
 "$FRANJA" render scene.fbin -o x.png --size 0x4 2>e3
 check "bad --size refused" grep -q "size: bad value '0x4'" e3
 "$FRANJA" render scene.fbin -o x.png --bogus 2>e4
