@@ -79,6 +79,8 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
     a->argv[n++] = format_names[s->format];
     a->argv[n++] = "-o";
     a->argv[n++] = s->out;
+    if (s->lifeline)
+        a->argv[n++] = "--lifeline";
     a->argv[n] = NULL;
     return 0;
 }
@@ -100,6 +102,8 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             return 0;
         } else if (!strcmp(a, "--check")) {
             check = 1;
+        } else if (!strcmp(a, "--lifeline")) {
+            r->slab.lifeline = 1;
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
                                 !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "-o"))) {
             return fr_fail(err, "%s needs a value", a);
@@ -204,9 +208,20 @@ int proto_parse_probe(const char *out, size_t len, proto_host *h, fr_error *err)
     uint32_t n;
     if (next_line(out, len, &pos, h->arch, sizeof h->arch) || next_line(out, len, &pos, h->os, sizeof h->os) ||
         next_line(out, len, &pos, cores, sizeof cores) ||
-        next_line(out, len, &pos, h->version, sizeof h->version) || parse_u32(cores, &n) || n == 0 ||
-        n > 1000000)
+        next_line(out, len, &pos, h->version, sizeof h->version) || parse_u32(cores, &n) || n == 0)
         return fr_fail(err, "unexpected answer to uname/nproc/--version");
-    h->cores = (int)n;
+    h->cores_reported = n;
+    h->cores = n > PROTO_MAX_CORES ? PROTO_MAX_CORES : (int)n;
+    proto_printable(h->arch);
+    proto_printable(h->os);
+    proto_printable(h->version);
     return 0;
+}
+
+char *proto_printable(char *s)
+{
+    for (char *c = s; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            *c = '?';
+    return s;
 }

@@ -38,6 +38,8 @@ typedef struct {
     uint32_t spp;              /**< samples per pixel; 0 = the scene's */
     img_format format;         /**< output format */
     const char *out;           /**< output file; "-" = standard output */
+    int lifeline;              /**< --lifeline: standard input is the coordinator's line; the worker ends
+                                    when it reaches its end (worker/lifeline.h) */
 } proto_slab;
 
 /** A worker command line built by proto_slab_argv: argv points into the
@@ -106,16 +108,29 @@ int proto_parse_check(const char *out, size_t len, uint64_t *hash, fr_error *err
  * worker path travels as $0, never inside the script. */
 extern const char PROTO_PROBE_SCRIPT[];
 
-/** What a host says about itself (the probe's answer). */
+/** The most processors a probe's answer is believed to report: a host
+ * saying more is taken to have this many (proto_host.cores_reported keeps
+ * what it said, so that the caller can tell the person). */
+#define PROTO_MAX_CORES 4096
+
+/** What a host says about itself (the probe's answer).  Its text fields
+ * hold no control characters (proto_printable). */
 typedef struct {
     char arch[32];             /**< uname -m */
     char os[64];               /**< uname -s */
-    int cores;                 /**< online processors */
+    int cores;                 /**< online processors, at most PROTO_MAX_CORES */
+    uint32_t cores_reported;   /**< the number the host gave (may exceed PROTO_MAX_CORES) */
     char version[128];         /**< the worker's --version line */
 } proto_host;
 
 /** Parses the probe's output (len bytes).  Fails if a line is missing, too
- * long, or the processor count is not a positive number. */
+ * long, or the processor count is not a positive number below 2^32.
+ * Control characters in the lines become '?'. */
 int proto_parse_probe(const char *out, size_t len, proto_host *h, fr_error *err);
+
+/** Replaces every ASCII control character (below 0x20, and 0x7f) of the
+ * NUL-terminated s with '?', in place, so that text from another machine
+ * cannot drive the terminal it is printed on.  Returns s. */
+char *proto_printable(char *s);
 
 #endif

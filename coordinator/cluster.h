@@ -45,9 +45,9 @@ int cl_check_versions(const cl_host *hosts, int n, fr_error *err);
 
 /** Closes every ready host whose worker's version line is not this
  * build's ("franja-worker VERSION scene-format N"), setting its err to say
- * which version it has and which is needed: for hosts that are meant to
- * run one and the same worker (the nodes of a Slurm allocation), where one
- * that differs is a broken node rather than a reason to stop. */
+ * which version it has and which is needed: a render goes on with the
+ * hosts that match (one host left behind by an upgrade, or a broken node
+ * of a Slurm allocation, is no reason to stop). */
 void cl_drop_other_versions(cl_host *hosts, int n);
 
 /** Closes every host (tr_close). */

@@ -59,6 +59,20 @@ static const char *debian_arch(const char *a)
     return a;
 }
 
+/* 1 if s may be a part of a file name under dist/: letters, digits and
+ * . _ + -, not starting with . or - (so no "..", no "/", nothing a
+ * terminal would act on). */
+static int plain_name(const char *s)
+{
+    if (!s[0] || s[0] == '.' || s[0] == '-')
+        return 0;
+    for (; *s; s++)
+        if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') || *s == '.' ||
+              *s == '_' || *s == '+' || *s == '-'))
+            return 0;
+    return 1;
+}
+
 /* dist/OS-ARCH/franja-worker if os is given and that build exists, else
  * dist/static-ARCH/franja-worker; the build's name goes to build[128]. */
 static int pick(const char *dist, const char *os, const char *arch, char *path, size_t cap, char *build,
@@ -96,8 +110,16 @@ static int deploy_one(cl_host *ch, int i, void *vctx, fr_error *err)
     const char *want = debian_arch(e->arch[0] ? e->arch : arch);
     if (e->arch[0] && strcmp(want, debian_arch(arch)))
         snprintf(note, 700, " (the table says arch=%s, the host reports %s)", e->arch, arch);
+    /* What the host says becomes part of a local path: plain names only. */
+    const char *use_os = e->os[0] ? e->os : os;
+    if (!plain_name(want))
+        return fr_fail(err, "the architecture '%s' it reports is not a plain name; give arch= in the host table",
+                       proto_printable(arch));
+    if (use_os[0] && !plain_name(use_os))
+        return fr_fail(err, "the OS name '%s' it reports (VERSION_CODENAME) is not a plain name; give os= in "
+                       "the host table", proto_printable(os));
     proto_host info;
-    if (pick(c->dist, e->os[0] ? e->os : os, want, path, sizeof path, build, err) ||
+    if (pick(c->dist, use_os, want, path, sizeof path, build, err) ||
         stage_install(h, path, "franja-worker", remote, sizeof remote, err) || stage_probe(h, &info, err))
         return -1;
     if (strcmp(info.version, c->expect))

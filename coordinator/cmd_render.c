@@ -327,8 +327,9 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     for (int i = 0; i < n; i++)
         cl[i].entry = &table->v[i];
     cl_open(cl, n, &a->tr, fbin, spec->hash);
-    if (a->slurm.on)
-        cl_drop_other_versions(cl, n);
+    /* A host whose worker is not this build's is left out, not a reason to
+     * stop: the others render. */
+    cl_drop_other_versions(cl, n);
     int ready = 0, ns = 0;
     for (int i = 0; i < n; i++) {
         if (!cl[i].tr) {
@@ -337,6 +338,9 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         }
         ready++;
         int slots = cl[i].entry->cores ? cl[i].entry->cores : cl[i].info.cores;
+        if (!cl[i].entry->cores && cl[i].info.cores_reported > (uint32_t)cl[i].info.cores)
+            fprintf(stderr, "franja: host %s reports %u processors; using %d (give its cores in the host table "
+                    "if it has more)\n", cl[i].entry->name, cl[i].info.cores_reported, cl[i].info.cores);
         int table = a->hosts || a->slurm.on;
         if (a->jobs && (!table || slots > (int)a->jobs))
             slots = (int)a->jobs;
@@ -351,11 +355,9 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
                     hosts_is_local(cl[i].entry) ? "local" : cl[i].uploaded ? "uploaded" : "already there",
                     cl[i].ready_s);
     }
-    int rc;
+    int rc = 0;
     if (!ready)
         rc = fr_fail(err, "no host could be used (see the messages above)");
-    else
-        rc = cl_check_versions(cl, n, err);
     if (rc == 0) {
         reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = ns, .spec = spec};
         sched_params p = {.spec = *spec,
@@ -365,6 +367,10 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
                           .max_attempts = (int)a->retries,
                           .max_host_failures = 3,
                           .stop = &stop_flag,
+                          /* An SSH channel closed (a losing copy, a dropped
+                           * host, this process gone) ends the worker, even
+                           * where signals do not reach it (worker/lifeline.h). */
+                          .lifeline = !a->slurm.on,
                           .hooks = {.event = on_event, .progress = on_progress, .ctx = &rep}};
         sched_stats st;
         double t0 = clk_now();

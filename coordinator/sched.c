@@ -164,7 +164,7 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     sched_host *h = &s->hosts[host_i];
     slab *sl = &s->slabs[slab_i];
     const job_spec *sp = &s->p->spec;
-    proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-"};
+    proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline};
     proto_argv pa;
     if (proto_slab_argv(&req, &pa, err))
         return -1;

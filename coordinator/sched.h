@@ -96,6 +96,9 @@ typedef struct {
     int max_attempts;          /**< failed attempts per slab before giving up */
     int max_host_failures;     /**< failures in a row before a host is dropped */
     volatile sig_atomic_t *stop; /**< set asynchronously (SIGINT): stop and keep what is done; may be NULL */
+    int lifeline;              /**< start workers with --lifeline: they end when their standard input does
+                                    (for backends that hold it open while they want the slab: SSH; not
+                                    Slurm, whose tasks see their input end at once) */
     sched_hooks hooks;
 } sched_params;
 

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "protocol.h"
 
 struct tr_host {
     const tr_backend *be;
@@ -226,12 +227,14 @@ void tr_proc_add_err(tr_proc *p, const void *data, size_t n)
     memcpy(p->err + p->err_len, d, n);
     p->err_len += n;
     p->err[p->err_len] = 0;
-    /* One line in messages: inner newlines become spaces. */
-    for (size_t i = 0; i < p->err_len; i++)
-        if (p->err[i] == '\n' && i + 1 < p->err_len)
-            p->err[i] = ' ';
     while (p->err_len && (p->err[p->err_len - 1] == '\n' || p->err[p->err_len - 1] == '\r'))
         p->err[--p->err_len] = 0;
+    /* One line in messages: inner newlines become spaces, other control
+     * characters (a remote host's escape sequences) '?'. */
+    for (size_t i = 0; i < p->err_len; i++)
+        if (p->err[i] == '\n' || p->err[i] == '\t')
+            p->err[i] = ' ';
+    proto_printable(p->err);
 }
 
 void tr_proc_fail(tr_proc *p, const char *fmt, ...)

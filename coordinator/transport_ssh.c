@@ -274,16 +274,43 @@ static void sftp_done(ssh_host *h)
     h->sftp = NULL;
 }
 
-/* mkdir -p over SFTP. */
+/* An SFTP status code in words. */
+static const char *sftp_words(int code)
+{
+    switch (code) {
+    case SSH_FX_NO_SUCH_FILE: return "no such file or directory";
+    case SSH_FX_PERMISSION_DENIED: return "permission denied";
+    case SSH_FX_NO_SUCH_PATH: return "no such path";
+    case SSH_FX_FILE_ALREADY_EXISTS: return "file exists";
+    case SSH_FX_WRITE_PROTECT: return "read-only file system";
+    case SSH_FX_NO_MEDIA: return "no medium";
+    case SSH_FX_OP_UNSUPPORTED: return "operation not supported";
+    default: return "failure";
+    }
+}
+
+/* mkdir -p over SFTP.  A mkdir fails harmlessly when the directory exists;
+ * when the directory is missing at the end, the error is the first mkdir
+ * that failed on a path that is not there (the reason, say "permission
+ * denied"), not what a later stat says. */
 static int sftp_mkdirs(ssh_host *h, const char *dir, fr_error *err)
 {
-    char path[700];
+    char path[700], failed[700] = "";
+    int code = 0;
     snprintf(path, sizeof path, "%s", dir);
     for (char *s = path + 1;; s++) {
         if (*s == '/' || *s == 0) {
             char c = *s;
             *s = 0;
-            sftp_mkdir(h->sftp, path, 0755); /* fails harmlessly when it exists */
+            if (sftp_mkdir(h->sftp, path, 0755) != SSH_OK && !failed[0]) {
+                int why = sftp_get_error(h->sftp);
+                sftp_attributes a = sftp_stat(h->sftp, path);
+                if (!a) {
+                    code = why;
+                    snprintf(failed, sizeof failed, "%s", path);
+                }
+                sftp_attributes_free(a);
+            }
             *s = c;
             if (!c)
                 break;
@@ -292,8 +319,12 @@ static int sftp_mkdirs(ssh_host *h, const char *dir, fr_error *err)
     sftp_attributes a = sftp_stat(h->sftp, dir);
     int ok = a && a->type == SSH_FILEXFER_TYPE_DIRECTORY;
     sftp_attributes_free(a);
-    return ok ? 0 : fr_fail(err, "%s: cannot create directory '%s': %s", h->label, dir,
-                            ssh_get_error(h->s));
+    if (ok)
+        return 0;
+    if (failed[0])
+        return fr_fail(err, "%s: cannot create directory '%s': mkdir %s: %s", h->label, dir, failed,
+                       sftp_words(code));
+    return fr_fail(err, "%s: cannot create directory '%s': %s", h->label, dir, ssh_get_error(h->s));
 }
 
 static int send_file(ssh_host *h, const char *local, const char *tmp, fr_error *err)

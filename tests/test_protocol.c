@@ -22,10 +22,11 @@ static int reparse(const proto_argv *a, proto_request *r, fr_error *err)
 static void test_round_trip(void)
 {
     const proto_slab cases[] = {
-        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-"},
-        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm"},
-        {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-"},
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-"}, /* the scene's size and samples */
+        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0},
+        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0},
+        {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-", 0},
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0}, /* the scene's size and samples */
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1}, /* --lifeline */
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         const proto_slab *s = &cases[k];
@@ -47,18 +48,19 @@ static void test_round_trip(void)
               r.slab.height);
         CHECK(r.slab.spp == s->spp && r.slab.format == s->format, "case %zu: spp %u format %d", k, r.slab.spp,
               (int)r.slab.format);
+        CHECK(r.slab.lifeline == s->lifeline, "case %zu: lifeline %d", k, r.slab.lifeline);
     }
 }
 
 static void test_build_refuses(void)
 {
     const proto_slab bad[] = {
-        {"s", 5, 5, 8, 8, 1, IMG_PF, "-"},                       /* empty rows */
-        {"s", 0, 9, 8, 8, 1, IMG_PF, "-"},                       /* rows past the height */
-        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-"},      /* too wide */
-        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-"},       /* too many samples */
-        {"s", 0, 1, 8, 0, 1, IMG_PF, "-"},                       /* half a size */
-        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-"},                      /* no scene */
+        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0},                       /* empty rows */
+        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0},                       /* rows past the height */
+        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0},      /* too wide */
+        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0},       /* too many samples */
+        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0},                       /* half a size */
+        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0},                      /* no scene */
     };
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
         proto_argv a;
@@ -157,6 +159,17 @@ static void test_probe_answer(void)
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++)
         CHECK(proto_parse_probe(bad[k], strlen(bad[k]), &ph, &err) < 0, "probe answer %zu accepted", k);
     CHECK(strstr(PROTO_PROBE_SCRIPT, "\"$0\" --version") != NULL, "the probe does not run its $0 --version");
+    /* An absurd processor count is clamped, and what the host said kept. */
+    const char many[] = "x86_64\nLinux\n2000000000\nv\n";
+    CHECK(proto_parse_probe(many, strlen(many), &ph, &err) == 0, "2000000000 processors refused: %s", err.msg);
+    CHECK(ph.cores == PROTO_MAX_CORES && ph.cores_reported == 2000000000u, "2000000000 processors read as %d (%u)",
+          ph.cores, ph.cores_reported);
+    /* Control characters from the host become '?'. */
+    const char esc[] = "x86\033[2J\nLin\007ux\n2\nfranja-worker \033]0;t\a 1 scene-format 4\r\n";
+    CHECK(proto_parse_probe(esc, strlen(esc), &ph, &err) == 0, "probe with escapes refused: %s", err.msg);
+    CHECK(!strcmp(ph.arch, "x86?[2J") && !strcmp(ph.os, "Lin?ux") &&
+              !strcmp(ph.version, "franja-worker ?]0;t? 1 scene-format 4?"),
+          "escapes kept: '%s' '%s' '%s'", ph.arch, ph.os, ph.version);
 }
 
 int main(void)

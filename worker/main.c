@@ -10,6 +10,7 @@
 #include "fbin.h"
 #include "file.h"
 #include "image.h"
+#include "lifeline.h"
 #include "pathtrace.h"
 #include "protocol.h"
 #include "quick.h"
@@ -19,7 +20,7 @@
 
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
-    "                     [--format pf|ppm16|ppm8] [-o FILE|-]\n"
+    "                     [--format pf|ppm16|ppm8] [-o FILE|-] [--lifeline]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --help | --version\n"
     "\n"
@@ -32,7 +33,11 @@ static const char usage[] =
     "  --size WxH     image size (default: the scene's)\n"
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
-    "  --check        validate the scene and print its content hash\n";
+    "  --check        validate the scene and print its content hash\n"
+    "  --lifeline     end when standard input (a pipe) reaches its end\n"
+    "\n"
+    "Writing to a pipe (-o -), the worker ends itself when the pipe's reader is\n"
+    "gone or its parent process ends.\n";
 
 static int load_scene(const char *path, fr_scene *s, fr_error *err)
 {
@@ -114,6 +119,8 @@ int main(int argc, char **argv)
         scn_free(&scene);
         return 2;
     }
+    /* The coordinator gone, the slab is wasted work: stop (lifeline.h). */
+    lifeline_start(to_stdout, sl->lifeline);
     size_t n = (size_t)scene.settings.width * (y1 - y0) * 3;
     float *rgb = malloc(n * sizeof *rgb);
     if (!rgb) {
@@ -122,6 +129,7 @@ int main(int argc, char **argv)
         return 1;
     }
     pt_render_rows(&scene, PT_MIS, y0, y1, rgb);
+    lifeline_stop();
 
     img_partial_info info = {scene.hash, y0, y1, scene.settings.spp, scene.settings.width, scene.settings.height};
     FILE *f = to_stdout ? stdout : fopen(out, "wb");
