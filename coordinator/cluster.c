@@ -3,7 +3,9 @@
 
 #include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "clock.h"
 #include "fbin.h"
@@ -112,18 +114,221 @@ int cl_check_versions(const cl_host *hosts, int n, fr_error *err)
     return 0;
 }
 
-void cl_drop_other_versions(cl_host *hosts, int n)
+int cl_check_version(cl_host *h)
 {
     char want[128];
     proto_version_line("franja-worker", want, sizeof want);
-    for (int i = 0; i < n; i++) {
-        cl_host *h = &hosts[i];
-        if (!h->tr || !strcmp(h->info.version, want))
-            continue;
-        fr_fail(&h->err, "its worker reports '%s', this franja needs '%s'", h->info.version, want);
-        tr_close(h->tr);
-        h->tr = NULL;
+    if (!h->tr || !strcmp(h->info.version, want))
+        return 0;
+    fr_fail(&h->err, "its worker reports '%s', this franja needs '%s'", h->info.version, want);
+    tr_close(h->tr);
+    h->tr = NULL;
+    return -1;
+}
+
+void cl_drop_other_versions(cl_host *hosts, int n)
+{
+    for (int i = 0; i < n; i++)
+        cl_check_version(&hosts[i]);
+}
+
+/* One host of a group: its thread's own copy of everything it touches. */
+typedef struct {
+    cl_group *g;
+    int i;
+    hosts_entry entry;
+    cl_host host;
+    tr_options o;
+    int done;                  /* the thread has finished (under g->mu) */
+    int handed;                /* given to the caller */
+} cl_slot;
+
+struct cl_group {
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int n, refs, ended;
+    note_sink notes;           /* the caller's */
+    open_ctx ctx;
+    char scene[4096];
+    pthread_t *tid;
+    int *started;
+    cl_slot *slot;
+};
+
+static void group_free(cl_group *g)
+{
+    pthread_mutex_destroy(&g->mu);
+    pthread_cond_destroy(&g->cv);
+    free(g->tid);
+    free(g->started);
+    free(g->slot);
+    free(g);
+}
+
+/* Drops one reference (under g->mu); frees the group with the last. */
+static void group_unref(cl_group *g)
+{
+    int last = --g->refs == 0;
+    pthread_mutex_unlock(&g->mu);
+    if (last)
+        group_free(g);
+}
+
+static void *prepare(void *arg)
+{
+    cl_slot *s = arg;
+    cl_group *g = s->g;
+    job j = {&s->host, s->i, s->o, probe_and_stage, &g->ctx};
+    ready_one(&j);
+    pthread_mutex_lock(&g->mu);
+    s->done = 1;
+    if (g->ended && !s->handed && s->host.tr) {
+        /* Abandoned: nobody will use it. */
+        tr_close(s->host.tr);
+        s->host.tr = NULL;
     }
+    pthread_cond_broadcast(&g->cv);
+    group_unref(g);
+    return NULL;
+}
+
+cl_group *cl_start(const cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash)
+{
+    cl_group *g = calloc(1, sizeof *g);
+    if (!g)
+        return NULL;
+    g->tid = calloc((size_t)(n > 0 ? n : 1), sizeof *g->tid);
+    g->started = calloc((size_t)(n > 0 ? n : 1), sizeof *g->started);
+    g->slot = calloc((size_t)(n > 0 ? n : 1), sizeof *g->slot);
+    if (!g->tid || !g->started || !g->slot || (scene && strlen(scene) >= sizeof g->scene)) {
+        free(g->tid);
+        free(g->started);
+        free(g->slot);
+        free(g);
+        return NULL;
+    }
+    pthread_mutex_init(&g->mu, NULL);
+    pthread_cond_init(&g->cv, NULL);
+    g->n = n;
+    g->notes = o->notes;
+    if (scene)
+        snprintf(g->scene, sizeof g->scene, "%s", scene);
+    g->ctx = (open_ctx){scene ? g->scene : NULL, hash};
+    g->refs = 1;
+    for (int i = 0; i < n; i++) {
+        cl_slot *s = &g->slot[i];
+        s->g = g;
+        s->i = i;
+        s->entry = *hosts[i].entry;
+        s->host = (cl_host){.entry = &s->entry};
+        s->o = *o;
+        s->o.notes = (note_sink){collect, &s->host};
+    }
+    pthread_mutex_lock(&g->mu);
+    for (int i = 0; i < n; i++) {
+        g->refs++;
+        g->started[i] = pthread_create(&g->tid[i], NULL, prepare, &g->slot[i]) == 0;
+        if (!g->started[i]) {
+            /* No thread: this host is prepared later, in cl_next_ready. */
+            g->refs--;
+        }
+    }
+    pthread_mutex_unlock(&g->mu);
+    return g;
+}
+
+static int cl_pending_locked(const cl_group *g)
+{
+    int n = 0;
+    for (int i = 0; i < g->n; i++)
+        n += !g->slot[i].handed;
+    return n;
+}
+
+int cl_pending(cl_group *g)
+{
+    pthread_mutex_lock(&g->mu);
+    int n = cl_pending_locked(g);
+    pthread_mutex_unlock(&g->mu);
+    return n;
+}
+
+int cl_end(cl_group *g, int wait)
+{
+    if (!g)
+        return 0;
+    if (wait)
+        for (int i = 0; i < g->n; i++)
+            if (g->started[i])
+                pthread_join(g->tid[i], NULL);
+    pthread_mutex_lock(&g->mu);
+    int abandoned = 0;
+    g->ended = 1;
+    for (int i = 0; i < g->n; i++) {
+        cl_slot *s = &g->slot[i];
+        if (s->handed)
+            continue;
+        if (s->done || !g->started[i]) {
+            tr_close(s->host.tr); /* ended, never handed over */
+            s->host.tr = NULL;
+        } else {
+            abandoned++;
+        }
+    }
+    if (!wait)
+        for (int i = 0; i < g->n; i++)
+            if (g->started[i])
+                pthread_detach(g->tid[i]);
+    group_unref(g);
+    return abandoned;
+}
+
+static int take(cl_group *g, cl_host *out)
+{
+    for (int i = 0; i < g->n; i++) {
+        cl_slot *s = &g->slot[i];
+        if (s->handed || !(s->done || !g->started[i]))
+            continue;
+        if (!g->started[i]) {
+            job j = {&s->host, i, s->o, probe_and_stage, &g->ctx};
+            pthread_mutex_unlock(&g->mu);
+            ready_one(&j);
+            pthread_mutex_lock(&g->mu);
+            s->done = 1;
+        }
+        s->handed = 1;
+        for (char *line = s->host.notes, *nl; (nl = strchr(line, '\n')); line = nl + 1) {
+            *nl = 0;
+            note_say(&g->notes, "%s", line);
+        }
+        s->host.notes_len = 0;
+        s->host.forward = &g->notes;
+        *out = s->host;
+        return i;
+    }
+    return -1;
+}
+
+int cl_next_ready(cl_group *g, cl_host *out, int ms)
+{
+    pthread_mutex_lock(&g->mu);
+    int i = take(g, out);
+    if (i < 0 && ms > 0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_sec += ms / 1000;
+        ts.tv_nsec += (long)(ms % 1000) * 1000000L;
+        if (ts.tv_nsec >= 1000000000L) {
+            ts.tv_sec++;
+            ts.tv_nsec -= 1000000000L;
+        }
+        while (i < 0 && cl_pending_locked(g) && pthread_cond_timedwait(&g->cv, &g->mu, &ts) == 0)
+            i = take(g, out);
+        if (i < 0)
+            i = take(g, out);
+    }
+    pthread_mutex_unlock(&g->mu);
+    return i;
 }
 
 void cl_close(cl_host *hosts, int n)

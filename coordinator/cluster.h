@@ -39,6 +39,41 @@ void cl_each(cl_host *hosts, int n, const tr_options *o, cl_step step, void *ctx
  * not NULL, stage the scene with content hash `hash` (stage_scene). */
 void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash);
 
+/** Hosts being made ready in the background (cl_start). */
+typedef struct cl_group cl_group;
+
+/** cl_open's work (probe, and stage the scene at path `scene` with content
+ * hash `hash`), in the background: one thread per host, and returns at
+ * once, so that a render can start on the first hosts that are ready
+ * while a slow or hung one is still being waited for.  Each thread works
+ * on its own copy of its host (entry included); cl_next_ready hands it
+ * over.  The strings o and scene point to must outlive the group (argv,
+ * static buffers); o->backend_ctx too, unless cl_end waits.  NULL when out
+ * of memory (nothing started). */
+cl_group *cl_start(const cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash);
+
+/** Waits up to ms milliseconds (0: not at all) for a host whose
+ * preparation has ended and not yet been handed over; copies it into *out
+ * (ready: tr set; or not: err says why), hands its remarks to o->notes and
+ * returns its index; later remarks of the host go straight to o->notes.
+ * -1 when none has ended in that time. */
+int cl_next_ready(cl_group *g, cl_host *out, int ms);
+
+/** Hosts still being prepared (not yet handed over). */
+int cl_pending(cl_group *g);
+
+/** Ends the group.  wait: wait for every thread; otherwise hosts still
+ * being prepared are abandoned: their threads close what they opened when
+ * their time-outs end, and the last one frees the group.  The hosts handed
+ * over must be closed (tr_close) before.  Returns how many were
+ * abandoned. */
+int cl_end(cl_group *g, int wait);
+
+/** The version check of one ready host: closes it, with err saying which
+ * version it has and which this build needs, when its worker's version line
+ * is not this build's.  Returns 0 if it stays ready. */
+int cl_check_version(cl_host *h);
+
 /** Refuses a set of ready hosts whose workers report different versions,
  * or a scene format other than this build's; the message names the host. */
 int cl_check_versions(const cl_host *hosts, int n, fr_error *err);

@@ -227,6 +227,8 @@ static void summary(const sched_host *hs, int n, const job_spec *spec, const sch
             "busy s", "state");
     for (int i = 0; i < n; i++) {
         const sched_host *h = &hs[i];
+        if (!h->tr)
+            continue; /* never ready: said when it was given up */
         fprintf(stderr, "  %-16s %5d %6d %6d %8d %6d %8.2f  %s%s\n", h->name, h->slots, h->slabs, h->rows,
                 h->failures, h->duplicates, h->busy_s, h->dropped ? "dropped: " : "ok",
                 h->dropped ? h->drop_reason : "");
@@ -249,6 +251,7 @@ typedef struct {
     double t;                  /* the latest progress report */
     int done, total;
     int drawn;                 /* a live line is on screen */
+    struct joiner *join;       /* hosts joining the render */
 } reporter;
 
 static void clear_line(reporter *r)
@@ -279,7 +282,11 @@ static void progress_text(const reporter *r, char *line, size_t cap)
     n += snprintf(line + n, cap - (size_t)n, "  %.2f Msamples/s ", rate * r->spec->width * r->spec->spp / 1e6);
     for (int i = 0; i < r->nhosts && n < (int)cap - 40; i++) {
         const sched_host *h = &r->hosts[i];
-        if (h->dropped)
+        if (!h->tr && h->dropped)
+            continue;
+        if (h->pending)
+            n += snprintf(line + n, cap - (size_t)n, " %s:starting", h->name);
+        else if (h->dropped)
             n += snprintf(line + n, cap - (size_t)n, " %s:down", h->name);
         else
             n += snprintf(line + n, cap - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
@@ -312,54 +319,108 @@ static void on_progress(void *ctx, double t, int done, int total)
     draw(r, 0);
 }
 
-/* Connects the hosts and runs the slabs not yet in the job directory. */
+/* Hosts joining the render as they become ready (the scheduler's admit
+ * hook): each is checked (version), given its slots and announced. */
+typedef struct joiner {
+    const render_args *a;
+    cl_group *g;
+    cl_host *cl;
+    reporter *rep;
+    int ready;                 /* hosts handed over ready */
+} joiner;
+
+/* Takes every host whose preparation has ended, waiting up to ms for the
+ * first one. */
+static void join_hosts(joiner *j, sched_host *sh, int ms)
+{
+    cl_host h;
+    int i;
+    while ((i = cl_next_ready(j->g, &h, ms)) >= 0) {
+        ms = 0;
+        j->cl[i] = h;
+        sched_host *s = &sh[i];
+        s->pending = 0;
+        if (j->rep)
+            clear_line(j->rep);
+        if (j->cl[i].tr)
+            cl_check_version(&j->cl[i]);
+        if (!j->cl[i].tr) {
+            fprintf(stderr, "franja: host %s is not used: %s\n", h.entry->name, j->cl[i].err.msg);
+            s->dropped = 1;
+            snprintf(s->drop_reason, sizeof s->drop_reason, "%s", j->cl[i].err.msg);
+            continue;
+        }
+        j->ready++;
+        const render_args *a = j->a;
+        int slots = h.entry->cores ? h.entry->cores : h.info.cores;
+        if (!h.entry->cores && h.info.cores_reported > (uint32_t)h.info.cores)
+            fprintf(stderr, "franja: host %s reports %u processors; using %d (give its cores in the host table "
+                    "if it has more)\n", h.entry->name, h.info.cores_reported, h.info.cores);
+        int table = a->hosts || a->slurm.on;
+        if (a->jobs && (!table || slots > (int)a->jobs))
+            slots = (int)a->jobs;
+        s->tr = h.tr;
+        s->slots = slots > 0 ? slots : 1;
+        snprintf(s->scene, sizeof s->scene, "%s", h.scene);
+        if (table || !isatty(2))
+            fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", s->name, h.info.os,
+                    h.info.arch, s->slots, h.info.version,
+                    hosts_is_local(h.entry) ? "local" : h.uploaded ? "uploaded" : "already there", h.ready_s);
+    }
+}
+
+static void on_admit(void *ctx, sched_host *hosts, int nhosts)
+{
+    (void)nhosts;
+    reporter *r = ctx;
+    join_hosts(r->join, hosts, 0);
+}
+
+/* Connects the hosts and runs the slabs not yet in the job directory.  The
+ * render starts as soon as one host is ready; the others join when they
+ * are (a host that accepts a connection and never answers costs nothing
+ * unless it is the only one). */
 static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
                      const char *jobdir, const unsigned char *have, int rows_missing, fr_error *err)
 {
     int n = table->n;
     cl_host *cl = calloc((size_t)n, sizeof *cl);
     sched_host *sh = calloc((size_t)n, sizeof *sh);
-    if (!cl || !sh) {
+    cl_group *g = NULL;
+    if (cl && sh) {
+        for (int i = 0; i < n; i++)
+            cl[i].entry = &table->v[i];
+        g = cl_start(cl, n, &a->tr, fbin, spec->hash);
+    }
+    if (!g) {
         free(cl);
         free(sh);
         return fr_fail(err, "out of memory");
     }
-    for (int i = 0; i < n; i++)
-        cl[i].entry = &table->v[i];
-    cl_open(cl, n, &a->tr, fbin, spec->hash);
-    /* A host whose worker is not this build's is left out, not a reason to
-     * stop: the others render. */
-    cl_drop_other_versions(cl, n);
-    int ready = 0, ns = 0;
     for (int i = 0; i < n; i++) {
-        if (!cl[i].tr) {
-            fprintf(stderr, "franja: host %s is not used: %s\n", cl[i].entry->name, cl[i].err.msg);
-            continue;
-        }
-        ready++;
-        int slots = cl[i].entry->cores ? cl[i].entry->cores : cl[i].info.cores;
-        if (!cl[i].entry->cores && cl[i].info.cores_reported > (uint32_t)cl[i].info.cores)
-            fprintf(stderr, "franja: host %s reports %u processors; using %d (give its cores in the host table "
-                    "if it has more)\n", cl[i].entry->name, cl[i].info.cores_reported, cl[i].info.cores);
-        int table = a->hosts || a->slurm.on;
-        if (a->jobs && (!table || slots > (int)a->jobs))
-            slots = (int)a->jobs;
-        sched_host *h = &sh[ns++];
-        h->tr = cl[i].tr;
-        h->name = cl[i].entry->name;
-        h->slots = slots > 0 ? slots : 1;
-        snprintf(h->scene, sizeof h->scene, "%s", cl[i].scene);
-        if (table || !isatty(2))
-            fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", h->name, cl[i].info.os,
-                    cl[i].info.arch, h->slots, cl[i].info.version,
-                    hosts_is_local(cl[i].entry) ? "local" : cl[i].uploaded ? "uploaded" : "already there",
-                    cl[i].ready_s);
+        sh[i].name = table->v[i].name;
+        sh[i].pending = 1;
+        sh[i].slots = table->v[i].cores; /* a guess for the slab size until it is ready */
     }
+    joiner j = {a, g, cl, NULL, 0};
+    /* The first host (or the end of them all). */
+    while (!j.ready && cl_pending(g))
+        join_hosts(&j, sh, 1000);
     int rc = 0;
-    if (!ready)
+    if (!j.ready)
         rc = fr_fail(err, "no host could be used (see the messages above)");
     if (rc == 0) {
-        reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = ns, .spec = spec};
+        /* Hosts not ready yet count in the slab size with the slots of the
+         * first ready one, unless the table says. */
+        int guess = 1;
+        for (int i = 0; i < n; i++)
+            if (!sh[i].pending && !sh[i].dropped && sh[i].slots > guess)
+                guess = sh[i].slots;
+        for (int i = 0; i < n; i++)
+            if (sh[i].pending && sh[i].slots < 1)
+                sh[i].slots = guess;
+        reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = n, .spec = spec, .join = &j};
+        j.rep = &rep;
         sched_params p = {.spec = *spec,
                           .jobdir = jobdir,
                           .have = have,
@@ -371,16 +432,23 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
                            * host, this process gone) ends the worker, even
                            * where signals do not reach it (worker/lifeline.h). */
                           .lifeline = !a->slurm.on,
-                          .hooks = {.event = on_event, .progress = on_progress, .ctx = &rep}};
+                          .hooks = {.event = on_event, .progress = on_progress, .admit = on_admit, .ctx = &rep}};
         sched_stats st;
         double t0 = clk_now();
-        rc = sched_run(&p, sh, ns, &st, err);
+        rc = sched_run(&p, sh, n, &st, err);
         draw(&rep, 1);
         if (rep.drawn)
             fputc('\n', stderr);
-        summary(sh, ns, spec, &st, rows_missing, clk_now() - t0);
+        summary(sh, n, spec, &st, rows_missing, clk_now() - t0);
     }
+    for (int i = 0; i < n; i++)
+        if (sh[i].pending)
+            fprintf(stderr, "franja: host %s was not ready before the render ended\n", table->v[i].name);
     cl_close(cl, n);
+    /* A host still being prepared is not waited for (its time-out would
+     * add to the render), except under Slurm, whose shared state goes with
+     * the allocation. */
+    cl_end(g, a->slurm.on);
     free(cl);
     free(sh);
     return rc;

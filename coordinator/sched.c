@@ -34,6 +34,8 @@ typedef struct {
     attempt *run;
     int nrun, caprun;
     int rows_total, rows_done;
+    double acc_s;              /* run time of accepted attempts, summed */
+    int acc_rows;              /* their rows */
     sched_stats *st;
     double t0;
 } sched;
@@ -111,13 +113,42 @@ static int running_on(sched *s, int slab_i, int host_i)
     return 0;
 }
 
-/* 1 if a live host other than host_i could run a slab. */
+/* 1 if a live, ready host other than host_i could run a slab. */
 static int other_host_alive(const sched *s, int host_i)
 {
     for (int i = 0; i < s->nhosts; i++)
-        if (i != host_i && !s->hosts[i].dropped)
+        if (i != host_i && !s->hosts[i].dropped && !s->hosts[i].pending)
             return 1;
     return 0;
+}
+
+/* Hosts still to be made ready. */
+static int pending_hosts(const sched *s)
+{
+    int n = 0;
+    for (int i = 0; i < s->nhosts; i++)
+        n += s->hosts[i].pending && !s->hosts[i].dropped;
+    return n;
+}
+
+/* Lets the caller make pending hosts ready (or drop them). */
+static void admit(sched *s)
+{
+    if (!pending_hosts(s))
+        return;
+    const sched_hooks *k = &s->p->hooks;
+    if (k->admit)
+        k->admit(k->ctx, s->hosts, s->nhosts);
+    for (int i = 0; i < s->nhosts; i++) {
+        sched_host *h = &s->hosts[i];
+        if (!k->admit && h->pending) {
+            h->pending = 0;
+            h->dropped = 1;
+            snprintf(h->drop_reason, sizeof h->drop_reason, "never ready");
+        }
+        if (!h->pending && !h->dropped && h->slots < 1)
+            h->slots = 1;
+    }
 }
 
 /* Most processes one slab runs at once (its first and two copies). */
@@ -272,6 +303,8 @@ static int accept_attempt(sched *s, int r, fr_error *err)
     if (job_save(s->p->jobdir, sl->y0, sl->y1, out, len, err))
         return -1;
     double dt = now(s) - a.start;
+    s->acc_s += dt;
+    s->acc_rows += (int)(sl->y1 - sl->y0);
     sl->done = 1;
     h->slabs++;
     h->rows += (int)(sl->y1 - sl->y0);
@@ -316,6 +349,50 @@ static int collect(sched *s, fr_error *err)
     return 0;
 }
 
+/* Slab deadlines.  Once three slabs are accepted, the seconds a row takes
+ * one process are known (all hosts together, or the host's own when it is
+ * slower); an attempt that runs DEADLINE_FACTOR times longer than its rows
+ * should take, plus DEADLINE_SLACK seconds (start-up, a busy machine), is a
+ * stuck stream: it is given up as a failure of its host, and the slab goes
+ * to another host.  Stragglers short of that get second copies (pick). */
+enum { DEADLINE_MIN_SLABS = 3 };
+#define DEADLINE_FACTOR 8.0
+#define DEADLINE_SLACK 5.0
+
+static double deadline(const sched *s, const attempt *a)
+{
+    int accepted = 0;
+    for (int i = 0; i < s->nhosts; i++)
+        accepted += s->hosts[i].slabs;
+    if (accepted < DEADLINE_MIN_SLABS || s->acc_rows <= 0)
+        return 0;
+    double per_row = s->acc_s / s->acc_rows;
+    const sched_host *h = &s->hosts[a->host];
+    if (h->rows > 0 && h->busy_s / h->rows > per_row)
+        per_row = h->busy_s / h->rows;
+    const slab *sl = &s->slabs[a->slab];
+    return DEADLINE_FACTOR * per_row * (sl->y1 - sl->y0) + DEADLINE_SLACK;
+}
+
+static int give_up_stuck(sched *s, fr_error *err)
+{
+    for (int r = s->nrun - 1; r >= 0; r--) {
+        if (r >= s->nrun)
+            continue;
+        attempt *a = &s->run[r];
+        double limit = deadline(s, a), ran = now(s) - a->start;
+        if (limit <= 0 || ran <= limit)
+            continue;
+        char why[200];
+        snprintf(why, sizeof why, "no result after %.1f s (the other slabs took %.2f s a row)", ran,
+                 s->acc_s / s->acc_rows);
+        tr_proc_kill(a->proc);
+        if (fail_attempt(s, r, why, err))
+            return -1;
+    }
+    return 0;
+}
+
 static int alive_hosts(sched *s)
 {
     int n = 0;
@@ -350,9 +427,10 @@ static int loop(sched *s, fr_error *err)
             rc = fr_fail(err, "interrupted");
             break;
         }
+        admit(s);
         for (int i = 0; i < s->nhosts; i++) {
             sched_host *h = &s->hosts[i];
-            while (!h->dropped && h->running < h->slots && now(s) >= h->retry_at) {
+            while (!h->dropped && !h->pending && h->running < h->slots && now(s) >= h->retry_at) {
                 int si = pick(s, i);
                 if (si < 0)
                     break;
@@ -380,7 +458,7 @@ static int loop(sched *s, fr_error *err)
                 break;
             }
         }
-        int waiting = 0;
+        int waiting = pending_hosts(s) > 0;
         for (int i = 0; i < s->nhosts; i++)
             waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > now(s);
         if (s->nrun == 0 && !waiting) {
@@ -389,7 +467,7 @@ static int loop(sched *s, fr_error *err)
         }
         int need = 0;
         for (int i = 0; i < s->nhosts; i++)
-            need += s->hosts[i].slots * 2 + 1;
+            need += s->hosts[i].pending ? 0 : s->hosts[i].slots * 2 + 1;
         if (need > cap_pfd) {
             struct pollfd *np = realloc(pfd, (size_t)need * sizeof *np);
             if (!np) {
@@ -401,7 +479,7 @@ static int loop(sched *s, fr_error *err)
         }
         int n = 0;
         for (int i = 0; i < s->nhosts; i++)
-            if (!s->hosts[i].dropped)
+            if (!s->hosts[i].dropped && !s->hosts[i].pending)
                 n += tr_pollfds(s->hosts[i].tr, pfd + n, cap_pfd - n);
         if (s->p->hooks.wait)
             s->p->hooks.wait(s->p->hooks.ctx, pfd, n, 100);
@@ -409,10 +487,10 @@ static int loop(sched *s, fr_error *err)
             poll(pfd, (nfds_t)n, 100);
         for (int i = 0; i < s->nhosts; i++) {
             fr_error e2;
-            if (!s->hosts[i].dropped && tr_service(s->hosts[i].tr, &e2))
+            if (!s->hosts[i].dropped && !s->hosts[i].pending && tr_service(s->hosts[i].tr, &e2))
                 drop_host(s, i, e2.msg); /* its slabs go back to the queue, not blamed */
         }
-        if (collect(s, err)) {
+        if (collect(s, err) || give_up_stuck(s, err)) {
             rc = -1;
             break;
         }

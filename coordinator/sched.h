@@ -15,6 +15,9 @@
  *   MaxSessions, a process limit) keeps the number of slots it runs.  One
  *   that refuses while running nothing is tried again after a pause, and
  *   dropped after `max_host_failures` refusals in a row.
+ * - Hosts may join while the run goes on (sched_host.pending, the admit
+ *   hook): slabs start on the hosts that are ready, and a host that takes
+ *   long to be ready (or never is) holds nobody up.
  * - When the queue is empty and a slot is idle, the slab that has been
  *   running longest with a single copy is started again, on another host
  *   when possible; the first valid copy wins and the others are killed.
@@ -48,6 +51,8 @@ typedef struct {
     int duplicates;            /**< straggler copies started here */
     int streak;                /**< failures in a row */
     int dropped;
+    int pending;               /**< not ready yet: no process is started on it until the admit hook clears
+                                    this (with tr, slots and scene set) or drops it; slots may hold a guess */
     int start_streak;          /**< refused starts in a row */
     double retry_at;           /**< no new process before this time (after a refused start) */
     char drop_reason[300];
@@ -84,6 +89,12 @@ typedef struct {
     double (*now)(void *ctx);
     /** Waits up to ms milliseconds for activity on pfd[0..n); NULL = poll. */
     int (*wait)(void *ctx, struct pollfd *pfd, int n, int ms);
+    /** Called every turn while a host is pending: makes pending hosts ready
+     * (tr, slots, scene set, pending cleared) or drops them (dropped and
+     * drop_reason set, pending cleared), from sched_run's thread.  A run
+     * with pending hosts and no admit hook waits for nothing: they are
+     * dropped at once. */
+    void (*admit)(void *ctx, sched_host *hosts, int nhosts);
     void *ctx;
 } sched_hooks;
 

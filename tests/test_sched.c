@@ -428,6 +428,114 @@ static void test_progress(void)
     teardown(r);
 }
 
+/* Hosts that are not ready at the start: slabs start at once on the ready
+ * one; b joins at 3 s (the admit hook), c never does (dropped at 5 s) and
+ * d stays pending to the end; nobody waits for them. */
+static double b_ready_at = 3, c_gone_at = 5;
+static int admits;
+static void admit_late(void *ctx, sched_host *hs, int n)
+{
+    run *r = ctx;
+    admits++;
+    (void)n;
+    if (hs[1].pending && r->world.now >= b_ready_at) {
+        hs[1].pending = 0;
+        hs[1].slots = 2;
+    }
+    if (hs[2].pending && r->world.now >= c_gone_at) {
+        hs[2].pending = 0;
+        hs[2].dropped = 1;
+        snprintf(hs[2].drop_reason, sizeof hs[2].drop_reason, "probe timed out");
+    }
+}
+
+static void test_pending_hosts(void)
+{
+    run *r = setup(40, 1);
+    r->p.hooks.admit = admit_late;
+    int a = host(r, "a", 1, (fake_script){.duration = 1});
+    int b = host(r, "b", 1, (fake_script){.duration = 1});
+    int c = host(r, "c", 1, (fake_script){.duration = 1});
+    int d = host(r, "d", 1, (fake_script){.duration = 1});
+    r->sh[b].pending = r->sh[c].pending = r->sh[d].pending = 1;
+    go(r);
+    CHECK(r->rc == 0, "run failed: %s", r->err.msg);
+    CHECK(admits > 0, "the admit hook was never called");
+    CHECK(r->world.nspawn > 0 && r->world.spawn[0].host == a && r->world.spawn[0].start < 0.01,
+          "the first slab did not start at once on the ready host");
+    double first_b = -1;
+    int on_c = 0, on_d = 0;
+    for (int i = 0; i < r->world.nspawn; i++) {
+        const fake_spawn *sp = &r->world.spawn[i];
+        if (sp->host == b && first_b < 0)
+            first_b = sp->start;
+        on_c += sp->host == c;
+        on_d += sp->host == d;
+    }
+    CHECK(first_b >= b_ready_at && first_b < b_ready_at + 0.5, "b's first slab at %.2f s, expected just after %.1f",
+          first_b, b_ready_at);
+    CHECK(r->sh[b].rows > 0 && r->sh[a].rows > 0, "rows a %d, b %d: both should render", r->sh[a].rows,
+          r->sh[b].rows);
+    CHECK(on_c == 0 && on_d == 0, "%d processes on c, %d on d, which were never ready", on_c, on_d);
+    CHECK(r->sh[c].dropped && !r->sh[d].dropped && r->sh[d].pending, "c dropped %d, d pending %d",
+          r->sh[c].dropped, r->sh[d].pending);
+    CHECK(r->st.wall_s < 30, "took %.1f virtual s: 40 one-second slabs on a then a and b", r->st.wall_s);
+    CHECK(stitched_ok(r), "stitched rows are not the fake pixels");
+    teardown(r);
+}
+
+/* A stream that never ends (a host whose processes hang): once the other
+ * slabs have shown how long a row takes (1 s here), an attempt that runs
+ * 8 times that plus 5 s is given up as a failure of its host, long before
+ * the queue is empty; after three the host is dropped. */
+static void test_deadline(void)
+{
+    run *r = setup(60, 1);
+    int a = host(r, "a", 1, (fake_script){.hang = 1});
+    int b = host(r, "b", 1, (fake_script){.duration = 1});
+    go(r);
+    CHECK(r->rc == 0, "run failed: %s", r->err.msg);
+    const event *f = first(r, SCHED_SLAB_FAILED);
+    CHECK(f && f->host == a && strstr(f->text, "no result after"), "first failure: %s", f ? f->text : "(none)");
+    CHECK(f && f->t >= 13 && f->t < 14, "first stuck attempt given up at %.1f s, expected at 8 * 1 s + 5 s",
+          f ? f->t : -1.0);
+    CHECK(r->sh[a].dropped && count(r, SCHED_SLAB_FAILED, a) == 3, "a dropped %d after %d failures",
+          r->sh[a].dropped, count(r, SCHED_SLAB_FAILED, a));
+    const event *d = first(r, SCHED_HOST_DROPPED);
+    CHECK(d && d->t < 45, "a dropped at %.1f s, before b's 60 slabs are done", d ? d->t : -1.0);
+    CHECK(r->sh[b].rows == 60, "b rendered %d rows", r->sh[b].rows);
+    CHECK(stitched_ok(r), "stitched rows are not the fake pixels");
+    teardown(r);
+}
+
+/* A host slower than the others (4 s a row against 1 s) is judged by its
+ * own pace once it has delivered: none of its slabs is given up. */
+static void test_deadline_slow_host(void)
+{
+    run *r = setup(30, 1);
+    int a = host(r, "a", 1, (fake_script){.duration = 4});
+    host(r, "b", 2, (fake_script){.duration = 1});
+    go(r);
+    CHECK(r->rc == 0, "run failed: %s", r->err.msg);
+    CHECK(count(r, SCHED_SLAB_FAILED, a) == 0, "%d slabs of the slow host given up",
+          count(r, SCHED_SLAB_FAILED, a));
+    CHECK(r->sh[a].slabs > 0, "the slow host delivered nothing");
+    teardown(r);
+}
+
+/* Pending hosts without an admit hook are dropped; the others render. */
+static void test_pending_without_hook(void)
+{
+    run *r = setup(8, 2);
+    host(r, "a", 1, (fake_script){0});
+    int b = host(r, "b", 1, (fake_script){0});
+    r->sh[b].pending = 1;
+    go(r);
+    CHECK(r->rc == 0, "run failed: %s", r->err.msg);
+    CHECK(r->sh[b].dropped && r->sh[b].slabs == 0, "b (never ready) ran slabs or was not dropped");
+    teardown(r);
+}
+
 int main(void)
 {
     test_plain();
@@ -443,5 +551,9 @@ int main(void)
     test_gives_up();
     test_interrupt();
     test_progress();
+    test_pending_hosts();
+    test_pending_without_hook();
+    test_deadline();
+    test_deadline_slow_host();
     return check_done();
 }
