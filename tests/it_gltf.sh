@@ -2,7 +2,8 @@
 # glTF 2.0 scenes end to end: files written by tests/tools/gengltf compile
 # and render; the same triangles as glTF and as JSON give the same binary
 # scene and image; node transforms, camera framing (yfov, aspectRatio) and
-# UV orientation land on known pixels; models of Debian's assimp-testmodels
+# UV orientation land on known pixels; the metallicRoughness texture's
+# channels reach the right pixels; models of Debian's assimp-testmodels
 # compile and render; malformed files are refused with a message naming the
 # file and the JSON pointer or byte offset.
 cd "$(dirname "$0")/.." || exit 1
@@ -83,6 +84,23 @@ done
 $F compile "$T/uvxf.gltf" -o "$T/uvxf.fbin" >/dev/null &&
     $W --scene "$T/uvxf.fbin" --rows 0:32 --size 32x32 --spp 1 -o "$T/uvxf.pfm" || bad "uvxf.gltf"
 for xy in "8 8" "24 8" "8 24" "24 24"; do pixel_is "$T/uvxf.pfm" $xy 0 1 0; done
+# The same image as a metallicRoughnessTexture (G roughness, B metallic) of a
+# white material under a point light: the smooth dielectric (red texel) and
+# the rough one (green) show their diffuse base, the smooth metal (blue)
+# reflects the light away from the camera (black), the rough metal (white)
+# glints.  Metallic read from another channel, or the texture ignored,
+# turns a quadrant the other way.
+# value IMAGE X Y: the pixel's mean channel.
+value() { $P "$1" "$2" "$3" | awk '{ print ($1 + $2 + $3) / 3 }'; }
+above() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a > b) }'; }
+$F compile "$T/mr.gltf" -o "$T/mr.fbin" >/dev/null 2>"$T/mr.err" &&
+    $W --scene "$T/mr.fbin" --rows 0:32 --size 32x32 --spp 16 -o "$T/mr.pfm" || bad "mr.gltf: $(cat "$T/mr.err")"
+tl=$(value "$T/mr.pfm" 8 8) tr=$(value "$T/mr.pfm" 24 8) bl=$(value "$T/mr.pfm" 8 24) br=$(value "$T/mr.pfm" 24 24)
+check "smooth dielectric texel lit ($tl)" above "$tl" 0.1
+check "rough dielectric texel lit ($tr)" above "$tr" 0.1
+check "smooth metal texel black ($bl)" above 0.005 "$bl"
+check "rough metal texel glints ($br), less than the diffuse ($tr)" above "$br" 0.01
+check "rough metal texel ($br) below the rough dielectric ($tr)" above "$tr" "$br"
 
 # --- a glTF file as a shape of a JSON scene ---
 cat >"$T/inc.json" <<EOF

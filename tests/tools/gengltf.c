@@ -426,13 +426,26 @@ static void gen_uv(const char *dir, const char *png)
     const float p[12] = {-1, 1, -1, 1, 1, -1, 1, -1, -1, -1, -1, -1};
     const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
     const uint16_t idx[6] = {0, 2, 1, 0, 3, 2};
-    for (int variant = 0; variant < 3; variant++) {
+    /* Variant 3 (mr.gltf): the image as a white material's
+     * metallicRoughnessTexture (roughness in G, metallic in B), lit by a
+     * point light at (0.5, 0.5, 0): a smooth dielectric top-left (red), a
+     * rough one top-right (green), a smooth metal bottom-left (blue), a
+     * rough metal bottom-right (white). */
+    for (int variant = 0; variant < 4; variant++) {
         doc d = {0};
         const char *xf = variant == 2 ? ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0],"
                                         "\"scale\":[0.5,0.5]}}" : "";
         char body[512];
-        snprintf(body, sizeof body, "\"emissiveFactor\":[1,1,1],\"emissiveTexture\":{\"index\":0%s},"
-                 "\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]}", xf);
+        if (variant == 3)
+            snprintf(body, sizeof body, "\"pbrMetallicRoughness\":{\"metallicRoughnessTexture\":{\"index\":0}}");
+        else
+            snprintf(body, sizeof body, "\"emissiveFactor\":[1,1,1],\"emissiveTexture\":{\"index\":0%s},"
+                     "\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]}", xf);
+        if (variant == 3) {
+            d.used = "[\"KHR_lights_punctual\"]";
+            addf(&d.lights, "{\"type\":\"point\",\"intensity\":683}");
+            node(&d, 1, "\"translation\":[0.5,0.5,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}");
+        }
         if (variant == 2)
             d.used = "[\"KHR_texture_transform\"]";
         int m = material(&d, body);
@@ -450,7 +463,8 @@ static void gen_uv(const char *dir, const char *png)
             b64(&d.images, (const unsigned char *)img.s, img.n);
             addf(&d.images, "\"}");
         }
-        write_doc(&d, dir, variant == 0 ? "uv.gltf" : variant == 1 ? "uv.glb" : "uvxf.gltf", variant == 1);
+        static const char *const names[] = {"uv.gltf", "uv.glb", "uvxf.gltf", "mr.gltf"};
+        write_doc(&d, dir, names[variant], variant == 1);
     }
     free(img.s);
 }
