@@ -51,7 +51,17 @@ struct bd_work {
 
 int bd_supported(const fr_scene *s, fr_error *err)
 {
-    if (s->n_media)
+    /* Fog, or a shape whose material holds a medium or bounds one. */
+    int media = s->volume.fog || s->volume.camera_medium;
+    for (uint32_t i = 0; i < s->n_prims && !media; i++) {
+        const fr_material *m = &s->materials[s->prims[i].material];
+        media = m->medium || m->interface;
+    }
+    for (uint32_t i = 0; i < s->n_planes && !media; i++) {
+        const fr_material *m = &s->materials[s->planes[i].material];
+        media = m->medium || m->interface;
+    }
+    if (media)
         return fr_fail(err, "the scene has participating media (fog or a medium inside a shape), which the "
                             "bidirectional integrator does not support; render it with the path integrator");
     return 0;

@@ -30,7 +30,8 @@
  * Russian roulette.  So each light subpath belongs to one pixel sample, and
  * a split of the image into rows traces every light subpath once.
  *
- * Scenes with participating media are refused (bd_supported).
+ * Scenes that use participating media (fog, a medium inside a shape) are
+ * refused (bd_supported).
  */
 #ifndef FRANJA_BDPT_H
 #define FRANJA_BDPT_H

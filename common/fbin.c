@@ -277,8 +277,8 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
 {
     const fr_settings *st = &s->settings;
     if (st->width == 0 || st->height == 0 || st->width > PROTO_MAX_SIZE || st->height > PROTO_MAX_SIZE ||
-        st->spp == 0 || st->spp > PROTO_MAX_SPP || st->max_depth > PROTO_MAX_DEPTH)
-        return fr_fail(err, "section settings, byte %zu: bad image size, sample count or depth",
+        st->spp == 0 || st->spp > PROTO_MAX_SPP || st->max_depth > PROTO_MAX_DEPTH || st->integrator >= FR_INTEGRATORS)
+        return fr_fail(err, "section settings, byte %zu: bad image size, sample count, depth or integrator",
                        AT1(SEC_SETTINGS, fr_settings, width));
     const fr_camera *c = &s->camera;
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||

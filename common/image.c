@@ -6,8 +6,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
 #include "fmath.h"
 #include "proto_limits.h"
+#include "splat.h"
 
 float img_srgb_encode(float v)
 {
@@ -27,16 +31,62 @@ int img_format_parse(const char *name, img_format *fmt)
     return 0;
 }
 
-int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, fr_error *err)
+/* The splat block as bytes: n sums, little-endian, a chunk at a time into
+ * tmp[SPLAT_CHUNK * 8], each chunk passed to fn. */
+#define SPLAT_CHUNK 4096
+static int splat_bytes(const uint64_t *splat, size_t n, unsigned char *tmp,
+                       int (*fn)(const unsigned char *bytes, size_t len, void *ctx), void *ctx)
+{
+    for (size_t at = 0; at < n; at += SPLAT_CHUNK) {
+        size_t k = n - at < SPLAT_CHUNK ? n - at : SPLAT_CHUNK;
+        for (size_t i = 0; i < k; i++)
+            for (int b = 0; b < 8; b++)
+                tmp[i * 8 + b] = (unsigned char)(splat[at + i] >> (8 * b));
+        if (fn(tmp, k * 8, ctx) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int hash_chunk(const unsigned char *bytes, size_t len, void *ctx)
+{
+    return XXH3_64bits_update(ctx, bytes, len) == XXH_OK ? 0 : -1;
+}
+
+static int write_chunk(const unsigned char *bytes, size_t len, void *ctx)
+{
+    return fwrite(bytes, 1, len, ctx) == len ? 0 : -1;
+}
+
+int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, const uint64_t *splat,
+              fr_error *err)
 {
     uint32_t w = info->width, rows = info->y1 - info->y0;
-    fprintf(f, "%s\n# franja scene=%016" PRIx64 " rows=%u:%u spp=%u size=%ux%u\n%u %u\n%s\n",
+    size_t nsplat = (size_t)info->width * info->height * 3;
+    char tail[64] = "";
+    unsigned char *tmp = NULL;
+    if (splat) {
+        if (fmt != IMG_PF)
+            return fr_fail(err, "light-tracing splats need the PF format");
+        tmp = malloc(SPLAT_CHUNK * 8);
+        XXH3_state_t *st = XXH3_createState();
+        if (!tmp || !st || XXH3_64bits_reset(st) != XXH_OK || splat_bytes(splat, nsplat, tmp, hash_chunk, st) < 0) {
+            free(tmp);
+            XXH3_freeState(st);
+            return fr_fail(err, "out of memory writing the image");
+        }
+        snprintf(tail, sizeof tail, " splat=%" PRIu64 ":%016" PRIx64, info->splat_paths, (uint64_t)XXH3_64bits_digest(st));
+        XXH3_freeState(st);
+    }
+    fprintf(f, "%s\n# franja scene=%016" PRIx64 " rows=%u:%u spp=%u size=%ux%u%s\n%u %u\n%s\n",
             fmt == IMG_PF ? "PF" : "P6", info->scene, info->y0, info->y1, info->spp, info->width,
-            info->height, w, rows, fmt == IMG_PF ? "-1.0" : fmt == IMG_PPM16 ? "65535" : "255");
+            info->height, tail, w, rows, fmt == IMG_PF ? "-1.0" : fmt == IMG_PPM16 ? "65535" : "255");
     size_t rowbytes = (size_t)w * 3 * (fmt == IMG_PF ? 4 : fmt == IMG_PPM16 ? 2 : 1);
     unsigned char *line = malloc(rowbytes ? rowbytes : 1);
-    if (!line)
+    if (!line) {
+        free(tmp);
         return fr_fail(err, "out of memory writing the image");
+    }
     for (uint32_t r = 0; r < rows; r++) {
         /* PFM stores the bottom row first. */
         const float *src = rgb + (size_t)(fmt == IMG_PF ? rows - 1 - r : r) * w * 3;
@@ -56,11 +106,14 @@ int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float
         }
         if (fwrite(line, 1, rowbytes, f) != rowbytes) {
             free(line);
+            free(tmp);
             return fr_fail(err, "write failed: %s", strerror(errno));
         }
     }
     free(line);
-    if (fflush(f) != 0)
+    int bad = splat && splat_bytes(splat, nsplat, tmp, write_chunk, f) < 0;
+    free(tmp);
+    if (bad || fflush(f) != 0)
         return fr_fail(err, "write failed: %s", strerror(errno));
     return 0;
 }
@@ -88,13 +141,26 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     if (header_line(buf, len, &pos, line, sizeof line) < 0 || strcmp(line, "PF") != 0)
         return fr_fail(err, "byte 0: not a PF (float RGB) partial image");
     at = pos;
-    unsigned long long scene;
+    unsigned long long scene, paths = 0, hash = 0;
     unsigned y0, y1, spp, fw, fh;
     char tail;
-    if (header_line(buf, len, &pos, line, sizeof line) < 0 ||
-        sscanf(line, "# franja scene=%16llx rows=%u:%u spp=%u size=%ux%u%c", &scene, &y0, &y1, &spp, &fw, &fh,
-               &tail) != 6)
+    if (header_line(buf, len, &pos, line, sizeof line) < 0)
         return fr_fail(err, "byte %zu: missing or malformed franja header comment", at);
+    int end = -1;
+    if (sscanf(line, "# franja scene=%16llx rows=%u:%u spp=%u size=%ux%u%n", &scene, &y0, &y1, &spp, &fw, &fh,
+               &end) != 6 || end < 0)
+        return fr_fail(err, "byte %zu: missing or malformed franja header comment", at);
+    const char *rest = line + end;
+    if (*rest) {
+        /* " splat=<paths>:<16 hex>": a positive count, a whole hash. */
+        int e2 = -1;
+        const char *colon = strchr(rest, ':');
+        if (strncmp(rest, " splat=", 7) != 0 || rest[7] < '1' || rest[7] > '9' || !colon ||
+            sscanf(rest, " splat=%llu:%16llx%n", &paths, &hash, &e2) != 2 || e2 < 0 || rest[e2] != 0 ||
+            strlen(colon + 1) != 16)
+            return fr_fail(err, "byte %zu: malformed franja header comment (after size=: expected nothing or "
+                                "splat=<paths>:<16 hex digits>)", at);
+    }
     at = pos;
     unsigned w, h;
     if (header_line(buf, len, &pos, line, sizeof line) < 0 || sscanf(line, "%u %u%c", &w, &h, &tail) != 2)
@@ -105,9 +171,12 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     if (y0 >= y1 || y1 > fh || w != fw || h != y1 - y0 || w == 0 || fw > PROTO_MAX_SIZE || fh > PROTO_MAX_SIZE)
         return fr_fail(err, "byte %zu: size %ux%u does not match rows %u:%u of a %ux%u image", at, w, h, y0, y1,
                        fw, fh);
-    size_t n = (size_t)w * h * 3;
-    if (len - pos != n * 4)
-        return fr_fail(err, "byte %zu: %zu bytes of pixels, expected %zu", pos, len - pos, n * 4);
+    size_t n = (size_t)w * h * 3, nsplat = paths ? (size_t)fw * fh * 3 : 0;
+    if (len - pos != n * 4 + nsplat * 8)
+        return fr_fail(err, "byte %zu: %zu bytes of pixels%s, expected %zu", pos, len - pos,
+                       paths ? " and splats" : "", n * 4 + nsplat * 8);
+    if (paths && XXH3_64bits(buf + pos + n * 4, nsplat * 8) != hash)
+        return fr_fail(err, "byte %zu: the splat block does not match its hash %016llx", pos + n * 4, hash);
     float *out = malloc(n * sizeof *out);
     if (!out)
         return fr_fail(err, "out of memory reading a partial image");
@@ -131,6 +200,21 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     }
     info->scene = scene;
     info->y0 = y0; info->y1 = y1; info->spp = spp; info->width = fw; info->height = fh;
+    info->splat_paths = paths;
+    info->splat_hash = hash;
+    info->splat_offset = paths ? pos + n * 4 : 0;
     *rgb = out;
     return 0;
+}
+
+void img_splat_add(const unsigned char *buf, const img_partial_info *info, uint64_t *acc)
+{
+    const unsigned char *p = buf + info->splat_offset;
+    size_t n = (size_t)info->width * info->height * 3;
+    for (size_t i = 0; i < n; i++, p += 8) {
+        uint64_t v = 0;
+        for (int b = 7; b >= 0; b--)
+            v = v << 8 | p[b];
+        spl_add(&acc[i], v);
+    }
 }

@@ -8,6 +8,13 @@
  *     # franja scene=<16 hex> rows=<y0>:<y1> spp=<n> size=<W>x<H>
  * naming what the pixels are, so a partial can be checked against what was
  * asked for.
+ *
+ * A bidirectional render's PF partial also carries the light its slab's
+ * light subpaths splatted onto the whole image (splat.h): the comment
+ * line ends with " splat=<paths>:<16 hex>", the number of light subpaths
+ * traced and the XXH3-64 hash of the splat block, and the block follows
+ * the pixels: W*H*3 unsigned 64-bit little-endian fixed-point sums (2^-32
+ * units), top row first, whole pixels of R, G, B (common/FORMAT.md).
  */
 #ifndef FRANJA_IMAGE_H
 #define FRANJA_IMAGE_H
@@ -27,19 +34,32 @@ typedef struct {
     uint32_t y0, y1;           /**< rows of the full image */
     uint32_t spp;
     uint32_t width, height;    /**< size of the full image */
+    uint64_t splat_paths;      /**< light subpaths whose splats follow the pixels; 0: no splat block */
+    uint64_t splat_hash;       /**< img_read_partial: XXH3-64 of the splat block */
+    size_t splat_offset;       /**< img_read_partial: where the splat block starts in the buffer */
 } img_partial_info;
 
 /** Write rows (3 floats per pixel, top row first, width*(y1-y0) pixels) in
- * the given format.  Returns -1 with err set if writing fails. */
-int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, fr_error *err);
+ * the given format, and when splat is not NULL (PF only) the splat block:
+ * width*height*3 sums, top row first, for info->splat_paths light
+ * subpaths (> 0).  Returns -1 with err set if writing fails or a P6 image
+ * is given splats. */
+int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, const uint64_t *splat,
+              fr_error *err);
 
 /** Parse a PF partial image held in buf[0..len).  Checks the magic, the
  * header comment, that the pixel rows match rows and width, that the
- * data length is exact, and that every float is finite and >= 0 (a NaN,
+ * data length is exact (with the splat block, if the header announces one,
+ * whose hash must match), and that every float is finite and >= 0 (a NaN,
  * infinity or negative value is refused, naming the pixel).  On success *rgb is a malloc'd array (caller
  * frees) of width*(y1-y0)*3 floats, top row first.  Errors give the byte
  * offset. */
 int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *info, float **rgb, fr_error *err);
+
+/** Add the splat block of a partial that img_read_partial accepted (buf
+ * and its info, splat_paths > 0) to acc (width*height*3 sums, top row
+ * first), saturating as spl_add does. */
+void img_splat_add(const unsigned char *buf, const img_partial_info *info, uint64_t *acc);
 
 /** sRGB transfer curve of a linear value, clamped to [0,1]. */
 float img_srgb_encode(float linear);

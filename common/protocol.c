@@ -7,8 +7,25 @@
 #include <string.h>
 
 #include "fbin.h"
+#include "scene.h"
 
 static const char *const format_names[] = {"pf", "ppm16", "ppm8"};
+static const char *const integrator_names[] = {"path", "bdpt"};
+
+int proto_integrator_parse(const char *name, int *out)
+{
+    for (int i = 0; i < FR_INTEGRATORS; i++)
+        if (!strcmp(name, integrator_names[i])) {
+            *out = i;
+            return 0;
+        }
+    return -1;
+}
+
+const char *proto_integrator_name(int i)
+{
+    return i >= 0 && i < FR_INTEGRATORS ? integrator_names[i] : "?";
+}
 
 static int parse_u32(const char *s, uint32_t *out)
 {
@@ -59,6 +76,8 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
         return fr_fail(err, "%u samples per pixel: more than %u", s->spp, PROTO_MAX_SPP);
     if ((unsigned)s->format >= sizeof format_names / sizeof *format_names)
         return fr_fail(err, "unknown partial image format %d", (int)s->format);
+    if (s->integrator < 0 || s->integrator > FR_INTEGRATORS)
+        return fr_fail(err, "unknown integrator %d", s->integrator - 1);
     int n = 0;
     snprintf(a->rows, sizeof a->rows, "%u:%u", s->y0, s->y1);
     a->argv[n++] = "--scene";
@@ -74,6 +93,10 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
         snprintf(a->size, sizeof a->size, "%ux%u", s->width, s->height);
         a->argv[n++] = "--size";
         a->argv[n++] = a->size;
+    }
+    if (s->integrator) {
+        a->argv[n++] = "--integrator";
+        a->argv[n++] = integrator_names[s->integrator - 1];
     }
     a->argv[n++] = "--format";
     a->argv[n++] = format_names[s->format];
@@ -105,7 +128,8 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         } else if (!strcmp(a, "--lifeline")) {
             r->slab.lifeline = 1;
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
-                                !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "-o"))) {
+                                !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "--integrator") ||
+                                !strcmp(a, "-o"))) {
             return fr_fail(err, "%s needs a value", a);
         } else if (!strcmp(a, "--scene")) {
             r->slab.scene = argv[++i];
@@ -119,6 +143,11 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
                 return fr_fail(err, "--size: expected WxH with 1 <= W,H <= %u, got '%s'", PROTO_MAX_SIZE, argv[i]);
         } else if (!strcmp(a, "--format")) {
             fmt_name = argv[++i];
+        } else if (!strcmp(a, "--integrator")) {
+            int k;
+            if (proto_integrator_parse(argv[++i], &k) < 0)
+                return fr_fail(err, "--integrator: expected path or bdpt, got '%s'", argv[i]);
+            r->slab.integrator = 1 + k;
         } else if (!strcmp(a, "-o")) {
             r->slab.out = argv[++i];
         } else {

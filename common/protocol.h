@@ -40,13 +40,14 @@ typedef struct {
     const char *out;           /**< output file; "-" = standard output */
     int lifeline;              /**< --lifeline: standard input is the coordinator's line; the worker ends
                                     when it reaches its end (worker/lifeline.h) */
+    int integrator;            /**< 1 + FR_INTEGRATOR_* (scene.h); 0 = the scene's (no --integrator) */
 } proto_slab;
 
 /** A worker command line built by proto_slab_argv: argv points into the
  * struct's own buffers (and at the caller's strings), NULL-terminated,
  * without the program name. */
 typedef struct {
-    const char *argv[16];
+    const char *argv[18];
     char rows[32], size[32], spp[16];
 } proto_argv;
 
@@ -75,6 +76,13 @@ typedef struct {
  * option is wrong and what was expected (the text a worker prints after
  * "franja-worker: "). */
 int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *err);
+
+/** Parses an integrator name, "path" or "bdpt", into FR_INTEGRATOR_*; -1
+ * if it is neither. */
+int proto_integrator_parse(const char *name, int *out);
+
+/** The name of integrator i (FR_INTEGRATOR_*), as --integrator takes it. */
+const char *proto_integrator_name(int i);
 
 /** Parses "WxH" with 1 <= W, H <= PROTO_MAX_SIZE; -1 if it is not that. */
 int proto_parse_size(const char *s, uint32_t *w, uint32_t *h);

@@ -23,13 +23,19 @@
 
 #define FR_NONE 0xffffffffu /**< "no index" for optional uint32 references */
 
+/** How a scene is rendered by default (franja-worker --integrator
+ * overrides it): unidirectional path tracing, or bidirectional path
+ * tracing (bdpt.h). */
+enum { FR_INTEGRATOR_PATH = 0, FR_INTEGRATOR_BDPT = 1, FR_INTEGRATORS };
+
 /** Image and sampling settings. */
 typedef struct {
     uint32_t width, height;    /**< pixels */
     uint32_t spp;              /**< samples per pixel */
     uint32_t max_depth;        /**< bounces; a path has at most max_depth+1 vertices after the camera */
     uint32_t seed;             /**< decorrelates renders of the same scene */
-    uint32_t pad[3];
+    uint32_t integrator;       /**< FR_INTEGRATOR_* */
+    uint32_t pad[2];
 } fr_settings;
 
 /** A pinhole or thin-lens camera. */

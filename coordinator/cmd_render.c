@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "bdpt.h"
 #include "cli.h"
 #include "opt.h"
 #include "clock.h"
@@ -41,6 +42,7 @@ static const char usage[] =
     "  --size WxH           image size (default: the scene's)\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
+    "  --integrator I       path or bdpt (default: the scene's, else path)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
     "                       (default: the scene's tonemap; HDR outputs .exr\n"
     "                       .hdr .pfm keep linear radiance)\n"
@@ -75,6 +77,7 @@ typedef struct {
     int exposure_set;          /* --exposure given: overrides the scene's */
     const char *curve;         /* --tonemap, or NULL for the scene's */
     char out_buf[4096];        /* out when -o is omitted */
+    int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
     int resume, keep_job, fresh, no_lock;
     tr_options tr;
     cli_slurm slurm;
@@ -121,7 +124,7 @@ static int parse(int argc, char **argv, render_args *a)
             continue;
         }
         static const char *valued[] = {"-o", "-j", "--spp", "--size", "--exposure", "--job", "--slab-rows",
-                                       "--retries", "--tonemap", "--camera"};
+                                       "--retries", "--tonemap", "--camera", "--integrator"};
         int known = 0;
         for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
             known |= !strcmp(s, valued[k]);
@@ -156,6 +159,11 @@ static int parse(int argc, char **argv, render_args *a)
             bad = cli_uint(v, 1, 1000, &a->retries);
         else if (!strcmp(s, "--size"))
             bad = proto_parse_size(v, &a->width, &a->height);
+        else if (!strcmp(s, "--integrator")) {
+            int k = 0;
+            bad = proto_integrator_parse(v, &k) < 0;
+            a->integrator = 1 + k;
+        }
         else {
             char *end;
             errno = 0;
@@ -549,7 +557,15 @@ int cmd_render(int argc, char **argv)
         return unlock_with(&lk, 1);
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
-                     a.spp ? a.spp : sc.settings.spp};
+                     a.spp ? a.spp : sc.settings.spp,
+                     a.integrator ? (uint32_t)(a.integrator - 1) : sc.settings.integrator};
+    if (spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
+        fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a.scene, err.msg);
+        scn_free(&sc);
+        hosts_free(&table);
+        slurm_close(&alloc);
+        return unlock_with(&lk, a.integrator ? 2 : 1);
+    }
     uint32_t asked = spec.spp;
     if (quick_spp(&spec.spp, &err) > 0)
         fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);

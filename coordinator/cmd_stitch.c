@@ -10,6 +10,7 @@
 #include "fbin.h"
 #include "jobdir.h"
 #include "output.h"
+#include "scene.h"
 #include "tonemap.h"
 
 static const char usage[] =
@@ -119,7 +120,14 @@ int cmd_stitch(int argc, char **argv)
         fprintf(stderr, "franja stitch: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
     }
-    int rows = job_gather(dir, &spec, rgb, have, &skipped, &err);
+    /* A bidirectional job: the rows lack the light traced from the lights
+     * (every slab's splats over the whole image), so only a complete job
+     * makes an image. */
+    int rows = spec.integrator == FR_INTEGRATOR_BDPT
+                   ? (job_stitch(dir, &spec, rgb, NULL, &err) ? -1 : (int)spec.height)
+                   : job_gather(dir, &spec, rgb, have, &skipped, &err);
+    if (rows > 0 && spec.integrator == FR_INTEGRATOR_BDPT)
+        memset(have, 1, spec.height);
     if (rows < 0) {
         fprintf(stderr, "franja stitch: %s\n", err.msg);
         goto done;

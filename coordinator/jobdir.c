@@ -11,6 +11,8 @@
 
 #include "file.h"
 #include "protocol.h"
+#include "scene.h"
+#include "splat.h"
 
 int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
                       uint32_t y1, fr_error *err)
@@ -30,13 +32,26 @@ int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec
         return fr_fail(err, "rows %u:%u, expected %u:%u", info.y0, info.y1, y0, y1);
     if (info.spp != spec->spp)
         return fr_fail(err, "%u samples per pixel, expected %u", info.spp, spec->spp);
+    uint64_t paths = spec->integrator == FR_INTEGRATOR_BDPT ? (uint64_t)spec->width * (y1 - y0) * spec->spp : 0;
+    if (info.splat_paths != paths)
+        return paths ? fr_fail(err, "%llu light subpaths splatted, expected %llu (one per pixel sample of its rows)",
+                               (unsigned long long)info.splat_paths, (unsigned long long)paths)
+                     : fr_fail(err, "light-tracing splats in a path-traced render");
     return 0;
+}
+
+size_t job_max_partial(const job_spec *spec, uint32_t y0, uint32_t y1)
+{
+    size_t n = 4096 + (size_t)spec->width * (y1 - y0) * 12;
+    if (spec->integrator == FR_INTEGRATOR_BDPT)
+        n += (size_t)spec->width * spec->height * 24;
+    return n;
 }
 
 static void spec_text(const job_spec *s, char *out, size_t cap)
 {
-    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n", (unsigned long long)s->hash,
-             s->width, s->height, s->spp);
+    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n%s", (unsigned long long)s->hash,
+             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT ? "integrator=bdpt\n" : "");
 }
 
 /* Calls fn for every slab file name in dir ("rows-Y0-Y1.pf"). */
@@ -103,7 +118,7 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
             free(have);
             if (!same)
                 return fr_fail(err, "%s: this job directory belongs to another render (different scene, "
-                               "size or samples); remove it or render without --resume", dir);
+                               "size, samples or integrator); remove it or render without --resume", dir);
             return 0;
         }
     } else {
@@ -237,12 +252,113 @@ void job_missing_rows(const unsigned char *have, uint32_t height, char *out, siz
     }
 }
 
+/* The slab files of a directory, for the bidirectional stitch. */
+typedef struct {
+    uint32_t y0, y1;
+    char name[64];
+} slab_file;
+
+typedef struct {
+    slab_file *v;
+    size_t n, cap;
+} slab_list;
+
+static int list_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
+{
+    (void)dir;
+    slab_list *l = vctx;
+    if (y0 >= y1 || strlen(name) >= sizeof l->v->name)
+        return 0;
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? l->cap * 2 : 64;
+        slab_file *v = realloc(l->v, cap * sizeof *v);
+        if (!v)
+            return -1;
+        l->v = v;
+        l->cap = cap;
+    }
+    l->v[l->n].y0 = y0;
+    l->v[l->n].y1 = y1;
+    snprintf(l->v[l->n].name, sizeof l->v[l->n].name, "%s", name);
+    l->n++;
+    return 0;
+}
+
+static int by_rows(const void *a, const void *b)
+{
+    const slab_file *x = a, *y = b;
+    if (x->y0 != y->y0)
+        return x->y0 < y->y0 ? -1 : 1;
+    return x->y1 < y->y1 ? -1 : x->y1 > y->y1;
+}
+
+/* Bidirectional: rows from a chain of slabs that splits [0, height) into
+ * non-overlapping pieces, and every chosen slab's splats summed. */
+static int stitch_splats(const char *dir, const job_spec *spec, float *rgb, fr_error *err)
+{
+    slab_list l = {NULL, 0, 0};
+    int32_t *from = malloc(sizeof *from * ((size_t)spec->height + 1));
+    uint64_t *sum = calloc((size_t)spec->width * spec->height * 3, sizeof *sum);
+    int rc = -1;
+    if (!from || !sum) {
+        fr_fail(err, "out of memory for the splats of a %ux%u image", spec->width, spec->height);
+        goto out;
+    }
+    if (each_slab(dir, list_one, &l, err))
+        goto out;
+    /* Slabs in row order; from[y] is the slab that ends a chain from row 0
+     * at row y (-1: none yet, -2: row 0 itself). */
+    qsort(l.v, l.n, sizeof *l.v, by_rows);
+    for (uint32_t y = 0; y <= spec->height; y++)
+        from[y] = -1;
+    from[0] = -2;
+    for (size_t i = 0; i < l.n; i++)
+        if (l.v[i].y1 <= spec->height && from[l.v[i].y0] != -1 && from[l.v[i].y1] == -1)
+            from[l.v[i].y1] = (int32_t)i;
+    if (from[spec->height] == -1) {
+        fr_fail(err, "the slabs in %s do not split the image into non-overlapping rows (a bidirectional render "
+                     "counts each slab's light paths once); the image was not written", dir);
+        goto out;
+    }
+    for (uint32_t y = spec->height; y > 0;) {
+        const slab_file *sf = &l.v[from[y]];
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", dir, sf->name);
+        char *text;
+        size_t len;
+        img_partial_info info;
+        float *rows;
+        if (file_read(path, &text, &len, err))
+            goto out;
+        const unsigned char *buf = (const unsigned char *)text;
+        if (job_check_partial(buf, len, spec, sf->y0, sf->y1, err) ||
+            img_read_partial(buf, len, &info, &rows, err)) {
+            fr_error e2 = *err;
+            fr_fail(err, "%s: %s", path, e2.msg);
+            free(text);
+            goto out;
+        }
+        memcpy(rgb + (size_t)sf->y0 * spec->width * 3, rows, (size_t)(sf->y1 - sf->y0) * spec->width * 3 * sizeof(float));
+        img_splat_add(buf, &info, sum);
+        free(rows);
+        free(text);
+        y = sf->y0;
+    }
+    spl_resolve(rgb, sum, spec->width, 0, spec->height, spec->spp);
+    rc = 0;
+out:
+    free(l.v);
+    free(from);
+    free(sum);
+    return rc;
+}
+
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err)
 {
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, rgb, 0, notes, 0, 0};
+    scan_ctx c = {spec, have, spec->integrator == FR_INTEGRATOR_BDPT ? NULL : rgb, 0, notes, 0, 0};
     int rc = each_slab(dir, scan_one, &c, err);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];
@@ -250,6 +366,8 @@ int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sin
         rc = fr_fail(err, "rows %s are missing from %s; the image was not written", missing, dir);
     }
     free(have);
+    if (rc == 0 && spec->integrator == FR_INTEGRATOR_BDPT)
+        rc = stitch_splats(dir, spec, rgb, err);
     return rc;
 }
 
@@ -273,24 +391,28 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
         return fr_fail(err, "%s: not a job directory (no readable job file: %s)", dir, err->msg);
     unsigned long long hash = 0;
     unsigned w = 0, h = 0, spp = 0;
-    int n = -1;
+    int n = -1, bdpt = 0;
     /* Exactly what spec_text writes, and nothing after it. */
     int ok = len < 200 && memchr(text, 0, len) == NULL;
     if (ok) {
         char copy[200];
         memcpy(copy, text, len);
         copy[len] = 0;
-        ok = sscanf(copy, "franja job\nscene=%16llx\nsize=%ux%u\nspp=%u\n%n", &hash, &w, &h, &spp, &n) == 4 &&
-             n == (int)len;
+        ok = sscanf(copy, "franja job\nscene=%16llx\nsize=%ux%u\nspp=%u\n%n", &hash, &w, &h, &spp, &n) == 4 && n > 0;
+        if (ok && n < (int)len) {
+            bdpt = !strcmp(copy + n, "integrator=bdpt\n");
+            ok = bdpt;
+        }
     }
     free(text);
     if (!ok || w == 0 || h == 0 || w > PROTO_MAX_SIZE || h > PROTO_MAX_SIZE || spp == 0 || spp > PROTO_MAX_SPP)
-        return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, "
+        return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, maybe integrator=bdpt, "
                        "sizes in 1..%u)", path, PROTO_MAX_SIZE);
     spec->hash = hash;
     spec->width = w;
     spec->height = h;
     spec->spp = spp;
+    spec->integrator = bdpt ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH;
     return 0;
 }
 

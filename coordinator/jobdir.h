@@ -26,11 +26,14 @@ typedef struct {
     uint64_t hash;             /**< scene content hash */
     uint32_t width, height;    /**< full image, pixels */
     uint32_t spp;              /**< samples per pixel */
+    uint32_t integrator;       /**< FR_INTEGRATOR_* (scene.h): bidirectional partials carry splats */
 } job_spec;
 
 /** Checks a partial image (PF bytes) against the spec and the rows asked
  * for.  Returns 0 if it is exactly that slab; otherwise err says what is
- * wrong (size, header, scene hash, rows, spp). */
+ * wrong (size, header, scene hash, rows, spp, and for a bidirectional
+ * render the splat block: one light subpath per pixel sample of the rows,
+ * its hash). */
 int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
                       uint32_t y1, fr_error *err);
 
@@ -44,12 +47,20 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err);
  * notes.  Returns the number of rows covered, or -1. */
 int job_scan(const char *dir, const job_spec *spec, unsigned char *have, const note_sink *notes, fr_error *err);
 
+/** Largest partial image a slab of rows [y0, y1) may be: the header and
+ * the pixels, and for a bidirectional render the whole image's splats. */
+size_t job_max_partial(const job_spec *spec, uint32_t y0, uint32_t y1);
+
 /** Stores a checked slab (the worker's bytes as they came). */
 int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf, size_t len, fr_error *err);
 
 /** Reads every slab into rgb (width*height*3 floats, top row first); slab
  * files that no longer check out are deleted with a line to notes, as in
- * job_scan.  Fails, naming the missing rows, unless every row is covered. */
+ * job_scan.  Fails, naming the missing rows, unless every row is covered.
+ * For a bidirectional render, the slabs used must split the image into
+ * non-overlapping rows (each light subpath counted once): their splats are
+ * summed in fixed point, in any order to the same bits, and added to the
+ * rows (spl_resolve); it fails if no such split is among the slabs. */
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err);
 
 /** Reads what render the job directory dir belongs to (DIR/job) into

@@ -42,8 +42,9 @@ static int write_pfm(file_out *o, const float *rgb, const job_spec *spec, fr_err
             close(fd);
         return fr_fail(err, "%s: %s", o->tmp, strerror(errno));
     }
-    img_partial_info info = {spec->hash, 0, spec->height, spec->spp, spec->width, spec->height};
-    int rc = img_write(f, IMG_PF, &info, rgb, err);
+    img_partial_info info = {.scene = spec->hash, .y1 = spec->height, .spp = spec->spp, .width = spec->width,
+                             .height = spec->height};
+    int rc = img_write(f, IMG_PF, &info, rgb, NULL, err);
     if (fclose(f) && rc == 0)
         rc = fr_fail(err, "%s: %s", o->tmp, strerror(errno));
     return rc;

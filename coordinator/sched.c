@@ -195,15 +195,17 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     sched_host *h = &s->hosts[host_i];
     slab *sl = &s->slabs[slab_i];
     const job_spec *sp = &s->p->spec;
-    proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline};
+    proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline,
+                      1 + (int)sp->integrator};
     proto_argv pa;
     if (proto_slab_argv(&req, &pa, err))
         return -1;
-    const char *argv[18] = {tr_host_worker(h->tr)};
+    const char *argv[20] = {tr_host_worker(h->tr)};
     for (int i = 0; pa.argv[i]; i++)
         argv[i + 1] = pa.argv[i];
-    /* The partial image: its header (well under 4 KB) and 12 bytes a pixel. */
-    size_t max_out = 4096 + (size_t)sp->width * (sl->y1 - sl->y0) * 12;
+    /* The partial image: its header (well under 4 KB), 12 bytes a pixel and
+     * the splats of a bidirectional render. */
+    size_t max_out = job_max_partial(sp, sl->y0, sl->y1);
     tr_proc *proc;
     if (tr_spawn(h->tr, argv, max_out, &proc, err))
         return -1;

@@ -50,7 +50,7 @@ static void start(fr_builder *b)
     m.diffuse = v3s(0.5f);
     bsdf_lobe_probs(&m);
     bld_push(&b->materials, &m);
-    b->settings = (fr_settings){64, 64, 1, 4, 0, {0, 0, 0}};
+    b->settings = (fr_settings){.width = 64, .height = 64, .spp = 1, .max_depth = 4};
     b->camera.position = v3(0, 0, -5);
     b->camera.target = v3(0, 0, 0);
     b->camera.up = v3(0, 1, 0);

@@ -206,7 +206,7 @@ static void many_area_lights(void)
 {
     fr_builder b;
     bld_init(&b);
-    b.settings = (fr_settings){8, 8, 1, 2, 0, {0, 0, 0}};
+    b.settings = (fr_settings){.width = 8, .height = 8, .spp = 1, .max_depth = 2};
     b.camera.position = v3(0, 0, -5);
     b.camera.target = v3(0, 0, 0);
     b.camera.up = v3(0, 1, 0);
@@ -258,7 +258,7 @@ static void textured_area_lights(void)
 {
     fr_builder b;
     bld_init(&b);
-    b.settings = (fr_settings){8, 8, 1, 2, 0, {0, 0, 0}};
+    b.settings = (fr_settings){.width = 8, .height = 8, .spp = 1, .max_depth = 2};
     b.camera.position = v3(0, 0, -5);
     b.camera.target = v3(0, 0, 0);
     b.camera.up = v3(0, 1, 0);

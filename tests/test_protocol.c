@@ -8,6 +8,7 @@
 #include "check.h"
 #include "fbin.h"
 #include "protocol.h"
+#include "scene.h"
 
 /* argv as a worker gets it: the program, then the built arguments. */
 static int reparse(const proto_argv *a, proto_request *r, fr_error *err)
@@ -22,11 +23,13 @@ static int reparse(const proto_argv *a, proto_request *r, fr_error *err)
 static void test_round_trip(void)
 {
     const proto_slab cases[] = {
-        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0},
-        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0},
-        {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-", 0},
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0}, /* the scene's size and samples */
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1}, /* --lifeline */
+        /* lifeline, then integrator: 1 + FR_INTEGRATOR_*, 0 for the scene's */
+        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0},
+        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH},
+        {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-", 0,
+         1 + FR_INTEGRATOR_BDPT},
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0}, /* the scene's size, samples and integrator */
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2}, /* --lifeline, --integrator bdpt */
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         const proto_slab *s = &cases[k];
@@ -49,18 +52,22 @@ static void test_round_trip(void)
         CHECK(r.slab.spp == s->spp && r.slab.format == s->format, "case %zu: spp %u format %d", k, r.slab.spp,
               (int)r.slab.format);
         CHECK(r.slab.lifeline == s->lifeline, "case %zu: lifeline %d", k, r.slab.lifeline);
+        CHECK(r.slab.integrator == s->integrator, "case %zu: integrator %d, expected %d", k, r.slab.integrator,
+              s->integrator);
     }
 }
 
 static void test_build_refuses(void)
 {
     const proto_slab bad[] = {
-        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0},                       /* empty rows */
-        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0},                       /* rows past the height */
-        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0},      /* too wide */
-        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0},       /* too many samples */
-        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0},                       /* half a size */
-        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0},                      /* no scene */
+        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0},                     /* empty rows */
+        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0},                     /* rows past the height */
+        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0},    /* too wide */
+        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0},     /* too many samples */
+        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0},                     /* half a size */
+        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0},                    /* no scene */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS},   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1},                   /* no such integrator */
     };
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
         proto_argv a;

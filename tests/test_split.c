@@ -1,13 +1,18 @@
 /* Split invariance: the full image and its concatenation from uneven
  * slabs (2, 3 and 7 of them) are byte-identical, on a scene with every
  * material kind, point and area lights, and on one lit by an environment
- * map, a sun disk and a spot, with a medium inside a box. */
+ * map, a sun disk and a spot, with a medium inside a box.  Bidirectional
+ * renders too: each slab's light tracing splats onto the whole image, and
+ * the slabs' fixed-point splat sums, added in any order, are the full
+ * render's to the bit. */
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "bdpt.h"
 #include "check.h"
 #include "pathtrace.h"
+#include "splat.h"
 #include "pfmmap.h"
 #include "scenes.h"
 
@@ -54,12 +59,27 @@ static void check_split(const fr_scene *s, const float *full, const uint32_t *cu
 }
 
 static void split_all(const fr_scene *s);
+static void split_bdpt(const fr_scene *s);
+
+/* Distant lights and a spot for the bidirectional split (no medium). */
+static const char lit_scene[] =
+    "{\"image\": {\"width\": 19, \"height\": 15, \"spp\": 2, \"max_depth\": 5, \"seed\": 3},"
+    " \"camera\": {\"position\": [0, 1, -5], \"target\": [0, 0.8, 0], \"fov\": 50},"
+    " \"environment\": {\"color\": [0.2, 0.25, 0.3]},"
+    " \"materials\": {\"floor\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]},"
+    "   \"glass\": {\"type\": \"glass\", \"ior\": 1.5}},"
+    " \"lights\": [{\"type\": \"sun\", \"direction\": [1, -2, 1], \"irradiance\": [3, 3, 2], \"angle\": 3},"
+    "   {\"type\": \"spot\", \"position\": [0, 3, 0], \"target\": [0, 0, 0], \"intensity\": [9, 9, 9]}],"
+    " \"shapes\": ["
+    "   {\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"floor\"},"
+    "   {\"type\": \"sphere\", \"center\": [0.8, 0.6, -0.5], \"radius\": 0.6, \"material\": \"glass\"}]}";
 
 int main(void)
 {
     fr_scene s;
     test_scene(scene, &s);
     split_all(&s);
+    split_bdpt(&s);
     /* A different seed gives a different image: the seed is really used. */
     uint32_t w = s.settings.width, h = s.settings.height;
     float *full = malloc((size_t)w * h * 3 * sizeof *full), *other = malloc((size_t)w * h * 3 * sizeof *other);
@@ -84,6 +104,9 @@ int main(void)
     rmdir(dir);
     split_all(&s);
     scn_free(&s);
+    test_scene(lit_scene, &s);
+    split_bdpt(&s);
+    scn_free(&s);
     return check_done();
 }
 
@@ -105,4 +128,46 @@ static void split_all(const fr_scene *s)
     check_split(s, full, three, 4);
     check_split(s, full, seven, 8);
     free(full);
+}
+
+/* Bidirectional: rows and splats of each split against the full render;
+ * the slabs are rendered and their splats added last slab first. */
+static void split_bdpt(const fr_scene *s)
+{
+    uint32_t w = s->settings.width, h = s->settings.height;
+    size_t n = (size_t)w * h * 3;
+    float *full = malloc(n * sizeof *full), *img = malloc(n * sizeof *img);
+    uint64_t *full_splat = calloc(n, sizeof *full_splat), *sum = malloc(n * sizeof *sum),
+             *part = malloc(n * sizeof *part);
+    fr_error err;
+    CHECK(bd_render_rows(s, 0, h, full, full_splat, &err) == 0, "bidirectional render: %s", err.msg);
+    const uint32_t two[] = {0, 7, h}, three[] = {0, 1, 9, h}, seven[] = {0, 2, 3, 6, 8, 11, h - 1, h};
+    const uint32_t *cuts[] = {two, three, seven};
+    const int slabs[] = {2, 3, 7};
+    int outside = 0;
+    for (int k = 0; k < 3; k++) {
+        memset(sum, 0, n * sizeof *sum);
+        for (int i = slabs[k] - 1; i >= 0; i--) {
+            uint32_t y0 = cuts[k][i], y1 = cuts[k][i + 1];
+            memset(part, 0, n * sizeof *part);
+            bd_render_rows(s, y0, y1, img + (size_t)y0 * w * 3, part, &err);
+            for (size_t j = 0; j < n; j++)
+                if (part[j] && (j / (3 * (size_t)w) < y0 || j / (3 * (size_t)w) >= y1))
+                    outside = 1;
+            spl_sum(sum, part, n);
+        }
+        CHECK(memcmp(img, full, n * sizeof *img) == 0, "bidirectional: %d slabs' rows differ", slabs[k]);
+        CHECK(memcmp(sum, full_splat, n * sizeof *sum) == 0, "bidirectional: %d slabs' splats differ", slabs[k]);
+    }
+    CHECK(outside, "no slab's light tracing reached another slab's rows (the test would be empty)");
+    spl_resolve(full, full_splat, w, 0, h, s->settings.spp);
+    double total = 0;
+    for (size_t j = 0; j < n; j++)
+        total += full[j];
+    CHECK(total > 1.0, "the bidirectional test image is black");
+    free(full);
+    free(img);
+    free(full_splat);
+    free(sum);
+    free(part);
 }

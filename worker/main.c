@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "bdpt.h"
 #include "fbin.h"
 #include "file.h"
 #include "image.h"
@@ -14,13 +15,14 @@
 #include "pathtrace.h"
 #include "protocol.h"
 #include "quick.h"
+#include "splat.h"
 #ifndef FRANJA_NO_JSON
 #include "scene_json.h"
 #endif
 
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
-    "                     [--format pf|ppm16|ppm8] [-o FILE|-] [--lifeline]\n"
+    "                     [--integrator path|bdpt] [--format pf|ppm16|ppm8] [-o FILE|-] [--lifeline]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --help | --version\n"
     "\n"
@@ -31,6 +33,7 @@ static const char usage[] =
     "  --rows Y0:Y1   rows of the full image, 0 <= Y0 < Y1 <= height\n"
     "  --spp N        samples per pixel (default: the scene's)\n"
     "  --size WxH     image size (default: the scene's)\n"
+    "  --integrator I path or bdpt (default: the scene's)\n"
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
@@ -119,25 +122,60 @@ int main(int argc, char **argv)
         scn_free(&scene);
         return 2;
     }
+    uint32_t width = scene.settings.width, height = scene.settings.height, spp = scene.settings.spp;
+    int bdpt = (sl->integrator ? sl->integrator - 1 : (int)scene.settings.integrator) == FR_INTEGRATOR_BDPT;
+    if (bdpt && bd_supported(&scene, &err) < 0) {
+        fprintf(stderr, "franja-worker: bidirectional path tracing: %s\n", err.msg);
+        scn_free(&scene);
+        return sl->integrator ? 2 : 1;
+    }
+    if (bdpt && sl->format != IMG_PF && (y0 != 0 || y1 != height)) {
+        fprintf(stderr, "franja-worker: --format %s with the bdpt integrator needs the whole image (--rows 0:%u): "
+                        "light tracing adds light to every row; use --format pf for a slab\n",
+                sl->format == IMG_PPM16 ? "ppm16" : "ppm8", height);
+        scn_free(&scene);
+        return 2;
+    }
     /* The coordinator gone, the slab is wasted work: stop (lifeline.h). */
     lifeline_start(to_stdout, sl->lifeline);
-    size_t n = (size_t)scene.settings.width * (y1 - y0) * 3;
+    size_t n = (size_t)width * (y1 - y0) * 3;
     float *rgb = malloc(n * sizeof *rgb);
-    if (!rgb) {
-        fprintf(stderr, "franja-worker: out of memory for %zu pixels\n", n / 3);
+    uint64_t *splat = bdpt ? calloc((size_t)width * height * 3, sizeof *splat) : NULL;
+    if (!rgb || (bdpt && !splat)) {
+        fprintf(stderr, "franja-worker: out of memory for %zu pixels\n", bdpt ? (size_t)width * height : n / 3);
+        free(rgb);
         scn_free(&scene);
         return 1;
     }
-    pt_render_rows(&scene, PT_MIS, y0, y1, rgb);
+    img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0};
+    if (bdpt) {
+        if (bd_render_rows(&scene, y0, y1, rgb, splat, &err) < 0) {
+            fprintf(stderr, "franja-worker: %s\n", err.msg);
+            free(rgb);
+            free(splat);
+            lifeline_stop();
+            scn_free(&scene);
+            return 1;
+        }
+        if (sl->format != IMG_PF) {
+            /* The whole image: its own splats are all there are. */
+            spl_resolve(rgb, splat, width, 0, height, spp);
+            free(splat);
+            splat = NULL;
+        } else {
+            info.splat_paths = (uint64_t)width * (y1 - y0) * spp;
+        }
+    } else {
+        pt_render_rows(&scene, PT_MIS, y0, y1, rgb);
+    }
     lifeline_stop();
 
-    img_partial_info info = {scene.hash, y0, y1, scene.settings.spp, scene.settings.width, scene.settings.height};
     FILE *f = to_stdout ? stdout : fopen(out, "wb");
     int rc = 0;
     if (!f) {
         fprintf(stderr, "franja-worker: %s: %s\n", out, strerror(errno));
         rc = 1;
-    } else if (img_write(f, sl->format, &info, rgb, &err) < 0) {
+    } else if (img_write(f, sl->format, &info, rgb, splat, &err) < 0) {
         fprintf(stderr, "franja-worker: %s: %s\n", to_stdout ? "standard output" : out, err.msg);
         rc = 1;
     }
@@ -148,6 +186,7 @@ int main(int argc, char **argv)
     if (rc && !to_stdout)
         remove(out);
     free(rgb);
+    free(splat);
     scn_free(&scene);
     return rc;
 }

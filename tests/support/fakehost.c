@@ -40,9 +40,10 @@ static int partial(const fake_world *w, uint64_t hash, uint32_t y0, uint32_t y1,
     FILE *f = open_memstream(&mem, &mlen);
     int rc = -1;
     if (f) {
-        img_partial_info info = {hash, y0, y1, w->spp, w->width, w->height};
+        img_partial_info info = {.scene = hash, .y0 = y0, .y1 = y1, .spp = w->spp, .width = w->width,
+                                 .height = w->height};
         fr_error err;
-        rc = img_write(f, IMG_PF, &info, rgb, &err);
+        rc = img_write(f, IMG_PF, &info, rgb, NULL, &err);
         if (fclose(f))
             rc = -1;
     }

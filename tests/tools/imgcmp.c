@@ -1,7 +1,7 @@
 /* imgcmp -- compare a rendered PFM against a reference PFM.
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
- *          [--max-block-rel Z [--block N]] [--down D]
+ *          [--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1]
  *
  * IMAGE is box-downsampled to the reference's size when it is an integer
  * multiple of it; with --down, both are then box-downsampled by D (which
@@ -12,7 +12,9 @@
  * relative difference of the mean (all channels, off the light) over the
  * N x N blocks of the reference (N = 64 by default).  With limits, prints
  * the closing "N passed, N failed" line and exits non-zero when one is
- * exceeded. */
+ * exceeded.  With --region (fractions of the width and height, top row 0),
+ * also the RMSE inside that rectangle of pixels and outside it, both off
+ * the light. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -69,11 +71,11 @@ static void box_down(image *im, int f)
 
 int main(int argc, char **argv)
 {
-    double max_rmse = -1, max_rel = -1, max_block = -1;
+    double max_rmse = -1, max_rel = -1, max_block = -1, reg[4] = {-1, -1, -1, -1};
     int bs = 64, down = 1;
     if (argc < 3) {
         fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y] "
-                        "[--max-block-rel Z [--block N]] [--down D]\n");
+                        "[--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1]\n");
         return 2;
     }
     for (int i = 3; i + 1 < argc; i += 2) {
@@ -82,6 +84,14 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--max-block-rel")) max_block = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--block")) bs = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--down")) down = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--region")) {
+            char tail;
+            if (sscanf(argv[i + 1], "%lf,%lf,%lf,%lf%c", &reg[0], &reg[1], &reg[2], &reg[3], &tail) != 4 ||
+                !(reg[0] >= 0 && reg[0] < reg[2] && reg[2] <= 1 && reg[1] >= 0 && reg[1] < reg[3] && reg[3] <= 1)) {
+                fprintf(stderr, "imgcmp: --region: expected X0,Y0,X1,Y1, fractions with X0 < X1, Y0 < Y1\n");
+                return 2;
+            }
+        }
         else { fprintf(stderr, "imgcmp: unknown option %s\n", argv[i]); return 2; }
     }
     if (bs < 1 || bs > 65536) { fprintf(stderr, "imgcmp: bad block size\n"); return 2; }
@@ -99,8 +109,8 @@ int main(int argc, char **argv)
     box_down(&a, a.w / r.w * down);
     box_down(&r, down);
     int k = 1;
-    double mean[3] = {0}, rmean[3] = {0}, se = 0;
-    long off = 0;
+    double mean[3] = {0}, rmean[3] = {0}, se = 0, se_in = 0, se_out = 0;
+    long off = 0, n_in = 0, n_out = 0;
     int nbx = (r.w + bs - 1) / bs, nby = (r.h + bs - 1) / bs;
     double *blk = calloc((size_t)nbx * nby * 2, sizeof(double));
     if (!blk) return 2;
@@ -108,6 +118,8 @@ int main(int argc, char **argv)
         for (int x = 0; x < r.w; x++) {
             const float *q = r.px + ((size_t)y * r.w + x) * 3;
             int light = q[0] >= 10 || q[1] >= 10 || q[2] >= 10;
+            double fx = (x + 0.5) / r.w, fy = (y + 0.5) / r.h, px_se = 0;
+            int in = fx >= reg[0] && fx < reg[2] && fy >= reg[1] && fy < reg[3];
             for (int ch = 0; ch < 3; ch++) {
                 double v = 0;
                 for (int j = 0; j < k; j++)
@@ -117,13 +129,16 @@ int main(int argc, char **argv)
                 mean[ch] += v;
                 rmean[ch] += q[ch];
                 if (!light) {
-                    se += (v - q[ch]) * (v - q[ch]);
+                    px_se += (v - q[ch]) * (v - q[ch]);
                     double *b = blk + ((size_t)(y / bs) * nbx + x / bs) * 2;
                     b[0] += v;
                     b[1] += q[ch];
                 }
             }
+            se += px_se;
             off += !light;
+            if (!light && in) { se_in += px_se; n_in++; }
+            if (!light && !in) { se_out += px_se; n_out++; }
         }
     int npx = r.w * r.h, pass = 0, fail = 0;
     double rmse = sqrt(se / (3.0 * off));
@@ -138,6 +153,9 @@ int main(int argc, char **argv)
         }
     }
     printf("rmse %.5f over %ld pixels off the light\n", rmse, off);
+    if (reg[0] >= 0)
+        printf("rmse in region %.5f over %ld pixels, outside %.5f over %ld pixels\n",
+               n_in ? sqrt(se_in / (3.0 * n_in)) : 0.0, n_in, n_out ? sqrt(se_out / (3.0 * n_out)) : 0.0, n_out);
     if (max_block >= 0) {
         double worst = 0;
         int wx = 0, wy = 0;
