@@ -1,7 +1,8 @@
 #!/bin/sh
 # The fully static workers (make static): they need no shared library, the
 # arm64 one runs under qemu-aarch64-static, and both render the test slab
-# byte-identical to this machine's bin/franja-worker.
+# byte-identical to this machine's bin/franja-worker, and a bidirectional
+# slab too (its rows and its light-tracing splats over the whole image).
 . "$(dirname "$0")/lib.sh"
 need readelf cmp "$QEMU"
 T=$(mktemp -d /tmp/franja-static.XXXXXX)
@@ -33,6 +34,16 @@ check "arm64 static slab under qemu is byte-identical" cmp "$T/sa64.pf" "$T/ref-
 check "arm64 static worker validates the scene to the same hash" \
     test "$("$QEMU" "$SA64" --scene "$T/scene.fbin" --check)" = \
          "$("$ROOT/bin/franja-worker" --scene "$T/scene.fbin" --check)"
+
+# Bidirectional: mirror, glass and Phong balls, rows and splats.
+"$ROOT/bin/franja" compile "$ROOT/scenes/spheres.json" -o "$T/spheres.fbin" >/dev/null 2>&1
+BD="--rows 10:14 --spp 2 --size 32x32 --integrator bdpt"
+"$ROOT/bin/franja-worker" --scene "$T/spheres.fbin" $BD -o "$T/bd-ref.pf"
+check "reference bidirectional slab carries splats" grep -q "splat=" "$T/bd-ref.pf"
+"$S64" --scene "$T/spheres.fbin" $BD -o "$T/bd-s64.pf"
+check "amd64 static bidirectional slab is byte-identical" cmp "$T/bd-s64.pf" "$T/bd-ref.pf"
+"$QEMU" "$SA64" --scene "$T/spheres.fbin" $BD -o "$T/bd-sa64.pf"
+check "arm64 static bidirectional slab under qemu is byte-identical" cmp "$T/bd-sa64.pf" "$T/bd-ref.pf"
 
 # Built without cJSON, the static worker refuses a JSON scene with a message
 # instead of misreading it.
