@@ -74,6 +74,23 @@ check "and the slab rendered again, to the same bytes" cmp -s keep.pfm one.pfm
 "$FRANJA" render scene.fbin -o other.pfm $SIZE -j 2 --job kj --resume 2>logo
 check "a bidirectional job directory is not resumed by a path-traced render" grep -q "belongs to another render" logo
 
+# A slab lost from a kept job, resumed with another slab height: the new
+# slabs fill the gap, and the stitch sums each light subpath once.
+"$FRANJA" render scene.fbin -o keep2.pfm $SIZE $B -j 2 --slab-rows 7 --job kj2 --keep-job 2>/dev/null
+rm -f kj2/rows-00007-00014.pf
+"$FRANJA" render scene.fbin -o keep2.pfm $SIZE $B -j 2 --slab-rows 2 --job kj2 --resume --keep-job 2>logk2
+check "a resume with 2-row slabs renders only the lost rows" grep -q "; 4 slabs" logk2
+check "and gives the same bytes" cmp -s keep2.pfm one.pfm
+check "the kept slabs split the image once" test "$(ls kj2/rows-*.pf | wc -l)" -eq 6
+
+# A stuck worker: its slab is started a second time elsewhere and the
+# first valid copy wins, its splats counted once.
+mkdir -p loc2
+printf 'here local - 2 worker=%s\n' "$(fh_wrapper loc2 hang)" >t_hang
+timeout 60 "$FRANJA" render scene.fbin -o hang.pfm $SIZE $B --slab-rows 3 --hosts t_hang 2>logh
+check "a stuck bidirectional slab is overtaken by a second copy" grep -q "starting a second copy" logh
+check "and the image has the bytes of one slab" cmp -s hang.pfm one.pfm
+
 # What bidirectional tracing cannot do is refused, with the reason.
 "$WORKER" --scene scene.fbin --rows 0:5 $SIZE $B --format ppm8 -o x.ppm 2>e1
 check "an sRGB slab of a bidirectional render is refused (status 2)" test $? -eq 2

@@ -84,6 +84,13 @@ check "3-node render is byte-identical to the one-process render ($(tail -n 3 lo
 check "the scene was broadcast to each node" test "$(grep -c 'scene uploaded\|uploaded' log3)" -ge 3
 check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
 check "no step is left after the render" no_leftovers
+
+# Bidirectional: every step's partial carries its splats over the whole
+# image, and the sum over nodes has the bytes of a one-process render.
+"$FRANJA" render scene.fbin -o bref.pfm $SIZE --integrator bdpt -j 1 --slab-rows 30 2>/dev/null
+render logb -N3 -n6 "$FRANJA" render scene.fbin -o b3.pfm $SIZE --integrator bdpt --slurm --workdir "$WD" --slab-rows 4
+check "a bidirectional 3-node render is byte-identical to one process ($(tail -n 3 logb))" cmp -s b3.pfm bref.pfm
+check "and differs from path tracing" sh -c "! cmp -s b3.pfm ref.pfm"
 render log2 -N2 -n3 "$FRANJA" render scene.fbin -o n2.pfm $SIZE --slurm --workdir "$WD" --slab-rows 3
 check "2 nodes (2 + 1 CPUs) give the same bytes" cmp -s n2.pfm ref.pfm
 check "the second render finds the scene cached" grep -q "already there" log2
