@@ -4,6 +4,8 @@
  *   block, BDPT's means agree with path tracing's within their noise.
  * - Each strategy (s, t) alone, with weight 1, estimates the same image of
  *   the paths of its depth as all strategies combined with MIS.
+ * - Rough materials (GGX conductor, rough glass, principled): all
+ *   strategies, alone and with MIS, agree with path tracing.
  * - Light tracing carries importance: through refraction into glass and
  *   over bump-mapped shading normals (Veach's adjoint corrections), BDPT
  *   still agrees with path tracing.
@@ -26,6 +28,7 @@
 #include <unistd.h>
 
 #include "bdpt.h"
+#include "bsdf.h"
 #include "camera.h"
 #include "check.h"
 #include "pathtrace.h"
@@ -223,6 +226,61 @@ static void strategies(void)
     scn_free(&s);
 }
 
+/* Rough materials (microfacet models): the open scene with a rough gold
+ * ball, a frosted glass ball (rough refraction is not symmetric: light
+ * subpaths evaluate it as radiance flows) and a principled floor.  Every
+ * strategy that can connect at a rough vertex does; each of depth 1 and 2
+ * alone and all of them with MIS agree with path tracing's image. */
+static const char rough_scene[] =
+    "{\"image\": {\"width\": 12, \"height\": 10, \"spp\": 1, \"max_depth\": 8},"
+    " \"camera\": {\"position\": [0, 1.5, -4], \"target\": [0, 0.6, 1], \"fov\": 40},"
+    " \"materials\": {"
+    "   \"floor\": {\"type\": \"principled\", \"base_color\": [0.6, 0.5, 0.4], \"metallic\": 0, \"roughness\": 0.5},"
+    "   \"gold\": {\"type\": \"conductor\", \"roughness\": 0.35, \"reflectance\": [1.0, 0.78, 0.34]},"
+    "   \"frosted\": {\"type\": \"glass\", \"roughness\": 0.4, \"ior\": 1.5},"
+    "   \"wall\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.6, 0.7]},"
+    "   \"panel\": {\"type\": \"emitter\", \"emission\": [3, 3, 3]},"
+    "   \"bulb\": {\"type\": \"emitter\", \"emission\": [20, 16, 12]}},"
+    " \"shapes\": ["
+    "   {\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"floor\"},"
+    "   {\"type\": \"sphere\", \"center\": [-0.7, 0.6, 0.5], \"radius\": 0.6, \"material\": \"gold\"},"
+    "   {\"type\": \"sphere\", \"center\": [0.8, 0.6, 0.3], \"radius\": 0.6, \"material\": \"frosted\"},"
+    "   {\"type\": \"rect\", \"origin\": [-3, 0.4, 3], \"edge_u\": [6, 0, 0], \"edge_v\": [0, 3, 0], \"material\": \"wall\"},"
+    "   {\"type\": \"rect\", \"origin\": [-1.5, 3, -1], \"edge_u\": [1.5, 0, 0], \"edge_v\": [0, 0, 1], \"material\": \"panel\"},"
+    "   {\"type\": \"sphere\", \"center\": [1.6, 1.8, -1], \"radius\": 0.15, \"material\": \"bulb\"}]}";
+
+static void rough(void)
+{
+    fr_scene s;
+    test_scene(rough_scene, &s);
+    int micro = 0;
+    for (uint32_t i = 0; i < s.n_materials; i++)
+        micro += s.materials[i].model != FR_MAT_LOBES && bsdf_has_smooth(&s.materials[i]);
+    CHECK(micro == 3, "rough: %d microfacet materials that connections may end on, expected 3", micro);
+    blocks pt, bd;
+    render(&s, NULL, 4096, 2, &pt);
+    render(&s, &all, 1024, 2, &bd);
+    agree("rough materials: BDPT vs path tracing", &bd, &pt, 4.5);
+    CHECK(bd.mean[0][1] + bd.mean[3][1] > 1e-3, "rough: black");
+    for (int depth = 1; depth <= 2; depth++) {
+        bd_strategy mis = {-1, -1, depth};
+        blocks ref;
+        render(&s, &mis, 512, 2, &ref);
+        for (int sv = 0; sv <= depth + 1; sv++) {
+            int t = depth + 2 - sv;
+            if (sv == 1 && t == 1)
+                continue;
+            bd_strategy one = {sv, t, -1};
+            blocks b;
+            render(&s, &one, sv == 0 ? 8192 : 1024, 2, &b);
+            char name[80];
+            snprintf(name, sizeof name, "rough: strategy (%d,%d) alone vs MIS at depth %d", sv, t, depth);
+            agree(name, &b, &ref, 4.5);
+        }
+    }
+    scn_free(&s);
+}
+
 /* Glass: the camera inside a box of glass (normals out), looking down at
  * a Lambert floor laid inside it; a lamp outside above.  The only paths
  * of depth 2 are camera - floor - glass (refraction) - lamp: the camera
@@ -248,22 +306,50 @@ static const char glass_box[] =
     "   {\"type\": \"rect\", \"origin\": [-0.95, 0.05, -0.95], \"edge_u\": [0, 0, 1.9], \"edge_v\": [1.9, 0, 0], \"material\": \"white\"},"
     "   {\"type\": \"rect\", \"origin\": [-3, 3, -3], \"edge_u\": [6, 0, 0], \"edge_v\": [0, 0, 6], \"material\": \"lamp\"}]}";
 
-static void through_glass(void)
+/* The glass box, smooth (as above) or rough: each strategy that can
+ * make the depth-2 paths (with rough glass, light sampling and joins at the
+ * glass too) alone against the camera path hitting the lamp. */
+static void glass_box_with(const char *json, const char *name, int rough)
 {
     fr_scene s;
-    test_scene(glass_box, &s);
-    blocks pt, bd, hit, traced, mis;
-    const bd_strategy camera_path = {0, 4, -1}, light_path = {3, 1, -1}, depth2 = {-1, -1, 2};
+    test_scene(json, &s);
+    blocks pt, bd, hit, mis;
+    const bd_strategy camera_path = {0, 4, -1}, depth2 = {-1, -1, 2};
     render(&s, &camera_path, 4096, 2, &hit);
-    render(&s, &light_path, 1024, 2, &traced);
+    char what[96];
+    for (int sv = 1; sv <= 3; sv++) {
+        if (!rough && sv != 3)
+            continue;  /* smooth glass: only light tracing besides (0,4) */
+        bd_strategy one = {sv, 4 - sv, -1};
+        blocks b;
+        render(&s, &one, 1024, 2, &b);
+        snprintf(what, sizeof what, "%s: strategy (%d,%d) vs hitting the lamp (0,4)", name, sv, 4 - sv);
+        agree(what, &b, &hit, 4.5);
+    }
     render(&s, &depth2, 1024, 2, &mis);
-    agree("glass box: light tracing (3,1) vs hitting the lamp (0,4)", &traced, &hit, 4.5);
-    agree("glass box: MIS at depth 2 vs hitting the lamp (0,4)", &mis, &hit, 4.5);
-    CHECK(hit.mean[0][1] > 0.05, "glass box: the floor is dark (%g)", hit.mean[0][1]);
+    snprintf(what, sizeof what, "%s: MIS at depth 2 vs hitting the lamp (0,4)", name);
+    agree(what, &mis, &hit, 4.5);
+    CHECK(hit.mean[0][1] > 0.05, "%s: the floor is dark (%g)", name, hit.mean[0][1]);
     render(&s, NULL, 4096, 2, &pt);
     render(&s, &all, 1024, 2, &bd);
-    agree("glass box: BDPT vs path tracing", &bd, &pt, 4.5);
+    snprintf(what, sizeof what, "%s: BDPT vs path tracing", name);
+    agree(what, &bd, &pt, 4.5);
     scn_free(&s);
+}
+
+static void through_glass(void)
+{
+    glass_box_with(glass_box, "glass box", 0);
+    /* Frosted: a rough dielectric (roughness 0.3). */
+    static char frosted[sizeof glass_box + 64];
+    const char *smooth = "\"type\": \"glass\", \"ior\": 1.5}";
+    const char *at = strstr(glass_box, smooth);
+    CHECK(at != NULL, "glass box: no glass material to roughen");
+    if (!at)
+        return;
+    snprintf(frosted, sizeof frosted, "%.*s\"type\": \"glass\", \"ior\": 1.5, \"roughness\": 0.3}%s",
+             (int)(at - glass_box), glass_box, at + strlen(smooth));
+    glass_box_with(frosted, "frosted glass box", 1);
 }
 
 /* Shading normals: a bump-mapped floor (a synthetic egg-crate height map)
@@ -612,6 +698,7 @@ int main(void)
 #define RUN(f) if (!only || !strcmp(only, #f)) { clock_t c0 = clock(); f(); printf("[%s %.1fs]\n", #f, (double)(clock() - c0) / CLOCKS_PER_SEC); }
     RUN(strategies);
     RUN(through_glass);
+    RUN(rough);
     RUN(shading_normals);
     RUN(furnace);
     RUN(media_refused);
