@@ -82,6 +82,12 @@ rm -f kj2/rows-00007-00014.pf
 check "a resume with 2-row slabs renders only the lost rows" grep -q "; 4 slabs" logk2
 check "and gives the same bytes" cmp -s keep2.pfm one.pfm
 check "the kept slabs split the image once" test "$(ls kj2/rows-*.pf | wc -l)" -eq 6
+"$FRANJA" stitch kj2 -o st.pfm >/dev/null 2>logst
+check "franja stitch of a complete bidirectional job adds the splats: the bytes of one slab" cmp -s st.pfm one.pfm
+rm -f kj2/rows-00007-00009.pf
+"$FRANJA" stitch kj2 -o st2.pfm >/dev/null 2>logst2
+check "franja stitch of an incomplete bidirectional job makes no image" test ! -e st2.pfm
+check "and names the missing rows" grep -q "rows 7:9 are missing" logst2
 
 # A stuck worker: its slab is started a second time elsewhere and the
 # first valid copy wins, its splats counted once.
