@@ -120,14 +120,22 @@ int cmd_stitch(int argc, char **argv)
         fprintf(stderr, "franja stitch: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
     }
-    /* A bidirectional job: the rows lack the light traced from the lights
-     * (every slab's splats over the whole image), so only a complete job
-     * makes an image. */
-    int rows = spec.integrator == FR_INTEGRATOR_BDPT
-                   ? (job_stitch(dir, &spec, rgb, NULL, &err) ? -1 : (int)spec.height)
-                   : job_gather(dir, &spec, rgb, have, &skipped, &err);
-    if (rows > 0 && spec.integrator == FR_INTEGRATOR_BDPT)
-        memset(have, 1, spec.height);
+    int rows = job_gather(dir, &spec, rgb, have, &skipped, &err);
+    if (rows >= 0 && spec.integrator == FR_INTEGRATOR_BDPT) {
+        /* A bidirectional job: the rows lack the light traced from the
+         * lights (every slab's splats over the whole image), so only a
+         * complete job, whose every slab checked out, makes an image. */
+        if ((uint32_t)rows < spec.height || skipped) {
+            char missing[300] = "";
+            job_missing_rows(have, spec.height, missing, sizeof missing);
+            fprintf(stderr, "franja stitch: %s: a bidirectional render makes an image only when every row is there "
+                            "(rows %s are missing, %d slab files did not check out)\n", dir,
+                    missing[0] ? missing : "none", skipped);
+            goto done;
+        }
+        if (job_stitch(dir, &spec, rgb, NULL, &err))
+            rows = -1;
+    }
     if (rows < 0) {
         fprintf(stderr, "franja stitch: %s\n", err.msg);
         goto done;

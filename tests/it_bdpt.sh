@@ -88,6 +88,7 @@ rm -f kj2/rows-00007-00009.pf
 "$FRANJA" stitch kj2 -o st2.pfm >/dev/null 2>logst2
 check "franja stitch of an incomplete bidirectional job makes no image" test ! -e st2.pfm
 check "and names the missing rows" grep -q "rows 7:9 are missing" logst2
+check "and leaves the other slabs alone" test "$(ls kj2/rows-*.pf | wc -l)" -eq 5
 
 # A stuck worker: its slab is started a second time elsewhere and the
 # first valid copy wins, its splats counted once.
