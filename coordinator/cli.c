@@ -17,19 +17,6 @@ const char cli_transport_help[] =
     "  --no-ssh-config      do not read any SSH client configuration\n"
     "  --timeout S          connect time-out and longest silence of a host (default 10)\n";
 
-int cli_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
-{
-    char *end;
-    errno = 0;
-    if (!s || !*s || *s == '-' || *s == '+')
-        return -1;
-    unsigned long v = strtoul(s, &end, 10);
-    if (errno || *end || v < lo || v > hi)
-        return -1;
-    *out = (uint32_t)v;
-    return 0;
-}
-
 const char *cli_beside_exe(const char *name, char *buf, size_t cap)
 {
     char exe[PATH_MAX];
@@ -66,98 +53,70 @@ void cli_transport_defaults(tr_options *o)
     o->local_worker = cli_local_worker();
 }
 
-int cli_transport_option(int argc, char **argv, int *i, tr_options *o)
+int cli_common_opt(const char *cmd, int c, const char *v, const char *usage, tr_options *o, const char **hosts)
 {
-    const char *a = argv[*i];
-    if (!strcmp(a, "--accept-new-hosts")) {
-        o->accept_new = 1;
-        return 1;
-    }
-    if (!strcmp(a, "--no-ssh-config")) {
-        o->read_ssh_config = 0;
-        return 1;
-    }
-    if (strcmp(a, "--known-hosts") && strcmp(a, "--timeout") && strcmp(a, "--ssh-config"))
-        return 0;
-    if (*i + 1 >= argc) {
-        fprintf(stderr, "franja: %s needs a value\n", a);
-        return -1;
-    }
-    const char *v = argv[++*i];
-    if (!strcmp(a, "--known-hosts")) {
-        o->known_hosts = v;
-        return 1;
-    }
-    if (!strcmp(a, "--ssh-config")) {
-        if (access(v, R_OK)) {
-            fprintf(stderr, "franja: --ssh-config: cannot read '%s': %s\n", v, strerror(errno));
-            return -1;
-        }
-        o->ssh_config = v;
-        return 1;
-    }
     uint32_t t;
-    if (cli_uint(v, 1, 3600, &t)) {
-        fprintf(stderr, "franja: --timeout: expected seconds in 1..3600, got '%s'\n", v);
-        return -1;
-    }
-    o->timeout_s = (int)t;
-    return 1;
-}
-
-int cli_common_option(int argc, char **argv, int *i, const char *usage, tr_options *o, const char **hosts)
-{
-    int t = cli_transport_option(argc, argv, i, o);
-    if (t)
-        return t < 0 ? CLI_BAD : CLI_TAKEN;
-    const char *a = argv[*i];
-    if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+    switch (c) {
+    case CLI_OPT_HELP:
         fputs(usage, stdout);
         fputs(cli_transport_help, stdout);
         return CLI_HELP;
+    case CLI_OPT_HOSTS:
+        *hosts = v;
+        return CLI_TAKEN;
+    case CLI_OPT_KNOWN_HOSTS:
+        o->known_hosts = v;
+        return CLI_TAKEN;
+    case CLI_OPT_ACCEPT_NEW:
+        o->accept_new = 1;
+        return CLI_TAKEN;
+    case CLI_OPT_NO_SSH_CONFIG:
+        o->read_ssh_config = 0;
+        return CLI_TAKEN;
+    case CLI_OPT_SSH_CONFIG:
+        if (access(v, R_OK)) {
+            fprintf(stderr, "franja %s: --ssh-config: cannot read '%s': %s\n", cmd, v, strerror(errno));
+            return CLI_BAD;
+        }
+        o->ssh_config = v;
+        return CLI_TAKEN;
+    case CLI_OPT_TIMEOUT:
+        if (opt_uint(cmd, "--timeout", v, 1, 3600, &t))
+            return CLI_BAD;
+        o->timeout_s = (int)t;
+        return CLI_TAKEN;
     }
-    if (strcmp(a, "--hosts"))
-        return CLI_OTHER;
-    if (*i + 1 >= argc) {
-        fprintf(stderr, "franja: --hosts needs a value\n");
-        return CLI_BAD;
-    }
-    *hosts = argv[++*i];
-    return CLI_TAKEN;
+    return CLI_OTHER;
 }
 
-int cli_slurm_option(int argc, char **argv, int *i, cli_slurm *s)
+int cli_slurm_opt(const char *cmd, int c, const char *v, cli_slurm *s)
 {
-    const char *a = argv[*i];
-    if (!strcmp(a, "--slurm")) {
+    static const char *const names[] = {"--worker", "--workdir", "--shared-workdir"};
+    if (c == CLI_OPT_SLURM) {
         s->on = 1;
         return CLI_TAKEN;
     }
-    if (strcmp(a, "--worker") && strcmp(a, "--workdir") && strcmp(a, "--shared-workdir"))
+    if (c != CLI_OPT_WORKER && c != CLI_OPT_WORKDIR && c != CLI_OPT_SHARED_WORKDIR)
         return CLI_OTHER;
-    if (*i + 1 >= argc) {
-        fprintf(stderr, "franja: %s needs a value\n", a);
-        return CLI_BAD;
-    }
-    const char *v = argv[++*i];
+    const char *a = names[c - CLI_OPT_WORKER];
     if (v[0] != '/') {
-        fprintf(stderr, "franja: %s: '%s' is not an absolute path (the nodes must find it wherever they run)\n",
-                a, v);
+        fprintf(stderr, "franja %s: %s: '%s' is not an absolute path (the nodes must find it wherever they run)\n",
+                cmd, a, v);
         return CLI_BAD;
     }
     if (strlen(v) >= 400) {
-        fprintf(stderr, "franja: %s: path too long\n", a);
+        fprintf(stderr, "franja %s: %s: path too long (at most 399 bytes)\n", cmd, a);
         return CLI_BAD;
     }
-    if (!strcmp(a, "--worker"))
+    if (c == CLI_OPT_WORKER)
         s->worker = v;
     else {
         if (s->workdir) {
-            fprintf(stderr, "franja: give one of --workdir and --shared-workdir, once\n");
+            fprintf(stderr, "franja %s: give one of --workdir and --shared-workdir, once\n", cmd);
             return CLI_BAD;
         }
         s->workdir = v;
-        s->shared = !strcmp(a, "--shared-workdir");
+        s->shared = c == CLI_OPT_SHARED_WORKDIR;
     }
     return CLI_TAKEN;
 }

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "hosts.h"
+#include "opt.h"
 #include "slurm.h"
 #include "transport.h"
 
@@ -19,24 +20,43 @@ extern const char cli_transport_help[];
  * stderr as "franja: LINE". */
 void cli_transport_defaults(tr_options *o);
 
-/** If argv[*i] is a transport option (--known-hosts, --accept-new-hosts,
- * --no-ssh-config, --timeout), consumes it (and its value) and returns 1;
- * returns 0 if it is not one, -1 (after a message) if its value is bad. */
-int cli_transport_option(int argc, char **argv, int *i, tr_options *o);
-
-/** What cli_common_option did with an argument. */
+/** getopt_long values of the options cli_common_opt and cli_slurm_opt
+ * handle (above every character, so a command's own may be letters). */
 enum {
-    CLI_BAD = -1,              /**< a bad or missing value; a message is on stderr */
-    CLI_OTHER = 0,             /**< not one of the common options: the caller's */
-    CLI_TAKEN = 1,             /**< consumed, with its value if it has one */
+    CLI_OPT_HELP = 'h',
+    CLI_OPT_KNOWN_HOSTS = 0x100,
+    CLI_OPT_ACCEPT_NEW,
+    CLI_OPT_SSH_CONFIG,
+    CLI_OPT_NO_SSH_CONFIG,
+    CLI_OPT_TIMEOUT,
+    CLI_OPT_HOSTS,
+    CLI_OPT_SLURM,
+    CLI_OPT_WORKER,
+    CLI_OPT_WORKDIR,
+    CLI_OPT_SHARED_WORKDIR,
+    CLI_OPT_OWN                /**< the first value free for a command's own options */
+};
+
+/** The getopt_long entries (struct option initializers) of --help, --hosts
+ * and the transport options, for a command's table. */
+#define CLI_COMMON_LONGOPTS                                                     {"help", no_argument, NULL, CLI_OPT_HELP},                                  {"hosts", required_argument, NULL, CLI_OPT_HOSTS},                          {"known-hosts", required_argument, NULL, CLI_OPT_KNOWN_HOSTS},              {"accept-new-hosts", no_argument, NULL, CLI_OPT_ACCEPT_NEW},                {"ssh-config", required_argument, NULL, CLI_OPT_SSH_CONFIG},                {"no-ssh-config", no_argument, NULL, CLI_OPT_NO_SSH_CONFIG},                {"timeout", required_argument, NULL, CLI_OPT_TIMEOUT}
+
+/** The getopt_long entries of the --slurm options. */
+#define CLI_SLURM_LONGOPTS                                                      {"slurm", no_argument, NULL, CLI_OPT_SLURM},                                {"worker", required_argument, NULL, CLI_OPT_WORKER},                        {"workdir", required_argument, NULL, CLI_OPT_WORKDIR},                      {"shared-workdir", required_argument, NULL, CLI_OPT_SHARED_WORKDIR}
+
+/** What cli_common_opt and cli_slurm_opt did with an option. */
+enum {
+    CLI_BAD = -1,              /**< a bad value; a message is on stderr */
+    CLI_OTHER = 0,             /**< not one of theirs: the caller's */
+    CLI_TAKEN = 1,             /**< consumed */
     CLI_HELP = 2               /**< usage and cli_transport_help printed on stdout */
 };
 
-/** Handles argv[*i] if it is an option that every subcommand reading a host
- * table takes: a transport option (cli_transport_option), --hosts FILE (sets
- * *hosts, which points into argv) or --help / -h (prints usage, then
- * cli_transport_help).  Advances *i past a consumed value. */
-int cli_common_option(int argc, char **argv, int *i, const char *usage, tr_options *o, const char **hosts);
+/** Handles option c (a CLI_COMMON_LONGOPTS value, as opt_next returned it,
+ * with its value v) for command cmd: sets o, or *hosts (pointing at v) for
+ * --hosts; for --help prints usage, then cli_transport_help.  Returns a
+ * CLI_* value. */
+int cli_common_opt(const char *cmd, int c, const char *v, const char *usage, tr_options *o, const char **hosts);
 
 /** Where the hosts come from when they are a Slurm allocation (--slurm). */
 typedef struct {
@@ -46,7 +66,7 @@ typedef struct {
     int shared;                /**< it was --shared-workdir */
 } cli_slurm;
 
-/** Help text for the options cli_slurm_option understands (a string
+/** Help text for the options cli_slurm_opt understands (a string
  * literal, to be joined to a command's usage). */
 #define CLI_SLURM_HELP                                                                    \
     "  --slurm              run the workers as job steps of the Slurm allocation this\n" \
@@ -58,10 +78,10 @@ typedef struct {
     "  --shared-workdir DIR (--slurm) a directory that this machine and every node\n"    \
     "                       share: scenes are copied there once, no sbcast\n"
 
-/** If argv[*i] is --slurm, --worker, --workdir or --shared-workdir,
- * consumes it (and its value) into *s and returns CLI_TAKEN; CLI_OTHER if
- * it is not one; CLI_BAD (after a message) for a missing or relative path. */
-int cli_slurm_option(int argc, char **argv, int *i, cli_slurm *s);
+/** Handles option c (a CLI_SLURM_LONGOPTS value, with its value v) into
+ * *s: CLI_TAKEN, CLI_OTHER if it is not one, CLI_BAD (after a message) for
+ * a relative or too long path, or a second work directory. */
+int cli_slurm_opt(const char *cmd, int c, const char *v, cli_slurm *s);
 
 /** Opens the Slurm allocation franja runs in (slurm_open) as the host
  * table t: one host per node, served by the Slurm backend (o->backend and
@@ -85,9 +105,6 @@ int cli_load_hosts(const char *cmd, const char *path, hosts_table *t);
 /** The note_sink function that prints "franja: LINE" on stderr (ctx
  * unused). */
 void cli_note_stderr(void *ctx, const char *line);
-
-/** Parses a decimal integer in [lo, hi]; -1 if it is not one. */
-int cli_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 
 /** The franja-worker next to this executable, or NULL. */
 const char *cli_local_worker(void);

@@ -32,33 +32,36 @@ static void print_warning(void *user, const char *msg)
 
 int cmd_compile(int argc, char **argv)
 {
+    enum { CAMERA = 0x100 };
+    static const struct option longopts[] = {
+        {"help", no_argument, NULL, 'h'},
+        {"camera", required_argument, NULL, CAMERA},
+        {NULL, 0, NULL, 0},
+    };
     const char *in = NULL, *out = NULL, *camera = NULL;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+    int c;
+    optind = 0;
+    while ((c = opt_next("compile", argc, argv, "ho:", longopts)) != -1) {
+        switch (c) {
+        case 'h':
             fputs(usage, stdout);
             return 0;
-        } else if (!strcmp(argv[i], "-o")) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "franja compile: -o needs a file name\n");
-                return 2;
-            }
-            out = argv[++i];
-        } else if (!strcmp(argv[i], "--camera")) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "franja compile: --camera needs a name\n");
-                return 2;
-            }
-            camera = argv[++i];
-        } else if (argv[i][0] == '-' && argv[i][1]) {
-            fprintf(stderr, "franja compile: unknown option '%s' (see franja compile --help)\n", argv[i]);
+        case 'o':
+            out = optarg;
+            break;
+        case CAMERA:
+            camera = optarg;
+            break;
+        default:
             return 2;
-        } else if (in) {
-            fprintf(stderr, "franja compile: one scene at a time ('%s' and '%s')\n", in, argv[i]);
-            return 2;
-        } else {
-            in = argv[i];
         }
     }
+    if (argc - optind > 1) {
+        fprintf(stderr, "franja compile: one scene at a time ('%s' and '%s')\n", argv[optind], argv[optind + 1]);
+        return 2;
+    }
+    if (optind < argc)
+        in = argv[optind];
     if (!in) {
         fputs(usage, stderr);
         return 2;

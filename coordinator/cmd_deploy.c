@@ -186,22 +186,30 @@ static int deploy_all(const hosts_table *t, const tr_options *o, const char *dis
 
 int cmd_deploy(int argc, char **argv)
 {
+    enum { DIST = CLI_OPT_OWN };
+    static const struct option longopts[] = {CLI_COMMON_LONGOPTS, {"dist", required_argument, NULL, DIST},
+                                             {NULL, 0, NULL, 0}};
     tr_options o;
     cli_transport_defaults(&o);
     const char *path = NULL, *dist = NULL;
-    for (int i = 1; i < argc; i++) {
-        int c = cli_common_option(argc, argv, &i, usage, &o, &path);
-        if (c != CLI_OTHER) {
-            if (c == CLI_TAKEN)
-                continue;
-            return c == CLI_HELP ? 0 : 2;
+    int c;
+    optind = 0;
+    while ((c = opt_next("deploy", argc, argv, "h", longopts)) != -1) {
+        if (c == DIST) {
+            dist = optarg;
+            continue;
         }
-        if (!strcmp(argv[i], "--dist") && i + 1 < argc)
-            dist = argv[++i];
-        else {
-            fprintf(stderr, "franja deploy: unexpected '%s' (see franja deploy --help)\n", argv[i]);
+        int r = c == '?' ? CLI_BAD : cli_common_opt("deploy", c, optarg, usage, &o, &path);
+        if (r == CLI_OTHER) {
+            fprintf(stderr, "franja deploy: unexpected option (see franja deploy --help)\n");
             return 2;
         }
+        if (r != CLI_TAKEN)
+            return r == CLI_HELP ? 0 : 2;
+    }
+    if (optind < argc) {
+        fprintf(stderr, "franja deploy: unexpected '%s' (see franja deploy --help)\n", argv[optind]);
+        return 2;
     }
     if (!path) {
         fprintf(stderr, "franja deploy: --hosts FILE is required (see franja deploy --help)\n");

@@ -105,26 +105,34 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
 
 int cmd_hosts(int argc, char **argv)
 {
+    static const struct option longopts[] = {CLI_COMMON_LONGOPTS, CLI_SLURM_LONGOPTS, {NULL, 0, NULL, 0}};
     tr_options o;
     cli_transport_defaults(&o);
     cli_slurm sl = {0};
     const char *path = NULL, *what = NULL;
-    for (int i = 1; i < argc; i++) {
-        int c = cli_slurm_option(argc, argv, &i, &sl);
-        if (c == CLI_OTHER)
-            c = cli_common_option(argc, argv, &i, usage, &o, &path);
-        if (c != CLI_OTHER) {
-            if (c == CLI_TAKEN)
-                continue;
-            return c == CLI_HELP ? 0 : 2;
-        }
-        if (!what && (!strcmp(argv[i], "check") || !strcmp(argv[i], "list")))
-            what = argv[i];
+    int c, r = CLI_TAKEN;
+    /* Parsed in a copy: argv stays as typed, for the salloc hint. */
+    char **args = opt_copy(argc, argv);
+    if (!args)
+        return 1;
+    optind = 0;
+    while (r == CLI_TAKEN && (c = opt_next("hosts", argc, args, "h", longopts)) != -1) {
+        r = c == '?' ? CLI_BAD : cli_slurm_opt("hosts", c, optarg, &sl);
+        if (r == CLI_OTHER)
+            r = cli_common_opt("hosts", c, optarg, usage, &o, &path);
+    }
+    for (int i = optind; r == CLI_TAKEN && i < argc; i++) {
+        if (!what && (!strcmp(args[i], "check") || !strcmp(args[i], "list")))
+            what = args[i];
         else {
-            fprintf(stderr, "franja hosts: unexpected '%s' (see franja hosts --help)\n", argv[i]);
-            return 2;
+            fprintf(stderr, "franja hosts: unexpected '%s'%s (see franja hosts --help)\n", args[i],
+                    what ? "" : "; expected check or list");
+            r = CLI_BAD;
         }
     }
+    free(args);
+    if (r != CLI_TAKEN)
+        return r == CLI_HELP ? 0 : 2;
     if (!what || (!path && !sl.on)) {
         fprintf(stderr, "franja hosts: expected 'check' or 'list' and --hosts FILE or --slurm "
                         "(see franja hosts --help)\n");

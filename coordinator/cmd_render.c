@@ -21,6 +21,7 @@
 #include "jobdir.h"
 #include "joblock.h"
 #include "output.h"
+#include "preview.h"
 #include "protocol.h"
 #include "quick.h"
 #include "sched.h"
@@ -54,6 +55,9 @@ static const char usage[] =
     "  --no-lock            use a job directory on a file system without locks\n"
     "  --slab-rows N        rows per slab (default: about 4 slabs per slot)\n"
     "  --retries N          attempts per slab before giving up (default 5)\n"
+    "  --preview FILE       write the image so far to FILE (any output type) while\n"
+    "                       rendering, rows not yet done as a grey checkerboard\n"
+    "  --preview-every S    seconds between preview images (default 5)\n"
     CLI_SLURM_HELP;
 
 static volatile sig_atomic_t stop_flag;
@@ -77,105 +81,131 @@ typedef struct {
     int exposure_set;          /* --exposure given: overrides the scene's */
     const char *curve;         /* --tonemap, or NULL for the scene's */
     char out_buf[4096];        /* out when -o is omitted */
+    const char *preview;       /* --preview FILE, or NULL */
+    uint32_t preview_every;    /* seconds */
     int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
     int resume, keep_job, fresh, no_lock;
     tr_options tr;
     cli_slurm slurm;
 } render_args;
 
+/* render's own options (getopt_long values). */
+enum {
+    OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
+    OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
+    OPT_INTEGRATOR
+};
+
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
 static int parse(int argc, char **argv, render_args *a)
 {
+    static const struct option longopts[] = {
+        CLI_COMMON_LONGOPTS,
+        CLI_SLURM_LONGOPTS,
+        {"spp", required_argument, NULL, OPT_SPP},
+        {"size", required_argument, NULL, OPT_SIZE},
+        {"camera", required_argument, NULL, OPT_CAMERA},
+        {"exposure", required_argument, NULL, OPT_EXPOSURE},
+        {"tonemap", required_argument, NULL, OPT_TONEMAP},
+        {"resume", no_argument, NULL, OPT_RESUME},
+        {"fresh", no_argument, NULL, OPT_FRESH},
+        {"job", required_argument, NULL, OPT_JOB},
+        {"keep-job", no_argument, NULL, OPT_KEEP_JOB},
+        {"no-lock", no_argument, NULL, OPT_NO_LOCK},
+        {"slab-rows", required_argument, NULL, OPT_SLAB_ROWS},
+        {"retries", required_argument, NULL, OPT_RETRIES},
+        {"preview", required_argument, NULL, OPT_PREVIEW},
+        {"preview-every", required_argument, NULL, OPT_PREVIEW_EVERY},
+        {"integrator", required_argument, NULL, OPT_INTEGRATOR},
+        {NULL, 0, NULL, 0},
+    };
+    static const char *const curves[] = {"none", "filmic", NULL};
+    static const char cmd[] = "render";
     memset(a, 0, sizeof *a);
     a->retries = 5;
+    a->preview_every = 5;
     cli_transport_defaults(&a->tr);
-    for (int i = 1; i < argc; i++) {
-        const char *s = argv[i];
-        int c = cli_slurm_option(argc, argv, &i, &a->slurm);
-        if (c == CLI_OTHER)
-            c = cli_common_option(argc, argv, &i, usage, &a->tr, &a->hosts);
-        if (c != CLI_OTHER) {
-            if (c == CLI_TAKEN)
-                continue;
-            return c == CLI_HELP ? 1 : 2;
-        }
-        if (!strcmp(s, "--resume")) {
-            a->resume = 1;
-            continue;
-        }
-        if (!strcmp(s, "--keep-job")) {
-            a->keep_job = 1;
-            continue;
-        }
-        if (!strcmp(s, "--fresh")) {
-            a->fresh = 1;
-            continue;
-        }
-        if (!strcmp(s, "--no-lock")) {
-            a->no_lock = 1;
-            continue;
-        }
-        if (s[0] != '-') {
-            if (a->scene) {
-                fprintf(stderr, "franja render: more than one scene ('%s' and '%s')\n", a->scene, s);
-                return 2;
-            }
-            a->scene = s;
-            continue;
-        }
-        static const char *valued[] = {"-o", "-j", "--spp", "--size", "--exposure", "--job", "--slab-rows",
-                                       "--retries", "--tonemap", "--camera", "--integrator"};
-        int known = 0;
-        for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
-            known |= !strcmp(s, valued[k]);
-        if (!known) {
-            fprintf(stderr, "franja render: unknown option '%s' (see franja render --help)\n", s);
+    int c, bad = 0;
+    optind = 0;
+    while (!bad && (c = opt_next(cmd, argc, argv, "ho:j:", longopts)) != -1) {
+        const char *v = optarg;
+        switch (c) {
+        case '?':
             return 2;
-        }
-        if (i + 1 >= argc) {
-            fprintf(stderr, "franja render: %s needs a value\n", s);
-            return 2;
-        }
-        const char *v = argv[++i];
-        int bad = 0;
-        if (!strcmp(s, "-o"))
+        case 'o':
             a->out = v;
-        else if (!strcmp(s, "--job"))
-            a->jobdir = v;
-        else if (!strcmp(s, "--camera"))
+            break;
+        case 'j':
+            bad = opt_uint(cmd, "-j", v, 1, HOSTS_MAX_CORES, &a->jobs);
+            break;
+        case OPT_SPP:
+            bad = opt_uint(cmd, "--spp", v, 1, PROTO_MAX_SPP, &a->spp);
+            break;
+        case OPT_SIZE:
+            bad = opt_size(cmd, "--size", v, &a->width, &a->height);
+            break;
+        case OPT_CAMERA:
             a->camera = v;
-        else if (!strcmp(s, "--tonemap")) {
-            uint32_t c;
-            a->curve = v;
-            bad = tm_curve_parse(v, &c) < 0;
-        }
-        else if (!strcmp(s, "-j"))
-            bad = cli_uint(v, 1, HOSTS_MAX_CORES, &a->jobs);
-        else if (!strcmp(s, "--spp"))
-            bad = cli_uint(v, 1, PROTO_MAX_SPP, &a->spp);
-        else if (!strcmp(s, "--slab-rows"))
-            bad = cli_uint(v, 1, PROTO_MAX_SIZE, &a->slab_rows);
-        else if (!strcmp(s, "--retries"))
-            bad = cli_uint(v, 1, 1000, &a->retries);
-        else if (!strcmp(s, "--size"))
-            bad = proto_parse_size(v, &a->width, &a->height);
-        else if (!strcmp(s, "--integrator")) {
-            int k = 0;
-            bad = proto_integrator_parse(v, &k) < 0;
-            a->integrator = 1 + k;
-        }
-        else {
-            char *end;
-            errno = 0;
-            a->exposure = strtof(v, &end);
+            break;
+        case OPT_EXPOSURE:
+            bad = opt_float(cmd, "--exposure", v, -64, 64, &a->exposure);
             a->exposure_set = 1;
-            bad = errno || *end || end == v || a->exposure < -64 || a->exposure > 64;
+            break;
+        case OPT_TONEMAP:
+            bad = opt_choice(cmd, "--tonemap", v, curves) < 0;
+            a->curve = v;
+            break;
+        case OPT_RESUME:
+            a->resume = 1;
+            break;
+        case OPT_FRESH:
+            a->fresh = 1;
+            break;
+        case OPT_JOB:
+            a->jobdir = v;
+            break;
+        case OPT_KEEP_JOB:
+            a->keep_job = 1;
+            break;
+        case OPT_NO_LOCK:
+            a->no_lock = 1;
+            break;
+        case OPT_SLAB_ROWS:
+            bad = opt_uint(cmd, "--slab-rows", v, 1, PROTO_MAX_SIZE, &a->slab_rows);
+            break;
+        case OPT_RETRIES:
+            bad = opt_uint(cmd, "--retries", v, 1, 1000, &a->retries);
+            break;
+        case OPT_PREVIEW:
+            a->preview = v;
+            break;
+        case OPT_INTEGRATOR: {
+            static const char *const integrators[] = {"path", "bdpt", NULL};
+            int k = opt_choice(cmd, "--integrator", v, integrators);
+            bad = k < 0 || proto_integrator_parse(v, &k) < 0;
+            a->integrator = 1 + k;
+            break;
         }
-        if (bad) {
-            fprintf(stderr, "franja render: %s: bad value '%s' (see franja render --help)\n", s, v);
-            return 2;
+        case OPT_PREVIEW_EVERY:
+            bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
+            break;
+        default: {
+            int r = cli_slurm_opt(cmd, c, v, &a->slurm);
+            if (r == CLI_OTHER)
+                r = cli_common_opt(cmd, c, v, usage, &a->tr, &a->hosts);
+            if (r == CLI_HELP)
+                return 1;
+            bad = r != CLI_TAKEN;
+        }
         }
     }
+    if (bad)
+        return 2;
+    if (argc - optind > 1) {
+        fprintf(stderr, "franja render: more than one scene ('%s' and '%s')\n", argv[optind], argv[optind + 1]);
+        return 2;
+    }
+    a->scene = optind < argc ? argv[optind] : NULL;
     if (!a->scene) {
         fprintf(stderr, "franja render: a SCENE is required (see franja render --help)\n");
         return 2;
@@ -186,6 +216,10 @@ static int parse(int argc, char **argv, render_args *a)
             return 2;
         }
         a->out = a->out_buf;
+    }
+    if (a->preview && !strcmp(a->preview, a->out)) {
+        fprintf(stderr, "franja render: --preview %s is the output itself; name another file\n", a->preview);
+        return 2;
     }
     if (a->resume && a->fresh) {
         fprintf(stderr, "franja render: --resume and --fresh exclude each other\n");
@@ -478,11 +512,15 @@ static int unlock_with(job_lock *lk, int rc)
 int cmd_render(int argc, char **argv)
 {
     render_args a;
-    int pr = parse(argc, argv, &a);
+    /* Parsed in a copy: argv stays as typed, for the lock file's command
+     * line and the salloc hint. */
+    char **args = opt_copy(argc, argv);
+    int pr = args ? parse(argc, args, &a) : 2;
+    free(args);
     if (pr)
         return pr == 1 ? 0 : 2;
     fr_error err;
-    if (out_check(a.out, &err)) {
+    if (out_check(a.out, &err) || (a.preview && out_check(a.preview, &err))) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return 2;
     }
@@ -597,8 +635,17 @@ int cmd_render(int argc, char **argv)
         }
         fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", rows_have, spec.height, jobdir);
     }
-    if ((uint32_t)rows_have < spec.height &&
-        run_slabs(&a, &table, fbin, &spec, jobdir, have, (int)spec.height - rows_have, &err)) {
+    pv_writer *pv = NULL;
+    if (a.preview && !(pv = pv_start(a.preview, jobdir, &spec, &tm, a.preview_every,
+                                     (note_sink){cli_note_stderr, NULL}, &err))) {
+        fprintf(stderr, "franja render: --preview: %s\n", err.msg);
+        goto done;
+    }
+    int slabs_rc = (uint32_t)rows_have < spec.height
+                       ? run_slabs(&a, &table, fbin, &spec, jobdir, have, (int)spec.height - rows_have, &err)
+                       : 0;
+    pv_stop(pv);
+    if (slabs_rc) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }

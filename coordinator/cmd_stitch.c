@@ -10,6 +10,7 @@
 #include "fbin.h"
 #include "jobdir.h"
 #include "output.h"
+#include "preview.h"
 #include "scene.h"
 #include "tonemap.h"
 
@@ -26,23 +27,6 @@ static const char usage[] =
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
     "                       (default: the scene's tonemap)\n"
     "  --tonemap CURVE      none or filmic (default: the scene's, else none)\n";
-
-/* Side of the squares that mark rows not rendered, pixels, and their two
- * linear values (dark greys on any exposure near 0). */
-enum { CHECKER = 8 };
-
-static void checker_rows(float *rgb, const unsigned char *have, uint32_t width, uint32_t height)
-{
-    for (uint32_t y = 0; y < height; y++) {
-        if (have[y])
-            continue;
-        for (uint32_t x = 0; x < width; x++) {
-            float v = ((x / CHECKER + y / CHECKER) & 1) ? 0.08f : 0.02f;
-            float *p = rgb + ((size_t)y * width + x) * 3;
-            p[0] = p[1] = p[2] = v;
-        }
-    }
-}
 
 int cmd_stitch(int argc, char **argv)
 {
@@ -120,7 +104,7 @@ int cmd_stitch(int argc, char **argv)
         fprintf(stderr, "franja stitch: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
     }
-    int rows = job_gather(dir, &spec, rgb, have, &skipped, &err);
+    int rows = pv_image(dir, &spec, rgb, have, &skipped, &err);
     if (rows >= 0 && spec.integrator == FR_INTEGRATOR_BDPT) {
         /* A bidirectional job: the rows lack the light traced from the
          * lights (every slab's splats over the whole image), so only a
@@ -140,7 +124,6 @@ int cmd_stitch(int argc, char **argv)
         fprintf(stderr, "franja stitch: %s\n", err.msg);
         goto done;
     }
-    checker_rows(rgb, have, spec.width, spec.height);
     if (out_write(out, rgb, &spec, &tm, &err)) {
         fprintf(stderr, "franja stitch: %s\n", err.msg);
         goto done;

@@ -113,6 +113,14 @@ int opt_suggest(const char *typed, const char *shortopts, const struct option *l
     return len < 0 || (size_t)len >= cap ? -1 : 0;
 }
 
+char **opt_copy(int argc, char **argv)
+{
+    char **v = calloc((size_t)argc + 1, sizeof *v);
+    if (v)
+        memcpy(v, argv, (size_t)argc * sizeof *v);
+    return v;
+}
+
 int opt_next(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts)
 {
     char spec[64];

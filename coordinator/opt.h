@@ -30,6 +30,11 @@ int opt_default_output(const char *scene, const char *ext, char *buf, size_t cap
  * missing value is reported on stderr as "franja CMD: ..." and returns '?'. */
 int opt_next(const char *cmd, int argc, char **argv, const char *shortopts, const struct option *longopts);
 
+/** A copy of argv[0..argc) (the pointers, then NULL), for opt_next to
+ * permute while argv keeps the order the person typed (for messages that
+ * repeat the command).  Free with free(); NULL when out of memory. */
+char **opt_copy(int argc, char **argv);
+
 /** The known option nearest to typed (an option as written, "--samples",
  * "--spp=0", "-x"), for "did you mean": a usual synonym ("--samples" ->
  * "--spp"), a long option within a few edits, or one that typed is a

@@ -75,4 +75,42 @@ printf 'franja job\nscene=zz\n' >"$T/here/job"
 expect_error "stitch of a bad job file" "not a job file" "$F" stitch "$T/here" -o "$T/x.png"
 expect_error "stitch without -o" "-o OUT is required" "$F" stitch "$J"
 expect_error "stitch to an unknown format" ".xyz" "$F" stitch "$J" -o "$T/x.xyz"
+# --- options: getopt_long everywhere ---
+# --opt=value and --opt value, options before or after the scene, -jN.
+(cd "$T/here" && "$F" render --size=12x8 --spp=3 -j2 -o eq.pfm "$ROOT/scenes/spheres.json") >"$T/out" 2>&1 &&
+    grep -q "(12x8, 3 spp)" "$T/out" && ok || bad "--size=12x8 --spp=3: $(tail -n 2 "$T/out")"
+(cd "$T/here" && "$F" render "$ROOT/scenes/spheres.json" -o sp.pfm --size 12x8 --spp 3 -j 2) >/dev/null 2>&1
+cmp -s "$T/here/eq.pfm" "$T/here/sp.pfm" && ok || bad "--opt=value and --opt value give different images"
+# An unambiguous abbreviation is the option.
+(cd "$T/here" && "$F" render "$ROOT/scenes/spheres.json" -o ab.pfm --si 12x8 --sp 3 -j 2) >/dev/null 2>&1
+cmp -s "$T/here/eq.pfm" "$T/here/ab.pfm" && ok || bad "--si/--sp abbreviations do not work"
+# -- ends the options: a scene whose name starts with a dash.
+cp scenes/spheres.json "$T/here/-dash.json"
+(cd "$T/here" && "$F" render --size 8x8 --spp 1 -j 1 -o dash.png -- -dash.json) >"$T/out" 2>&1 &&
+    [ -s "$T/here/dash.png" ] && ok || bad "render -- -dash.json: $(tail -n 2 "$T/out")"
+# Bad values say what is allowed.
+expect_error "--spp 0" "--spp: '0' is not an integer in 1..1048576" "$F" render scenes/spheres.json --spp 0
+expect_error "--spp=x" "--spp: 'x' is not an integer in 1..1048576" "$F" render scenes/spheres.json --spp=x
+expect_error "--tonemap aces" "--tonemap: 'aces' is not one of: none, filmic" "$F" render scenes/spheres.json --tonemap aces
+expect_error "--size 64" "--size: '64' is not WxH" "$F" render scenes/spheres.json --size 64
+expect_error "-j 0" "-j: '0' is not an integer in 1..4096" "$F" render scenes/spheres.json -j 0
+expect_error "--exposure x" "--exposure: 'x' is not a number in -64..64" "$F" render scenes/spheres.json --exposure x
+expect_error "--timeout 0" "--timeout: '0' is not an integer in 1..3600" "$F" hosts check --hosts hosts/local.hosts --timeout 0
+expect_error "--retries" "--retries: '1001' is not an integer in 1..1000" "$F" render scenes/spheres.json --retries=1001
+expect_error "--stitch --tonemap" "is not one of: none, filmic" "$F" stitch "$J" -o "$T/x.png" --tonemap=aces
+# A missing value, a value for a flag, an ambiguous abbreviation.
+expect_error "--spp at the end" "--spp needs a value" "$F" render scenes/spheres.json --spp
+expect_error "--resume=1" "--resume takes no value" "$F" render scenes/spheres.json --resume=1
+expect_error "--s" "--s is ambiguous" "$F" render scenes/spheres.json --s 1
+# Unknown options: the nearest known one, in every command.
+expect_error "render --samples" "unknown option '--samples'; did you mean --spp?" "$F" render scenes/spheres.json --samples 8
+expect_error "render --szie" "did you mean --size?" "$F" render scenes/spheres.json --szie 8x8
+expect_error "render --threads" "did you mean -j?" "$F" render scenes/spheres.json --threads 8
+expect_error "compile --camra" "did you mean --camera?" "$F" compile scenes/spheres.json --camra x
+expect_error "hosts --hots" "did you mean --hosts?" "$F" hosts check --hots hosts/local.hosts
+expect_error "deploy --dst" "did you mean --dist?" "$F" deploy --hosts hosts/local.hosts --dst x
+expect_error "stitch --exposre" "did you mean --exposure?" "$F" stitch "$J" -o x.png --exposre 1
+expect_error "render --zzzz" "unknown option '--zzzz' (see franja render --help)" "$F" render scenes/spheres.json --zzzz
+expect_error "hosts: two verbs" "unexpected 'list'" "$F" hosts check list --hosts hosts/local.hosts
+
 summary

@@ -79,7 +79,7 @@ check "unknown output type named" grep -q "unknown image type 'xyz'" e1
 "$FRANJA" render -o x.png 2>e2
 check "missing scene refused" test $? -eq 2
 "$FRANJA" render scene.fbin -o x.png --size 0x4 2>e3
-check "bad --size refused" grep -q "size: bad value '0x4'" e3
+check "bad --size refused" grep -q "size: '0x4' is not WxH" e3
 "$FRANJA" render scene.fbin -o x.png --bogus 2>e4
 check "unknown option refused" grep -q "unknown option '--bogus'" e4
 "$FRANJA" render missing.fbin -o x.png 2>e5

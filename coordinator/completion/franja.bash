@@ -51,12 +51,12 @@ _franja()
     fi
     case $prev in
     --tonemap) COMPREPLY=($(compgen -W "none filmic" -- "$cur")); return 0 ;;
-    --hosts | --known-hosts | --ssh-config | -o)
+    --hosts | --known-hosts | --ssh-config | --preview | -o)
         _franja_files "$cur" ""; return 0 ;;
     --job | --dist | --workdir | --shared-workdir)
         COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     --worker) _franja_files "$cur" ""; return 0 ;;
-    -j | --spp | --size | --exposure | --slab-rows | --retries | --timeout | --camera)
+    -j | --spp | --size | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every)
         return 0 ;;
     esac
     if [[ $cur == -* ]]; then

@@ -1,0 +1,68 @@
+#!/bin/sh
+# it_preview.sh -- franja render --preview FILE: the image so far, written
+# atomically every few seconds while the render runs (rows not yet done as
+# a grey checkerboard), and the whole image at the end.
+cd "$(dirname "$0")/.." || exit 1
+. tests/lib.sh
+need cmp
+T=$(mktemp -d)
+trap 'kill $pid 2>/dev/null; rm -rf "$T"' EXIT
+ROOT=$(pwd)
+F="$ROOT/bin/franja"
+IS="$ROOT/bin/tools/imgstat"
+pid=""
+
+# A render of some seconds: many slabs, one worker, previews every second.
+"$F" render scenes/cornell.json -o "$T/out.pfm" --size 64x64 --spp 48 -j 1 --slab-rows 2 \
+    --preview "$T/pre.pfm" --preview-every 1 >"$T/log" 2>&1 &
+pid=$!
+# Copy every preview that appears while it runs.
+n=0 last=""
+while kill -0 $pid 2>/dev/null; do
+    if [ -e "$T/pre.pfm" ]; then
+        sum=$(cksum <"$T/pre.pfm")
+        if [ "$sum" != "$last" ]; then
+            n=$((n + 1)); cp "$T/pre.pfm" "$T/seen.$n.pfm"; last=$sum
+        fi
+    fi
+    sleep 0.1
+done
+wait $pid && ok || bad "render with --preview failed: $(tail -n 3 "$T/log")"
+pid=""
+[ "$n" -ge 2 ] && ok || bad "only $n distinct previews seen while rendering"
+# Each preview seen is a whole image of the render's size (written atomically),
+# and a preview before the end has rows shown as the checkerboard.
+partial=0
+for k in $(seq 1 "$n"); do
+    st=$("$IS" "$T/seen.$k.pfm" 2>&1)
+    case $st in size=64x64*) ok ;; *) bad "preview $k is not a whole 64x64 image: $st" ;; esac
+    # The bottom row band: the checkerboard (0.02 and 0.08, mean 0.05) until rendered.
+    b=$("$IS" "$T/seen.$k.pfm" --rect 0 56 64 64)
+    case $b in *"mean=0.05 "*"min=0.02 max=0.08"*) partial=$((partial + 1)) ;; esac
+done
+[ "$partial" -ge 1 ] && ok || bad "no preview showed rows not yet rendered"
+# Rows a preview shows as rendered are the final image's rows.
+for k in $(seq 1 "$n"); do
+    d=$("$IS" "$T/seen.$k.pfm" --rect 0 0 64 2 --diff "$T/out.pfm")
+    b=$("$IS" "$T/seen.$k.pfm" --rect 0 0 64 2)
+    case $b in *"min=0.02 max=0.08"*) continue ;; esac
+    case $d in *" max=0 "*) ok ;; *) bad "preview $k: the top rows differ from the final image: $d" ;; esac
+done
+# At the end the preview is the whole image.
+cmp -s "$T/pre.pfm" "$T/out.pfm" && ok || bad "the last preview is not the final image"
+ls "$T" | grep -q 'tmp' && bad "temporary files left: $(ls "$T")" || ok
+
+# A PNG preview of a PFM render: tone-mapped like an output.
+"$F" render scenes/spheres.json -o "$T/s.pfm" --size 16x16 --spp 2 -j 1 --preview "$T/s.png" >/dev/null 2>&1 &&
+    "$F" render scenes/spheres.json -o "$T/s2.png" --size 16x16 --spp 2 -j 1 >/dev/null 2>&1 &&
+    cmp -s "$T/s.png" "$T/s2.png" && ok || bad "a PNG preview's last image is not the PNG render"
+
+expect_error "preview to the output" "is the output itself" "$F" render scenes/spheres.json -o "$T/a.png" --preview "$T/a.png"
+expect_error "preview type" "xyz" "$F" render scenes/spheres.json -o "$T/a.png" --preview "$T/a.xyz"
+expect_error "preview-every 0" "--preview-every: '0' is not an integer in 1..3600" "$F" render scenes/spheres.json --preview-every 0
+# A preview that cannot be written says so once, and the render goes on.
+"$F" render scenes/spheres.json -o "$T/ok.png" --size 16x16 --spp 1 -j 1 --preview "$T/no/such/dir/p.png" \
+    >"$T/log" 2>&1 && [ -s "$T/ok.png" ] && ok || bad "an unwritable preview stopped the render: $(tail -n 2 "$T/log")"
+c=$(grep -c "preview .*not written" "$T/log")
+[ "$c" -eq 1 ] && ok || bad "an unwritable preview is reported $c times, not once: $(cat "$T/log")"
+summary
