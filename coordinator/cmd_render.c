@@ -22,6 +22,7 @@
 #include "joblock.h"
 #include "output.h"
 #include "preview.h"
+#include "progress.h"
 #include "protocol.h"
 #include "quick.h"
 #include "sched.h"
@@ -58,6 +59,9 @@ static const char usage[] =
     "  --preview FILE       write the image so far to FILE (any output type) while\n"
     "                       rendering, rows not yet done as a grey checkerboard\n"
     "  --preview-every S    seconds between preview images (default 5)\n"
+    "  --progress MODE      auto (a live line on a terminal, else plain lines) or\n"
+    "                       json (also one JSON object a line on stdout, for\n"
+    "                       wrapper tools) (default auto)\n"
     CLI_SLURM_HELP;
 
 static volatile sig_atomic_t stop_flag;
@@ -84,6 +88,7 @@ typedef struct {
     const char *preview;       /* --preview FILE, or NULL */
     uint32_t preview_every;    /* seconds */
     int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
+    int json;                  /* --progress json */
     int resume, keep_job, fresh, no_lock;
     tr_options tr;
     cli_slurm slurm;
@@ -93,7 +98,7 @@ typedef struct {
 enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
-    OPT_INTEGRATOR
+    OPT_INTEGRATOR, OPT_PROGRESS
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -117,9 +122,11 @@ static int parse(int argc, char **argv, render_args *a)
         {"preview", required_argument, NULL, OPT_PREVIEW},
         {"preview-every", required_argument, NULL, OPT_PREVIEW_EVERY},
         {"integrator", required_argument, NULL, OPT_INTEGRATOR},
+        {"progress", required_argument, NULL, OPT_PROGRESS},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
+    static const char *const progress[] = {"auto", "json", NULL};
     static const char cmd[] = "render";
     memset(a, 0, sizeof *a);
     a->retries = 5;
@@ -184,6 +191,12 @@ static int parse(int argc, char **argv, render_args *a)
             int k = opt_choice(cmd, "--integrator", v, integrators);
             bad = k < 0 || proto_integrator_parse(v, &k) < 0;
             a->integrator = 1 + k;
+            break;
+        }
+        case OPT_PROGRESS: {
+            int k = opt_choice(cmd, "--progress", v, progress);
+            bad = k < 0;
+            a->json = k == 1;
             break;
         }
         case OPT_PREVIEW_EVERY:
@@ -618,6 +631,7 @@ int cmd_render(int argc, char **argv)
     unsigned char *have = calloc(spec.height, 1);
     float *rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *rgb);
     int rc = 1;
+    pg_reporter *pg = NULL;
     if (!have || !rgb) {
         fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
@@ -634,6 +648,10 @@ int cmd_render(int argc, char **argv)
             goto done;
         }
         fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", rows_have, spec.height, jobdir);
+    }
+    if (a.json && !(pg = pg_start(stdout, a.out, jobdir, &spec, &err))) {
+        fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
+        goto done;
     }
     pv_writer *pv = NULL;
     if (a.preview && !(pv = pv_start(a.preview, jobdir, &spec, &tm, a.preview_every,
@@ -653,6 +671,8 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
+    pg_stop(pg, "ok");
+    pg = NULL;
     if (!a.keep_job)
         job_remove(jobdir);
     jlk_release(&lk, !a.keep_job);
@@ -660,6 +680,7 @@ int cmd_render(int argc, char **argv)
             clk_now() - t0);
     rc = 0;
 done:
+    pg_stop(pg, stop_flag ? "interrupted" : "failed");
     if (rc)
         unlock_with(&lk, rc);
     if (rc && stop_flag)

@@ -82,6 +82,7 @@ c=$(comp franja compile "")
 has "franja compile <TAB>" "$c" room.json shot.glb
 hasnt "franja compile <TAB>" "$c" room.fbin notes.txt
 has "franja render --tonemap <TAB>" "$(comp franja render x.json --tonemap "")" none filmic
+has "franja render --progress <TAB>" "$(comp franja render x.json --progress "")" auto json
 c=$(comp franja stitch "")
 has "franja stitch <TAB>" "$c" sub
 hasnt "franja stitch <TAB>" "$c" room.json

@@ -1,10 +1,11 @@
 #!/bin/sh
 # it_preview.sh -- franja render --preview FILE: the image so far, written
 # atomically every few seconds while the render runs (rows not yet done as
-# a grey checkerboard), and the whole image at the end.
+# a grey checkerboard), and the whole image at the end; --progress json:
+# one JSON object a line on stdout.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
-need cmp
+need cmp jq
 T=$(mktemp -d)
 trap 'kill $pid 2>/dev/null; rm -rf "$T"' EXIT
 ROOT=$(pwd)
@@ -65,4 +66,34 @@ expect_error "preview-every 0" "--preview-every: '0' is not an integer in 1..360
     >"$T/log" 2>&1 && [ -s "$T/ok.png" ] && ok || bad "an unwritable preview stopped the render: $(tail -n 2 "$T/log")"
 c=$(grep -c "preview .*not written" "$T/log")
 [ "$c" -eq 1 ] && ok || bad "an unwritable preview is reported $c times, not once: $(cat "$T/log")"
+
+# --- --progress json ---
+"$F" render scenes/cornell.json -o "$T/j.png" --size 32x32 --spp 8 -j 1 --slab-rows 2 --progress json \
+    >"$T/events" 2>"$T/log" && ok || bad "render --progress json failed: $(tail -n 2 "$T/log")"
+jq -e . "$T/events" >/dev/null 2>&1 && ok || bad "--progress json: not one JSON object a line: $(head -n 3 "$T/events")"
+[ "$(head -n 1 "$T/events" | jq -r '.event + " " + .output + " " + (.width|tostring) + " " + (.spp|tostring)')" = \
+    "start $T/j.png 32 8" ] && ok || bad "first event: $(head -n 1 "$T/events")"
+[ "$(tail -n 1 "$T/events" | jq -r '.event + " " + .status + " " + (.rows_done|tostring)')" = "done ok 32" ] && ok ||
+    bad "last event: $(tail -n 1 "$T/events")"
+# Progress: rows done only grow, end at every row, each event with an ETA.
+jq -r 'select(.event == "progress") | .rows_done' "$T/events" >"$T/rows"
+[ "$(wc -l <"$T/rows")" -ge 2 ] && ok || bad "fewer than two progress events: $(cat "$T/events")"
+sort -n -c "$T/rows" 2>/dev/null && ok || bad "rows_done goes down: $(tr '\n' ' ' <"$T/rows")"
+[ "$(tail -n 1 "$T/rows")" = 32 ] && ok || bad "the last progress event is not every row"
+[ "$(jq -r 'select(.event == "progress") | has("eta_s") and has("elapsed_s") and has("rows_per_s")' "$T/events" | sort -u)" = true ] &&
+    ok || bad "a progress event lacks eta_s, elapsed_s or rows_per_s"
+grep -q '^{' "$T/log" && bad "JSON events on stderr" || ok
+expect_error "--progress bad" "--progress: 'xml' is not one of: auto, json" "$F" render scenes/spheres.json --progress xml
+# Interrupted: the done event says so.
+"$F" render scenes/cornell.json -o "$T/i.png" --size 64x64 --spp 64 -j 1 --slab-rows 1 --progress json \
+    >"$T/events" 2>"$T/log" &
+pid=$!
+k=0
+while [ $k -lt 300 ] && ! grep -q '"progress"' "$T/events"; do sleep 0.1; k=$((k + 1)); done
+kill -INT $pid
+wait $pid
+rc=$?
+pid=""
+[ $rc -eq 130 ] && ok || bad "interrupted render: exit status $rc"
+[ "$(tail -n 1 "$T/events" | jq -r .status)" = interrupted ] && ok || bad "interrupted: last event $(tail -n 1 "$T/events")"
 summary

@@ -51,6 +51,7 @@ _franja()
     fi
     case $prev in
     --tonemap) COMPREPLY=($(compgen -W "none filmic" -- "$cur")); return 0 ;;
+    --progress) COMPREPLY=($(compgen -W "auto json" -- "$cur")); return 0 ;;
     --hosts | --known-hosts | --ssh-config | --preview | -o)
         _franja_files "$cur" ""; return 0 ;;
     --job | --dist | --workdir | --shared-workdir)

@@ -1,0 +1,141 @@
+/* progress.c -- JSON progress events (see progress.h). */
+#include "progress.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "clock.h"
+
+struct pg_reporter {
+    FILE *out;
+    char *dir;
+    job_spec spec;
+    double t0;
+    int rows0;                 /* rows done when this run started */
+    int rows;                  /* last count printed */
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    int stop;
+};
+
+void pg_json_string(FILE *out, const char *s)
+{
+    fputc('"', out);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(out, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(out, "\\u%04x", *p);
+        else
+            fputc(*p, out);
+    }
+    fputc('"', out);
+}
+
+/* Prints a progress event if the count of finished rows changed. */
+static void poll_once(pg_reporter *r)
+{
+    int rows = job_rows_present(r->dir);
+    if (rows == r->rows || rows < 0)
+        return;
+    r->rows = rows;
+    double t = clk_now() - r->t0;
+    double rate = t > 0 ? (rows - r->rows0) / t : 0;
+    fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
+                    "\"eta_s\":",
+            rows, r->spec.height, t, rate);
+    if (rate > 0)
+        fprintf(r->out, "%.1f}\n", (r->spec.height - (uint32_t)rows) / rate);
+    else
+        fputs("null}\n", r->out);
+    fflush(r->out);
+}
+
+static void *run(void *arg)
+{
+    pg_reporter *r = arg;
+    pthread_mutex_lock(&r->lock);
+    while (!r->stop) {
+        pthread_mutex_unlock(&r->lock);
+        poll_once(r);
+        pthread_mutex_lock(&r->lock);
+        struct timespec until;
+        clock_gettime(CLOCK_MONOTONIC, &until);
+        until.tv_nsec += 500000000L;
+        if (until.tv_nsec >= 1000000000L) {
+            until.tv_sec++;
+            until.tv_nsec -= 1000000000L;
+        }
+        while (!r->stop && pthread_cond_timedwait(&r->wake, &r->lock, &until) != ETIMEDOUT)
+            ;
+    }
+    pthread_mutex_unlock(&r->lock);
+    return NULL;
+}
+
+pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_spec *spec, fr_error *err)
+{
+    pg_reporter *r = calloc(1, sizeof *r);
+    if (!r || !(r->dir = strdup(dir))) {
+        free(r);
+        fr_fail(err, "out of memory");
+        return NULL;
+    }
+    r->out = out;
+    r->spec = *spec;
+    r->t0 = clk_now();
+    r->rows0 = r->rows = job_rows_present(dir);
+    fputs("{\"event\":\"start\",\"output\":", out);
+    pg_json_string(out, output);
+    fprintf(out, ",\"width\":%u,\"height\":%u,\"spp\":%u,\"rows_done\":%d,\"time\":%lld}\n", spec->width,
+            spec->height, spec->spp, r->rows0, (long long)time(NULL));
+    fflush(out);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&r->wake, &ca);
+    pthread_condattr_destroy(&ca);
+    pthread_mutex_init(&r->lock, NULL);
+    int e = pthread_create(&r->thread, NULL, run, r);
+    if (e) {
+        pthread_cond_destroy(&r->wake);
+        pthread_mutex_destroy(&r->lock);
+        free(r->dir);
+        free(r);
+        fr_fail(err, "cannot start the progress thread: %s", strerror(e));
+        return NULL;
+    }
+    return r;
+}
+
+void pg_stop(pg_reporter *r, const char *status)
+{
+    if (!r)
+        return;
+    pthread_mutex_lock(&r->lock);
+    r->stop = 1;
+    pthread_cond_signal(&r->wake);
+    pthread_mutex_unlock(&r->lock);
+    pthread_join(r->thread, NULL);
+    if (!strcmp(status, "ok") && r->rows != (int)r->spec.height) {
+        /* Every row is in the image now, whatever the directory shows. */
+        double t = clk_now() - r->t0;
+        fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%u,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
+                        "\"eta_s\":0}\n",
+                r->spec.height, r->spec.height, t, t > 0 ? (r->spec.height - (uint32_t)r->rows0) / t : 0.0);
+        r->rows = (int)r->spec.height;
+    } else if (strcmp(status, "ok")) {
+        poll_once(r);
+    }
+    fprintf(r->out, "{\"event\":\"done\",\"status\":\"%s\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n", status,
+            r->rows, r->spec.height, clk_now() - r->t0);
+    fflush(r->out);
+    pthread_cond_destroy(&r->wake);
+    pthread_mutex_destroy(&r->lock);
+    free(r->dir);
+    free(r);
+}

@@ -1,0 +1,38 @@
+/** @file progress.h
+ * `franja render --progress json`: one JSON object a line on standard
+ * output for wrapper tools, written by a thread of its own that watches the
+ * job directory (the rows of the finished slabs there), so it depends on no
+ * scheduler state.  Events:
+ *
+ *     {"event":"start","output":OUT,"width":W,"height":H,"spp":N,"rows_done":R,"time":T}
+ *     {"event":"progress","rows_done":R,"rows":H,"elapsed_s":S,"rows_per_s":V,"eta_s":E}
+ *     {"event":"done","status":"ok"|"failed"|"interrupted","rows_done":R,"rows":H,"elapsed_s":S}
+ *
+ * "progress" comes when the count of finished rows changes (checked every
+ * half second); eta_s is null until a row has been rendered in this run.
+ */
+#ifndef FRANJA_PROGRESS_H
+#define FRANJA_PROGRESS_H
+
+#include <stdio.h>
+
+#include "error.h"
+#include "jobdir.h"
+
+/** A running JSON progress reporter. */
+typedef struct pg_reporter pg_reporter;
+
+/** Prints the start event to out and starts the thread that prints the
+ * progress events of the job directory dir.  Strings are copied; out must
+ * stay open until pg_stop.  NULL with err set if the thread cannot start. */
+pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_spec *spec, fr_error *err);
+
+/** Stops the thread, prints the last progress (if the count changed) and
+ * the done event with status ("ok", "failed", "interrupted"), and frees r
+ * (NULL: nothing). */
+void pg_stop(pg_reporter *r, const char *status);
+
+/** Writes s to out as a JSON string, quoted and escaped. */
+void pg_json_string(FILE *out, const char *s);
+
+#endif
