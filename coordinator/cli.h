@@ -12,7 +12,7 @@
 #include "slurm.h"
 #include "transport.h"
 
-/** Help text for the options cli_transport_option understands. */
+/** Help text for the transport options (CLI_COMMON_LONGOPTS). */
 extern const char cli_transport_help[];
 
 /** Sets o's defaults: ~/.ssh/known_hosts, ~/.ssh/config read, 10 s time-out,
