@@ -11,9 +11,16 @@
 
 int pv_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped, fr_error *err)
 {
-    int rows = job_gather(dir, spec, rgb, have, skipped, err);
+    int bad = 0;
+    int rows = job_gather(dir, spec, rgb, have, &bad, err);
+    if (skipped)
+        *skipped = bad;
     if (rows < 0)
         return -1;
+    /* A whole bidirectional job: the rows with every slab's splats added,
+     * as the render's own image has them. */
+    if (spec->integrator == FR_INTEGRATOR_BDPT && (uint32_t)rows == spec->height && !bad)
+        return job_stitch(dir, spec, rgb, NULL, err) ? -1 : rows;
     for (uint32_t y = 0; y < spec->height; y++) {
         if (have[y])
             continue;

@@ -24,7 +24,10 @@
  * finished slabs of dir (job_gather: nothing in dir changes) and paints the
  * rows not covered as the checkerboard.  have (height bytes, the caller's)
  * receives the rows covered.  Returns their number, or -1 when dir cannot
- * be read; *skipped counts slab files that did not check out. */
+ * be read; *skipped counts slab files that did not check out.  For a
+ * bidirectional job the light-traced splats are in the image only once
+ * every row is there (job_stitch); until then the rows have the camera
+ * paths' part alone. */
 int pv_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped, fr_error *err);
 
 /** A running preview writer. */

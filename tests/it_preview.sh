@@ -58,6 +58,10 @@ ls "$T" | grep -q 'tmp' && bad "temporary files left: $(ls "$T")" || ok
     "$F" render scenes/spheres.json -o "$T/s2.png" --size 16x16 --spp 2 -j 1 >/dev/null 2>&1 &&
     cmp -s "$T/s.png" "$T/s2.png" && ok || bad "a PNG preview's last image is not the PNG render"
 
+# A bidirectional render: the last preview has the light-traced splats too.
+"$F" render scenes/spheres.json --integrator bdpt -o "$T/b.pfm" --size 24x16 --spp 2 -j 2 --preview "$T/bp.pfm" \
+    >/dev/null 2>&1 && cmp -s "$T/b.pfm" "$T/bp.pfm" && ok || bad "a bidirectional render's last preview is not its image"
+
 expect_error "preview to the output" "is the output itself" "$F" render scenes/spheres.json -o "$T/a.png" --preview "$T/a.png"
 expect_error "preview type" "xyz" "$F" render scenes/spheres.json -o "$T/a.png" --preview "$T/a.xyz"
 expect_error "preview-every 0" "--preview-every: '0' is not an integer in 1..3600" "$F" render scenes/spheres.json --preview-every 0
