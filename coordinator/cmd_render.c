@@ -667,8 +667,13 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err) || out_write(a.out, rgb, &spec, &tm, &err)) {
+    if (job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
+        goto done;
+    }
+    if (out_write(a.out, rgb, &spec, &tm, &err)) {
+        fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume to "
+                "write %s\n", err.msg, jobdir, a.out);
         goto done;
     }
     pg_stop(pg, "ok");

@@ -3,10 +3,16 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
+
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 extern "C" {
 #include "imageio.h"
@@ -14,30 +20,70 @@ extern "C" {
 
 using namespace OIIO;
 
-extern "C" int iio_write(const char *path, const void *pixels, iio_type type, uint32_t width,
-                         uint32_t height, fr_error *err)
+// Encodes into an anonymous memory file: OpenImageIO's writers open files
+// by name, and several of them (PNG, BMP, TGA) do not report a failed write
+// while libjpeg's exits the process; in memory no write can fail for lack
+// of disk space, and the caller then writes the bytes with every write
+// checked.  The writer is chosen by the extension of `name`, and opens the
+// memory file through /proc/self/fd.
+extern "C" int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
+                          unsigned char **data, size_t *len, fr_error *err)
 {
+    *data = nullptr;
+    *len = 0;
+    int fd = memfd_create("franja-image", MFD_CLOEXEC);
+    if (fd < 0)
+        return fr_fail(err, "%s: cannot make an in-memory file to encode into: %s", name, strerror(errno));
+    char mem[64];
+    snprintf(mem, sizeof mem, "/proc/self/fd/%d", fd);
+    int rc = 0;
     try {
         TypeDesc td = type == IIO_U8 ? TypeDesc::UINT8 : type == IIO_U16 ? TypeDesc::UINT16 : TypeDesc::FLOAT;
-        std::unique_ptr<ImageOutput> out = ImageOutput::create(path);
-        if (!out)
-            return fr_fail(err, "%s: no image writer for this extension: %s", path, OIIO::geterror().c_str());
-        ImageSpec spec((int)width, (int)height, 3, td);
-        spec.attribute("oiio:ColorSpace", type == IIO_F32 ? "linear" : "sRGB");
-        spec.attribute("Software", "franja");
-        if (!out->open(path, spec))
-            return fr_fail(err, "%s: %s", path, out->geterror().c_str());
-        if (!out->write_image(td, pixels)) {
-            std::string e = out->geterror();
-            out->close();
-            return fr_fail(err, "%s: %s", path, e.c_str());
+        std::unique_ptr<ImageOutput> out = ImageOutput::create(name);
+        if (!out) {
+            rc = fr_fail(err, "%s: no image writer for this extension: %s", name, OIIO::geterror().c_str());
+        } else {
+            ImageSpec spec((int)width, (int)height, 3, td);
+            spec.attribute("oiio:ColorSpace", type == IIO_F32 ? "linear" : "sRGB");
+            spec.attribute("Software", "franja");
+            if (!out->open(mem, spec)) {
+                rc = fr_fail(err, "%s: encoding: %s", name, out->geterror().c_str());
+            } else if (!out->write_image(td, pixels)) {
+                std::string e = out->geterror();
+                out->close();
+                rc = fr_fail(err, "%s: encoding: %s", name, e.c_str());
+            } else if (!out->close()) {
+                rc = fr_fail(err, "%s: encoding: %s", name, out->geterror().c_str());
+            }
         }
-        if (!out->close())
-            return fr_fail(err, "%s: %s", path, out->geterror().c_str());
-        return 0;
     } catch (const std::exception &e) {
-        return fr_fail(err, "%s: %s", path, e.what());
+        rc = fr_fail(err, "%s: encoding: %s", name, e.what());
     }
+    struct stat st;
+    if (rc == 0 && fstat(fd, &st))
+        rc = fr_fail(err, "%s: encoding: %s", name, strerror(errno));
+    if (rc == 0 && st.st_size <= 0)
+        rc = fr_fail(err, "%s: encoding: the image writer wrote nothing", name);
+    unsigned char *buf = nullptr;
+    if (rc == 0 && !(buf = (unsigned char *)malloc((size_t)st.st_size)))
+        rc = fr_fail(err, "%s: out of memory for the encoded image (%lld bytes)", name, (long long)st.st_size);
+    for (size_t got = 0; rc == 0 && got < (size_t)st.st_size;) {
+        ssize_t k = pread(fd, buf + got, (size_t)st.st_size - got, (off_t)got);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            rc = fr_fail(err, "%s: encoding: reading back: %s", name, k < 0 ? strerror(errno) : "short file");
+        else
+            got += (size_t)k;
+    }
+    close(fd);
+    if (rc) {
+        free(buf);
+        return rc;
+    }
+    *data = buf;
+    *len = (size_t)st.st_size;
+    return 0;
 }
 
 // Reads the first image of an opened input into *pixels (see iio_read).

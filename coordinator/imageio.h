@@ -1,6 +1,7 @@
 /** @file imageio.h
  * The coordinator's bridge to OpenImageIO (imageio.cpp, the one C++ file):
- * writes a finished image in the format its file name's extension names.
+ * encodes a finished image in the format its file name's extension names,
+ * and reads images (textures).
  */
 #ifndef FRANJA_IMAGEIO_H
 #define FRANJA_IMAGEIO_H
@@ -10,14 +11,19 @@
 
 #include "error.h"
 
-/** Pixel types iio_write accepts. */
+/** Pixel types iio_encode accepts. */
 typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32 } iio_type;
 
-/** Writes width x height RGB pixels (top row first, 3 values of `type` per
- * pixel) to `path`; OpenImageIO picks the format from the extension (png,
- * exr, tif, jpg, hdr, bmp, ppm ...).  Fails with OpenImageIO's message. */
-int iio_write(const char *path, const void *pixels, iio_type type, uint32_t width, uint32_t height,
-              fr_error *err);
+/** Encodes width x height RGB pixels (top row first, 3 values of `type`
+ * per pixel) in the format the extension of `name` names (png, exr, tif,
+ * jpg, hdr, bmp, tga, ppm ...), into memory: *data (malloc'd, the caller
+ * frees) receives the *len bytes of the file, which the caller writes.
+ * Nothing is written to disk, so a full file system cannot truncate the
+ * image or end the process (libjpeg exits on a failed write).  Fails,
+ * naming `name`, with OpenImageIO's message or for lack of memory; *data
+ * is then NULL. */
+int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
+               unsigned char **data, size_t *len, fr_error *err);
 
 /** Reads the first image of `path` as floats: *pixels (malloc'd, the
  * caller frees) holds width*height*channels values, top row first, as

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "file.h"
@@ -27,50 +28,63 @@ static int is_ext(const char *path, const char *ext) { return !strcasecmp(extens
 
 int out_check(const char *path, fr_error *err)
 {
-    if (is_ext(path, "pfm") || (*extension(path) && iio_can_write(path)))
-        return 0;
-    return fr_fail(err, "%s: unknown image type '%s': expected .png, .exr, .tif, .jpg, .hdr, .ppm, .bmp "
-                   "or .pfm", path, extension(path));
+    if (!is_ext(path, "pfm") && !(*extension(path) && iio_can_write(path)))
+        return fr_fail(err, "%s: unknown image type '%s': expected .png, .exr, .tif, .jpg, .hdr, .ppm, .bmp, "
+                       ".tga or .pfm", path, extension(path));
+    /* Before any rendering: the output is not a directory the rename could
+     * not replace, and a file can be made beside it (the directory exists
+     * and is writable); the trial file is removed at once. */
+    struct stat st;
+    if (lstat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return fr_fail(err, "%s: is a directory", path);
+    file_out o;
+    if (file_out_open(path, &o, err))
+        return -1;
+    file_out_abort(&o);
+    return 0;
 }
 
-static int write_pfm(file_out *o, const float *rgb, const job_spec *spec, fr_error *err)
+/* The PFM file in memory: the header a one-process worker render has. */
+static int encode_pfm(const char *path, const float *rgb, const job_spec *spec, unsigned char **data, size_t *len,
+                      fr_error *err)
 {
-    int fd = dup(o->fd);
-    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
-    if (!f) {
-        if (fd >= 0)
-            close(fd);
-        return fr_fail(err, "%s: %s", o->tmp, strerror(errno));
-    }
+    char *buf = NULL;
+    size_t n = 0;
+    FILE *f = open_memstream(&buf, &n);
+    if (!f)
+        return fr_fail(err, "%s: out of memory for the encoded image", path);
     img_partial_info info = {.scene = spec->hash, .y1 = spec->height, .spp = spec->spp, .width = spec->width,
                              .height = spec->height};
     int rc = img_write(f, IMG_PF, &info, rgb, NULL, err);
     if (fclose(f) && rc == 0)
-        rc = fr_fail(err, "%s: %s", o->tmp, strerror(errno));
-    return rc;
+        rc = fr_fail(err, "%s: out of memory for the encoded image", path);
+    if (rc) {
+        free(buf);
+        return -1;
+    }
+    *data = (unsigned char *)buf;
+    *len = n;
+    return 0;
 }
 
 int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err)
 {
-    /* OpenImageIO writes by name: into the temporary file file_out_open
-     * made (same extension, so the same format), which the commit renames. */
-    file_out o;
-    if (file_out_open(path, &o, err))
-        return -1;
-    const char *tmp = o.tmp;
+    /* Encoded in memory (OpenImageIO's writers do not all report a failed
+     * write, and libjpeg's exits), then written by file_write_atomic, which
+     * checks every write, the fsync and the close before the rename. */
     size_t n = (size_t)spec->width * spec->height * 3;
+    unsigned char *data = NULL;
+    size_t len = 0;
     int rc;
     if (is_ext(path, "pfm")) {
-        rc = write_pfm(&o, rgb, spec, err);
+        rc = encode_pfm(path, rgb, spec, &data, &len, err);
     } else if (is_ext(path, "exr") || is_ext(path, "hdr")) {
-        rc = iio_write(tmp, rgb, IIO_F32, spec->width, spec->height, err);
+        rc = iio_encode(path, rgb, IIO_F32, spec->width, spec->height, &data, &len, err);
     } else {
         int wide = is_ext(path, "tif") || is_ext(path, "tiff");
         void *px = malloc(n * (wide ? 2 : 1));
-        if (!px) {
-            file_out_abort(&o);
-            return fr_fail(err, "out of memory for the final image");
-        }
+        if (!px)
+            return fr_fail(err, "%s: out of memory for the final image", path);
         for (size_t i = 0; i < n; i++) {
             float v = tm_display(tm, rgb[i]);
             if (wide)
@@ -78,12 +92,14 @@ int out_write(const char *path, const float *rgb, const job_spec *spec, const fr
             else
                 ((uint8_t *)px)[i] = (uint8_t)(v * 255.0f + 0.5f);
         }
-        rc = iio_write(tmp, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, err);
+        rc = iio_encode(path, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, &data, &len, err);
         free(px);
     }
-    if (rc) {
-        file_out_abort(&o);
-        return rc;
+    if (rc == 0) {
+        fr_error e;
+        if (file_write_atomic(path, data, len, &e))
+            rc = fr_fail(err, "%s: not written (%zu bytes): %s", path, len, e.msg);
     }
-    return file_out_commit(&o, path, err);
+    free(data);
+    return rc;
 }
