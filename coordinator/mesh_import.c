@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "file.h"
+#include "plyhead.h"
 
 #define BUDGET_BASE ((size_t)256 << 20)   /* address space for an import, plus ... */
 #define BUDGET_PER_BYTE 64                 /* ... this much per byte of the file */
@@ -448,11 +449,44 @@ static int receive(int fd, const char *path, size_t budget, double deadline, obj
     return GOT;
 }
 
+/* The file is a regular file of at most MESH_IMPORT_MAX_BYTES (*size), and
+ * a PLY header in it declares no more than the file can hold. */
+static int check_header(const char *path, size_t *size, fr_error *err)
+{
+    int fd;
+    if (file_open_regular(path, MESH_IMPORT_MAX_BYTES, &fd, size, err) < 0)
+        return -1;
+    char *head = malloc(PLY_HEADER_MAX);
+    if (!head) {
+        close(fd);
+        return fr_fail(err, "%s: out of memory", path);
+    }
+    size_t got = 0;
+    while (got < PLY_HEADER_MAX) {
+        ssize_t k = read(fd, head + got, PLY_HEADER_MAX - got);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k < 0) {
+            int e = errno;
+            free(head);
+            close(fd);
+            return fr_fail(err, "%s: read error: %s", path, strerror(e));
+        }
+        if (k == 0)
+            break;
+        got += (size_t)k;
+    }
+    close(fd);
+    int rc = ply_check(path, head, got, *size, err);
+    free(head);
+    return rc;
+}
+
 int mesh_import(const char *path, obj_mesh *m, fr_error *err)
 {
     memset(m, 0, sizeof *m);
     size_t size;
-    if (file_check_regular(path, MESH_IMPORT_MAX_BYTES, &size, err) < 0)
+    if (check_header(path, &size, err) < 0)
         return -1;
     int p[2];
     if (pipe2(p, O_CLOEXEC) < 0)

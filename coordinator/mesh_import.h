@@ -3,8 +3,9 @@
  * 3ds ...), read in a child process.
  *
  * Assimp trusts its input more than Franja may: a malformed file can make
- * it abort (its internal assertions), crash or allocate without bound (an
- * ASCII PLY header declaring 10^8 faces).  So the import runs in a forked
+ * it abort (its internal assertions), crash or allocate without bound (a
+ * PLY header declaring 10^8 faces: refused before the import by
+ * plyhead.h, as more than the file holds).  So the import runs in a forked
  * child with limits (address space: 256 MiB plus 64 bytes per byte of the
  * file; CPU time: 60 s plus 1 s per MiB; no core file) and sends the mesh
  * back through a pipe; whatever happens to the child, the caller gets an
@@ -22,7 +23,7 @@
 
 /** Reads the mesh file `path` into m (node transforms applied, polygons
  * triangulated, points and lines dropped; free with obj_free).  Fails,
- * with m empty, with Assimp's own message, or "PATH: the mesh importer
+ * with m empty, with Assimp's own message, ply_check's, or "PATH: the mesh importer
  * (Assimp) crashed (signal N: NAME)", "... ran out of its memory limit",
  * "... took more than N s". */
 int mesh_import(const char *path, obj_mesh *m, fr_error *err);

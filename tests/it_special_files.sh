@@ -96,19 +96,53 @@ refused "symlink to /dev/zero as texture" "zero.png: not a regular file (a chara
 H='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n'
 printf "${H}element face 100000000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" >"$T/huge.ply"
 printf "${H}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0\n" >"$T/abort.ply"
-printf "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\001\002" >"$T/crash.ply"
+# (a face of 255 indices where the file ends: as many bytes as the header
+# asks for at least, so it reaches Assimp, which reads past the end)
+printf "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n%036d\377" 0 >"$T/crash.ply"
 printf "${H}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" >"$T/good.ply"
 mesh huge huge.ply m
 start=$(date +%s)
-refused "PLY declaring 10^8 faces" "huge.ply: the mesh importer (Assimp) ran out of its" $F compile "$T/huge.json" -o "$T/x.fbin"
-[ $(($(date +%s) - start)) -lt 30 ] && ok || bad "PLY declaring 10^8 faces: refused after $(($(date +%s) - start)) s"
+refused "PLY declaring 10^8 faces" "huge.ply: the PLY header declares 100000000 'face' elements, which take at least 200000000 bytes" $F compile "$T/huge.json" -o "$T/x.fbin"
+[ $(($(date +%s) - start)) -lt 5 ] && ok || bad "PLY declaring 10^8 faces: refused after $(($(date +%s) - start)) s"
+# The same in binary, and a count past 2^64 bytes; one element more than
+# the file holds.
+printf "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 100000000\nproperty list uchar int vertex_indices\nend_header\n" >"$T/huge-bin.ply"
+mesh huge-bin huge-bin.ply m
+refused "binary PLY declaring 10^8 faces" "huge-bin.ply: the PLY header declares 100000000 'face' elements" $F compile "$T/huge-bin.json" -o "$T/x.fbin"
+printf "${H}element face 18446744073709551615\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n" >"$T/wrap.ply"
+mesh wrap wrap.ply m
+refused "PLY declaring 2^64-1 faces" "wrap.ply: the PLY header declares 18446744073709551615 'face' elements" $F compile "$T/wrap.json" -o "$T/x.fbin"
+printf "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nend_header\n%036d" 0 >"$T/short.ply"
+mesh short short.ply m
+refused "binary PLY one vertex short" "short.ply: the PLY header declares elements of at least 48 bytes, more than the 36 bytes after the header" $F compile "$T/short.json" -o "$T/x.fbin"
 mesh abort abort.ply m
 refused "PLY that makes Assimp abort" "abort.ply: the mesh importer (Assimp) crashed (signal 6" $F compile "$T/abort.json" -o "$T/x.fbin"
 mesh crash crash.ply m
 refused "truncated binary PLY that crashes Assimp" "crash.ply: the mesh importer (Assimp) crashed (signal 11" $F compile "$T/crash.json" -o "$T/x.fbin"
-# ... while a good one still arrives.
+# ... while a good one still arrives (also in binary, exactly the size its
+# header declares).
 mesh good good.ply m
 bounded 60 $F compile "$T/good.json" -o "$T/good.fbin" >"$T/out" 2>&1 && grep -q '1 primitives (1 triangles)' "$T/out" &&
     ok || bad "a good PLY: $(cat "$T/out")"
+printf "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" >"$T/goodbin.ply"
+printf '\000\000\000\000\000\000\000\000\000\000\000\000\000\000\200\077\000\000\000\000\000\000\000\000\000\000\000\000\000\000\200\077\000\000\000\000\003\000\000\000\000\001\000\000\000\002\000\000\000' >>"$T/goodbin.ply"
+mesh goodbin goodbin.ply m
+bounded 60 $F compile "$T/goodbin.json" -o "$T/good.fbin" >"$T/out" 2>&1 && grep -q '1 primitives (1 triangles)' "$T/out" &&
+    ok || bad "a good binary PLY: $(cat "$T/out")"
+
+# --- size caps: files larger than a reader takes (sparse, so they cost
+# nothing) are refused by their size before anything is read ---
+truncate -s 1073741825 "$T/big.json" "$T/big.obj" "$T/big.mtl" "$T/big.ply"
+truncate -s 4294967297 "$T/big.png"
+refused "a scene over 1 GiB" "big.json: 1073741825 bytes, more than the 1073741824 this reader takes" $F compile "$T/big.json" -o "$T/x.fbin"
+mesh big-obj big.obj m
+refused "an OBJ mesh over 1 GiB" "big.obj: 1073741825 bytes, more than the 1073741824 this reader takes" $F compile "$T/big-obj.json" -o "$T/x.fbin"
+mesh big-ply big.ply m
+refused "a PLY mesh over 1 GiB" "big.ply: 1073741825 bytes, more than the 1073741824 this reader takes" $F compile "$T/big-ply.json" -o "$T/x.fbin"
+printf 'mtllib big.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/c.obj"
+mesh mtl-big c.obj
+refused "an MTL file over 1 GiB" "big.mtl: 1073741825 bytes, more than the 1073741824 this reader takes" $F compile "$T/mtl-big.json" -o "$T/x.fbin"
+sed 's/fifo.png/big.png/' "$T/tex-fifo.json" >"$T/tex-big.json"
+refused "a texture over 4 GiB" "big.png: 4294967297 bytes, more than the 4294967296 this reader takes" $F compile "$T/tex-big.json" -o "$T/x.fbin"
 
 summary

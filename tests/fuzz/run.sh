@@ -5,7 +5,8 @@
 # and any crashing input go to build/fuzz/run/.  Exit status 1 if a target
 # crashed, leaked, hit undefined behaviour or timed out.
 #
-# Seeds: tests/fuzz/corpus/json, tests/fuzz/corpus/gltf (written by
+# Seeds: tests/fuzz/corpus/json, tests/fuzz/corpus/ply (PLY headers after
+# a 4-byte file size), tests/fuzz/corpus/gltf (written by
 # tests/tools/gengltf) and tests/fuzz/corpus/obj (inputs starting with 'M'
 # are MTL files); the binary-scene seeds are compiled now, so that
 # they are always the current format, from the example scenes without
@@ -33,7 +34,7 @@ for s in scenes/*.json tests/fuzz/corpus/fbin/*.json; do
 done
 echo "== fuzz: ${SECS} s per target, clang $(clang --version | sed -n 's/.*version \([0-9.]*\).*/\1/p;q'), ASan + UBSan"
 rc=0
-for t in fbin json obj gltf; do
+for t in fbin json obj gltf ply; do
     seeds=tests/fuzz/corpus/$t
     [ "$t" = fbin ] && seeds=$W/seed-fbin
     mkdir -p "$W/corpus-$t"
