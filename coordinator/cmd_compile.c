@@ -1,13 +1,13 @@
 /* cmd_compile.c -- `franja compile`: a JSON or glTF scene into a binary scene. */
 #include "cmd.h"
 
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "opt.h"
-#include "clock.h"
 #include "compile.h"
-#include "fbin.h"
+#include "compile_child.h"
 
 static const char usage[] =
     "usage: franja compile SCENE(.json|.gltf|.glb) [-o SCENE.fbin] [--camera NAME]\n"
@@ -24,6 +24,14 @@ static const char usage[] =
     "                  current directory)\n"
     "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
     "                  name (default: the first in the scene)\n";
+
+static volatile sig_atomic_t stop_flag;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_flag = 1;
+}
 
 static void print_warning(void *user, const char *msg)
 {
@@ -74,26 +82,22 @@ int cmd_compile(int argc, char **argv)
         }
         out = def;
     }
-    fr_scene s;
+    /* The compile runs in a child process (compile_child.h): Ctrl-C or a
+     * SIGTERM stops it at once and leaves no partial output. */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
     fr_error err;
-    double t0 = clk_now();
+    compile_child_stats st;
     compile_opts co = {camera, print_warning, (void *)"franja compile"};
-    if (compile_scene(in, &co, &s, &err) < 0) {
+    if (compile_child(in, &co, out, &stop_flag, &st, &err) < 0) {
         fprintf(stderr, "franja compile: %s\n", err.msg);
-        return 1;
+        return stop_flag ? 130 : 1;
     }
-    double t1 = clk_now();
-    if (fbin_write(&s, out, &err) < 0) {
-        fprintf(stderr, "franja compile: %s\n", err.msg);
-        scn_free(&s);
-        return 1;
-    }
-    char hex[17];
-    fbin_hash_hex(s.hash, hex);
-    printf("%s: scene %s, %zu bytes: %u primitives (%u triangles), %u materials, %u lights, "
+    printf("%s: scene %s, %llu bytes: %u primitives (%u triangles), %u materials, %u lights, "
            "%u BVH nodes, %u leaf blocks; compiled in %.3f s\n",
-           out, hex, s.blob_size, s.n_prims, s.n_triangles, s.n_materials, s.n_lights, s.n_nodes, s.n_leaves,
-           t1 - t0);
-    scn_free(&s);
+           out, st.hash, st.bytes, st.prims, st.triangles, st.materials, st.lights, st.nodes, st.leaves, st.seconds);
     return 0;
 }

@@ -17,6 +17,7 @@
 #include "clock.h"
 #include "cluster.h"
 #include "compile.h"
+#include "compile_child.h"
 #include "fbin.h"
 #include "jobdir.h"
 #include "joblock.h"
@@ -260,13 +261,11 @@ static int scene_binary(const render_args *a, const char *jobdir, char *path, si
     if (mkdir(jobdir, 0755) && errno != EEXIST)
         return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
     snprintf(path, cap, "%s/scene.fbin", jobdir);
-    fr_scene compiled;
+    /* In a child process, so that Ctrl-C stops a long compile at once. */
     compile_opts co = {a->camera, print_warning, (void *)"franja"};
-    if (compile_scene(a->scene, &co, &compiled, err))
+    if (compile_child(a->scene, &co, path, &stop_flag, NULL, err))
         return -1;
-    int rc = fbin_write(&compiled, path, err);
-    scn_free(&compiled);
-    return rc ? -1 : fbin_load(path, sc, err);
+    return fbin_load(path, sc, err);
 }
 
 static void summary(const sched_host *hs, int n, const job_spec *spec, const sched_stats *st, int rows_run,
@@ -605,7 +604,7 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: %s\n", err.msg);
         hosts_free(&table);
         slurm_close(&alloc);
-        return unlock_with(&lk, 1);
+        return unlock_with(&lk, stop_flag ? 130 : 1);
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
                      a.spp ? a.spp : sc.settings.spp,

@@ -1,0 +1,173 @@
+/* compile_child.c -- the scene compiled in a child process that an
+ * interruption can stop at once. */
+#include "compile_child.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "fbin.h"
+
+/* What the child sends back, in one write. */
+typedef struct {
+    int rc;
+    fr_error err;
+    compile_child_stats st;
+} answer;
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void child(const char *scene, const compile_opts *o, const char *file, int fd)
+{
+    answer a;
+    memset(&a, 0, sizeof a);
+    fr_scene s;
+    double t0 = now();
+    a.rc = compile_scene(scene, o, &s, &a.err);
+    if (a.rc == 0) {
+        a.st.seconds = now() - t0;
+        a.rc = fbin_write(&s, file, &a.err);
+        fbin_hash_hex(s.hash, a.st.hash);
+        a.st.bytes = s.blob_size;
+        a.st.prims = s.n_prims;
+        a.st.triangles = s.n_triangles;
+        a.st.materials = s.n_materials;
+        a.st.lights = s.n_lights;
+        a.st.nodes = s.n_nodes;
+        a.st.leaves = s.n_leaves;
+        scn_free(&s);
+    }
+    const char *p = (const char *)&a;
+    for (size_t left = sizeof a; left;) {
+        ssize_t k = write(fd, p, left);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            break;
+        p += k;
+        left -= (size_t)k;
+    }
+}
+
+/* Removes the private directory and whatever the child left in it. */
+static void remove_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char path[4400];
+        while ((e = readdir(d)))
+            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+                snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+                unlink(path);
+            }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
+/* Reads the answer, polling stop.  Returns 1 when read whole, 0 when the
+ * child ended without one, -1 when stopped. */
+static int wait_answer(int fd, answer *a, volatile sig_atomic_t *stop)
+{
+    size_t got = 0;
+    while (got < sizeof *a) {
+        if (stop && *stop)
+            return -1;
+        struct pollfd p = {fd, POLLIN, 0};
+        int r = poll(&p, 1, 100);
+        if (r < 0 && errno != EINTR)
+            return 0;
+        if (r <= 0)
+            continue;
+        ssize_t k = read(fd, (char *)a + got, sizeof *a - got);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            return 0;
+        got += (size_t)k;
+    }
+    return 1;
+}
+
+int compile_child(const char *scene, const compile_opts *o, const char *out, volatile sig_atomic_t *stop,
+                  compile_child_stats *st, fr_error *err)
+{
+    char dir[4200], file[4300];
+    const char *slash = strrchr(out, '/');
+    int dirlen = slash ? (int)(slash - out + 1) : 0;
+    if (snprintf(dir, sizeof dir, "%.*s.%s.compile-XXXXXX", dirlen, out, out + dirlen) >= (int)sizeof dir)
+        return fr_fail(err, "%s: name too long", out);
+    if (!mkdtemp(dir))
+        return fr_fail(err, "%s: cannot create a directory beside it to compile into: %s", out, strerror(errno));
+    snprintf(file, sizeof file, "%s/scene.fbin", dir);
+    int p[2];
+    if (pipe2(p, O_CLOEXEC) < 0) {
+        int e = errno;
+        rmdir(dir);
+        return fr_fail(err, "%s: cannot start the compiler: %s", scene, strerror(e));
+    }
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid < 0) {
+        int e = errno;
+        close(p[0]);
+        close(p[1]);
+        rmdir(dir);
+        return fr_fail(err, "%s: cannot start the compiler: %s", scene, strerror(e));
+    }
+    if (pid == 0) {
+        close(p[0]);
+        child(scene, o, file, p[1]);
+        fflush(NULL);
+        _exit(0);
+    }
+    close(p[1]);
+    answer a;
+    int got = wait_answer(p[0], &a, stop);
+    close(p[0]);
+    if (got < 0)
+        kill(pid, SIGKILL);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    int rc;
+    if (got < 0) {
+        rc = fr_fail(err, "%s: compile interrupted", scene);
+    } else if (got == 0) {
+        if (WIFSIGNALED(status))
+            rc = fr_fail(err, "%s: the compiling process died (signal %d: %s)", scene, WTERMSIG(status),
+                         strsignal(WTERMSIG(status)));
+        else
+            rc = fr_fail(err, "%s: the compiling process stopped without an answer (exit status %d)", scene,
+                         WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    } else if (a.rc) {
+        a.err.msg[sizeof a.err.msg - 1] = 0;
+        *err = a.err;
+        rc = -1;
+    } else if (stop && *stop) {
+        rc = fr_fail(err, "%s: compile interrupted", scene);
+    } else if (rename(file, out)) {
+        rc = fr_fail(err, "%s: %s", out, strerror(errno));
+    } else {
+        rc = 0;
+        if (st) {
+            *st = a.st;
+            st->hash[sizeof st->hash - 1] = 0;
+        }
+    }
+    remove_dir(dir);
+    return rc;
+}
