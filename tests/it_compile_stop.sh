@@ -3,6 +3,7 @@
 # franja compile at once (the compile runs in a child process that is
 # killed), leaves no partial scene.fbin, no private compile directory and
 # no job directory; an uninterrupted compile still writes the same scene.
+# A scene that fails to compile leaves no job directory.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 F=$PWD/bin/franja
@@ -81,6 +82,11 @@ stopped "compile, SIGTERM" TERM "$T" "$F" compile "$T/big.json" -o "$T/full.fbin
 check "compile, SIGTERM: the older scene is left as it was" cmp -s "$T/full.fbin" "$T/keep.fbin"
 left=$(ls -A "$T" | grep -v -e '^big\.' -e '^full\.fbin$' -e '^keep\.fbin$' -e '^out$' -e '^err$')
 [ -z "$left" ] && ok || bad "left behind: $left"
+# A scene that fails to compile leaves no job directory either.
+printf '{"image": {"width": 8, "height": 8, "spp": 1},\n "camera": 3}\n' >"$T/bad.json"
+expect_error "render of a scene that fails to parse" "bad.json: camera: missing or not an object" "$F" render "$T/bad.json" -o "$T/bad.png"
+check "a failed parse leaves no job directory" test ! -e "$T/bad.png.franja-job"
+rm -f "$T/bad.json"
 sleep 0.2
 [ -z "$(pgrep -f "$T/big.json")" ] && ok || bad "a compiling process outlived the interruption"
 
