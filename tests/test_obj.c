@@ -189,6 +189,12 @@ static void test_groups_materials(void)
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\n");
     CHECK(obj_read(path, &m, &err) < 0 && strstr(err.msg, "a.mtl:2:") && strstr(err.msg, "Kd"), "MTL error: %s",
           err.msg);
+    /* Two MTL files of one OBJ defining one name: which was meant? */
+    put_file(path, sizeof path, dir, "a.mtl", "newmtl red\nKd 0.8 0.1 0.1\n");
+    put_file(path, sizeof path, dir, "b.mtl", "newmtl blue\nKd 0.1 0.1 0.8\nnewmtl red\nKd 0.9 0 0\n");
+    put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+    CHECK(obj_read(path, &m, &err) < 0 && strstr(err.msg, "b.mtl:3:") && strstr(err.msg, "'red' is defined twice"),
+          "one material name in two MTL files: %s", err.msg);
     const char *files[] = {"a.mtl", "b.mtl", "m.obj"};
     for (int i = 0; i < 3; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
