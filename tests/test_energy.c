@@ -72,6 +72,49 @@ static void furnace_box(float rho, float le)
     scn_free(&s);
 }
 
+/* Russian roulette keeps the estimator unbiased on deep paths: inside a
+ * sphere whose wall reflects rho = (0.9, 0.5, 0.2) per channel and emits Le,
+ * channel c sees Le / (1 - rho_c) (ten bounces on average in red, where
+ * roulette ends almost every path since the depth limit is far away).  The
+ * mean of each channel must match within four standard errors of the
+ * samples' own spread, and within 1 %. */
+static void furnace_roulette(void)
+{
+    const float rho[3] = {0.9f, 0.5f, 0.2f}, le = 0.5f;
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{\"image\": {\"width\": 4, \"height\": 4, \"spp\": 1, \"max_depth\": 4096},"
+             " \"camera\": {\"position\": [0.3, -0.4, 0.2], \"target\": [0, 1, 1], \"fov\": 90},"
+             " \"materials\": {\"wall\": {\"type\": \"lambert\", \"albedo\": [%g, %g, %g],"
+             "   \"emission\": [%g, %g, %g], \"two_sided\": true}},"
+             " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 2, \"material\": \"wall\"}]}",
+             rho[0], rho[1], rho[2], le, le, le);
+    fr_scene s;
+    test_scene(json, &s);
+    const pt_strategy all[] = {PT_MIS, PT_BSDF_ONLY};
+    const char *names[] = {"MIS", "BSDF sampling"};
+    for (int k = 0; k < 2; k++) {
+        double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+        uint32_t n = 0;
+        for (uint32_t y = 0; y < 4; y++)
+            for (uint32_t x = 0; x < 4; x++)
+                for (uint32_t i = 0; i < 8192; i++, n++) {
+                    vec3 c = pt_sample(&s, all[k], x, y, i);
+                    double v[3] = {c.x, c.y, c.z};
+                    for (int ch = 0; ch < 3; ch++)
+                        sum[ch] += v[ch], sum2[ch] += v[ch] * v[ch];
+                }
+        for (int ch = 0; ch < 3; ch++) {
+            double mean = sum[ch] / n, var = sum2[ch] / n - mean * mean, se = sqrt(var / n);
+            double expect = le / (1.0 - rho[ch]);
+            printf("roulette furnace (%s) channel %d: %.5f +- %.5f, expected %.5f\n", names[k], ch, mean, se, expect);
+            CHECK(fabs(mean - expect) < 4.0 * se && fabs(mean - expect) < 0.01 * expect,
+                  "roulette furnace (%s) channel %d: %g +- %g, expected %g", names[k], ch, mean, se, expect);
+        }
+    }
+    scn_free(&s);
+}
+
 /* A point light of intensity I at height h over a Lambert plane of albedo
  * rho: the point right below it has radiance rho/pi * I / h^2.  A narrow
  * camera looks straight down at it (the plane is the only surface, so no
@@ -139,6 +182,7 @@ int main(void)
     furnace_sphere(0.5f, 1.0f);
     furnace_sphere(0.8f, 0.25f);
     furnace_box(0.7f, 1.0f);
+    furnace_roulette();
     point_over_plane();
     return check_done();
 }
