@@ -157,6 +157,8 @@ refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
 	blender -b --factory-startup --python tests/refs/cycles_rough.py -- tests/data/cycles-rough.json tests/data
+	for s in glass fog; do blender -b --factory-startup --python tests/refs/cycles_noise.py -- \
+	    tests/bench/scenes/cornell-$$s.json tests/data/cycles-noise-$$s.pfm 1024 7; done
 
 # make install [PREFIX=/usr/local] [DESTDIR=staging]: the two programs, their
 # manual pages and bash completion; make uninstall removes exactly those files.
