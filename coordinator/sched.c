@@ -16,6 +16,8 @@ typedef struct {
     int attempts;              /* failed attempts so far */
     int copies;                /* processes running it now */
     int failed_on;             /* host of the last failed attempt, -1 if none */
+    int *failed_hosts;         /* the distinct hosts it failed on, nfailed of them */
+    int nfailed;
     char last_error[300];
 } slab;
 
@@ -257,6 +259,35 @@ static void drop_host(sched *s, int host_i, const char *why)
         }
 }
 
+/* Notes that slab sl failed on host_i; -1 when out of memory. */
+static int note_failed_host(slab *sl, int host_i)
+{
+    for (int i = 0; i < sl->nfailed; i++)
+        if (sl->failed_hosts[i] == host_i)
+            return 0;
+    int *f = realloc(sl->failed_hosts, (size_t)(sl->nfailed + 1) * sizeof *f);
+    if (!f)
+        return -1;
+    sl->failed_hosts = f;
+    sl->failed_hosts[sl->nfailed++] = host_i;
+    return 0;
+}
+
+/* Whether a host that is ready or still joining has not yet failed sl. */
+static int untried_host(const sched *s, const slab *sl)
+{
+    for (int h = 0; h < s->nhosts; h++) {
+        if (s->hosts[h].dropped)
+            continue;
+        int tried = 0;
+        for (int i = 0; i < sl->nfailed && !tried; i++)
+            tried = sl->failed_hosts[i] == h;
+        if (!tried)
+            return 1;
+    }
+    return 0;
+}
+
 static int fail_attempt(sched *s, int r, const char *why, fr_error *err)
 {
     attempt a = s->run[r];
@@ -273,7 +304,14 @@ static int fail_attempt(sched *s, int r, const char *why, fr_error *err)
     snprintf(sl->last_error, sizeof sl->last_error, "%s: %s", h->name, why);
     emit(s, SCHED_SLAB_FAILED, a.host, sl, "rows %u:%u failed on %s (attempt %d of %d): %s", sl->y0, sl->y1,
          h->name, sl->attempts, s->p->max_attempts, why);
-    if (sl->attempts >= s->p->max_attempts && !sl->copies)
+    if (note_failed_host(sl, a.host))
+        return fr_fail(err, "out of memory");
+    /* A slab is given up once it has failed max_attempts times, unless
+     * those failures came from fewer than max_attempts hosts and a host it
+     * has not failed on is ready or still joining: a few broken hosts that
+     * are ready first must not doom the render before a good one joins. */
+    if (sl->attempts >= s->p->max_attempts && !sl->copies &&
+        (sl->nfailed >= s->p->max_attempts || !untried_host(s, sl)))
         return fr_fail(err, "rows %u:%u failed %d times, last on %s", sl->y0, sl->y1, sl->attempts,
                        sl->last_error);
     if (h->streak >= s->p->max_host_failures) {
@@ -530,6 +568,8 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         fr_fail(err, "%s; rows %s not rendered (%s)", why, missing, kept);
     }
     st->wall_s = now(&s) - s.t0;
+    for (int i = 0; i < s.nslabs; i++)
+        free(s.slabs[i].failed_hosts);
     free(s.slabs);
     free(s.run);
     return rc;

@@ -5,7 +5,9 @@
  * - More slabs than slots, from one queue, so faster hosts take more.
  * - A slab whose worker fails, dies, or returns a partial that does not
  *   check out (size, header, scene hash, rows, spp) goes back to the queue,
- *   at most `max_attempts` times.  Its next attempt goes to another host
+ *   at most `max_attempts` times (failures on fewer than `max_attempts`
+ *   hosts do not give it up while a host it has not failed on is ready or
+ *   joining).  Its next attempt goes to another host
  *   when one is alive: a host takes back a slab that failed on it only when
  *   no other host is left.
  * - A host with `max_host_failures` failures in a row, or whose connection

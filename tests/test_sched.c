@@ -449,6 +449,35 @@ static void admit_late(void *ctx, sched_host *hs, int n)
     }
 }
 
+static void admit_b_late(void *ctx, sched_host *hs, int n)
+{
+    run *r = ctx;
+    (void)n;
+    if (hs[1].pending && r->world.now >= b_ready_at) {
+        hs[1].pending = 0;
+        hs[1].slots = 1;
+    }
+}
+
+/* Broken hosts ready first, a good one joining later: the slabs that fail
+ * on the broken hosts more than max_attempts times wait for the good host
+ * instead of ending the run; a slab that failed on every host still ends it. */
+static void test_good_host_late(void)
+{
+    run *r = setup(8, 4);
+    r->p.hooks.admit = admit_b_late;
+    r->p.max_attempts = 2;
+    r->p.max_host_failures = 100;
+    host(r, "bad", 2, (fake_script){.fail_always = 1, .duration = 0.25});
+    int b = host(r, "good", 1, (fake_script){.duration = 1});
+    r->sh[b].pending = 1;
+    go(r);
+    CHECK(r->rc == 0, "run failed before the good host joined: %s", r->err.msg);
+    CHECK(r->sh[b].rows == 8, "the good host rendered %d rows of 8", r->sh[b].rows);
+    CHECK(stitched_ok(r), "stitched rows are not the fake pixels");
+    teardown(r);
+}
+
 static void test_pending_hosts(void)
 {
     run *r = setup(40, 1);
@@ -552,6 +581,7 @@ int main(void)
     test_interrupt();
     test_progress();
     test_pending_hosts();
+    test_good_host_late();
     test_pending_without_hook();
     test_deadline();
     test_deadline_slow_host();
