@@ -532,7 +532,7 @@ int cmd_render(int argc, char **argv)
     if (pr)
         return pr == 1 ? 0 : 2;
     fr_error err;
-    if (out_check(a.out, &err) || (a.preview && out_check(a.preview, &err))) {
+    if (out_check(a.out, &err) || (a.preview && out_check_type(a.preview, &err))) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return 2;
     }

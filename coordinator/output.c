@@ -26,11 +26,18 @@ static const char *extension(const char *path)
 
 static int is_ext(const char *path, const char *ext) { return !strcasecmp(extension(path), ext); }
 
-int out_check(const char *path, fr_error *err)
+int out_check_type(const char *path, fr_error *err)
 {
     if (!is_ext(path, "pfm") && !(*extension(path) && iio_can_write(path)))
         return fr_fail(err, "%s: unknown image type '%s': expected .png, .exr, .tif, .jpg, .hdr, .ppm, .bmp, "
                        ".tga or .pfm", path, extension(path));
+    return 0;
+}
+
+int out_check(const char *path, fr_error *err)
+{
+    if (out_check_type(path, err))
+        return -1;
     /* Before any rendering: the output is not a directory the rename could
      * not replace, and a file can be made beside it (the directory exists
      * and is writable); the trial file is removed at once. */

@@ -17,7 +17,12 @@
 #include "jobdir.h"
 #include "scene.h"
 
-/** Fails, before any rendering, if no writer handles the path's extension. */
+/** Fails if no writer handles the path's extension. */
+int out_check_type(const char *path, fr_error *err);
+
+/** Fails, before any rendering, if no writer handles the path's extension,
+ * if path is a directory, or if no file can be created beside it (the trial
+ * file is removed at once). */
 int out_check(const char *path, fr_error *err);
 
 /** Writes rgb (width*height*3 linear floats, top row first) to path via a

@@ -72,18 +72,20 @@ c=$(grep -c "preview .*not written" "$T/log")
 [ "$c" -eq 1 ] && ok || bad "an unwritable preview is reported $c times, not once: $(cat "$T/log")"
 
 # --- --progress json ---
-"$F" render scenes/cornell.json -o "$T/j.png" --size 32x32 --spp 8 -j 1 --slab-rows 2 --progress json \
+# Long enough (a few seconds even on a fast machine) for progress events
+# at their half-second pace.
+"$F" render scenes/cornell.json -o "$T/j.png" --size 48x48 --spp 128 -j 1 --slab-rows 2 --progress json \
     >"$T/events" 2>"$T/log" && ok || bad "render --progress json failed: $(tail -n 2 "$T/log")"
 jq -e . "$T/events" >/dev/null 2>&1 && ok || bad "--progress json: not one JSON object a line: $(head -n 3 "$T/events")"
 [ "$(head -n 1 "$T/events" | jq -r '.event + " " + .output + " " + (.width|tostring) + " " + (.spp|tostring)')" = \
-    "start $T/j.png 32 8" ] && ok || bad "first event: $(head -n 1 "$T/events")"
-[ "$(tail -n 1 "$T/events" | jq -r '.event + " " + .status + " " + (.rows_done|tostring)')" = "done ok 32" ] && ok ||
+    "start $T/j.png 48 128" ] && ok || bad "first event: $(head -n 1 "$T/events")"
+[ "$(tail -n 1 "$T/events" | jq -r '.event + " " + .status + " " + (.rows_done|tostring)')" = "done ok 48" ] && ok ||
     bad "last event: $(tail -n 1 "$T/events")"
 # Progress: rows done only grow, end at every row, each event with an ETA.
 jq -r 'select(.event == "progress") | .rows_done' "$T/events" >"$T/rows"
 [ "$(wc -l <"$T/rows")" -ge 2 ] && ok || bad "fewer than two progress events: $(cat "$T/events")"
 sort -n -c "$T/rows" 2>/dev/null && ok || bad "rows_done goes down: $(tr '\n' ' ' <"$T/rows")"
-[ "$(tail -n 1 "$T/rows")" = 32 ] && ok || bad "the last progress event is not every row"
+[ "$(tail -n 1 "$T/rows")" = 48 ] && ok || bad "the last progress event is not every row"
 [ "$(jq -r 'select(.event == "progress") | has("eta_s") and has("elapsed_s") and has("rows_per_s")' "$T/events" | sort -u)" = true ] &&
     ok || bad "a progress event lacks eta_s, elapsed_s or rows_per_s"
 grep -q '^{' "$T/log" && bad "JSON events on stderr" || ok
