@@ -13,8 +13,9 @@ F="$ROOT/bin/franja"
 IS="$ROOT/bin/tools/imgstat"
 pid=""
 
-# A render of some seconds: many slabs, one worker, previews every second.
-"$F" render scenes/cornell.json -o "$T/out.pfm" --size 64x64 --spp 48 -j 1 --slab-rows 2 \
+# A render of some seconds even on a fast machine: many slabs, one worker,
+# previews every second.
+"$F" render scenes/cornell.json -o "$T/out.pfm" --size 64x64 --spp 768 -j 1 --slab-rows 2 \
     --preview "$T/pre.pfm" --preview-every 1 >"$T/log" 2>&1 &
 pid=$!
 # Copy every preview that appears while it runs.
@@ -91,15 +92,15 @@ sort -n -c "$T/rows" 2>/dev/null && ok || bad "rows_done goes down: $(tr '\n' ' 
 grep -q '^{' "$T/log" && bad "JSON events on stderr" || ok
 expect_error "--progress bad" "--progress: 'xml' is not one of: auto, json" "$F" render scenes/spheres.json --progress xml
 # Interrupted: the done event says so.
-"$F" render scenes/cornell.json -o "$T/i.png" --size 64x64 --spp 64 -j 1 --slab-rows 1 --progress json \
-    >"$T/events" 2>"$T/log" &
+"$F" render scenes/cornell.json -o "$T/i.png" --size 64x64 --spp 1024 -j 1 --slab-rows 1 --progress json \
+    >"$T/ievents" 2>"$T/log" &
 pid=$!
 k=0
-while [ $k -lt 300 ] && ! grep -q '"progress"' "$T/events"; do sleep 0.1; k=$((k + 1)); done
+while [ $k -lt 300 ] && ! grep -q '"progress"' "$T/ievents"; do sleep 0.1; k=$((k + 1)); done
 kill -INT $pid
 wait $pid
 rc=$?
 pid=""
 [ $rc -eq 130 ] && ok || bad "interrupted render: exit status $rc"
-[ "$(tail -n 1 "$T/events" | jq -r .status)" = interrupted ] && ok || bad "interrupted: last event $(tail -n 1 "$T/events")"
+[ "$(tail -n 1 "$T/ievents" | jq -r .status)" = interrupted ] && ok || bad "interrupted: last event $(tail -n 1 "$T/ievents")"
 summary
