@@ -99,7 +99,10 @@ if [ "$(id -u)" -eq 0 ]; then
         : >hosts
         saved=$FH_USER
         FH_USER=$LT
-        fh_start plain 3 2
+        # A worker the throwaway user can reach: the checkout may sit under
+        # a directory only its owner enters (a mktemp -d clone).
+        mkdir -p "$FH/bin" && cp "$WORKER" "$FH/bin/" && chmod 755 "$FH/bin" "$FH/bin/franja-worker"
+        fh_start plain 3 2 "$FH/bin/franja-worker"
         FH_USER=$saved
         chown -R "$LT" "$FH/home-$LT" "$FH/plain/work"
         ssh_case "ordinary user" plain "$LT"

@@ -75,7 +75,9 @@ if [ "$(id -u)" -eq 0 ]; then
         LT_MADE=1
         saved=$FH_USER
         FH_USER=$LT
-        fh_start denied 8 1
+        # A worker the throwaway user can reach wherever the checkout is.
+        mkdir -p "$FH/bin" && cp "$WORKER" "$FH/bin/" && chmod 755 "$FH/bin" "$FH/bin/franja-worker"
+        fh_start denied 8 1 "$FH/bin/franja-worker"
         FH_USER=$saved
     else
         bad "cannot create a throwaway user: $(cat useradd.err)"
