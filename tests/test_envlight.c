@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "estimate.h"
 #include "stats.h"
 #include "envmap.h"
 #include "fmath.h"
@@ -177,30 +178,6 @@ static void pdf_follows_radiance(const char *filter)
     scn_free(&s);
 }
 
-typedef struct { double mean, se; } estimate;
-
-/* Mean of the green channel over the pixels in [x0, x1) x [y0, y1), with
- * its standard error. */
-static estimate region(const fr_scene *s, pt_strategy strategy, uint32_t spp, uint32_t x0, uint32_t x1, uint32_t y0,
-                       uint32_t y1)
-{
-    double sum = 0, var = 0;
-    uint32_t n = (x1 - x0) * (y1 - y0);
-    for (uint32_t y = y0; y < y1; y++)
-        for (uint32_t x = x0; x < x1; x++) {
-            double px = 0, px2 = 0;
-            for (uint32_t i = 0; i < spp; i++) {
-                double v = pt_sample(s, strategy, x, y, i).y;
-                px += v;
-                px2 += v * v;
-            }
-            double m = px / spp;
-            sum += m;
-            var += (px2 / spp - m * m) / spp;
-        }
-    estimate e = {sum / n, sqrt(var) / n};
-    return e;
-}
 
 /* A white Lambert sphere inside a constant environment looks like the
  * environment (one bounce off a convex shape sees only the sky). */
@@ -217,7 +194,7 @@ static void furnace(void)
     static const pt_strategy strategies[3] = {PT_MIS, PT_LIGHT_ONLY, PT_BSDF_ONLY};
     static const char *const names[3] = {"MIS", "light only", "BSDF only"};
     for (int k = 0; k < 3; k++) {
-        estimate e = region(&s, strategies[k], 64, 4, 8, 4, 8); /* on the sphere */
+        estimate e = est_region(&s, strategies[k], 64, 4, 8, 4, 8); /* on the sphere */
         CHECK(fabs(e.mean - 1.2) < 4 * e.se + 1e-4, "furnace (%s): %.5f +- %.5f, expected 1.2", names[k], e.mean,
               e.se);
         CHECK(k != 0 || e.se < 0.01, "furnace (%s): noise %.4f", names[k], e.se);
@@ -260,9 +237,9 @@ static void mis_agree(void)
               ", {\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"floor\"}",
               ", \"floor\": {\"type\": \"phong\", \"diffuse\": [0.3, 0.3, 0.3], \"glossy\": [0.5, 0.5, 0.5], "
               "\"exponent\": 40}", 12, 9, 3, &s);
-    estimate mis = region(&s, PT_MIS, 256, 0, 12, 0, 9);
-    estimate light = region(&s, PT_LIGHT_ONLY, 256, 0, 12, 0, 9);
-    estimate bsdf = region(&s, PT_BSDF_ONLY, 1024, 0, 12, 0, 9);
+    estimate mis = est_region(&s, PT_MIS, 256, 0, 12, 0, 9);
+    estimate light = est_region(&s, PT_LIGHT_ONLY, 256, 0, 12, 0, 9);
+    estimate bsdf = est_region(&s, PT_BSDF_ONLY, 1024, 0, 12, 0, 9);
     printf("env MIS %.5f +- %.5f, light only %.5f +- %.5f, BSDF only %.5f +- %.5f\n", mis.mean, mis.se, light.mean,
            light.se, bsdf.mean, bsdf.se);
     double d1 = fabs(mis.mean - light.mean), s1 = hypot(mis.se, light.se);

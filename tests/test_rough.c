@@ -10,6 +10,7 @@
 
 #include "bsdf.h"
 #include "check.h"
+#include "estimate.h"
 #include "microfacet.h"
 #include "pathtrace.h"
 #include "sampler.h"
@@ -390,33 +391,12 @@ static const char mis_scene[] =
     "   {\"type\": \"rect\", \"origin\": [-1, 3, -1], \"edge_u\": [2, 0, 0], \"edge_v\": [0, 0, 1], \"material\": \"panel\"},"
     "   {\"type\": \"sphere\", \"center\": [1.2, 2.6, -2], \"radius\": 0.15, \"material\": \"bulb\"}]}";
 
-typedef struct { double mean, se; } estimate;
-
-static estimate run(const fr_scene *s, pt_strategy strategy, uint32_t spp)
-{
-    double sum = 0, var = 0;
-    uint32_t npix = s->settings.width * s->settings.height;
-    for (uint32_t y = 0; y < s->settings.height; y++)
-        for (uint32_t x = 0; x < s->settings.width; x++) {
-            double px = 0, px2 = 0;
-            for (uint32_t i = 0; i < spp; i++) {
-                double v = pt_sample(s, strategy, x, y, i).y;
-                px += v;
-                px2 += v * v;
-            }
-            double m = px / spp;
-            sum += m;
-            var += (px2 / spp - m * m) / spp;
-        }
-    estimate e = {sum / npix, sqrt(var) / npix};
-    return e;
-}
 
 static void test_mis(void)
 {
     fr_scene s;
     test_scene(mis_scene, &s);
-    estimate mis = run(&s, PT_MIS, 512), light = run(&s, PT_LIGHT_ONLY, 512), bsdf = run(&s, PT_BSDF_ONLY, 1024);
+    estimate mis = est_image(&s, PT_MIS, 512), light = est_image(&s, PT_LIGHT_ONLY, 512), bsdf = est_image(&s, PT_BSDF_ONLY, 1024);
     printf("rough scene: MIS %.5f +- %.5f, light only %.5f +- %.5f, BSDF only %.5f +- %.5f\n", mis.mean, mis.se,
            light.mean, light.se, bsdf.mean, bsdf.se);
     double d1 = fabs(mis.mean - light.mean), s1 = sqrt(mis.se * mis.se + light.se * light.se);
