@@ -280,6 +280,9 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
         st->spp == 0 || st->spp > PROTO_MAX_SPP || st->max_depth > PROTO_MAX_DEPTH || st->integrator >= FR_INTEGRATORS)
         return fr_fail(err, "section settings, byte %zu: bad image size, sample count, depth or integrator",
                        AT1(SEC_SETTINGS, fr_settings, width));
+    if (!(st->noise_threshold >= 0.0f && st->noise_threshold <= 1.0f))
+        return fr_fail(err, "section settings, byte %zu: noise threshold not in [0, 1]",
+                       AT1(SEC_SETTINGS, fr_settings, noise_threshold));
     const fr_camera *c = &s->camera;
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
         !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !isfinite(c->aperture) ||

@@ -169,20 +169,57 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
     return L;
 }
 
+/* Adaptive sampling: a pixel's error is estimated after every block of
+ * this many samples (whole blocks keep the sampler's stratification
+ * whole: each block of 16 indices is a well-spread point set). */
+#define ADAPT_BLOCK 16u
+
+/* Samples every pixel takes before its error is first estimated: a
+ * sixteenth of spp, at least one block, so that a pixel whose few first
+ * samples missed a rare bright path is not stopped on them. */
+static uint32_t adapt_min(uint32_t spp)
+{
+    uint32_t m = spp / 16u;
+    m = m < ADAPT_BLOCK ? ADAPT_BLOCK : m - m % ADAPT_BLOCK;
+    return m;
+}
+
+/* Whether the mean of n luminance samples (sum, sum of squares) has a
+ * relative standard error at most e: sqrt(var / n) <= e * mean, squared
+ * (no square root needed).  Means below 1e-3 are compared as 1e-3, so
+ * that near-black pixels, invisible once tone-mapped, stop early. */
+static int adapt_done(double sum, double sum2, uint32_t n, float e)
+{
+    double mean = sum / n, var = (sum2 - sum * mean) / (n - 1), ref = mean > 1e-3 ? mean : 1e-3;
+    return var / n <= (double)e * e * ref * ref;
+}
+
 void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb)
 {
     uint32_t w = s->settings.width, spp = s->settings.spp;
+    float e = s->settings.noise_threshold;
+    uint32_t first_check = e > 0.0f ? adapt_min(spp) : spp;
     for (uint32_t y = y0; y < y1; y++) {
         for (uint32_t x = 0; x < w; x++) {
-            double acc[3] = {0, 0, 0};
-            for (uint32_t i = 0; i < spp; i++) {
-                vec3 c = pt_sample(s, strategy, x, y, i);
+            /* The decision to stop reads this pixel's own samples only, so
+             * a slab renders the same bits whatever the split. */
+            double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0;
+            uint32_t n = 0;
+            while (n < spp) {
+                vec3 c = pt_sample(s, strategy, x, y, n++);
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
+                if (first_check < spp) {
+                    double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+                    lsum += l;
+                    lsum2 += l * l;
+                    if (n >= first_check && n % ADAPT_BLOCK == 0 && n < spp && adapt_done(lsum, lsum2, n, e))
+                        break;
+                }
             }
             float *px = rgb + ((size_t)(y - y0) * w + x) * 3;
-            px[0] = (float)(acc[0] / spp);
-            px[1] = (float)(acc[1] / spp);
-            px[2] = (float)(acc[2] / spp);
+            px[0] = (float)(acc[0] / n);
+            px[1] = (float)(acc[1] / n);
+            px[2] = (float)(acc[2] / n);
         }
     }
 }

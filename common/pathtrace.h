@@ -34,7 +34,13 @@ fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float 
 vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index);
 
 /** Render rows [y0, y1) with s->settings' size and spp into rgb
- * (3 floats per pixel, row y0 first, caller-owned, width*(y1-y0)*3). */
+ * (3 floats per pixel, row y0 first, caller-owned, width*(y1-y0)*3).
+ * With s->settings.noise_threshold E > 0 (adaptive sampling), a pixel
+ * takes at least max(16, spp / 16) samples, then stops at the first
+ * multiple of 16 samples where the standard error of its mean luminance
+ * is at most E times that mean (the mean taken as at least 1e-3); it
+ * never takes more than spp.  The decision reads only the pixel's own
+ * samples, so any split of the rows renders the same bits. */
 void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb);
 
 #endif

@@ -74,6 +74,8 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
                        PROTO_MAX_SIZE, s->y0, s->y1);
     if (s->spp > PROTO_MAX_SPP)
         return fr_fail(err, "%u samples per pixel: more than %u", s->spp, PROTO_MAX_SPP);
+    if (!(s->noise_threshold >= 0.0f && s->noise_threshold <= 1.0f))
+        return fr_fail(err, "noise threshold %g: not in [0, 1]", (double)s->noise_threshold);
     if ((unsigned)s->format >= sizeof format_names / sizeof *format_names)
         return fr_fail(err, "unknown partial image format %d", (int)s->format);
     if (s->integrator < 0 || s->integrator > FR_INTEGRATORS)
@@ -88,6 +90,12 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
         snprintf(a->spp, sizeof a->spp, "%u", s->spp);
         a->argv[n++] = "--spp";
         a->argv[n++] = a->spp;
+    }
+    if (s->noise_threshold > 0.0f) {
+        /* Nine significant digits give back the same float. */
+        snprintf(a->noise, sizeof a->noise, "%.9g", (double)s->noise_threshold);
+        a->argv[n++] = "--noise-threshold";
+        a->argv[n++] = a->noise;
     }
     if (s->width) {
         snprintf(a->size, sizeof a->size, "%ux%u", s->width, s->height);
@@ -129,7 +137,7 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             r->slab.lifeline = 1;
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
                                 !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "--integrator") ||
-                                !strcmp(a, "-o"))) {
+                                !strcmp(a, "--noise-threshold") || !strcmp(a, "-o"))) {
             return fr_fail(err, "%s needs a value", a);
         } else if (!strcmp(a, "--scene")) {
             r->slab.scene = argv[++i];
@@ -138,6 +146,12 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         } else if (!strcmp(a, "--spp")) {
             if (parse_u32(argv[++i], &r->slab.spp) < 0 || r->slab.spp == 0 || r->slab.spp > PROTO_MAX_SPP)
                 return fr_fail(err, "--spp: expected an integer in [1, %u], got '%s'", PROTO_MAX_SPP, argv[i]);
+        } else if (!strcmp(a, "--noise-threshold")) {
+            char *end;
+            float e = strtof(argv[++i], &end);
+            if (end == argv[i] || *end || !(e > 0.0f && e <= 1.0f))
+                return fr_fail(err, "--noise-threshold: expected a number in (0, 1], got '%s'", argv[i]);
+            r->slab.noise_threshold = e;
         } else if (!strcmp(a, "--size")) {
             if (proto_parse_size(argv[++i], &r->slab.width, &r->slab.height) < 0)
                 return fr_fail(err, "--size: expected WxH with 1 <= W,H <= %u, got '%s'", PROTO_MAX_SIZE, argv[i]);

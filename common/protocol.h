@@ -41,14 +41,15 @@ typedef struct {
     int lifeline;              /**< --lifeline: standard input is the coordinator's line; the worker ends
                                     when it reaches its end (worker/lifeline.h) */
     int integrator;            /**< 1 + FR_INTEGRATOR_* (scene.h); 0 = the scene's (no --integrator) */
+    float noise_threshold;     /**< adaptive sampling threshold in (0, 1]; 0 = the scene's */
 } proto_slab;
 
 /** A worker command line built by proto_slab_argv: argv points into the
  * struct's own buffers (and at the caller's strings), NULL-terminated,
  * without the program name. */
 typedef struct {
-    const char *argv[18];
-    char rows[32], size[32], spp[16];
+    const char *argv[20];
+    char rows[32], size[32], spp[16], noise[32];
 } proto_argv;
 
 /** Builds the worker arguments that ask for slab s.  Fails when a number

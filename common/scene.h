@@ -35,7 +35,9 @@ typedef struct {
     uint32_t max_depth;        /**< bounces; a path has at most max_depth+1 vertices after the camera */
     uint32_t seed;             /**< decorrelates renders of the same scene */
     uint32_t integrator;       /**< FR_INTEGRATOR_* */
-    uint32_t pad[2];
+    float noise_threshold;     /**< adaptive sampling: a pixel stops once the estimated relative standard error of
+                                    its mean luminance is below this (pathtrace.h); 0 = off, every pixel takes spp */
+    uint32_t pad;
 } fr_settings;
 
 /** A pinhole or thin-lens camera. */

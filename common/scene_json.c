@@ -34,7 +34,8 @@ static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
 
 static int parse_image(ctx *c, const cJSON *o)
 {
-    static const char *const fields[] = {"width", "height", "spp", "max_depth", "seed", "integrator", NULL};
+    static const char *const fields[] = {"width", "height", "spp", "max_depth", "seed", "integrator",
+                                         "noise_threshold", NULL};
     static const char *const integrators[] = {"path", "bdpt", NULL};
     fr_settings *s = &c->b->settings;
     int integrator;
@@ -46,9 +47,13 @@ static int parse_image(ctx *c, const cJSON *o)
         jv_uint(o, "spp", "image", 0, 16, 1, PROTO_MAX_SPP, &s->spp, c->err) < 0 ||
         jv_uint(o, "max_depth", "image", 0, 8, 0, PROTO_MAX_DEPTH, &s->max_depth, c->err) < 0 ||
         jv_uint(o, "seed", "image", 0, 0, 0, 0xffffffffu, &s->seed, c->err) < 0 ||
-        jv_choice(o, "integrator", "image", integrators, FR_INTEGRATOR_PATH, &integrator, c->err) < 0)
+        jv_choice(o, "integrator", "image", integrators, FR_INTEGRATOR_PATH, &integrator, c->err) < 0 ||
+        jv_number(o, "noise_threshold", "image", 0, 0.0f, &s->noise_threshold, c->err) < 0)
         return -1;
     s->integrator = (uint32_t)integrator;
+    if (!(s->noise_threshold >= 0.0f && s->noise_threshold <= 1.0f))
+        return fr_fail(c->err, "image.noise_threshold: expected a number in [0, 1] (0: off), got %g",
+                       (double)s->noise_threshold);
     return 0;
 }
 

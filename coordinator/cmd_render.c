@@ -46,6 +46,9 @@ static const char usage[] =
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
+    "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
+    "                       the relative error of its mean is below E, in (0, 1]\n"
+    "                       (default: the scene's, else off)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
     "                       (default: the scene's tonemap; HDR outputs .exr\n"
     "                       .hdr .pfm keep linear radiance)\n"
@@ -89,6 +92,7 @@ typedef struct {
     const char *preview;       /* --preview FILE, or NULL */
     uint32_t preview_every;    /* seconds */
     int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
+    float noise_threshold;     /* --noise-threshold, 0 for the scene's */
     int json;                  /* --progress json */
     int resume, keep_job, fresh, no_lock;
     tr_options tr;
@@ -99,7 +103,7 @@ typedef struct {
 enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
-    OPT_INTEGRATOR, OPT_PROGRESS
+    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -124,6 +128,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"preview-every", required_argument, NULL, OPT_PREVIEW_EVERY},
         {"integrator", required_argument, NULL, OPT_INTEGRATOR},
         {"progress", required_argument, NULL, OPT_PROGRESS},
+        {"noise-threshold", required_argument, NULL, OPT_NOISE},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -194,6 +199,13 @@ static int parse(int argc, char **argv, render_args *a)
             a->integrator = 1 + k;
             break;
         }
+        case OPT_NOISE:
+            bad = opt_float(cmd, "--noise-threshold", v, 0, 1, &a->noise_threshold);
+            if (!bad && !(a->noise_threshold > 0.0f)) {
+                fprintf(stderr, "franja render: --noise-threshold: expected a number in (0, 1], got '%s'\n", v);
+                bad = 1;
+            }
+            break;
         case OPT_PROGRESS: {
             int k = opt_choice(cmd, "--progress", v, progress);
             bad = k < 0;
@@ -608,7 +620,17 @@ int cmd_render(int argc, char **argv)
     }
     job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
                      a.spp ? a.spp : sc.settings.spp,
-                     a.integrator ? (uint32_t)(a.integrator - 1) : sc.settings.integrator};
+                     a.integrator ? (uint32_t)(a.integrator - 1) : sc.settings.integrator,
+                     a.noise_threshold > 0.0f ? a.noise_threshold : sc.settings.noise_threshold};
+    if (spec.integrator == FR_INTEGRATOR_BDPT && a.noise_threshold > 0.0f) {
+        fprintf(stderr, "franja render: --noise-threshold: adaptive sampling is for path tracing, not bdpt\n");
+        scn_free(&sc);
+        hosts_free(&table);
+        slurm_close(&alloc);
+        return unlock_with(&lk, 2);
+    }
+    if (spec.integrator == FR_INTEGRATOR_BDPT)
+        spec.noise_threshold = 0.0f; /* bidirectional workers take every sample */
     if (spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
         fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a.scene, err.msg);
         scn_free(&sc);

@@ -50,8 +50,11 @@ size_t job_max_partial(const job_spec *spec, uint32_t y0, uint32_t y1)
 
 static void spec_text(const job_spec *s, char *out, size_t cap)
 {
-    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n%s", (unsigned long long)s->hash,
-             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT ? "integrator=bdpt\n" : "");
+    char noise[48] = "";
+    if (s->noise_threshold > 0.0f) /* nine significant digits give back the same float */
+        snprintf(noise, sizeof noise, "noise_threshold=%.9g\n", (double)s->noise_threshold);
+    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n%s%s", (unsigned long long)s->hash,
+             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT ? "integrator=bdpt\n" : "", noise);
 }
 
 /* Calls fn for every slab file name in dir ("rows-Y0-Y1.pf"). */
@@ -118,7 +121,7 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
             free(have);
             if (!same)
                 return fr_fail(err, "%s: this job directory belongs to another render (different scene, "
-                               "size, samples or integrator); remove it or render without --resume", dir);
+                               "size, samples, integrator or noise threshold); remove it or render without --resume", dir);
             return 0;
         }
     } else {
@@ -392,6 +395,7 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
     unsigned long long hash = 0;
     unsigned w = 0, h = 0, spp = 0;
     int n = -1, bdpt = 0;
+    float noise = 0.0f;
     /* Exactly what spec_text writes, and nothing after it. */
     int ok = len < 200 && memchr(text, 0, len) == NULL;
     if (ok) {
@@ -399,20 +403,26 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
         memcpy(copy, text, len);
         copy[len] = 0;
         ok = sscanf(copy, "franja job\nscene=%16llx\nsize=%ux%u\nspp=%u\n%n", &hash, &w, &h, &spp, &n) == 4 && n > 0;
+        if (ok && !strncmp(copy + n, "integrator=bdpt\n", 16)) {
+            bdpt = 1;
+            n += 16;
+        }
         if (ok && n < (int)len) {
-            bdpt = !strcmp(copy + n, "integrator=bdpt\n");
-            ok = bdpt;
+            int m = -1;
+            ok = sscanf(copy + n, "noise_threshold=%g\n%n", &noise, &m) == 1 && m > 0 && n + m == (int)len &&
+                 noise > 0.0f && noise <= 1.0f && !bdpt;
         }
     }
     free(text);
     if (!ok || w == 0 || h == 0 || w > PROTO_MAX_SIZE || h > PROTO_MAX_SIZE || spp == 0 || spp > PROTO_MAX_SPP)
-        return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, maybe integrator=bdpt, "
-                       "sizes in 1..%u)", path, PROTO_MAX_SIZE);
+        return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, maybe integrator=bdpt "
+                       "or noise_threshold=E in (0, 1], sizes in 1..%u)", path, PROTO_MAX_SIZE);
     spec->hash = hash;
     spec->width = w;
     spec->height = h;
     spec->spp = spp;
     spec->integrator = bdpt ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH;
+    spec->noise_threshold = noise;
     return 0;
 }
 

@@ -27,6 +27,7 @@ typedef struct {
     uint32_t width, height;    /**< full image, pixels */
     uint32_t spp;              /**< samples per pixel */
     uint32_t integrator;       /**< FR_INTEGRATOR_* (scene.h): bidirectional partials carry splats */
+    float noise_threshold;     /**< adaptive sampling threshold the workers render with (pathtrace.h); 0 = off */
 } job_spec;
 
 /** Checks a partial image (PF bytes) against the spec and the rows asked

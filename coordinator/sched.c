@@ -198,7 +198,7 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     slab *sl = &s->slabs[slab_i];
     const job_spec *sp = &s->p->spec;
     proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline,
-                      1 + (int)sp->integrator};
+                      1 + (int)sp->integrator, sp->noise_threshold};
     proto_argv pa;
     if (proto_slab_argv(&req, &pa, err))
         return -1;

@@ -23,13 +23,13 @@ static int reparse(const proto_argv *a, proto_request *r, fr_error *err)
 static void test_round_trip(void)
 {
     const proto_slab cases[] = {
-        /* lifeline, then integrator: 1 + FR_INTEGRATOR_*, 0 for the scene's */
-        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0},
-        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH},
+        /* lifeline, integrator (1 + FR_INTEGRATOR_*, 0 for the scene's), noise threshold */
+        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0, 0.0f},
+        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH, 0.0123f},
         {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-", 0,
-         1 + FR_INTEGRATOR_BDPT},
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0}, /* the scene's size, samples and integrator */
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2}, /* --lifeline, --integrator bdpt */
+         1 + FR_INTEGRATOR_BDPT, 1.0f},
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f}, /* the scene's size, samples, integrator, threshold */
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2, 0.05f}, /* --lifeline, --integrator bdpt, a threshold */
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         const proto_slab *s = &cases[k];
@@ -54,20 +54,24 @@ static void test_round_trip(void)
         CHECK(r.slab.lifeline == s->lifeline, "case %zu: lifeline %d", k, r.slab.lifeline);
         CHECK(r.slab.integrator == s->integrator, "case %zu: integrator %d, expected %d", k, r.slab.integrator,
               s->integrator);
+        CHECK(r.slab.noise_threshold == s->noise_threshold, "case %zu: noise threshold %.9g", k,
+              (double)r.slab.noise_threshold);
     }
 }
 
 static void test_build_refuses(void)
 {
     const proto_slab bad[] = {
-        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0},                     /* empty rows */
-        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0},                     /* rows past the height */
-        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0},    /* too wide */
-        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0},     /* too many samples */
-        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0},                     /* half a size */
-        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0},                    /* no scene */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS},   /* no such integrator */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1},                   /* no such integrator */
+        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f},                     /* empty rows */
+        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f},                     /* rows past the height */
+        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0, 0.0f},    /* too wide */
+        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0, 0.0f},     /* too many samples */
+        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0, 0.0f},                     /* half a size */
+        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f},                    /* no scene */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS, 0.0f},   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1, 0.0f},                   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 1.5f},                     /* threshold above 1 */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, -0.5f},                    /* negative threshold */
     };
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
         proto_argv a;

@@ -22,7 +22,8 @@
 
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
-    "                     [--integrator path|bdpt] [--format pf|ppm16|ppm8] [-o FILE|-] [--lifeline]\n"
+    "                     [--integrator path|bdpt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
+    "                     [-o FILE|-] [--lifeline]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --help | --version\n"
     "\n"
@@ -32,6 +33,8 @@ static const char usage[] =
     "  --scene FILE   binary scene (.fbin, from `franja compile`) or JSON scene\n"
     "  --rows Y0:Y1   rows of the full image, 0 <= Y0 < Y1 <= height\n"
     "  --spp N        samples per pixel (default: the scene's)\n"
+    "  --noise-threshold E  adaptive sampling: each pixel stops once its relative\n"
+    "                 error estimate is below E, in (0, 1] (default: the scene's)\n"
     "  --size WxH     image size (default: the scene's)\n"
     "  --integrator I path or bdpt (default: the scene's)\n"
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
@@ -105,6 +108,8 @@ int main(int argc, char **argv)
     }
     if (sl->spp)
         scene.settings.spp = sl->spp;
+    if (sl->noise_threshold > 0.0f)
+        scene.settings.noise_threshold = sl->noise_threshold;
     if (quick_spp(&scene.settings.spp, &err) < 0) {
         fprintf(stderr, "franja-worker: %s\n", err.msg);
         scn_free(&scene);
