@@ -26,6 +26,7 @@ SSH_LIBS     := $(shell $(PKG) --libs libssh 2>/dev/null || echo -lssh)
 OIIO_CFLAGS  := $(shell $(PKG) --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS    := $(shell $(PKG) --libs OpenImageIO 2>/dev/null)
 ASSIMP_LIBS  := $(shell $(PKG) --libs assimp 2>/dev/null || echo -lassimp)
+MHD_LIBS     := $(shell $(PKG) --libs libmicrohttpd 2>/dev/null || echo -lmicrohttpd)
 
 B = build
 COMMON_SRC  = $(wildcard common/*.c)
@@ -51,7 +52,7 @@ BENCH_BIN   = $(BENCH_SRC:tests/bench/%.c=bin/bench/%)
 LIB         = $(B)/libfranja.a
 
 WORKER_LIBS = $(CJSON_LIBS) -lm
-COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) -lstdc++ -lm -pthread
+COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) -lstdc++ -lm -pthread
 
 .PHONY: all deps check test bench render clean docs fuzz static dist check-cross refs install uninstall
 all: bin/franja-worker bin/franja

@@ -21,6 +21,7 @@
 #include "fbin.h"
 #include "jobdir.h"
 #include "joblock.h"
+#include "monitor.h"
 #include "output.h"
 #include "preview.h"
 #include "progress.h"
@@ -66,6 +67,9 @@ static const char usage[] =
     "  --progress MODE      auto (a live line on a terminal, else plain lines) or\n"
     "                       json (also one JSON object a line on stdout, for\n"
     "                       wrapper tools) (default auto)\n"
+    "  --monitor PORT       serve a live page of the render (image so far, hosts,\n"
+    "                       ETA) on http://127.0.0.1:PORT/ (0: a free port, said\n"
+    "                       on stderr); from another machine: ssh -L\n"
     CLI_SLURM_HELP;
 
 static volatile sig_atomic_t stop_flag;
@@ -94,6 +98,8 @@ typedef struct {
     int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
     float noise_threshold;     /* --noise-threshold, 0 for the scene's */
     int json;                  /* --progress json */
+    int monitor;               /* --monitor given */
+    uint32_t monitor_port;
     int resume, keep_job, fresh, no_lock;
     tr_options tr;
     cli_slurm slurm;
@@ -103,7 +109,7 @@ typedef struct {
 enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
-    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE
+    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -129,6 +135,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"integrator", required_argument, NULL, OPT_INTEGRATOR},
         {"progress", required_argument, NULL, OPT_PROGRESS},
         {"noise-threshold", required_argument, NULL, OPT_NOISE},
+        {"monitor", required_argument, NULL, OPT_MONITOR},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -212,6 +219,10 @@ static int parse(int argc, char **argv, render_args *a)
             a->json = k == 1;
             break;
         }
+        case OPT_MONITOR:
+            bad = opt_uint(cmd, "--monitor", v, 0, 65535, &a->monitor_port);
+            a->monitor = 1;
+            break;
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;
@@ -318,7 +329,20 @@ typedef struct {
     int done, total;
     int drawn;                 /* a live line is on screen */
     struct joiner *join;       /* hosts joining the render */
+    pg_reporter *pg;           /* --progress json, or NULL */
+    mon_server *mon;           /* --monitor, or NULL */
+    int rows_before;           /* rows done before this run (resumed) */
+    mon_host *mh;              /* nhosts entries for the monitor */
+    char (*mstate)[320];       /* their state strings */
 } reporter;
+
+/* A host's event to the JSON stream and the monitor. */
+static void host_event(reporter *r, const char *what, const char *host, uint32_t y0, uint32_t y1, double t,
+                       const char *text)
+{
+    pg_event(r->pg, what, host, y0, y1, text);
+    mon_event(r->mon, t, host, what, text);
+}
 
 static void clear_line(reporter *r)
 {
@@ -331,6 +355,12 @@ static void clear_line(reporter *r)
 static void on_event(void *ctx, const sched_event *ev)
 {
     reporter *r = ctx;
+    static const char *const what[] = {
+        [SCHED_SLAB_DONE] = "done", [SCHED_SLAB_FAILED] = "failed", [SCHED_COPY] = "copy",
+        [SCHED_HOST_DROPPED] = "dropped", [SCHED_HOST_SHRUNK] = "shrunk", [SCHED_HOST_RETRY] = "retry",
+    };
+    if (ev->kind != SCHED_SLAB_DONE && ev->host >= 0 && ev->host < r->nhosts)
+        host_event(r, what[ev->kind], r->hosts[ev->host].name, ev->y0, ev->y1, ev->t, ev->text);
     if (ev->kind == SCHED_SLAB_DONE || (r->tty && ev->kind == SCHED_COPY))
         return;
     clear_line(r);
@@ -376,6 +406,24 @@ static void draw(reporter *r, int force)
     }
 }
 
+/* The hosts' state for the monitor. */
+static void monitor_update(reporter *r)
+{
+    if (!r->mon)
+        return;
+    for (int i = 0; i < r->nhosts; i++) {
+        const sched_host *h = &r->hosts[i];
+        if (h->pending)
+            snprintf(r->mstate[i], sizeof r->mstate[i], "starting");
+        else if (h->dropped)
+            snprintf(r->mstate[i], sizeof r->mstate[i], "dropped: %s", h->drop_reason);
+        else
+            snprintf(r->mstate[i], sizeof r->mstate[i], "%s", h->running ? "rendering" : "idle");
+        r->mh[i] = (mon_host){h->name, r->mstate[i], h->running, h->slots, h->rows, h->failures};
+    }
+    mon_progress(r->mon, r->t, r->done, r->total, r->rows_before, r->mh, r->nhosts);
+}
+
 static void on_progress(void *ctx, double t, int done, int total)
 {
     reporter *r = ctx;
@@ -383,6 +431,7 @@ static void on_progress(void *ctx, double t, int done, int total)
     r->done = done;
     r->total = total;
     draw(r, 0);
+    monitor_update(r);
 }
 
 /* Hosts joining the render as they become ready (the scheduler's admit
@@ -412,6 +461,11 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
             cl_check_version(&j->cl[i]);
         if (!j->cl[i].tr) {
             fprintf(stderr, "franja: host %s is not used: %s\n", h.entry->name, j->cl[i].err.msg);
+            if (j->rep) {
+                char line[1200];
+                snprintf(line, sizeof line, "host %s is not used: %s", h.entry->name, j->cl[i].err.msg);
+                host_event(j->rep, "unused", h.entry->name, 0, 0, j->rep->t, line);
+            }
             s->dropped = 1;
             snprintf(s->drop_reason, sizeof s->drop_reason, "%s", j->cl[i].err.msg);
             continue;
@@ -432,6 +486,12 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", s->name, h.info.os,
                     h.info.arch, s->slots, h.info.version,
                     hosts_is_local(h.entry) ? "local" : h.uploaded ? "uploaded" : "already there", h.ready_s);
+        if (j->rep) {
+            char line[600];
+            snprintf(line, sizeof line, "host %s ready: %s %s, %d slots (%.2f s)", s->name, h.info.os, h.info.arch,
+                     s->slots, h.ready_s);
+            host_event(j->rep, "ready", s->name, 0, 0, j->rep->t, line);
+        }
     }
 }
 
@@ -447,13 +507,16 @@ static void on_admit(void *ctx, sched_host *hosts, int nhosts)
  * are (a host that accepts a connection and never answers costs nothing
  * unless it is the only one). */
 static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
-                     const char *jobdir, const unsigned char *have, int rows_missing, fr_error *err)
+                     const char *jobdir, const unsigned char *have, int rows_missing, pg_reporter *pg,
+                     mon_server *mon, fr_error *err)
 {
     int n = table->n;
     cl_host *cl = calloc((size_t)n, sizeof *cl);
     sched_host *sh = calloc((size_t)n, sizeof *sh);
+    mon_host *mh = calloc((size_t)n, sizeof *mh);
+    char(*mstate)[320] = calloc((size_t)n, sizeof *mstate);
     cl_group *g = NULL;
-    if (cl && sh) {
+    if (cl && sh && mh && mstate) {
         for (int i = 0; i < n; i++)
             cl[i].entry = &table->v[i];
         g = cl_start(cl, n, &a->tr, fbin, spec->hash);
@@ -461,6 +524,8 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     if (!g) {
         free(cl);
         free(sh);
+        free(mh);
+        free(mstate);
         return fr_fail(err, "out of memory");
     }
     for (int i = 0; i < n; i++) {
@@ -468,10 +533,17 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         sh[i].pending = 1;
         sh[i].slots = table->v[i].cores; /* a guess for the slab size until it is ready */
     }
-    joiner j = {a, g, cl, NULL, 0};
+    reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = n, .spec = spec, .pg = pg, .mon = mon,
+                    .rows_before = (int)spec->height - rows_missing, .mh = mh, .mstate = mstate,
+                    .done = (int)spec->height - rows_missing, .total = (int)spec->height};
+    joiner j = {a, g, cl, &rep, 0};
+    rep.join = &j;
+    monitor_update(&rep);
     /* The first host (or the end of them all). */
-    while (!j.ready && cl_pending(g))
+    while (!j.ready && cl_pending(g)) {
         join_hosts(&j, sh, 1000);
+        monitor_update(&rep);
+    }
     int rc = 0;
     if (!j.ready)
         rc = fr_fail(err, "no host could be used (see the messages above)");
@@ -485,8 +557,6 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         for (int i = 0; i < n; i++)
             if (sh[i].pending && sh[i].slots < 1)
                 sh[i].slots = guess;
-        reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = n, .spec = spec, .join = &j};
-        j.rep = &rep;
         sched_params p = {.spec = *spec,
                           .jobdir = jobdir,
                           .have = have,
@@ -517,6 +587,8 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     cl_end(g, a->slurm.on);
     free(cl);
     free(sh);
+    free(mh);
+    free(mstate);
     return rc;
 }
 
@@ -653,6 +725,7 @@ int cmd_render(int argc, char **argv)
     float *rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *rgb);
     int rc = 1;
     pg_reporter *pg = NULL;
+    mon_server *mon = NULL;
     if (!have || !rgb) {
         fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
@@ -674,6 +747,14 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         goto done;
     }
+    if (a.monitor) {
+        if (!(mon = mon_start((uint16_t)a.monitor_port, a.out, jobdir, &spec, &tm, &err))) {
+            fprintf(stderr, "franja render: --monitor: %s\n", err.msg);
+            goto done;
+        }
+        mon_status(mon, "rendering");
+        fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(mon));
+    }
     pv_writer *pv = NULL;
     if (a.preview && !(pv = pv_start(a.preview, jobdir, &spec, &tm, a.preview_every,
                                      (note_sink){cli_note_stderr, NULL}, &err))) {
@@ -681,7 +762,7 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     int slabs_rc = (uint32_t)rows_have < spec.height
-                       ? run_slabs(&a, &table, fbin, &spec, jobdir, have, (int)spec.height - rows_have, &err)
+                       ? run_slabs(&a, &table, fbin, &spec, jobdir, have, (int)spec.height - rows_have, pg, mon, &err)
                        : 0;
     pv_stop(pv);
     if (slabs_rc) {
@@ -699,6 +780,9 @@ int cmd_render(int argc, char **argv)
     }
     pg_stop(pg, "ok");
     pg = NULL;
+    mon_status(mon, "done");
+    mon_stop(mon);
+    mon = NULL;
     if (!a.keep_job)
         job_remove(jobdir);
     jlk_release(&lk, !a.keep_job);
@@ -707,6 +791,7 @@ int cmd_render(int argc, char **argv)
     rc = 0;
 done:
     pg_stop(pg, stop_flag ? "interrupted" : "failed");
+    mon_stop(mon);
     if (rc)
         unlock_with(&lk, rc);
     if (rc && stop_flag)

@@ -9,7 +9,7 @@
 static const char usage[] =
     "usage: franja render SCENE [-o OUT] [--hosts FILE | --slurm] [-j N] [--spp N]\n"
     "                     [--size WxH] [--exposure E] [--resume] [--preview FILE]\n"
-    "                     [--progress json] [--accept-new-hosts] ...\n"
+    "                     [--progress json] [--monitor PORT] [--accept-new-hosts] ...\n"
     "       franja compile SCENE [-o SCENE.fbin] [--camera NAME]\n"
     "       franja hosts check|list --hosts FILE | --slurm\n"
     "       franja deploy --hosts FILE [--dist DIR]\n"

@@ -74,34 +74,41 @@ static int encode_pfm(const char *path, const float *rgb, const job_spec *spec, 
     return 0;
 }
 
+int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
+               size_t *len, fr_error *err)
+{
+    /* Encoded in memory: OpenImageIO's writers do not all report a failed
+     * write, and libjpeg's exits. */
+    size_t n = (size_t)spec->width * spec->height * 3;
+    *data = NULL;
+    *len = 0;
+    if (is_ext(path, "pfm"))
+        return encode_pfm(path, rgb, spec, data, len, err);
+    if (is_ext(path, "exr") || is_ext(path, "hdr"))
+        return iio_encode(path, rgb, IIO_F32, spec->width, spec->height, data, len, err);
+    int wide = is_ext(path, "tif") || is_ext(path, "tiff");
+    void *px = malloc(n * (wide ? 2 : 1));
+    if (!px)
+        return fr_fail(err, "%s: out of memory for the final image", path);
+    for (size_t i = 0; i < n; i++) {
+        float v = tm_display(tm, rgb[i]);
+        if (wide)
+            ((uint16_t *)px)[i] = (uint16_t)(v * 65535.0f + 0.5f);
+        else
+            ((uint8_t *)px)[i] = (uint8_t)(v * 255.0f + 0.5f);
+    }
+    int rc = iio_encode(path, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, data, len, err);
+    free(px);
+    return rc;
+}
+
 int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err)
 {
-    /* Encoded in memory (OpenImageIO's writers do not all report a failed
-     * write, and libjpeg's exits), then written by file_write_atomic, which
-     * checks every write, the fsync and the close before the rename. */
-    size_t n = (size_t)spec->width * spec->height * 3;
+    /* file_write_atomic checks every write, the fsync and the close before
+     * the rename. */
     unsigned char *data = NULL;
     size_t len = 0;
-    int rc;
-    if (is_ext(path, "pfm")) {
-        rc = encode_pfm(path, rgb, spec, &data, &len, err);
-    } else if (is_ext(path, "exr") || is_ext(path, "hdr")) {
-        rc = iio_encode(path, rgb, IIO_F32, spec->width, spec->height, &data, &len, err);
-    } else {
-        int wide = is_ext(path, "tif") || is_ext(path, "tiff");
-        void *px = malloc(n * (wide ? 2 : 1));
-        if (!px)
-            return fr_fail(err, "%s: out of memory for the final image", path);
-        for (size_t i = 0; i < n; i++) {
-            float v = tm_display(tm, rgb[i]);
-            if (wide)
-                ((uint16_t *)px)[i] = (uint16_t)(v * 65535.0f + 0.5f);
-            else
-                ((uint8_t *)px)[i] = (uint8_t)(v * 255.0f + 0.5f);
-        }
-        rc = iio_encode(path, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, &data, &len, err);
-        free(px);
-    }
+    int rc = out_encode(path, rgb, spec, tm, &data, &len, err);
     if (rc == 0) {
         fr_error e;
         if (file_write_atomic(path, data, len, &e))

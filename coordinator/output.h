@@ -25,6 +25,14 @@ int out_check_type(const char *path, fr_error *err);
  * file is removed at once). */
 int out_check(const char *path, fr_error *err);
 
+/** Encodes rgb (width*height*3 linear floats, top row first) in memory as
+ * the file path would hold it (by its extension; LDR types tone-mapped by
+ * tm): *data (malloc'd, the caller frees) receives *len bytes.  Nothing is
+ * written.  Fails, naming path, for lack of memory or with the encoder's
+ * message; *data is then NULL. */
+int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
+               size_t *len, fr_error *err);
+
 /** Writes rgb (width*height*3 linear floats, top row first) to path via a
  * temporary file in the same directory and a rename, so path is either the
  * old file or the complete new one. */

@@ -44,6 +44,7 @@ static void poll_once(pg_reporter *r)
         return;
     r->rows = rows;
     double t = clk_now() - r->t0;
+    flockfile(r->out);
     double rate = t > 0 ? (rows - r->rows0) / t : 0;
     fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
                     "\"eta_s\":",
@@ -53,6 +54,26 @@ static void poll_once(pg_reporter *r)
     else
         fputs("null}\n", r->out);
     fflush(r->out);
+    funlockfile(r->out);
+}
+
+void pg_event(pg_reporter *r, const char *what, const char *host, uint32_t y0, uint32_t y1, const char *text)
+{
+    if (!r)
+        return;
+    flockfile(r->out);
+    fputs("{\"event\":\"host\",\"what\":", r->out);
+    pg_json_string(r->out, what);
+    fputs(",\"host\":", r->out);
+    pg_json_string(r->out, host);
+    fprintf(r->out, ",\"elapsed_s\":%.3f", clk_now() - r->t0);
+    if (y1 > y0)
+        fprintf(r->out, ",\"y0\":%u,\"y1\":%u", y0, y1);
+    fputs(",\"text\":", r->out);
+    pg_json_string(r->out, text);
+    fputs("}\n", r->out);
+    fflush(r->out);
+    funlockfile(r->out);
 }
 
 static void *run(void *arg)

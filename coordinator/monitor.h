@@ -1,0 +1,70 @@
+/** @file monitor.h
+ * `franja render --monitor PORT`: a small live web page of the render,
+ * served on 127.0.0.1 only by libmicrohttpd from a thread of its own.
+ *
+ *     /              the page (HTML, its script polls the two below)
+ *     /state.json    the render now: rows, elapsed time, ETA, each host's
+ *                    state, slots, rows, rows/s and failures, the last events
+ *     /image.png     the image so far (preview.h: rows not rendered yet as a
+ *                    checkerboard), tone-mapped like an LDR output
+ *
+ * Only GET and HEAD are answered, only for a Host header naming this
+ * machine (localhost, 127.0.0.1, [::1], any port: a page of another site
+ * cannot read the monitor through a rebound DNS name); at most 16
+ * connections, each closed after 10 s of silence.  The image is read from
+ * the job directory (like --preview), at most once a second and only when
+ * its rows changed; nothing the scheduler owns is touched by the server's
+ * thread: the render hands it copies (mon_progress, mon_event).
+ */
+#ifndef FRANJA_MONITOR_H
+#define FRANJA_MONITOR_H
+
+#include <stdint.h>
+
+#include "error.h"
+#include "jobdir.h"
+#include "scene.h"
+
+/** A running monitor. */
+typedef struct mon_server mon_server;
+
+/** One host as the page shows it (strings are copied by mon_progress). */
+typedef struct {
+    const char *name;
+    const char *state;         /**< "starting", "ready", "dropped: REASON" ... */
+    int running, slots;        /**< worker processes now, and at most */
+    int rows, failures;        /**< accepted rows, failed attempts */
+} mon_host;
+
+/** Starts serving on 127.0.0.1:port (0: a free port the system picks; see
+ * mon_port) the render of output from job directory dir.  Strings are
+ * copied.  NULL with err set when the port cannot be bound (in use,
+ * privileged) or the server cannot start. */
+mon_server *mon_start(uint16_t port, const char *output, const char *dir, const job_spec *spec, const fr_tonemap *tm,
+                      fr_error *err);
+
+/** The port the monitor listens on. */
+uint16_t mon_port(const mon_server *m);
+
+/** The render's state now: t seconds since it began, rows done of total
+ * (rows_before of them were done before this run: resumed), and the
+ * hosts.  Copies everything; any thread. */
+void mon_progress(mon_server *m, double t, int rows_done, int rows_total, int rows_before, const mon_host *hosts,
+                  int nhosts);
+
+/** Adds an event (a host's failure, a dropped host ...) to the page's
+ * list of the last 50: t seconds since the render began, the host's name
+ * (NULL: none), a short kind ("failed", "dropped" ...) and a line. */
+void mon_event(mon_server *m, double t, const char *host, const char *kind, const char *text);
+
+/** Sets the render's status shown on the page ("rendering" at the start;
+ * "done", "failed", "interrupted"). */
+void mon_status(mon_server *m, const char *status);
+
+/** Stops serving and frees m (NULL: nothing). */
+void mon_stop(mon_server *m);
+
+/** The page itself (monitor_page.c). */
+extern const char mon_page_html[];
+
+#endif
