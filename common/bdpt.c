@@ -11,8 +11,9 @@
 #include "splat.h"
 #include "texture.h"
 
-/* Bounces before Russian roulette may end a subpath (as in pathtrace.c). */
-#define RR_DEPTH 4
+/* Scattering vertices a subpath passes before Russian roulette may end it:
+ * the fourth and later may, as in pathtrace.c. */
+#define RR_DEPTH 3
 /* First dimension pair of a light subpath's numbers (bdpt.h). */
 #define LIGHT_DIM 65536u
 
@@ -20,12 +21,29 @@ enum { BD_CAMERA, BD_LIGHT, BD_SURFACE };
 
 /* A subpath vertex.  pdf_fwd is the area density with which its own
  * subpath reached it, pdf_rev the one with which the other direction
- * would (from the next vertex of its subpath).  A step through a delta
- * lobe has density 1 both ways: the delta factor is the same for every
- * strategy that can make the path, so it cancels from their ratios.  A
- * genuine 0 (a direction that the BSDF never samples though it reflects
- * light there, as below the shading hemisphere) stays 0, so the strategy
- * that would need it does not count. */
+ * would (from the next vertex of its subpath).  A genuine 0 (a direction
+ * that the BSDF never samples though it reflects light there, as below the
+ * shading hemisphere) stays 0, so the strategy that would need it does not
+ * count.
+ *
+ * Delta lobes (mirror, smooth glass) make chains: a vertex a that is not
+ * delta, the delta vertices, and the next vertex b that is not.  The chain
+ * is sampled at one end, by a direction there, and the other end is
+ * determined; the delta vertices themselves count 1 both ways (their delta
+ * factor is the same for every strategy that can make the path) and are
+ * skipped in the ratios.  The density of b reached from a is the
+ * direction's density at a times the generalized geometry term of the chain
+ * (cos_a cos_b / d^2 unfolded, with the spreading by the curved surfaces
+ * in d) over cos_a; from b to a the same with the ends swapped.  Every
+ * strategy that can make the path has both densities in its ratios or
+ * neither (a connection never ends on a delta vertex), so the common
+ * factor cancels and is left out: b's pdf_fwd is p_a(w) * cos_b and a's
+ * pdf_rev is p_b(w') * cos_a (chain_pdf).  Converting only the first
+ * segment to area measure instead (density 1 for the rest) misweighs
+ * caustics badly: a floor point next to the glass ball makes the glass
+ * look near and the camera path hitting the lamp through it look far
+ * likelier than light tracing, which is the better strategy there by the
+ * ratio of the lamp's area density to the camera's. */
 typedef struct {
     int type;                  /* BD_* */
     int delta;                 /* surface: the subpath left it by a delta lobe */
@@ -122,6 +140,20 @@ static float to_area(const fr_scene *s, float pdf, const vert *from, const vert 
     return pdf * inv;
 }
 
+/* The density of the far end `to` of a chain of delta vertices that
+ * starts at `from` with solid-angle density pdf, in the measure that
+ * leaves out the chain's geometry term over the cosines (the comment on
+ * vert): pdf times the cosine at `to` of unit direction w (the chain's
+ * segment at `to`), the disk's density instead of pdf after a distant
+ * light, pdf itself at a distant light. */
+static float chain_pdf(const fr_scene *s, float pdf, const vert *from, const vert *to, vec3 w)
+{
+    if (to->distant)
+        return pdf;
+    float c = on_surface(to) ? fabsf(v3_dot(to->ng, w)) : 1.0f;
+    return (from->distant ? disk_pdf(s) : pdf) * c;
+}
+
 /* Unit direction from vertex a toward vertex b (toward the light for a
  * distant b, away from it for a distant a). */
 static vec3 dir_to(const vert *a, const vert *b)
@@ -184,30 +216,67 @@ static float emit_pdf_dir(const fr_scene *s, const vert *v, vec3 w)
     return dir;
 }
 
-/* Density at `next` (to_area's measure) of the step from v to next, given
- * that the path came to v from prev (unused at the camera and at lights). */
-static float vert_pdf(const fr_scene *s, const vert *v, const vert *prev, const vert *next)
+/* Solid-angle density at v of the step from v toward next, given that the
+ * path came to v from prev (unused at the camera and at lights); 0 at a
+ * distant light (its next vertex has the disk's density: to_area's). */
+static float dir_pdf(const fr_scene *s, const vert *v, const vert *prev, const vert *next)
 {
     float pdf;
     if (v->distant)
-        pdf = 0.0f;    /* the disk's density: to_area's */
+        pdf = 0.0f;
     else if (v->type == BD_CAMERA)
         cam_importance(s, v->p, dir_to(v, next), &pdf, NULL, NULL);
     else if (v->type == BD_LIGHT)
         pdf = emit_pdf_dir(s, v, dir_to(v, next));
     else
         pdf = bsdf_pdf(&v->m, &v->sf, dir_to(v, prev), dir_to(v, next));
-    return to_area(s, pdf, v, next);
+    return pdf;
+}
+
+/* Density at `next` (to_area's measure) of the step from v to next. */
+static float vert_pdf(const fr_scene *s, const vert *v, const vert *prev, const vert *next)
+{
+    return to_area(s, dir_pdf(s, v, prev, next), v, next);
+}
+
+/* The reverse density of the step from path[i] back to path[i - 1],
+ * leaving path[i] (or `v`, standing in for it) with solid-angle density
+ * pdf: at path[i - 1], or, when path[i - 1] is a delta vertex, 1 there
+ * and chain_pdf's density at the chain's first end.  The pdf_rev values it
+ * changes are saved in save[0..1] (with their vertices in at[]) first;
+ * returns how many. */
+static int set_rev_back(const fr_scene *s, vert *path, int i, const vert *v, float pdf, vert *at[2], float save[2])
+{
+    vert *prev = &path[i - 1];
+    at[0] = prev;
+    save[0] = prev->pdf_rev;
+    if (!prev->delta) {
+        prev->pdf_rev = to_area(s, pdf, v, prev);
+        return 1;
+    }
+    prev->pdf_rev = 1.0f;
+    int a = i - 2;
+    while (a > 0 && path[a].delta)
+        a--;
+    at[1] = &path[a];
+    save[1] = path[a].pdf_rev;
+    path[a].pdf_rev = chain_pdf(s, pdf, v, &path[a], path[a + 1].wo);
+    return 2;
 }
 
 /* Russian roulette on a subpath whose throughput went from beta0 to *beta
- * (the ratio is what its scattering kept).  Returns 0 when it ends. */
+ * (the ratio m of their largest channels is what its scattering kept), as
+ * pathtrace.c plays it: survival q = min(1, sqrt(m)), survivors reweighted
+ * by 1 / q.  Returns 0 when it ends. */
 static int roulette(fr_sampler *smp, uint32_t depth, vec3 beta0, vec3 *beta)
 {
     if (depth < RR_DEPTH)
         return 1;
-    float r = v3_max(*beta) / v3_max(beta0), q = r < 0.95f ? r : 0.95f;
-    if (!(smp_random(smp) < q))
+    float m = v3_max(*beta) / v3_max(beta0), u = smp_random(smp);
+    if (m >= 1.0f)
+        return 1;
+    float q = sqrtf(m);
+    if (!(u < q))
         return 0;
     *beta = v3_scale(*beta, 1.0f / q);
     return 1;
@@ -223,6 +292,10 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
 {
     vec3 beta0 = beta;
     int n = 1, delta_in = 0;
+    /* The first end of the current chain of delta vertices and the density
+     * of the direction it left by (the comment on vert). */
+    int anchor = 0;
+    float anchor_pdf = pdf_dir;
     for (uint32_t depth = 0; n < maxv; depth++) {
         fr_hit hit;
         vert *v = &path[n], *prev = &path[n - 1];
@@ -236,7 +309,7 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
                 v->wo = ray.d;
                 v->beta = beta;
                 v->light = FR_NONE;
-                v->pdf_fwd = delta_in ? 1.0f : pdf_dir;
+                v->pdf_fwd = delta_in ? anchor_pdf : pdf_dir;
                 v->pdf_rev = 0.0f;
                 n++;
             }
@@ -253,7 +326,13 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
         v->wo = v3_neg(ray.d);
         v->beta = beta;
         v->light = v->sf.light;
-        v->pdf_fwd = delta_in ? 1.0f : to_area(s, pdf_dir, prev, v);
+        if (delta_in) {
+            v->pdf_fwd = chain_pdf(s, anchor_pdf, &path[anchor], v, ray.d);
+        } else {
+            v->pdf_fwd = to_area(s, pdf_dir, prev, v);
+            anchor = n - 1;
+            anchor_pdf = pdf_dir;
+        }
         v->pdf_rev = 0.0f;
         n++;
         /* Three pairs per vertex: camera side (light pick, lobe), light
@@ -292,7 +371,13 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
         beta = v3_mul(beta, weight);
         v->delta = delta_in = bs.delta;
         pdf_dir = bs.pdf;
-        prev->pdf_rev = bs.delta ? 1.0f : to_area(s, bsdf_pdf(&v->m, &v->sf, bs.wi, v->wo), v, prev);
+        if (bs.delta) {
+            prev->pdf_rev = 1.0f;
+        } else {
+            vert *at[2];
+            float save[2];
+            set_rev_back(s, path, n - 1, v, bsdf_pdf(&v->m, &v->sf, bs.wi, v->wo), at, save);
+        }
         ray.o = geo_offset(v->p, v->sf.perr, v->ng, bs.wi);
         ray.d = bs.wi;
         if (v3_is_zero(beta) || !roulette(smp, depth, beta0, &beta))
@@ -371,8 +456,9 @@ static int visible(const fr_scene *s, const vert *a, const vert *b)
 
 /* Power-heuristic weight of strategy (s_, t) for the path it made, by the
  * ratios of each neighbouring strategy's density to this one's (pbrt-v3's
- * MISWeight with squared ratios).  `sampled` is the vertex the strategy
- * sampled itself (s_ = 1: a light point, t = 1: a lens point). */
+ * MISWeight with squared ratios, and chains of delta vertices as the
+ * comment on vert says).  `sampled` is the vertex the strategy sampled
+ * itself (s_ = 1: a light point, t = 1: a lens point). */
 static float mis_weight(const fr_scene *s, vert *cam, vert *lgt, const vert *sampled, int s_, int t)
 {
     if (s_ + t == 2)
@@ -386,53 +472,63 @@ static float mis_weight(const fr_scene *s, vert *cam, vert *lgt, const vert *sam
         saved = *slot;
         *slot = *sampled;
     }
+    /* The reverse densities at the connection and behind its ends: up to
+     * six pdf_rev values, restored at the end. */
+    vert *at[6];
+    float save[6];
+    int n = 0;
     int pt_delta = pt->delta, qs_delta = qs ? qs->delta : 0;
-    float pt_rev = pt->pdf_rev, pt_m_rev = pt_m ? pt_m->pdf_rev : 0.0f;
-    float qs_rev = qs ? qs->pdf_rev : 0.0f, qs_m_rev = qs_m ? qs_m->pdf_rev : 0.0f;
     pt->delta = 0;
     if (qs)
         qs->delta = 0;
+    at[n] = pt;
+    save[n++] = pt->pdf_rev;
     pt->pdf_rev = s_ > 0 ? vert_pdf(s, qs, qs_m, pt) : emit_pdf_origin(s, pt);
     if (pt_m) {
-        if (s_ > 0)
-            pt_m->pdf_rev = vert_pdf(s, pt, qs, pt_m);
-        else    /* pt is an emitter the camera subpath found: as a light subpath's start */
-            pt_m->pdf_rev = to_area(s, pt->distant ? 0.0f : emit_pdf_dir(s, pt, dir_to(pt, pt_m)), pt, pt_m);
+        /* s = 0: pt is an emitter the camera subpath found, seen as the
+         * start of a light subpath. */
+        float pdf = s_ > 0 ? dir_pdf(s, pt, qs, pt_m) : pt->distant ? 0.0f : emit_pdf_dir(s, pt, dir_to(pt, pt_m));
+        n += set_rev_back(s, cam, t - 1, pt, pdf, at + n, save + n);
     }
-    if (qs)
+    if (qs) {
+        at[n] = qs;
+        save[n++] = qs->pdf_rev;
         qs->pdf_rev = vert_pdf(s, pt, pt_m, qs);
+    }
     if (qs_m)
-        qs_m->pdf_rev = vert_pdf(s, qs, pt, qs_m);
+        n += set_rev_back(s, lgt, s_ - 1, qs, dir_pdf(s, qs, pt, qs_m), at + n, save + n);
 
+    /* Delta vertices count 1 both ways: skipped. */
     float sum = 0.0f, r = 1.0f;
     for (int i = t - 1; i > 0; i--) {
+        if (cam[i].delta)
+            continue;
         r *= cam[i].pdf_rev / remap0(cam[i].pdf_fwd);
-        if (!cam[i].delta && !cam[i - 1].delta)
+        if (!cam[i - 1].delta)
             sum += r * r;
     }
     r = 1.0f;
     for (int i = s_ - 1; i >= 0; i--) {
+        if (lgt[i].delta)
+            continue;
         r *= lgt[i].pdf_rev / remap0(lgt[i].pdf_fwd);
         int delta_before = i > 0 ? lgt[i - 1].delta : lgt[0].delta_light;
-        if (!lgt[i].delta && !delta_before)
+        if (!delta_before)
             sum += r * r;
     }
 
-    pt->delta = pt_delta;
-    pt->pdf_rev = pt_rev;
-    if (pt_m)
-        pt_m->pdf_rev = pt_m_rev;
-    if (qs) {
-        qs->delta = qs_delta;
-        qs->pdf_rev = qs_rev;
+    /* Restore in reverse order: a vertex saved twice gets its first value. */
+    while (n > 0) {
+        n--;
+        at[n]->pdf_rev = save[n];
     }
-    if (qs_m)
-        qs_m->pdf_rev = qs_m_rev;
+    pt->delta = pt_delta;
+    if (qs)
+        qs->delta = qs_delta;
     if (slot)
         *slot = saved;
     return 1.0f / (1.0f + sum);
 }
-
 
 /* The unweighted contribution of strategy (s_, t), 0 when it makes no
  * path; *sampled receives the vertex it sampled (s_ = 1 or t = 1) and, for

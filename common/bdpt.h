@@ -15,10 +15,18 @@
  * each vertex in area measure and the ratios of neighbouring strategies
  * multiplied out (no pdf is recomputed beyond the two vertices at each end
  * of the connection).  (1, 1), a light point joined to a lens point, is
- * left out: the camera subpath hitting the light (0, 2) covers it.
+ * left out: it only renders lights seen directly, which the camera
+ * subpath hitting the light (0, 2) renders without noise beyond the
+ * pixel's own (it gets weight 1), and it would add a shadow ray and a
+ * splat to every sample.
  *
  * Vertices reached by a delta lobe (mirror, smooth glass) are never
- * connection ends.  Light subpaths carry importance: refraction does not
+ * connection ends; a chain of them between two other vertices counts as
+ * one step whose density is the direction's at the end that sampled it
+ * times the cosine at the other end (the chain's geometry term, common to
+ * both directions, cancels from the ratios), so that caustics seen through
+ * glass weigh light tracing against camera paths that hit the lamp by the
+ * true ratio of their densities.  Light subpaths carry importance: refraction does not
  * scale it by eta^2 as it does radiance, and shading normals get Veach's
  * adjoint correction |wo.ns||wi.ng| / (|wo.ng||wi.ns|).
  *
