@@ -12,7 +12,9 @@
  * - A white furnace gives Le / (1 - rho) everywhere.
  * - A glass ball focusing a point light onto a floor: a caustic only light
  *   tracing can render; its power and centroid against the test's own ray
- *   tracing of the ball in double precision.
+ *   tracing of the ball in double precision.  Under a small round lamp,
+ *   light tracing and the camera path hitting the lamp through the ball
+ *   agree, MIS agrees with both and is about as good as light tracing.
  * - Scenes with media are refused, with a message.
  *
  * Standard errors come from each pixel's spread of sample values, and for
@@ -613,6 +615,62 @@ static void caustic(void)
     scn_free(&s);
 }
 
+/* The same ball and floor under a small round lamp, seen from beside the
+ * ball (which no camera ray hits).  Every path of depth 3 that reaches
+ * the camera is lamp - glass - glass - floor - camera: made by light
+ * tracing (4,1) and by the camera path that hits the lamp through the ball
+ * (0,5), nothing else.  Each alone and both with MIS agree (the weights of
+ * the two sum to 1 across the chain of delta vertices); and MIS is nearly
+ * as good as light tracing alone: the camera path's chance to hit the
+ * small lamp through the ball is tiny, so the power heuristic must give it
+ * almost no weight.  Weighing the chain by its first segment alone gave the
+ * camera path most of the weight near the ball's foot, and MIS several
+ * times light tracing's noise. */
+static void caustic_weights(void)
+{
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{\"image\": {\"width\": 12, \"height\": 9, \"spp\": 1, \"max_depth\": 3},"
+             " \"camera\": {\"position\": [2.6, 0.7, 0.2], \"target\": [0.9, 0, 0], \"fov\": 20},"
+             " \"materials\": {\"glass\": {\"type\": \"glass\", \"ior\": %g},"
+             "   \"floor\": {\"type\": \"lambert\", \"albedo\": [%g, %g, %g]},"
+             "   \"lamp\": {\"type\": \"emitter\", \"emission\": [400, 400, 400]}},"
+             " \"shapes\": [{\"type\": \"sphere\", \"center\": [%g, %g, %g], \"radius\": %g, \"material\": \"glass\"},"
+             "   {\"type\": \"rect\", \"origin\": [0.3, 0, -0.6], \"edge_u\": [0, 0, 1.2], \"edge_v\": [1.2, 0, 0],"
+             "    \"material\": \"floor\"},"
+             "   {\"type\": \"sphere\", \"center\": [%g, %g, %g], \"radius\": 0.1, \"material\": \"lamp\"}]}",
+             ior, floor_rho, floor_rho, floor_rho, ball_c[0], ball_c[1], ball_c[2], ball_r, lamp_p[0], lamp_p[1],
+             lamp_p[2]);
+    fr_scene s;
+    test_scene(json, &s);
+    int seen = 0;
+    for (uint32_t y = 0; y < s.settings.height; y++)
+        for (uint32_t x = 0; x < s.settings.width; x++)
+            for (int c = 0; c < 4; c++) {
+                fr_ray r = pt_camera_ray(&s, x, y, (float)(c & 1), (float)(c >> 1), 0.5f, 0.5f);
+                fr_hit h;
+                seen += trace_closest(&s, &r, INFINITY, &h) && s.prims[h.prim].kind != FR_PRIM_RECT;
+            }
+    CHECK(seen == 0, "caustic weights: the camera sees the ball (the test is set up wrong)");
+    const bd_strategy lt = {4, 1, -1}, hit = {0, 5, -1}, mis3 = {-1, -1, 3};
+    blocks b_lt, b_hit, b_mis;
+    render(&s, &lt, 256, 2, &b_lt);
+    render(&s, &hit, 4096, 2, &b_hit);
+    render(&s, &mis3, 256, 2, &b_mis);
+    agree("caustic weights: light tracing (4,1) vs hitting the lamp (0,5)", &b_lt, &b_hit, 4.5);
+    agree("caustic weights: MIS at depth 3 vs light tracing (4,1)", &b_mis, &b_lt, 4.5);
+    double lit = 0, worst = 0;
+    for (int b = 0; b < 4; b++) {
+        lit += b_lt.mean[b][1];
+        if (b_lt.se[b][1] > 0)
+            worst = fmax(worst, b_mis.se[b][1] / b_lt.se[b][1]);
+    }
+    printf("caustic weights: MIS's standard error at most %.2f times light tracing's (same samples)\n", worst);
+    CHECK(lit > 0.05, "caustic weights: no caustic on the floor (%g)", lit);
+    CHECK(worst < 1.3, "caustic weights: MIS %.2f times as noisy as light tracing alone", worst);
+    scn_free(&s);
+}
+
 /* Distant and delta lights: an environment, a sun with a disk and a spot
  * over a floor, a ball and a wall.  Camera paths that leave the scene end
  * on the distant lights; light paths start on a disk facing the scene. */
@@ -703,6 +761,7 @@ int main(void)
     RUN(furnace);
     RUN(media_refused);
     RUN(caustic);
+    RUN(caustic_weights);
     RUN(distant_lights);
     RUN(cornell);
     RUN(spheres);
