@@ -1,7 +1,7 @@
 /* imgcmp -- compare a rendered PFM against a reference PFM.
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
- *          [--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1]
+ *          [--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]]
  *
  * IMAGE is box-downsampled to the reference's size when it is an integer
  * multiple of it; with --down, both are then box-downsampled by D (which
@@ -14,7 +14,9 @@
  * the closing "N passed, N failed" line and exits non-zero when one is
  * exceeded.  With --region (fractions of the width and height, top row 0),
  * also the RMSE inside that rectangle of pixels and outside it, both off
- * the light. */
+ * the light; with --mask (a PFM of the reference's size, before --down),
+ * the pixels where the mask has a channel above 0 are not in the region
+ * (they count as outside it). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,10 +74,11 @@ static void box_down(image *im, int f)
 int main(int argc, char **argv)
 {
     double max_rmse = -1, max_rel = -1, max_block = -1, reg[4] = {-1, -1, -1, -1};
+    const char *mask_path = NULL;
     int bs = 64, down = 1;
     if (argc < 3) {
         fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y] "
-                        "[--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1]\n");
+                        "[--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]]\n");
         return 2;
     }
     for (int i = 3; i + 1 < argc; i += 2) {
@@ -84,6 +87,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--max-block-rel")) max_block = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--block")) bs = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--down")) down = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--mask")) mask_path = argv[i + 1];
         else if (!strcmp(argv[i], "--region")) {
             char tail;
             if (sscanf(argv[i + 1], "%lf,%lf,%lf,%lf%c", &reg[0], &reg[1], &reg[2], &reg[3], &tail) != 4 ||
@@ -98,6 +102,15 @@ int main(int argc, char **argv)
     if (down < 1 || down > 65536) { fprintf(stderr, "imgcmp: bad --down\n"); return 2; }
     image a, r;
     if (read_pfm(argv[1], &a) < 0 || read_pfm(argv[2], &r) < 0) return 2;
+    image m = {0, 0, NULL};
+    if (mask_path) {
+        if (reg[0] < 0) { fprintf(stderr, "imgcmp: --mask needs --region\n"); return 2; }
+        if (read_pfm(mask_path, &m) < 0) return 2;
+        if (m.w != r.w || m.h != r.h) {
+            fprintf(stderr, "imgcmp: the mask is %dx%d, the reference %dx%d\n", m.w, m.h, r.w, r.h);
+            return 2;
+        }
+    }
     if (a.w % r.w || a.h % r.h || a.w / r.w != a.h / r.h) {
         fprintf(stderr, "imgcmp: %dx%d is not a multiple of %dx%d\n", a.w, a.h, r.w, r.h);
         return 2;
@@ -108,6 +121,7 @@ int main(int argc, char **argv)
     }
     box_down(&a, a.w / r.w * down);
     box_down(&r, down);
+    if (m.px) box_down(&m, down);
     int k = 1;
     double mean[3] = {0}, rmean[3] = {0}, se = 0, se_in = 0, se_out = 0;
     long off = 0, n_in = 0, n_out = 0;
@@ -120,6 +134,10 @@ int main(int argc, char **argv)
             int light = q[0] >= 10 || q[1] >= 10 || q[2] >= 10;
             double fx = (x + 0.5) / r.w, fy = (y + 0.5) / r.h, px_se = 0;
             int in = fx >= reg[0] && fx < reg[2] && fy >= reg[1] && fy < reg[3];
+            if (in && m.px) {
+                const float *mq = m.px + ((size_t)y * m.w + x) * 3;
+                in = !(mq[0] > 0 || mq[1] > 0 || mq[2] > 0);
+            }
             for (int ch = 0; ch < 3; ch++) {
                 double v = 0;
                 for (int j = 0; j < k; j++)
