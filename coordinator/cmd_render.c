@@ -18,6 +18,7 @@
 #include "cluster.h"
 #include "compile.h"
 #include "compile_child.h"
+#include "crop.h"
 #include "fbin.h"
 #include "jobdir.h"
 #include "joblock.h"
@@ -28,6 +29,7 @@
 #include "protocol.h"
 #include "quick.h"
 #include "sched.h"
+#include "statusline.h"
 #include "tonemap.h"
 
 static const char usage[] =
@@ -44,6 +46,9 @@ static const char usage[] =
     "                       with --hosts or --slurm: at most N per host)\n"
     "  --spp N              samples per pixel (default: the scene's)\n"
     "  --size WxH           image size (default: the scene's)\n"
+    "  --crop X0:Y0:X1:Y1   render only the window [X0,X1) x [Y0,Y1) (pixels, y down\n"
+    "                       from the top); the rest of the image is black\n"
+    "  --crop-output        with --crop: write the window alone\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
@@ -98,6 +103,8 @@ typedef struct {
     int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
     float noise_threshold;     /* --noise-threshold, 0 for the scene's */
     int json;                  /* --progress json */
+    int crop, crop_output;     /* --crop given, --crop-output */
+    crop_window win;
     int monitor;               /* --monitor given */
     uint32_t monitor_port;
     int resume, keep_job, fresh, no_lock;
@@ -109,7 +116,7 @@ typedef struct {
 enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
-    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR
+    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -136,6 +143,8 @@ static int parse(int argc, char **argv, render_args *a)
         {"progress", required_argument, NULL, OPT_PROGRESS},
         {"noise-threshold", required_argument, NULL, OPT_NOISE},
         {"monitor", required_argument, NULL, OPT_MONITOR},
+        {"crop", required_argument, NULL, OPT_CROP},
+        {"crop-output", no_argument, NULL, OPT_CROP_OUTPUT},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -223,6 +232,17 @@ static int parse(int argc, char **argv, render_args *a)
             bad = opt_uint(cmd, "--monitor", v, 0, 65535, &a->monitor_port);
             a->monitor = 1;
             break;
+        case OPT_CROP: {
+            fr_error e;
+            bad = crop_parse(v, &a->win, &e);
+            if (bad)
+                fprintf(stderr, "franja render: --crop: %s\n", e.msg);
+            a->crop = 1;
+            break;
+        }
+        case OPT_CROP_OUTPUT:
+            a->crop_output = 1;
+            break;
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;
@@ -256,6 +276,10 @@ static int parse(int argc, char **argv, render_args *a)
     }
     if (a->preview && !strcmp(a->preview, a->out)) {
         fprintf(stderr, "franja render: --preview %s is the output itself; name another file\n", a->preview);
+        return 2;
+    }
+    if (a->crop_output && !a->crop) {
+        fprintf(stderr, "franja render: --crop-output needs --crop X0:Y0:X1:Y1\n");
         return 2;
     }
     if (a->resume && a->fresh) {
@@ -367,36 +391,14 @@ static void on_event(void *ctx, const sched_event *ev)
     fprintf(stderr, "franja: [%6.1fs] %s\n", ev->t, ev->text);
 }
 
-/* "rows 120/512 (23%)  ETA 40s  1.20 Msamples/s  alpha:8/8 3.1r/s ..." */
-static void progress_text(const reporter *r, char *line, size_t cap)
-{
-    double t = r->t, rate = t > 0 ? r->done / t : 0;
-    int n = snprintf(line, cap, "rows %d/%d (%3.0f%%)", r->done, r->total,
-                     r->total ? 100.0 * r->done / r->total : 100.0);
-    if (rate > 0 && r->done < r->total)
-        n += snprintf(line + n, cap - (size_t)n, "  ETA %.0fs", (r->total - r->done) / rate);
-    n += snprintf(line + n, cap - (size_t)n, "  %.2f Msamples/s ", rate * r->spec->width * r->spec->spp / 1e6);
-    for (int i = 0; i < r->nhosts && n < (int)cap - 40; i++) {
-        const sched_host *h = &r->hosts[i];
-        if (!h->tr && h->dropped)
-            continue;
-        if (h->pending)
-            n += snprintf(line + n, cap - (size_t)n, " %s:starting", h->name);
-        else if (h->dropped)
-            n += snprintf(line + n, cap - (size_t)n, " %s:down", h->name);
-        else
-            n += snprintf(line + n, cap - (size_t)n, " %s:%d/%d %.1fr/s", h->name, h->running, h->slots,
-                          t > 0 ? h->rows / t : 0.0);
-    }
-}
-
 static void draw(reporter *r, int force)
 {
     if (!force && r->t - r->last_draw < (r->tty ? 0.25 : LOG_EVERY))
         return;
     r->last_draw = r->t;
     char line[1024];
-    progress_text(r, line, sizeof line);
+    sl_figures f = {r->t, r->done, r->total, (double)r->spec->width * r->spec->spp};
+    sl_format(line, sizeof line, r->tty ? sl_columns(2) : 0, &f, r->hosts, r->nhosts);
     if (r->tty) {
         fprintf(stderr, "\r\033[K%s", line);
         fflush(stderr);
@@ -421,7 +423,7 @@ static void monitor_update(reporter *r)
             snprintf(r->mstate[i], sizeof r->mstate[i], "%s", h->running ? "rendering" : "idle");
         r->mh[i] = (mon_host){h->name, r->mstate[i], h->running, h->slots, h->rows, h->failures};
     }
-    mon_progress(r->mon, r->t, r->done, r->total, r->rows_before, r->mh, r->nhosts);
+    mon_progress(r->mon, r->t, r->rows_before + r->done, r->rows_before + r->total, r->rows_before, r->mh, r->nhosts);
 }
 
 static void on_progress(void *ctx, double t, int done, int total)
@@ -507,8 +509,8 @@ static void on_admit(void *ctx, sched_host *hosts, int nhosts)
  * are (a host that accepts a connection and never answers costs nothing
  * unless it is the only one). */
 static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
-                     const char *jobdir, const unsigned char *have, int rows_missing, pg_reporter *pg,
-                     mon_server *mon, fr_error *err)
+                     const char *jobdir, const unsigned char *have, int rows_job, int rows_missing,
+                     pg_reporter *pg, mon_server *mon, fr_error *err)
 {
     int n = table->n;
     cl_host *cl = calloc((size_t)n, sizeof *cl);
@@ -534,8 +536,7 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         sh[i].slots = table->v[i].cores; /* a guess for the slab size until it is ready */
     }
     reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = n, .spec = spec, .pg = pg, .mon = mon,
-                    .rows_before = (int)spec->height - rows_missing, .mh = mh, .mstate = mstate,
-                    .done = (int)spec->height - rows_missing, .total = (int)spec->height};
+                    .rows_before = rows_job - rows_missing, .mh = mh, .mstate = mstate, .total = rows_missing};
     joiner j = {a, g, cl, &rep, 0};
     rep.join = &j;
     monitor_update(&rep);
@@ -603,6 +604,28 @@ static int unlock_with(job_lock *lk, int rc)
     }
     jlk_release(lk, 0);
     return rc;
+}
+
+/* The window's rows from the job directory into rgb (the other rows are
+ * left as they are); fails naming the window's rows that are missing.
+ * have (height bytes) is scratch. */
+static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_window *win, float *rgb,
+                       unsigned char *have, fr_error *err)
+{
+    if (job_gather(jobdir, spec, rgb, have, NULL, err) < 0)
+        return -1;
+    int missing = 0;
+    for (uint32_t y = 0; y < spec->height; y++) {
+        if (y < win->y0 || y >= win->y1)
+            have[y] = 1;
+        missing += !have[y];
+    }
+    if (missing) {
+        char rows[512];
+        job_missing_rows(have, spec->height, rows, sizeof rows);
+        return fr_fail(err, "%s: rows %s of the window are missing", jobdir, rows);
+    }
+    return 0;
 }
 
 int cmd_render(int argc, char **argv)
@@ -710,6 +733,19 @@ int cmd_render(int argc, char **argv)
         slurm_close(&alloc);
         return unlock_with(&lk, a.integrator ? 2 : 1);
     }
+    if (a.crop && crop_check(&a.win, spec.width, spec.height, &err)) {
+        fprintf(stderr, "franja render: --crop %s\n", err.msg);
+        scn_free(&sc);
+        hosts_free(&table);
+        slurm_close(&alloc);
+        return unlock_with(&lk, 2);
+    }
+    /* A crop renders the window's rows only, except bidirectionally: light
+     * paths started from every pixel of the image reach the window. */
+    int crop_rows = a.crop && spec.integrator != FR_INTEGRATOR_BDPT;
+    if (a.crop && !crop_rows)
+        fprintf(stderr, "franja: --crop with --integrator bdpt renders every row (light traced from the whole "
+                "image reaches the window)\n");
     uint32_t asked = spec.spp;
     if (quick_spp(&spec.spp, &err) > 0)
         fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
@@ -743,7 +779,18 @@ int cmd_render(int argc, char **argv)
         }
         fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", rows_have, spec.height, jobdir);
     }
-    if (a.json && !(pg = pg_start(stdout, a.out, jobdir, &spec, &err))) {
+    /* The rows this render needs (a crop's window), and those of them done. */
+    int rows_job = crop_rows ? (int)(a.win.y1 - a.win.y0) : (int)spec.height;
+    if (crop_rows) {
+        rows_have = 0;
+        for (uint32_t y = 0; y < spec.height; y++) {
+            int inside = y >= a.win.y0 && y < a.win.y1;
+            rows_have += inside && have[y];
+            if (!inside)
+                have[y] = 1; /* not rendered */
+        }
+    }
+    if (a.json && !(pg = pg_start(stdout, a.out, jobdir, &spec, (uint32_t)rows_job, &err))) {
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         goto done;
     }
@@ -761,19 +808,37 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: --preview: %s\n", err.msg);
         goto done;
     }
-    int slabs_rc = (uint32_t)rows_have < spec.height
-                       ? run_slabs(&a, &table, fbin, &spec, jobdir, have, (int)spec.height - rows_have, pg, mon, &err)
-                       : 0;
+    int slabs_rc = rows_have < rows_job ? run_slabs(&a, &table, fbin, &spec, jobdir, have, rows_job,
+                                                    rows_job - rows_have, pg, mon, &err)
+                                        : 0;
     pv_stop(pv);
     if (slabs_rc) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err)) {
+    if (crop_rows ? crop_stitch(jobdir, &spec, &a.win, rgb, have, &err)
+                  : job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (out_write(a.out, rgb, &spec, &tm, &err)) {
+    job_spec out_spec = spec;
+    if (a.crop) {
+        crop_black(&a.win, rgb, spec.width, spec.height);
+        if (a.crop_output) {
+            /* The window moves to the start of the buffer. */
+            float *w = malloc((size_t)(a.win.x1 - a.win.x0) * (a.win.y1 - a.win.y0) * 3 * sizeof *w);
+            if (!w) {
+                fprintf(stderr, "franja render: out of memory for the window\n");
+                goto done;
+            }
+            crop_extract(&a.win, rgb, spec.width, w);
+            free(rgb);
+            rgb = w;
+            out_spec.width = a.win.x1 - a.win.x0;
+            out_spec.height = a.win.y1 - a.win.y0;
+        }
+    }
+    if (out_write(a.out, rgb, &out_spec, &tm, &err)) {
         fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume to "
                 "write %s\n", err.msg, jobdir, a.out);
         goto done;
@@ -786,7 +851,7 @@ int cmd_render(int argc, char **argv)
     if (!a.keep_job)
         job_remove(jobdir);
     jlk_release(&lk, !a.keep_job);
-    fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, spec.width, spec.height, spec.spp,
+    fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, out_spec.width, out_spec.height, spec.spp,
             clk_now() - t0);
     rc = 0;
 done:

@@ -8,7 +8,8 @@
 
 static const char usage[] =
     "usage: franja render SCENE [-o OUT] [--hosts FILE | --slurm] [-j N] [--spp N]\n"
-    "                     [--size WxH] [--exposure E] [--resume] [--preview FILE]\n"
+    "                     [--size WxH] [--crop X0:Y0:X1:Y1 [--crop-output]] [--exposure E]\n"
+    "                     [--resume] [--preview FILE]\n"
     "                     [--progress json] [--monitor PORT] [--accept-new-hosts] ...\n"
     "       franja compile SCENE [-o SCENE.fbin] [--camera NAME]\n"
     "       franja hosts check|list --hosts FILE | --slurm\n"

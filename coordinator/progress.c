@@ -13,6 +13,7 @@ struct pg_reporter {
     FILE *out;
     char *dir;
     job_spec spec;
+    uint32_t total;            /* rows the render needs */
     double t0;
     int rows0;                 /* rows done when this run started */
     int rows;                  /* last count printed */
@@ -48,9 +49,9 @@ static void poll_once(pg_reporter *r)
     double rate = t > 0 ? (rows - r->rows0) / t : 0;
     fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
                     "\"eta_s\":",
-            rows, r->spec.height, t, rate);
+            rows, r->total, t, rate);
     if (rate > 0)
-        fprintf(r->out, "%.1f}\n", (r->spec.height - (uint32_t)rows) / rate);
+        fprintf(r->out, "%.1f}\n", rows < (int)r->total ? (r->total - (uint32_t)rows) / rate : 0.0);
     else
         fputs("null}\n", r->out);
     fflush(r->out);
@@ -98,7 +99,8 @@ static void *run(void *arg)
     return NULL;
 }
 
-pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_spec *spec, fr_error *err)
+pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_spec *spec, uint32_t rows,
+                      fr_error *err)
 {
     pg_reporter *r = calloc(1, sizeof *r);
     if (!r || !(r->dir = strdup(dir))) {
@@ -108,12 +110,13 @@ pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_
     }
     r->out = out;
     r->spec = *spec;
+    r->total = rows;
     r->t0 = clk_now();
     r->rows0 = r->rows = job_rows_present(dir);
     fputs("{\"event\":\"start\",\"output\":", out);
     pg_json_string(out, output);
-    fprintf(out, ",\"width\":%u,\"height\":%u,\"spp\":%u,\"rows_done\":%d,\"time\":%lld}\n", spec->width,
-            spec->height, spec->spp, r->rows0, (long long)time(NULL));
+    fprintf(out, ",\"width\":%u,\"height\":%u,\"spp\":%u,\"rows\":%u,\"rows_done\":%d,\"time\":%lld}\n",
+            spec->width, spec->height, spec->spp, rows, r->rows0, (long long)time(NULL));
     fflush(out);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
@@ -142,18 +145,18 @@ void pg_stop(pg_reporter *r, const char *status)
     pthread_cond_signal(&r->wake);
     pthread_mutex_unlock(&r->lock);
     pthread_join(r->thread, NULL);
-    if (!strcmp(status, "ok") && r->rows != (int)r->spec.height) {
+    if (!strcmp(status, "ok") && r->rows != (int)r->total) {
         /* Every row is in the image now, whatever the directory shows. */
         double t = clk_now() - r->t0;
         fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%u,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
                         "\"eta_s\":0}\n",
-                r->spec.height, r->spec.height, t, t > 0 ? (r->spec.height - (uint32_t)r->rows0) / t : 0.0);
-        r->rows = (int)r->spec.height;
+                r->total, r->total, t, t > 0 ? (r->total - (uint32_t)r->rows0) / t : 0.0);
+        r->rows = (int)r->total;
     } else if (strcmp(status, "ok")) {
         poll_once(r);
     }
     fprintf(r->out, "{\"event\":\"done\",\"status\":\"%s\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n", status,
-            r->rows, r->spec.height, clk_now() - r->t0);
+            r->rows, r->total, clk_now() - r->t0);
     fflush(r->out);
     pthread_cond_destroy(&r->wake);
     pthread_mutex_destroy(&r->lock);
