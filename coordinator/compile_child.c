@@ -1,5 +1,6 @@
 /* compile_child.c -- the scene compiled in a child process that an
- * interruption can stop at once. */
+ * interruption can stop at once, and that ends with the process that
+ * started it (PR_SET_PDEATHSIG), even one killed by SIGKILL. */
 #include "compile_child.h"
 
 #include <dirent.h>
@@ -9,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -120,6 +122,7 @@ int compile_child(const char *scene, const compile_opts *o, const char *out, vol
         return fr_fail(err, "%s: cannot start the compiler: %s", scene, strerror(e));
     }
     fflush(NULL);
+    pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         int e = errno;
@@ -129,6 +132,11 @@ int compile_child(const char *scene, const compile_opts *o, const char *out, vol
         return fr_fail(err, "%s: cannot start the compiler: %s", scene, strerror(e));
     }
     if (pid == 0) {
+        /* The child holds what the parent held (the job lock): it must not
+         * outlive a parent killed by SIGKILL, which could not stop it.  A
+         * parent gone before the signal was set is seen by getppid. */
+        if (prctl(PR_SET_PDEATHSIG, SIGKILL) || getppid() != parent)
+            _exit(1);
         close(p[0]);
         child(scene, o, file, p[1]);
         fflush(NULL);

@@ -9,8 +9,11 @@
  * the output); the parent waits, looking at the caller's stop flag ten
  * times a second.  When the flag is set (SIGINT, SIGTERM) the child is
  * killed at once.  The output appears, by a rename, only when complete;
- * the private directory is removed in every case.  The caller must have no
- * other threads running (fork).
+ * the private directory is removed in every case but one: a caller killed
+ * by SIGKILL.  The child then gets SIGKILL too (PR_SET_PDEATHSIG), so it
+ * neither keeps what it inherited (a job lock) nor goes on compiling; its
+ * private directory is left.  The caller must have no other threads
+ * running (fork).
  */
 #ifndef FRANJA_COMPILE_CHILD_H
 #define FRANJA_COMPILE_CHILD_H

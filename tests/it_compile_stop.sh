@@ -3,6 +3,8 @@
 # franja compile at once (the compile runs in a child process that is
 # killed), leaves no partial scene.fbin, no private compile directory and
 # no job directory; an uninterrupted compile still writes the same scene.
+# SIGKILL of franja render ends its compiling child with it, so the job
+# lock is free for the next render.
 # A scene that fails to compile leaves no job directory.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
@@ -88,6 +90,48 @@ stopped "compile, SIGTERM" TERM "$T" "$F" compile "$T/big.json" -o "$T/full.fbin
 check "compile, SIGTERM: the older scene is left as it was" cmp -s "$T/full.fbin" "$T/keep.fbin"
 left=$(ls -A "$T" | grep -v -e '^big\.' -e '^full\.fbin$' -e '^keep\.fbin$' -e '^out$' -e '^err$')
 [ -z "$left" ] && ok || bad "left behind: $left"
+# SIGKILL, which franja cannot catch: the compiling child ends with it
+# (it must not go on compiling, nor keep the job lock it inherited), so a
+# second render of the same image starts at once.
+compiling_child() { # the pid of franja's compiling child, once there is one
+    for c in $(pgrep -P "$1" 2>/dev/null); do
+        [ "$(cat /proc/"$c"/comm 2>/dev/null)" = franja ] && { echo "$c"; return 0; }
+    done
+    return 1
+}
+"$F" render "$T/big.json" -o "$T/k.png" >"$T/out" 2>"$T/err" &
+pid=$!
+i=0
+while [ $i -lt 600 ] && ! child=$(compiling_child $pid); do sleep 0.05; i=$((i + 1)); done
+if [ -z "$child" ]; then
+    bad "render, SIGKILL: never seen compiling"
+    kill -KILL $pid 2>/dev/null
+else
+    until_compiling "$T/k.png.franja-job" && ok || bad "render, SIGKILL: no private compile directory"
+    kill -KILL $pid
+    t0=$(secs)
+    i=0
+    # Gone means no longer running: a zombie waits for a late reaper.
+    running() { [ -r /proc/"$1"/stat ] && ! grep -Eq '^[0-9]+ \(.*\) [ZX] ' /proc/"$1"/stat; }
+    while [ $i -lt 100 ] && running "$child"; do sleep 0.05; i=$((i + 1)); done
+    took=$(elapsed "$t0")
+    ! running "$child" && ok || bad "render, SIGKILL: the compiling child $child is still running $took s later"
+    less "$took" 1.5 && ok || bad "render, SIGKILL: the compiling child ended $took s after its parent"
+    # A second render of the same image takes the job lock and compiles.
+    "$F" render "$T/big.json" -o "$T/k.png" >"$T/out2" 2>"$T/err2" &
+    pid2=$!
+    i=0
+    while [ $i -lt 600 ] && ! compiling_child $pid2 >/dev/null && kill -0 $pid2 2>/dev/null; do
+        sleep 0.05
+        i=$((i + 1))
+    done
+    compiling_child $pid2 >/dev/null && ok || bad "render after SIGKILL: not compiling: $(cat "$T/err2")"
+    ! grep -q "being rendered by another franja" "$T/err2" && ok || bad "render after SIGKILL: $(cat "$T/err2")"
+    kill -INT $pid2 2>/dev/null
+    wait $pid2
+fi
+wait $pid 2>/dev/null
+rm -rf "$T/k.png.franja-job" "$T/out2" "$T/err2"
 # A scene that fails to compile leaves no job directory either.
 printf '{"image": {"width": 8, "height": 8, "spp": 1},\n "camera": 3}\n' >"$T/bad.json"
 expect_error "render of a scene that fails to parse" "bad.json: camera: missing or not an object" "$F" render "$T/bad.json" -o "$T/bad.png"
