@@ -133,6 +133,14 @@ int tr_shell_quote(const char *word, char *out, size_t cap, fr_error *err);
  * processes.  p->impl belongs to these functions.
  * @{ */
 int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err);
+/** tr_pipe_spawn for a process that must not outlive its starter: it gets
+ * signal sig (SIGTERM when sig <= 0) when the thread that called this ends
+ * (PR_SET_PDEATHSIG), however it ends, SIGKILL of the whole process
+ * included; it is not started if this process has already gone.  Call it
+ * from a thread that lives as long as the process may run (the main
+ * thread, for processes that outlive a helper thread).  Fails like
+ * tr_pipe_spawn ("cannot start NAME: REASON"). */
+int tr_pipe_spawn_tied(tr_proc *p, const char *const *argv, int sig, fr_error *err);
 int tr_pipe_pollfds(tr_proc *procs, struct pollfd *pfd, int max);
 void tr_pipe_service(tr_proc *procs);
 void tr_pipe_kill(tr_proc *p);

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,7 +24,93 @@ typedef struct {
     int reaped;
 } pipe_proc;
 
-int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err)
+/* The program file execvp would run for name: name itself when it holds a
+ * slash, else the first executable PATH entry.  Found here, before fork,
+ * so that the child calls nothing that might take a lock (the coordinator
+ * has threads). */
+static int find_program(const char *name, char *out, size_t cap)
+{
+    if (strchr(name, '/'))
+        return snprintf(out, cap, "%s", name) < (int)cap ? 0 : ENAMETOOLONG;
+    const char *path = getenv("PATH");
+    if (!path || !*path)
+        path = "/usr/local/bin:/usr/bin:/bin";
+    for (const char *d = path;; d++) {
+        const char *end = strchr(d, ':');
+        size_t len = end ? (size_t)(end - d) : strlen(d);
+        int n = snprintf(out, cap, "%.*s%s%s", (int)len, d, len ? "/" : "", name);
+        if (n > 0 && n < (int)cap && access(out, X_OK) == 0)
+            return 0;
+        if (!end)
+            return ENOENT;
+        d = end;
+    }
+}
+
+/* Makes fd the descriptor target of the child, open across exec
+ * (async-signal-safe). */
+static int onto(int fd, int target)
+{
+    if (fd == target)
+        return fcntl(fd, F_SETFD, 0) < 0 ? -1 : 0;
+    return dup2(fd, target) < 0 ? -1 : 0;
+}
+
+/* fork and exec with the parent-death signal set: the child gets sig when
+ * the thread that started it ends (the whole coordinator, for the main
+ * thread), SIGKILL included.  The exec's failure comes back on a pipe. */
+static int spawn_tied(pid_t *pid, const char *const *argv, int sig, int out, int err_fd)
+{
+    char prog[4096];
+    int rc = find_program(argv[0], prog, sizeof prog);
+    if (rc)
+        return rc;
+    int null = open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (null < 0)
+        return errno;
+    int st[2];
+    if (pipe2(st, O_CLOEXEC)) {
+        rc = errno;
+        close(null);
+        return rc;
+    }
+    pid_t parent = getpid();
+    pid_t c = fork();
+    if (c == 0) {
+        /* Only async-signal-safe calls from here on. */
+        int e = 0;
+        if (prctl(PR_SET_PDEATHSIG, sig) || getppid() != parent)
+            e = ESRCH; /* the parent is already gone: do not start */
+        else if (onto(null, 0) || onto(out, 1) || onto(err_fd, 2))
+            e = errno;
+        else {
+            execve(prog, (char *const *)argv, environ);
+            e = errno;
+        }
+        while (write(st[1], &e, sizeof e) < 0 && errno == EINTR) {
+        }
+        _exit(127);
+    }
+    rc = c < 0 ? errno : 0;
+    close(st[1]);
+    close(null);
+    if (c > 0) {
+        int e;
+        ssize_t k;
+        while ((k = read(st[0], &e, sizeof e)) < 0 && errno == EINTR) {
+        }
+        if (k == (ssize_t)sizeof e) {
+            rc = e;
+            while (waitpid(c, NULL, 0) < 0 && errno == EINTR) {
+            }
+        } else
+            *pid = c;
+    }
+    close(st[0]);
+    return rc;
+}
+
+static int spawn(tr_proc *p, const char *const *argv, int death_sig, fr_error *err)
 {
     pipe_proc *pp = calloc(1, sizeof *pp);
     if (!pp)
@@ -39,14 +126,19 @@ int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err)
         free(pp);
         return fr_fail(err, "pipe: %s", strerror(errno));
     }
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_adddup2(&fa, po[1], 1);
-    posix_spawn_file_actions_adddup2(&fa, pe[1], 2);
     pid_t pid;
-    int rc = posix_spawnp(&pid, argv[0], &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
+    int rc;
+    if (death_sig)
+        rc = spawn_tied(&pid, argv, death_sig, po[1], pe[1]);
+    else {
+        posix_spawn_file_actions_t fa;
+        posix_spawn_file_actions_init(&fa);
+        posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+        posix_spawn_file_actions_adddup2(&fa, po[1], 1);
+        posix_spawn_file_actions_adddup2(&fa, pe[1], 2);
+        rc = posix_spawnp(&pid, argv[0], &fa, NULL, (char *const *)argv, environ);
+        posix_spawn_file_actions_destroy(&fa);
+    }
     close(po[1]);
     close(pe[1]);
     if (rc) {
@@ -63,6 +155,13 @@ int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err)
     p->impl = pp;
     p->state = TR_RUNNING;
     return 0;
+}
+
+int tr_pipe_spawn(tr_proc *p, const char *const *argv, fr_error *err) { return spawn(p, argv, 0, err); }
+
+int tr_pipe_spawn_tied(tr_proc *p, const char *const *argv, int sig, fr_error *err)
+{
+    return spawn(p, argv, sig > 0 ? sig : SIGTERM, err);
 }
 
 /* Reads what is there; closes the descriptor at end of file.  Output that

@@ -17,10 +17,15 @@
  * was given.
  *
  * Stopping: an srun that gets SIGTERM cancels its step (the task is gone
- * within ~40 ms) and exits; SIGKILL would leave the step running, so it is
- * sent only to an srun still there long after its SIGTERM, at close.  An
- * srun whose node died may take Slurm's KillWait to exit: such sruns are
- * kept and reaped later instead of blocking the event loop.
+ * within ~40 ms) and exits; after SIGKILL only srun's helper process
+ * cancels the step, seconds later, so SIGKILL is sent only to an srun
+ * still there long after its SIGTERM, at close.  An srun whose node died
+ * may take Slurm's KillWait to exit: such sruns are kept and reaped later
+ * instead of blocking the event loop.  Every srun gets SIGTERM from the
+ * kernel when franja dies (tr_pipe_spawn_tied): a franja killed by
+ * SIGKILL leaves no step running.  Steps are started by the thread that
+ * renders (the main one); the short steps of the per-node threads (probes,
+ * scene copies) end before their thread. 
  *
  * A lost node: srun reports it ("Node failure on", a failed task launch,
  * or a step that cannot be created on the node any more); service() then
@@ -116,7 +121,7 @@ static int start_step(slurm_host *s, tr_proc *p, char *const *argv, int shared, 
     }
     full[n] = NULL;
     fr_error e;
-    if (tr_pipe_spawn(p, full, &e))
+    if (tr_pipe_spawn_tied(p, full, SIGTERM, &e))
         return fr_fail(err, "%s: %s", s->label, e.msg);
     return 0;
 }

@@ -5,7 +5,8 @@
 # render whatever the node count; the scene is broadcast once per node;
 # a node killed or set down mid-render loses only its slabs, a drained one
 # goes on; Ctrl-C and scancel
-# mid-render leave no step and no worker running; --resume finishes in a
+# mid-render leave no step and no worker running, and so does SIGKILL of
+# franja in an allocation that lives on; --resume finishes in a
 # second allocation (a batch job from hosts/franja.sbatch);
 # a node whose worker is another version is dropped, by name; outside an
 # allocation --slurm says what to run instead.
@@ -167,6 +168,25 @@ check "and exits 130 ($rc)" test $rc -eq 130
 check "Ctrl-C leaves no step and no worker running ($(sl_steps) $(sl_pids))" no_leftovers
 check "the slabs done so far are kept" test -n "$(ls i.pfm.franja-job/rows-* 2>/dev/null)"
 
+# SIGKILL of franja in an allocation that outlives it (an interactive
+# salloc shell): franja can do nothing, yet its sruns are told by the
+# kernel (parent-death signal) and cancel their steps.  The slabs take
+# 60 s, so a step that was not cancelled would still be there.
+sl_alloc_bg 120 -N3 -n6 sh -c 'echo $$ >alloc.pid; "$@" & wait; exec sleep 100' sh "$FRANJA" render scene.fbin -o kill.pfm $SIZE --slurm \
+    --workdir "$WD" --worker "$(wrapper slow 60)" --slab-rows 1 >/dev/null 2>logkill
+sl_until 40 sh -c "test \"\$(timeout 5 squeue -h -s </dev/null | grep -vc '\.extern')\" -ge 6"
+check "six steps of the render are running ($(sl_steps | tr '\n' ' '))" test "$(sl_steps | grep -vc '\.extern')" -ge 6
+pid=$(pgrep -f "render scene.fbin -o kill.pfm" | while read -r p; do
+    [ "$(cat /proc/"$p"/comm 2>/dev/null)" = franja ] && echo "$p"; done | head -n 1)
+kill -KILL "$pid"
+sl_until 10 no_leftovers
+check "SIGKILL of franja leaves no step and no worker running within 10 s ($(sl_steps) $(sl_pids))" no_leftovers
+check "while the allocation lives on" test -n "$(sl_jobs)"
+kill "$(cat alloc.pid)" # the allocation's shell ends, and so does the allocation
+wait "$SL_BG"
+SL_BG=
+sl_until 10 sh -c "test -z \"\$(timeout 5 squeue -h </dev/null)\""
+
 # scancel mid-render: every step goes, franja stops and keeps its slabs;
 # --resume in a second allocation (a batch job) finishes the same image.
 sl_alloc_bg 90 -N3 -n6 "$FRANJA" render scene.fbin -o c.pfm $SIZE --slurm --workdir "$WD" \
@@ -188,5 +208,10 @@ check "--resume in a batch job finishes the image ($(tail -n 3 resume.log))" cmp
 check "it renders only the missing rows" grep -q "resuming: [1-9][0-9]* of 30 rows already done" resume.log
 check "progress in a batch job is plain lines" sh -c "! grep -q \"$(printf '\r')\" resume.log"
 check "nothing left running after the batch job" no_leftovers
+
+sl_stop
+check "the cluster stops, leaving no daemon, step or task ($(sh "$CLUSTER" pids "$T/cl"))" \
+    test -z "$(sh "$CLUSTER" pids "$T/cl")"
+check "nothing started in an allocation is left running ($(sl_strays | tr '\n' ' '))" test -z "$(sl_strays)"
 
 summary

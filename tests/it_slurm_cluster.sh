@@ -47,4 +47,5 @@ check "stop leaves no daemon or step ($(sh "$CLUSTER" pids "$T/cl" | tr '\n' ' '
 check "stop removes the controller's and nodes' state" test ! -e "$T/cl/ctld" -a ! -e "$T/cl/spool"
 sh "$CLUSTER" stop "$T/cl"
 check "a second stop is harmless" test $? -eq 0
+check "nothing started in an allocation is left running ($(sl_strays | tr '\n' ' '))" test -z "$(sl_strays)"
 summary

@@ -16,6 +16,10 @@
 #   sl_steps                job steps the controller still knows (squeue -s)
 #   sl_jobs                 jobs the controller still knows (squeue)
 #   sl_pids [NODE]          live step and task processes of the cluster
+#   sl_strays               live processes started in an allocation of the
+#                           cluster (salloc's command and what it started),
+#                           which outlive an salloc that is stopped
+#   sl_stop                 stops the cluster now (the exit trap does it too)
 #   sl_until SECS CMD...    runs CMD every 0.1 s until it succeeds
 #
 # The checks and the closing line are tests/lib.sh's (check, summary ...).
@@ -28,7 +32,10 @@ WORKER="$ROOT/bin/franja-worker"
 
 sl_cleanup() {
     sl_bg_stop
-    [ -n "${T:-}" ] && [ -d "$T/cl" ] && sh "$CLUSTER" stop "$T/cl"
+    sl_stop
+    # salloc's command outlives a salloc stopped by a signal.
+    left=$(sl_strays)
+    [ -z "$left" ] || kill -KILL $left 2>/dev/null
     [ -n "${T:-}" ] && [ -z "${KEEP:-}" ] && rm -rf "$T"
 }
 
@@ -82,6 +89,19 @@ sl_steps() { sl_q squeue -h -s -o '%i %N'; }
 sl_jobs() { sl_q squeue -h -o '%i %T %N'; }
 
 sl_pids() { sh "$CLUSTER" steps "$T/cl" "${1:-}"; }
+
+sl_stop() { [ -n "${T:-}" ] && [ -d "$T/cl" ] && sh "$CLUSTER" stop "$T/cl"; }
+
+sl_strays() {
+    for f in $(grep -lzFx "SLURM_CONF=$T/cl/slurm.conf" /proc/[0-9]*/environ 2>/dev/null); do
+        d=${f%/environ}
+        p=${d#/proc/}
+        [ "$p" = "$$" ] && continue
+        grep -qz '^SLURM_JOB_ID=' "$f" 2>/dev/null || continue
+        st=$(sed -E 's/^[0-9]+ \(.*\) (.).*/\1/' "$d/stat" 2>/dev/null)
+        [ -n "$st" ] && [ "$st" != Z ] && [ "$st" != X ] && echo "$p"
+    done
+}
 
 sl_until() {
     n=$(($1 * 10))
