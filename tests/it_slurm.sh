@@ -2,7 +2,10 @@
 # franja render --slurm and franja hosts check --slurm on a real Slurm
 # cluster of three nodes on this machine (tests/slurm/cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process
-# render whatever the node count; the scene is broadcast once per node;
+# render whatever the node count; the scene is broadcast once per node,
+# found cached later and sent again when the cached copy is damaged; a
+# straggling node's slabs get second copies elsewhere; progress in a batch
+# job is a plain line every 10 s;
 # a node killed or set down mid-render loses only its slabs, a drained one
 # goes on; Ctrl-C and scancel
 # mid-render leave no step and no worker running, and so does SIGKILL of
@@ -29,6 +32,7 @@ case "$1" in
 slow) case " \$* " in *" --rows "*) sleep $2 ;; esac ;;
 version) if [ "\$SLURMD_NODENAME" = "$2" ] && [ "\$1" = --version ]; then
         echo "franja-worker 0.0.1 scene-format 1"; exit 0; fi ;;
+straggler) if [ "\$SLURMD_NODENAME" = "$2" ]; then case " \$* " in *" --rows "*) sleep 60 ;; esac; fi ;;
 esac
 exec "$WORKER" "\$@"
 SH
@@ -76,13 +80,20 @@ expect_error "a relative --workdir" "not an absolute path" "$FRANJA" render scen
 sl_alloc 60 -N3 -n6 "$FRANJA" hosts check --slurm >check.out 2>check.err
 check "hosts check --slurm succeeds ($(cat check.err))" test $? -eq 0
 for n in n1 n2 n3; do
-    check "hosts check lists $n with 2 CPUs and the worker" grep -Eq "^$n +ok +$(uname -m) .* 2 +franja-worker" check.out
+    check "hosts check lists $n with its arch, 2 CPUs and this build's worker version" \
+        grep -Eq "^$n +ok +$(uname -m) .* 2 +$("$WORKER" --version) " check.out
 done
 
 # Three nodes, then two of unequal size: the same bytes as one process.
 render log3 -N3 -n6 "$FRANJA" render scene.fbin -o n3.pfm $SIZE --slurm --workdir "$WD"
 check "3-node render is byte-identical to the one-process render ($(tail -n 3 log3))" cmp -s n3.pfm ref.pfm
-check "the scene was broadcast to each node" test "$(grep -c 'scene uploaded\|uploaded' log3)" -ge 3
+for n in n1 n2 n3; do
+    check "the scene was broadcast to $n once ($(grep -c "^franja: host $n: .*scene uploaded" log3))" \
+        test "$(grep -c "^franja: host $n: .*scene uploaded" log3)" -eq 1
+done
+check "and to no one else" test "$(grep -c 'scene uploaded' log3)" -eq 3
+check "it lies in the nodes' cache under its content hash" \
+    test "$(ls "$WD/scenes" | grep -Ec '^[0-9a-f]{16}\.fbin$')" -eq 1
 check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
 check "no step is left after the render" no_leftovers
 
@@ -94,7 +105,8 @@ check "a bidirectional 3-node render is byte-identical to one process ($(tail -n
 check "and differs from path tracing" sh -c "! cmp -s b3.pfm ref.pfm"
 render log2 -N2 -n3 "$FRANJA" render scene.fbin -o n2.pfm $SIZE --slurm --workdir "$WD" --slab-rows 3
 check "2 nodes (2 + 1 CPUs) give the same bytes" cmp -s n2.pfm ref.pfm
-check "the second render finds the scene cached" grep -q "already there" log2
+check "the second render finds the scene cached on both nodes" test "$(grep -c "scene already there" log2)" -eq 2
+check "and sends nothing" test "$(grep -c "scene uploaded" log2)" -eq 0
 check "a 1-CPU node runs one worker" grep -Eq "^  n2 +1 " log2
 
 # A shared work directory: the scene is copied there, once, no sbcast.
@@ -111,6 +123,29 @@ check "n2 rendered nothing" sh -c "! grep -Eq '^  n2 +[0-9]+ +[1-9]' logv"
 sl_alloc 60 -N3 -n6 "$FRANJA" hosts check --slurm --worker "$T/worker-version" >checkv.out 2>&1
 check "hosts check --slurm fails for a node with another worker version" test $? -eq 1
 check "and names it ($(cat checkv.out))" grep -Eq "^n2 +FAIL .*0\.0\.1" checkv.out
+
+# A damaged copy in the nodes' cache (same name, other bytes) is found
+# by the workers' hash check and sent again.
+f=$(ls "$WD"/scenes/*.fbin)
+printf 'XXXXXXXX' | dd of="$f" bs=1 seek=200 conv=notrunc 2>/dev/null
+render logr -N3 -n6 "$FRANJA" render scene.fbin -o r.pfm $SIZE --slurm --workdir "$WD"
+check "a damaged cached scene is noticed and sent again ($(grep -c damaged logr))" \
+    grep -q "cached scene .* is damaged; uploading it again" logr
+check "and the image is the same" cmp -s r.pfm ref.pfm
+check "the cache holds the right scene again" cmp -s "$f" scene.fbin
+
+# A straggler: n3's workers take a minute per slab.  Once nothing is
+# queued, the other nodes run second copies of its slabs, the first copy
+# to finish wins, and n3's losing steps are cancelled.
+t0=$(date +%s)
+render logs3 -N3 -n6 "$FRANJA" render scene.fbin -o st.pfm $SIZE --slurm --workdir "$WD" \
+    --worker "$(wrapper straggler n3)" --slab-rows 2
+took=$(($(date +%s) - t0))
+check "a render with a straggling node succeeds ($(tail -n 3 logs3))" cmp -s st.pfm ref.pfm
+check "without waiting for the straggler (${took} s)" test $took -lt 50
+check "n3's slabs got second copies on n1 or n2" grep -q "still running; starting a second copy on n[12]" logs3
+check "n3 finished no slab" grep -Eq "^  n3 +2 +0 " logs3
+check "its steps are cancelled at the end ($(sl_steps) $(sl_pids))" no_leftovers
 
 # An administrator sets n2 down and drains n1 mid-render: n2's steps fail
 # and it is dropped at once, its slabs going elsewhere; a drained node
@@ -208,6 +243,20 @@ check "--resume in a batch job finishes the image ($(tail -n 3 resume.log))" cmp
 check "it renders only the missing rows" grep -q "resuming: [1-9][0-9]* of 30 rows already done" resume.log
 check "progress in a batch job is plain lines" sh -c "! grep -q \"$(printf '\r')\" resume.log"
 check "nothing left running after the batch job" no_leftovers
+
+# Progress in a batch job (no terminal): a plain line every 10 s and one
+# at the end.  Each slab waits 2 s, so this render lasts about 16 s.
+FRANJA="$FRANJA" sl_q sbatch -N2 -n4 -o "$T/prog.log" "$ROOT/hosts/franja.sbatch" \
+    scene.fbin -o p.pfm $SIZE --workdir "$WD" --slab-rows 1 --worker "$(wrapper slow 2)" >/dev/null
+sl_until 120 sh -c "test -z \"\$(timeout 5 squeue -h </dev/null)\""
+check "the batch render is the same image ($(tail -n 2 prog.log))" cmp -s p.pfm ref.pfm
+sed -n 's/^franja: \[ *\([0-9.]*\)s\] rows \([0-9]*\)\/30 .*/\1 \2/p' prog.log >prog.lines
+check "its log has progress lines, the last at 30/30 ($(tr '\n' ' ' <prog.lines))" \
+    sh -c "test \"\$(tail -n 1 prog.lines | cut -d' ' -f2)\" = 30"
+check "including one before the end" sh -c "awk '\$2 < 30' prog.lines | grep -q ."
+check "10 s apart (but the last)" awk 'NR > 1 && prev_t != "" && $2 < 30 && $1 - prev_t < 9.9 { bad = 1 }
+    { prev_t = $1 } END { exit bad }' prog.lines
+check "no terminal control characters" sh -c "! grep -q \"\$(printf '\033')\" prog.log"
 
 sl_stop
 check "the cluster stops, leaving no daemon, step or task ($(sh "$CLUSTER" pids "$T/cl"))" \
