@@ -189,22 +189,21 @@ static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u
 static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2, vec3 *p, vec3 *n, float *ua, float *ub,
                        vec3 *err)
 {
-    vec3 unused;
-    if (!err)
-        err = &unused;
     if (pr->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[pr->index];
         float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
         fm_sincosf(2.0f * FM_PI * u2, &sn, &cs);
         *n = v3(r * cs, r * sn, z);
         *p = v3_madd(sp->center, *n, sp->radius);
-        geo_sphere_point(sp, *n, err);
+        if (err)
+            geo_sphere_point(sp, *n, err);
         *ua = *ub = 0.0f;
     } else if (pr->kind == FR_PRIM_RECT) {
         const fr_rect *q = &s->rects[pr->index];
         *p = v3_add(q->origin, v3_add(v3_scale(q->edge_u, u1), v3_scale(q->edge_v, u2)));
         *n = v3_norm(q->normal);
-        geo_rect_point(q, u1, u2, err);
+        if (err)
+            geo_rect_point(q, u1, u2, err);
         *ua = u1;
         *ub = u2;
     } else {
@@ -215,8 +214,31 @@ static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2,
         *n = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
         *ua = b1;
         *ub = 1.0f - b0 - b1;
-        geo_triangle_point(p0, p1, p2, *ua, *ub, err);
+        if (err)
+            geo_triangle_point(p0, p1, p2, *ua, *ub, err);
     }
+}
+
+int lgt_has_fixed_point(const fr_scene *s, uint32_t light)
+{
+    const fr_light *l = &s->lights[light];
+    return l->kind == FR_LIGHT_POINT || l->kind == FR_LIGHT_SPOT ||
+           (l->kind == FR_LIGHT_PRIM && s->prims[l->prim].kind != FR_PRIM_SPHERE);
+}
+
+int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 *p)
+{
+    const fr_light *l = &s->lights[light];
+    if (!lgt_has_fixed_point(s, light))
+        return 0;
+    if (l->kind != FR_LIGHT_PRIM) {
+        *p = l->position;
+        return 1;
+    }
+    vec3 n;
+    float ua, ub;
+    prim_point(s, &s->prims[l->prim], u1, u2, p, &n, &ua, &ub, NULL);
+    return 1;
 }
 
 int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out)

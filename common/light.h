@@ -50,6 +50,18 @@ uint32_t lgt_n_distant(const fr_scene *s);
  * outside a spot's cone, a black part of a map). */
 int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out);
 
+/** The point lgt_sample picks on light `light` with (u1, u2) wherever it is
+ * seen from, into *p: a point or spot light's position, or the point
+ * uniform by area on a rectangle or triangle.  Returns 0 for lights whose
+ * sampled point depends on where they are seen from (spheres) or that have
+ * none (sun, environment).  Equiangular sampling in media picks the light
+ * point first and the scattering point after it. */
+int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 *p);
+
+/** Whether lgt_fixed_point has a point for light `light` (it fails for a
+ * kind of light, never for a point). */
+int lgt_has_fixed_point(const fr_scene *s, uint32_t light);
+
 /** Solid-angle pdf that lgt_sample would have produced the point `p` (normal
  * `n`) of area light `light` from `from`. */
 float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n);

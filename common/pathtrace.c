@@ -56,9 +56,12 @@ fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float 
  * vertex sf of material m, seen along wo: its emission times beta, weighted
  * against light sampling from the previous vertex prev_p, whose scattering
  * sampled this direction with solid-angle density prev_pdf (or a delta
- * event: weight 1). */
-static vec3 emission(const fr_scene *s, pt_strategy strategy, const fr_material *m, const fr_surface *sf, vec3 wo,
-                     vec3 beta, float prev_pdf, int prev_delta, vec3 prev_p)
+ * event: weight 1); when that vertex was medium vertex prev_v (in medium
+ * prev_medium, not 0), against the equiangular sampling of its segment
+ * too. */
+static vec3 emission(const fr_scene *s, pt_strategy strategy, vtx_mis mis, const fr_material *m, const fr_surface *sf,
+                     vec3 wo, vec3 beta, float prev_pdf, int prev_delta, vec3 prev_p, const vtx_vertex *prev_v,
+                     uint32_t prev_medium)
 {
     vec3 le = lgt_emitted(m, sf->ng, wo);
     if (v3_is_zero(le))
@@ -67,8 +70,11 @@ static vec3 emission(const fr_scene *s, pt_strategy strategy, const fr_material 
     if (!prev_delta) {
         if (strategy == PT_LIGHT_ONLY)
             w = 0.0f;
-        else if (strategy != PT_BSDF_ONLY)
-            w = vtx_power_heuristic(prev_pdf, lgt_pdf(s, sf->light, prev_p, sf->p, sf->ng));
+        else if (strategy != PT_BSDF_ONLY) {
+            float pl = lgt_pdf(s, sf->light, prev_p, sf->p, sf->ng);
+            w = prev_medium ? vtx_medium_hit_weight(s, prev_v, prev_medium, mis, sf->light, sf->p, prev_pdf, pl)
+                            : vtx_power_heuristic(prev_pdf, pl);
+        }
     }
     return v3_scale(v3_mul(beta, le), w);
 }
@@ -110,6 +116,8 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
     float prev_pdf = 0.0f;     /* solid-angle pdf of the last BSDF or phase sample */
     int prev_delta = 1;        /* the camera ray counts as a delta event */
     vec3 prev_p = ray.o;
+    vtx_vertex prev_v;         /* the last vertex, when it was in a medium */
+    uint32_t prev_medium = 0;  /* its medium (1 + index); 0: the last vertex was not in a medium */
     uint32_t medium = s->volume.camera_medium;   /* the ray's medium: 1 + index, 0 = vacuum */
     const uint32_t max_depth = s->settings.max_depth;
     vtx_mis mis = {strategy != PT_LIGHT_ONLY, strategy == PT_MIS || strategy == PT_LIGHT_ONLY};
@@ -117,7 +125,7 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
     for (uint32_t depth = 0;; depth++) {
         vtx_vertex v;
         int equi = mis.equiangular && depth < max_depth && s->n_lights;
-        int kind = vtx_next(s, &smp, &ray, &medium, &beta, equi ? &L : NULL, &v);
+        int kind = vtx_next(s, &smp, &ray, &medium, &beta, mis, equi ? &L : NULL, &v);
         if (kind == VTX_ESCAPED)
             L = v3_add(L, escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta));
         if (kind == VTX_ESCAPED || kind == VTX_LOST)
@@ -138,12 +146,15 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
             vtx_scatter_medium(s, &v, medium, v1, v2, &ray, &prev_pdf);
             prev_delta = 0;
             prev_p = v.p;
+            prev_v = v;
+            prev_medium = medium;
         } else {
             fr_material textured;
             const fr_material *m = tex_material(s, &s->materials[v.sf.material], &v.sf, &textured);
             vec3 wo = v3_neg(ray.d);
             if (v.sf.light != FR_NONE)
-                L = v3_add(L, emission(s, strategy, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p));
+                L = v3_add(L, emission(s, strategy, mis, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p, &prev_v,
+                                       prev_medium));
             if (depth >= max_depth)
                 break;
             smp_2d(&smp, &upick, &ulobe);
@@ -158,6 +169,7 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
             prev_pdf = bs.pdf;
             prev_delta = bs.delta;
             prev_p = v.sf.p;
+            prev_medium = 0;
         }
         if (!roulette(&smp, depth, &beta))
             break;

@@ -13,35 +13,67 @@ float vtx_power_heuristic(float a, float b)
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
-/* Equiangular sampling toward a point light over one medium segment
- * (o + t d, t in [0, tmax), medium `medium`, throughput beta at o): the
- * single-scattering estimate of light picked by upick, at a distance chosen
- * by u, weighted by MIS against the free-flight sampling that the path
- * itself does on the same segment (its vertices' point-light estimates take
- * the complementary weight).  Area lights are left to the path's vertices. */
-static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, float tmax, vec3 beta, float upick,
-                        float u)
+float vtx_power_heuristic3(float a, float b, float c)
 {
-    const fr_medium *md = &s->media[medium - 1];
-    const fr_light *l = &s->lights[lgt_pick(s, upick)];
-    float t, pe;
-    if ((l->kind != FR_LIGHT_POINT && l->kind != FR_LIGHT_SPOT) || v3_is_zero(md->sigma_s) ||
-        !med_equiangular(ray->o, ray->d, tmax, l->position, u, &t, &pe))
-        return v3s(0.0f);
-    vec3 x = v3_madd(ray->o, ray->d, t), to = v3_sub(l->position, x);
-    float d2 = v3_len2(to), d = sqrtf(d2);
-    fr_ray shadow = {x, v3_scale(to, 1.0f / d)};
-    vec3 tr = med_shadow(s, medium, &shadow, d, FR_NONE);
-    if (v3_is_zero(tr))
-        return v3s(0.0f);
-    float pd = med_distance_pdf(md, beta, t);
-    float w = vtx_power_heuristic(pe, pd) * med_phase(md->g, v3_dot(ray->d, shadow.d)) / (pe * l->pick * d2);
-    vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, lgt_intensity(l, v3_neg(shadow.d))));
-    return v3_scale(v3_mul(beta, f), w);
+    float a2 = a * a, sum = a2 + b * b + c * c;
+    return sum > 0.0f ? a2 / sum : 0.0f;
 }
 
-int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vec3 *equi_L,
-             vtx_vertex *v)
+/* Equiangular sampling over one medium segment (o + t d, t in [0, tmax),
+ * medium `medium`, throughput beta at o): the light picked by upick, its
+ * point first (lgt_fixed_point with (ul1, ul2): a point or spot light's
+ * position, a point of a rectangle or triangle), then a distance by u with
+ * density proportional to the inverse squared distance to that point; the
+ * single-scattering estimate of the light, weighted by MIS against the
+ * free-flight sampling that the path itself does on the same segment (its
+ * medium vertex's light sample, and for area lights the phase sample that
+ * hits the light when mis.area), which take the complementary weights
+ * (vtx_direct_medium, vtx_medium_hit_weight).  Lights sampled by where
+ * they are seen from (spheres) and distant lights are left to the path's
+ * vertices. */
+static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, float tmax, vec3 beta, vtx_mis mis,
+                        float upick, float u, float ul1, float ul2)
+{
+    const fr_medium *md = &s->media[medium - 1];
+    vec3 c, x;
+    float t, pe;
+    fr_light_sample ls;
+    if (v3_is_zero(md->sigma_s) || !lgt_fixed_point(s, lgt_pick(s, upick), ul1, ul2, &c) ||
+        !med_equiangular(ray->o, ray->d, tmax, c, u, &t, &pe))
+        return v3s(0.0f);
+    /* The same light and point, now seen from the scattering point: its
+     * direction, distance, radiance and solid-angle pdf there. */
+    x = v3_madd(ray->o, ray->d, t);
+    if (!lgt_sample(s, x, upick, ul1, ul2, &ls))
+        return v3s(0.0f);
+    fr_ray shadow = {x, ls.wi};
+    vec3 tr = med_shadow(s, medium, &shadow, ls.dist, ls.prim);
+    if (v3_is_zero(tr))
+        return v3s(0.0f);
+    float pd = med_distance_pdf(md, beta, t), ph = med_phase(md->g, v3_dot(ray->d, ls.wi));
+    /* Densities of the (distance, light point) pair, each technique's
+     * pdf of the point in solid angle at x: equiangular pe * pl, the
+     * vertex's light sample pd * pl, its phase sample pd * ph. */
+    float w = ls.delta ? vtx_power_heuristic(pe, pd)
+                       : vtx_power_heuristic3(pe * ls.pdf, pd * ls.pdf, mis.area ? pd * ph : 0.0f);
+    vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, ls.radiance));
+    return v3_scale(v3_mul(beta, f), w * ph / (pe * ls.pdf));
+}
+
+float vtx_medium_hit_weight(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vtx_mis mis, uint32_t light,
+                            vec3 p, float phase_pdf, float light_pdf)
+{
+    float pe = 0.0f;
+    if (mis.equiangular && lgt_has_fixed_point(s, light))
+        pe = med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, p, v->t);
+    if (pe == 0.0f)
+        return vtx_power_heuristic(phase_pdf, light_pdf);
+    float pd = med_distance_pdf(&s->media[medium - 1], v->seg_beta, v->t);
+    return vtx_power_heuristic3(pd * phase_pdf, pd * light_pdf, pe * light_pdf);
+}
+
+int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vtx_mis mis,
+             vec3 *equi_L, vtx_vertex *v)
 {
     fr_hit hit;
     int found = trace_closest(s, ray, INFINITY, &hit);
@@ -59,11 +91,12 @@ int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, 
         float tmax = found ? hit.t : INFINITY;
         if (*medium) {
             const fr_medium *md = &s->media[*medium - 1];
-            float uch, ud, ueq_pick, ueq, t;
+            float uch, ud, ueq_pick, ueq, ul1, ul2, t;
             smp_2d(smp, &uch, &ud);
             smp_2d(smp, &ueq_pick, &ueq);
+            smp_2d(smp, &ul1, &ul2);
             if (equi_L)
-                *equi_L = v3_add(*equi_L, equiangular(s, *medium, ray, tmax, *beta, ueq_pick, ueq));
+                *equi_L = v3_add(*equi_L, equiangular(s, *medium, ray, tmax, *beta, mis, ueq_pick, ueq, ul1, ul2));
             vec3 w;
             int scattered = med_sample_distance(md, tmax, *beta, uch, ud, &t, &w);
             if (scattered) {
@@ -126,10 +159,15 @@ int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, v
     float ph = med_phase(md->g, v3_dot(v->seg.d, ls->wi));
     out->scatter_pdf = ph;
     out->weight = 1.0f;
-    if (ls->delta && !ls->distant && mis.equiangular)
-        out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t),
-                                          med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, ls->p, v->t));
-    else if (!ls->delta && mis.area)
+    float pe = 0.0f;
+    if (mis.equiangular && lgt_has_fixed_point(s, ls->light))
+        pe = med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, ls->p, v->t);
+    if (ls->delta && pe > 0.0f)
+        out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t), pe);
+    else if (!ls->delta && pe > 0.0f) {
+        float pd = med_distance_pdf(md, v->seg_beta, v->t);
+        out->weight = vtx_power_heuristic3(pd * ls->pdf, mis.area ? pd * ph : 0.0f, pe * ls->pdf);
+    } else if (!ls->delta && mis.area)
         out->weight = vtx_power_heuristic(ls->pdf, ph);
     out->L = v3_scale(v3_mul(beta, v3_mul(tr, ls->radiance)), out->weight * ph / ls->pdf);
     return 1;

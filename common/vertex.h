@@ -41,32 +41,40 @@ typedef struct {
 typedef struct {
     int area;                  /**< lights a ray can hit (area lights, sun disks, the environment) against the
                                     vertex's own scattering (BSDF or phase) */
-    int equiangular;           /**< point and spot lights seen from a medium: distance sampling against
-                                    equiangular */
+    int equiangular;           /**< lights seen from a medium (point and spot lights, rectangles and triangles):
+                                    distance sampling against equiangular */
 } vtx_mis;
 
 /** Power heuristic with beta = 2 (Veach 1997): the weight of a sample of
  * density a against a technique of density b; 0 when both are 0. */
 float vtx_power_heuristic(float a, float b);
 
+/** The power heuristic among three techniques: a^2 / (a^2 + b^2 + c^2); 0
+ * when all are 0. */
+float vtx_power_heuristic3(float a, float b, float c);
+
 /** Follow *ray, travelling in *medium (1 + index into media, 0: vacuum)
  * with path throughput *beta, to the path's next vertex, into *v; returns
  * v->kind.
  *
  * Without media in the scene: the closest surface, and nothing is drawn
- * from smp.  With media: every segment inside a medium draws two pairs
+ * from smp.  With media: every segment inside a medium draws three pairs
  * from smp, (colour channel, distance) for free-flight sampling
- * (med_sample_distance), then (light pick, position) for equiangular
- * sampling; the path scatters on the segment (VTX_MEDIUM) or reaches its
- * end, and *beta takes the segment's weight.  Interface surfaces are
- * crossed (updating *medium and ray->o; at most 64, then the path is lost:
- * VTX_LOST).  When equi_L is not NULL, each medium segment also adds to
- * *equi_L the single-scattering estimate of a point or spot light by equiangular
- * sampling (Kulla and Fajardo 2012), weighted against the free-flight
- * sampling this walk does; vtx_direct_medium gives the complementary
- * weight.  The numbers are drawn either way. */
-int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vec3 *equi_L,
-             vtx_vertex *v);
+ * (med_sample_distance), then (light pick, distance) and (the light point)
+ * for equiangular sampling; the path scatters on the segment (VTX_MEDIUM)
+ * or reaches its end, and *beta takes the segment's weight.  Interface
+ * surfaces are crossed (updating *medium and ray->o; at most 64, then the
+ * path is lost: VTX_LOST).  When equi_L is not NULL, each medium segment
+ * also adds to *equi_L the single-scattering estimate of a light by
+ * equiangular sampling (Kulla and Fajardo 2012): a point or spot light, or
+ * a point of a rectangle or triangle light chosen first (lgt_fixed_point),
+ * the distance then chosen toward it.  It is weighted against the
+ * free-flight sampling this walk does (mis: for area lights also against
+ * the phase sample that hits the light); vtx_direct_medium and
+ * vtx_medium_hit_weight give the complementary weights.  The numbers are
+ * drawn either way. */
+int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vtx_mis mis,
+             vec3 *equi_L, vtx_vertex *v);
 
 /** Next-event estimation at a vertex: one light sample and what it adds. */
 typedef struct {
@@ -87,12 +95,22 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
                        vec3 beta, vtx_mis mis, float upick, float u1, float u2, vtx_direct *out);
 
 /** Next-event estimation at medium vertex v (in `medium`), as
- * vtx_direct_surface with the phase function for the BSDF.  A point or spot light
- * is weighted against the equiangular sampling of v's segment when
- * mis.equiangular.  Returns 1 when a light was sampled (out->L may still
+ * vtx_direct_surface with the phase function for the BSDF.  When
+ * mis.equiangular, a light that equiangular sampling covers (vtx_next) is
+ * weighted against the equiangular sampling of v's segment as well (and
+ * an area light against the phase sample when mis.area).  Returns 1 when a light was sampled (out->L may still
  * be 0: blocked), 0 when none was. */
 int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, float upick,
                       float u1, float u2, vtx_direct *out);
+
+/** The MIS weight of light from area light `light`, at its point p, that
+ * a path found by sampling the phase function at medium vertex v (in
+ * `medium`) with solid-angle pdf phase_pdf, where light sampling from v
+ * has pdf light_pdf: against light sampling alone, or with
+ * mis.equiangular and a light that equiangular sampling covers, against
+ * both light sampling and equiangular sampling of v's segment toward p. */
+float vtx_medium_hit_weight(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vtx_mis mis, uint32_t light,
+                            vec3 p, float phase_pdf, float light_pdf);
 
 /** Scatter onward from medium vertex v (in `medium`): *next leaves v->p in
  * a direction sampled from the phase function with (u1, u2); *pdf is its

@@ -56,7 +56,7 @@ static int floor_vertex(const fr_scene *s, fr_sampler *smp, vtx_vertex *v)
     uint32_t medium = 0;
     vec3 beta = v3s(1.0f);
     smp_start(smp, 3, 4, 0, 0);
-    return vtx_next(s, smp, &ray, &medium, &beta, NULL, v);
+    return vtx_next(s, smp, &ray, &medium, &beta, (vtx_mis){1, 1}, NULL, v);
 }
 
 static void power_heuristic(void)
@@ -106,7 +106,7 @@ static void point_light(void)
           "a ball between the floor and the light blocks it");
     fr_ray up = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, 1.0f, 0.0f)};
     uint32_t medium = 0;
-    CHECK(vtx_next(&s, &smp, &up, &medium, &beta, NULL, &v) == VTX_ESCAPED, "a ray into the sky escapes");
+    CHECK(vtx_next(&s, &smp, &up, &medium, &beta, (vtx_mis){1, 1}, NULL, &v) == VTX_ESCAPED, "a ray into the sky escapes");
     scn_free(&s);
 }
 
@@ -152,7 +152,7 @@ static void media(void)
 {
     fr_scene s;
     test_scene(fog_scene, &s);
-    /* A ray in the fog draws two pairs per medium segment, whether or not
+    /* A ray in the fog draws three pairs per medium segment, whether or not
      * it adds the equiangular estimate; both walks go the same way. */
     int scattered = 0;
     for (uint32_t i = 0; i < 64; i++) {
@@ -163,9 +163,9 @@ static void media(void)
         uint32_t m1 = 1, m2 = 1;
         vec3 b1 = v3s(1.0f), b2 = v3s(1.0f), L = v3s(0.0f);
         vtx_vertex v1, v2;
-        int k1 = vtx_next(&s, &s1, &r1, &m1, &b1, &L, &v1);
-        int k2 = vtx_next(&s, &s2, &r2, &m2, &b2, NULL, &v2);
-        CHECK(k1 == k2 && s1.dim == 2 && s2.dim == 2 && !memcmp(&b1, &b2, sizeof b1), "sample %u: kinds %d %d, dims %u %u",
+        int k1 = vtx_next(&s, &s1, &r1, &m1, &b1, (vtx_mis){1, 1}, &L, &v1);
+        int k2 = vtx_next(&s, &s2, &r2, &m2, &b2, (vtx_mis){1, 1}, NULL, &v2);
+        CHECK(k1 == k2 && s1.dim == 3 && s2.dim == 3 && !memcmp(&b1, &b2, sizeof b1), "sample %u: kinds %d %d, dims %u %u",
               i, k1, k2, s1.dim, s2.dim);
         CHECK(k1 != VTX_ESCAPED, "sample %u: the floor or the fog stops the ray", i);
         CHECK(L.x >= 0.0f && isfinite(L.x), "sample %u: equiangular estimate %g", i, (double)L.x);
@@ -196,7 +196,7 @@ static void media(void)
     uint32_t medium = 0;
     vec3 beta = v3s(1.0f);
     vtx_vertex v;
-    CHECK(vtx_next(&s, &smp, &r, &medium, &beta, NULL, &v) == VTX_SURFACE && smp.dim == 0,
+    CHECK(vtx_next(&s, &smp, &r, &medium, &beta, (vtx_mis){1, 1}, NULL, &v) == VTX_SURFACE && smp.dim == 0,
           "vacuum: the floor, no dimension drawn (%u)", smp.dim);
     scn_free(&s);
 }

@@ -6,14 +6,15 @@
 # samples with another seed, rendered here; Cycles: 1024 samples, in
 # tests/data, made by `make refs`), so the RMSE measures noise, not the
 # small differences between the two models.  RUNS seeds each; medians.
-# Cycles (blender) is run at the same SPP when it is installed.
+# Cycles (blender) is run at the same SPP when it is installed (CYCLES=0:
+# not at all).  SCENES picks the cases (default: glass fog).
 cd "$(dirname "$0")/../.." || exit 1
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-SPP=${SPP:-32} REF_SPP=${REF_SPP:-1024} RUNS=${RUNS:-3} N=$(nproc)
+SPP=${SPP:-32} REF_SPP=${REF_SPP:-1024} RUNS=${RUNS:-3} N=$(nproc) CYCLES=${CYCLES:-1} SCENES=${SCENES:-glass fog}
 echo "== noise: RMSE at ${SPP} spp against each renderer's converged image, 128x128, medians of $RUNS seeds"
 echo "machine: $N cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "reproduce: sh tests/bench/noise.sh   (SPP, REF_SPP, RUNS in the environment)"
+echo "reproduce: sh tests/bench/noise.sh   (SPP, REF_SPP, RUNS, CYCLES, SCENES in the environment)"
 median() { tr ' ' '\n' | grep . | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 rmse() { bin/tools/imgcmp "$1" "$2" | sed -n 's/^rmse \([0-9.]*\).*/\1/p'; }
 # Render scene $1 at $2 spp with seed $3 into $4, in N row slabs at once.
@@ -35,7 +36,7 @@ franja() {
         done
     } >"$4"
 }
-for s in glass fog; do
+for s in $SCENES; do
     scene=tests/bench/scenes/cornell-$s.json
     franja "$scene" "$REF_SPP" 7 "$T/ref.pfm"
     fr="" cy="" tf="" tc=""
@@ -45,7 +46,7 @@ for s in glass fog; do
         t1=$(date +%s.%N)
         fr="$fr $(rmse "$T/fr.pfm" "$T/ref.pfm")"
         tf="$tf $(awk "BEGIN { print $t1 - $t0 }")"
-        if command -v blender >/dev/null 2>&1; then
+        if [ "$CYCLES" != 0 ] && command -v blender >/dev/null 2>&1; then
             t0=$(date +%s.%N)
             blender -b --factory-startup --python tests/refs/cycles_noise.py -- "$scene" "$T/cy.pfm" "$SPP" "$seed" \
                 >"$T/blender.log" 2>&1 || { echo "blender failed:"; tail -5 "$T/blender.log"; exit 1; }
