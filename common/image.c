@@ -58,16 +58,17 @@ static int write_chunk(const unsigned char *bytes, size_t len, void *ctx)
     return fwrite(bytes, 1, len, ctx) == len ? 0 : -1;
 }
 
-int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, const uint64_t *splat,
-              fr_error *err)
+/* The image, then (PF only) a block of nsplat 64-bit values after the
+ * pixels: the splats (sums == 0) or the sample sums (sums != 0). */
+static int write_image(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb,
+                       const uint64_t *splat, size_t nsplat, int sums, fr_error *err)
 {
     uint32_t w = info->width, rows = info->y1 - info->y0;
-    size_t nsplat = (size_t)info->width * info->height * 3;
     char tail[64] = "";
     unsigned char *tmp = NULL;
     if (splat) {
         if (fmt != IMG_PF)
-            return fr_fail(err, "light-tracing splats need the PF format");
+            return fr_fail(err, "%s need the PF format", sums ? "sample sums" : "light-tracing splats");
         tmp = malloc(SPLAT_CHUNK * 8);
         XXH3_state_t *st = XXH3_createState();
         if (!tmp || !st || XXH3_64bits_reset(st) != XXH_OK || splat_bytes(splat, nsplat, tmp, hash_chunk, st) < 0) {
@@ -75,7 +76,11 @@ int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float
             XXH3_freeState(st);
             return fr_fail(err, "out of memory writing the image");
         }
-        snprintf(tail, sizeof tail, " splat=%" PRIu64 ":%016" PRIx64, info->splat_paths, (uint64_t)XXH3_64bits_digest(st));
+        if (sums)
+            snprintf(tail, sizeof tail, " sums=%016" PRIx64, (uint64_t)XXH3_64bits_digest(st));
+        else
+            snprintf(tail, sizeof tail, " splat=%" PRIu64 ":%016" PRIx64, info->splat_paths,
+                     (uint64_t)XXH3_64bits_digest(st));
         XXH3_freeState(st);
     }
     fprintf(f, "%s\n# franja scene=%016" PRIx64 " rows=%u:%u spp=%u size=%ux%u%s\n%u %u\n%s\n",
@@ -118,6 +123,24 @@ int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float
     return 0;
 }
 
+int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, const uint64_t *splat,
+              fr_error *err)
+{
+    return write_image(f, fmt, info, rgb, splat, (size_t)info->width * info->height * 3, 0, err);
+}
+
+int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, const double *sums, fr_error *err)
+{
+    size_t n = (size_t)info->width * (info->y1 - info->y0) * 3;
+    uint64_t *bits = malloc((n ? n : 1) * sizeof *bits);
+    if (!bits)
+        return fr_fail(err, "out of memory writing the image");
+    memcpy(bits, sums, n * sizeof *bits);
+    int rc = write_image(f, IMG_PF, info, rgb, bits, n, 1, err);
+    free(bits);
+    return rc;
+}
+
 /* Read one header line (without the newline) starting at *pos. */
 static int header_line(const unsigned char *buf, size_t len, size_t *pos, char *out, size_t cap)
 {
@@ -134,6 +157,24 @@ static int header_line(const unsigned char *buf, size_t len, size_t *pos, char *
     return 0;
 }
 
+/* A little-endian IEEE double at p. */
+static double get_double(const unsigned char *p)
+{
+    uint64_t bits = 0;
+    for (int b = 7; b >= 0; b--)
+        bits = bits << 8 | p[b];
+    double d;
+    memcpy(&d, &bits, 8);
+    return d;
+}
+
+void img_sums_get(const unsigned char *buf, const img_partial_info *info, double *sums)
+{
+    size_t n = (size_t)info->width * (info->y1 - info->y0) * 3;
+    for (size_t k = 0; k < n; k++)
+        sums[k] = get_double(buf + info->sums_offset + k * 8);
+}
+
 int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *info, float **rgb, fr_error *err)
 {
     char line[256];
@@ -141,7 +182,8 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     if (header_line(buf, len, &pos, line, sizeof line) < 0 || strcmp(line, "PF") != 0)
         return fr_fail(err, "byte 0: not a PF (float RGB) partial image");
     at = pos;
-    unsigned long long scene, paths = 0, hash = 0;
+    unsigned long long scene, paths = 0, hash = 0, shash = 0;
+    int sums = 0;
     unsigned y0, y1, spp, fw, fh;
     char tail;
     if (header_line(buf, len, &pos, line, sizeof line) < 0)
@@ -151,15 +193,22 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
                &end) != 6 || end < 0)
         return fr_fail(err, "byte %zu: missing or malformed franja header comment", at);
     const char *rest = line + end;
-    if (*rest) {
+    if (!strncmp(rest, " sums=", 6)) {
+        /* " sums=<16 hex>": the sample sums follow the pixels. */
+        int e2 = -1;
+        if (strspn(rest + 6, "0123456789abcdef") != 16 || sscanf(rest, " sums=%16llx%n", &shash, &e2) != 1 ||
+            e2 != 22 || rest[e2] != 0)
+            return fr_fail(err, "byte %zu: malformed franja header comment (expected sums=<16 hex digits>)", at);
+        sums = 1;
+    } else if (*rest) {
         /* " splat=<paths>:<16 hex>": a positive count, a whole hash. */
         int e2 = -1;
         const char *colon = strchr(rest, ':');
         if (strncmp(rest, " splat=", 7) != 0 || rest[7] < '1' || rest[7] > '9' || !colon ||
             sscanf(rest, " splat=%llu:%16llx%n", &paths, &hash, &e2) != 2 || e2 < 0 || rest[e2] != 0 ||
             strlen(colon + 1) != 16)
-            return fr_fail(err, "byte %zu: malformed franja header comment (after size=: expected nothing or "
-                                "splat=<paths>:<16 hex digits>)", at);
+            return fr_fail(err, "byte %zu: malformed franja header comment (after size=: expected nothing, "
+                                "sums=<16 hex digits> or splat=<paths>:<16 hex digits>)", at);
     }
     at = pos;
     unsigned w, h;
@@ -171,12 +220,14 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     if (y0 >= y1 || y1 > fh || w != fw || h != y1 - y0 || w == 0 || fw > PROTO_MAX_SIZE || fh > PROTO_MAX_SIZE)
         return fr_fail(err, "byte %zu: size %ux%u does not match rows %u:%u of a %ux%u image", at, w, h, y0, y1,
                        fw, fh);
-    size_t n = (size_t)w * h * 3, nsplat = paths ? (size_t)fw * fh * 3 : 0;
+    size_t n = (size_t)w * h * 3, nsplat = paths ? (size_t)fw * fh * 3 : sums ? n : 0;
     if (len - pos != n * 4 + nsplat * 8)
         return fr_fail(err, "byte %zu: %zu bytes of pixels%s, expected %zu", pos, len - pos,
-                       paths ? " and splats" : "", n * 4 + nsplat * 8);
+                       paths ? " and splats" : sums ? " and sums" : "", n * 4 + nsplat * 8);
     if (paths && XXH3_64bits(buf + pos + n * 4, nsplat * 8) != hash)
         return fr_fail(err, "byte %zu: the splat block does not match its hash %016llx", pos + n * 4, hash);
+    if (sums && XXH3_64bits(buf + pos + n * 4, nsplat * 8) != shash)
+        return fr_fail(err, "byte %zu: the sums block does not match its hash %016llx", pos + n * 4, shash);
     float *out = malloc(n * sizeof *out);
     if (!out)
         return fr_fail(err, "out of memory reading a partial image");
@@ -196,6 +247,16 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
                                (double)v);
             }
             out[r * w * 3 + i] = v;
+            if (sums) {
+                /* The pixel is its sum over spp samples, to the bit. */
+                size_t k = r * w * 3 + i, o = pos + n * 4 + k * 8;
+                double sum = get_double(buf + o);
+                if (!(sum >= 0.0 && sum <= DBL_MAX) || (float)(sum / spp) != v) {
+                    free(out);
+                    return fr_fail(err, "byte %zu: the sum of pixel (%zu, %zu) is %g, not %u samples of %g", o,
+                                   i / 3, y0 + r, sum, spp, (double)v);
+                }
+            }
         }
     }
     info->scene = scene;
@@ -203,6 +264,7 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     info->splat_paths = paths;
     info->splat_hash = hash;
     info->splat_offset = paths ? pos + n * 4 : 0;
+    info->sums_offset = sums ? pos + n * 4 : 0;
     *rgb = out;
     return 0;
 }

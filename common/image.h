@@ -15,6 +15,14 @@
  * traced and the XXH3-64 hash of the splat block, and the block follows
  * the pixels: W*H*3 unsigned 64-bit little-endian fixed-point sums (2^-32
  * units), top row first, whole pixels of R, G, B (common/FORMAT.md).
+ *
+ * A path-traced PF partial may instead carry its sample sums, what an exact
+ * continuation with more samples needs (franja-worker --sums, --continue):
+ * the comment line ends with " sums=<16 hex>", the XXH3-64 hash of the
+ * block that follows the pixels: W*(y1-y0)*3 IEEE 754 doubles,
+ * little-endian, top row first, each the sum of the pixel channel's spp
+ * samples in sample order; each pixel value is (float)(sum / spp), which
+ * the reader checks to the bit.
  */
 #ifndef FRANJA_IMAGE_H
 #define FRANJA_IMAGE_H
@@ -37,6 +45,7 @@ typedef struct {
     uint64_t splat_paths;      /**< light subpaths whose splats follow the pixels; 0: no splat block */
     uint64_t splat_hash;       /**< img_read_partial: XXH3-64 of the splat block */
     size_t splat_offset;       /**< img_read_partial: where the splat block starts in the buffer */
+    size_t sums_offset;        /**< img_read_partial: where the sums block starts; 0: none */
 } img_partial_info;
 
 /** Write rows (3 floats per pixel, top row first, width*(y1-y0) pixels) in
@@ -47,10 +56,19 @@ typedef struct {
 int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, const uint64_t *splat,
               fr_error *err);
 
+/** Write a PF partial with its sample sums (width*(y1-y0)*3 doubles, top
+ * row first) after the pixels.  Returns -1 with err set if writing fails. */
+int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, const double *sums, fr_error *err);
+
+/** Copies the sums block of a partial that img_read_partial accepted with
+ * sums_offset != 0 into sums (width*(y1-y0)*3 doubles, the caller's). */
+void img_sums_get(const unsigned char *buf, const img_partial_info *info, double *sums);
+
 /** Parse a PF partial image held in buf[0..len).  Checks the magic, the
  * header comment, that the pixel rows match rows and width, that the
  * data length is exact (with the splat block, if the header announces one,
- * whose hash must match), and that every float is finite and >= 0 (a NaN,
+ * whose hash must match, or the sums block, whose hash must match and
+ * whose every sum must be finite, >= 0 and give its pixel), and that every float is finite and >= 0 (a NaN,
  * infinity or negative value is refused, naming the pixel).  On success *rgb is a malloc'd array (caller
  * frees) of width*(y1-y0)*3 floats, top row first.  Errors give the byte
  * offset. */

@@ -235,3 +235,25 @@ void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32
         }
     }
 }
+
+void pt_render_rows_sums(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, uint32_t first,
+                         double *sums, float *rgb)
+{
+    /* The loop of pt_render_rows without adaptive stops, from sample
+     * `first` on: the same additions in the same order, so the same bits. */
+    uint32_t w = s->settings.width, spp = s->settings.spp;
+    for (uint32_t y = y0; y < y1; y++) {
+        for (uint32_t x = 0; x < w; x++) {
+            size_t k = ((size_t)(y - y0) * w + x) * 3;
+            double acc[3] = {sums[k], sums[k + 1], sums[k + 2]};
+            for (uint32_t n = first; n < spp; n++) {
+                vec3 c = pt_sample(s, strategy, x, y, n);
+                acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
+            }
+            for (int i = 0; i < 3; i++) {
+                sums[k + i] = acc[i];
+                rgb[k + i] = (float)(acc[i] / spp);
+            }
+        }
+    }
+}

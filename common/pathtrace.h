@@ -43,4 +43,12 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
  * samples, so any split of the rows renders the same bits. */
 void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb);
 
+/** Like pt_render_rows without adaptive sampling (noise_threshold is
+ * ignored), keeping each pixel's sums: sums (width*(y1-y0)*3 doubles)
+ * holds the sums of samples [0, first) on entry (zeros for first = 0) and
+ * of samples [0, spp) on return, and rgb receives sum / spp.  Continuing
+ * from `first` gives the bits of a render of every sample at once. */
+void pt_render_rows_sums(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, uint32_t first,
+                         double *sums, float *rgb);
+
 #endif

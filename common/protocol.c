@@ -112,6 +112,12 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
     a->argv[n++] = s->out;
     if (s->lifeline)
         a->argv[n++] = "--lifeline";
+    if (s->sums)
+        a->argv[n++] = "--sums";
+    if (s->continue_from) {
+        a->argv[n++] = "--continue";
+        a->argv[n++] = s->continue_from;
+    }
     a->argv[n] = NULL;
     return 0;
 }
@@ -135,9 +141,11 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             check = 1;
         } else if (!strcmp(a, "--lifeline")) {
             r->slab.lifeline = 1;
+        } else if (!strcmp(a, "--sums")) {
+            r->slab.sums = 1;
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
                                 !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "--integrator") ||
-                                !strcmp(a, "--noise-threshold") || !strcmp(a, "-o"))) {
+                                !strcmp(a, "--noise-threshold") || !strcmp(a, "--continue") || !strcmp(a, "-o"))) {
             return fr_fail(err, "%s needs a value", a);
         } else if (!strcmp(a, "--scene")) {
             r->slab.scene = argv[++i];
@@ -164,6 +172,8 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             r->slab.integrator = 1 + k;
         } else if (!strcmp(a, "-o")) {
             r->slab.out = argv[++i];
+        } else if (!strcmp(a, "--continue")) {
+            r->slab.continue_from = argv[++i];
         } else {
             return fr_fail(err, "unknown argument '%s' (see --help)", a);
         }

@@ -42,13 +42,16 @@ typedef struct {
                                     when it reaches its end (worker/lifeline.h) */
     int integrator;            /**< 1 + FR_INTEGRATOR_* (scene.h); 0 = the scene's (no --integrator) */
     float noise_threshold;     /**< adaptive sampling threshold in (0, 1]; 0 = the scene's */
+    int sums;                  /**< --sums: the PF partial carries its sample sums (image.h) */
+    const char *continue_from; /**< --continue FILE: a partial with sums of the same slab and fewer samples,
+                                    whose samples are not rendered again; NULL = none */
 } proto_slab;
 
 /** A worker command line built by proto_slab_argv: argv points into the
  * struct's own buffers (and at the caller's strings), NULL-terminated,
  * without the program name. */
 typedef struct {
-    const char *argv[20];
+    const char *argv[24];
     char rows[32], size[32], spp[16], noise[32];
 } proto_argv;
 

@@ -198,11 +198,11 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     slab *sl = &s->slabs[slab_i];
     const job_spec *sp = &s->p->spec;
     proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline,
-                      1 + (int)sp->integrator, sp->noise_threshold};
+                      1 + (int)sp->integrator, sp->noise_threshold, 0, NULL};
     proto_argv pa;
     if (proto_slab_argv(&req, &pa, err))
         return -1;
-    const char *argv[20] = {tr_host_worker(h->tr)};
+    const char *argv[sizeof pa.argv / sizeof *pa.argv + 1] = {tr_host_worker(h->tr)};
     for (int i = 0; pa.argv[i]; i++)
         argv[i + 1] = pa.argv[i];
     /* The partial image: its header (well under 4 KB), 12 bytes a pixel and

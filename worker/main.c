@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "bdpt.h"
+#include "cont.h"
 #include "fbin.h"
 #include "file.h"
 #include "image.h"
@@ -23,7 +24,7 @@
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
     "                     [--integrator path|bdpt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
-    "                     [-o FILE|-] [--lifeline]\n"
+    "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --help | --version\n"
     "\n"
@@ -41,6 +42,12 @@ static const char usage[] =
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
     "  --lifeline     end when standard input (a pipe) reaches its end\n"
+    "  --sums         append each pixel's sample sums to the PF image, so that a\n"
+    "                 later render can add samples exactly (path integrator, no\n"
+    "                 adaptive sampling)\n"
+    "  --continue FILE  start from the sums in FILE, a --sums image of the same\n"
+    "                 rows with fewer samples: only the samples it lacks are\n"
+    "                 rendered, to the bits of a render of them all\n"
     "\n"
     "Writing to a pipe (-o -), the worker ends itself when the pipe's reader is\n"
     "gone or its parent process ends.\n";
@@ -141,18 +148,38 @@ int main(int argc, char **argv)
         scn_free(&scene);
         return 2;
     }
+    int keep_sums = sl->sums || sl->continue_from;
+    if (keep_sums && (bdpt || sl->format != IMG_PF || scene.settings.noise_threshold > 0.0f)) {
+        fprintf(stderr, "franja-worker: --sums and --continue need the path integrator without adaptive sampling "
+                        "and --format pf\n");
+        scn_free(&scene);
+        return 2;
+    }
     /* The coordinator gone, the slab is wasted work: stop (lifeline.h). */
     lifeline_start(to_stdout, sl->lifeline);
     size_t n = (size_t)width * (y1 - y0) * 3;
     float *rgb = malloc(n * sizeof *rgb);
     uint64_t *splat = bdpt ? calloc((size_t)width * height * 3, sizeof *splat) : NULL;
-    if (!rgb || (bdpt && !splat)) {
+    double *sums = keep_sums ? calloc(n, sizeof *sums) : NULL;
+    if (!rgb || (bdpt && !splat) || (keep_sums && !sums)) {
         fprintf(stderr, "franja-worker: out of memory for %zu pixels\n", bdpt ? (size_t)width * height : n / 3);
         free(rgb);
+        free(splat);
+        free(sums);
+        lifeline_stop();
         scn_free(&scene);
         return 1;
     }
-    img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0};
+    uint32_t first = 0;
+    if (sl->continue_from && cont_load(sl->continue_from, &scene, y0, y1, sums, &first, &err) < 0) {
+        fprintf(stderr, "franja-worker: %s\n", err.msg);
+        free(rgb);
+        free(sums);
+        lifeline_stop();
+        scn_free(&scene);
+        return 2;
+    }
+    img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0, 0};
     if (bdpt) {
         if (bd_render_rows(&scene, y0, y1, rgb, splat, &err) < 0) {
             fprintf(stderr, "franja-worker: %s\n", err.msg);
@@ -170,6 +197,8 @@ int main(int argc, char **argv)
         } else {
             info.splat_paths = (uint64_t)width * (y1 - y0) * spp;
         }
+    } else if (keep_sums) {
+        pt_render_rows_sums(&scene, PT_MIS, y0, y1, first, sums, rgb);
     } else {
         pt_render_rows(&scene, PT_MIS, y0, y1, rgb);
     }
@@ -180,7 +209,8 @@ int main(int argc, char **argv)
     if (!f) {
         fprintf(stderr, "franja-worker: %s: %s\n", out, strerror(errno));
         rc = 1;
-    } else if (img_write(f, sl->format, &info, rgb, splat, &err) < 0) {
+    } else if ((sl->sums ? img_write_sums(f, &info, rgb, sums, &err) : img_write(f, sl->format, &info, rgb, splat, &err)) <
+               0) {
         fprintf(stderr, "franja-worker: %s: %s\n", to_stdout ? "standard output" : out, err.msg);
         rc = 1;
     }
@@ -192,6 +222,7 @@ int main(int argc, char **argv)
         remove(out);
     free(rgb);
     free(splat);
+    free(sums);
     scn_free(&scene);
     return rc;
 }
