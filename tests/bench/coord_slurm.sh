@@ -8,7 +8,7 @@
 # work, steps would get more CPU than local workers sharing franja's
 # session.  So the local workers start through `setsid` too (a host table
 # whose worker is a wrapper), and both sides compete alike.
-# Also measured: the launch latency of one job step (srun of `true` on a
+# Also measured: the launch latency of one job step (median of 20 sruns of `true` on a
 # node, against starting `true` here), and the scene broadcast (a first
 # render that sbcasts the scene to every node, against a second one that
 # finds it cached).
@@ -25,17 +25,25 @@ bin/franja compile scenes/cornell.json -o "$T/scene.fbin" >/dev/null 2>&1 &&
 SCENE="$T/scene.fbin"
 BIG="$T/knot.fbin"
 
-# Step launch latency, inside one allocation: 20 steps one after the other.
+# Step launch latency, inside one allocation: 20 steps one after the
+# other, each timed; the median and the range (and the same for starting
+# `true` here).
 cat >"$T/launch.sh" <<'SH'
-i=0; s=$(date +%s.%N)
-while [ $i -lt 20 ]; do srun --exclusive -N1 -n1 -c1 --mem=0 -Q -w n1 true </dev/null || exit 1; i=$((i + 1)); done
-a=$(date +%s.%N)
+now() { date +%s%N; }
 i=0
-while [ $i -lt 20 ]; do true </dev/null; /bin/true; i=$((i + 1)); done
-b=$(date +%s.%N)
-awk "BEGIN { printf \"step launch: %.1f ms per srun step, %.2f ms per local process\n\", ($a - $s) * 50, ($b - $a) * 50 }"
+while [ $i -lt 20 ]; do
+    s=$(now); srun --exclusive -N1 -n1 -c1 --mem=0 -Q -w n1 true </dev/null || exit 1; echo "srun $(($(now) - s))"
+    s=$(now); /bin/true </dev/null; echo "local $(($(now) - s))"
+    i=$((i + 1))
+done >"$T/launch.times"
+for k in srun local; do
+    sed -n "s/^$k //p" "$T/launch.times" | sort -n | awk -v k=$k '{ a[NR] = $1 / 1e6 }
+        END { printf "%s %.1f %.1f %.1f\n", k, a[int((NR + 1) / 2)], a[1], a[NR] }'
+done | awk '{ m[$1] = $2; lo[$1] = $3; hi[$1] = $4 }
+    END { printf "step launch (median of 20): %.1f ms per srun step (%.1f-%.1f), %.2f ms per local process (%.2f-%.2f)\n",
+          m["srun"], lo["srun"], hi["srun"], m["local"], lo["local"], hi["local"] }'
 SH
-sl_alloc 120 -N"$N" -n"$N" sh "$T/launch.sh" 2>/dev/null
+sl_alloc 120 -N"$N" -n"$N" env T="$T" sh "$T/launch.sh" 2>/dev/null
 
 # Scene broadcast: the first render on fresh nodes sends the scene (the
 # knot, a mesh scene of some megabytes), the second finds it cached.
