@@ -64,7 +64,7 @@ static const char usage[] =
     "  --job DIR            job directory (default OUT.franja-job)\n"
     "  --keep-job           keep the job directory after success\n"
     "  --no-lock            use a job directory on a file system without locks\n"
-    "  --slab-rows N        rows per slab (default: about 4 slabs per slot)\n"
+    "  --slab-rows N        rows per slab (default: shrinking toward the end)\n"
     "  --retries N          attempts per slab before giving up (default 5)\n"
     "  --preview FILE       write the image so far to FILE (any output type) while\n"
     "                       rendering, rows not yet done as a grey checkerboard\n"

@@ -82,13 +82,15 @@ static int make_slabs(sched *s)
     uint32_t missing = 0;
     for (uint32_t y = 0; y < p->spec.height; y++)
         missing += !(p->have && p->have[y]);
-    uint32_t per = p->slab_rows > 0 ? (uint32_t)p->slab_rows : 0;
-    if (!per) {
-        uint32_t want = (uint32_t)(slots > 0 ? slots : 1) * 4;
-        per = (missing + want - 1) / want;
-        if (per < 1)
-            per = 1;
-    }
+    /* --slab-rows: every slab that size.  Otherwise slabs shrink toward
+     * the end (guided scheduling): each is the rows still to cut over
+     * twice the slots, at least a sixteenth per slot of the whole, so the
+     * first are large (few worker starts) and the last small (the slots
+     * finish close together). */
+    uint32_t per = p->slab_rows > 0 ? (uint32_t)p->slab_rows : 0, n_slots = (uint32_t)(slots > 0 ? slots : 1);
+    uint32_t least = (missing + 16 * n_slots - 1) / (16 * n_slots), left = missing;
+    if (least < 1)
+        least = 1;
     s->slabs = calloc(missing ? missing : 1, sizeof *s->slabs);
     if (!s->slabs)
         return -1;
@@ -97,9 +99,16 @@ static int make_slabs(sched *s)
             y++;
             continue;
         }
+        uint32_t size = per;
+        if (!per) {
+            size = (left + 2 * n_slots - 1) / (2 * n_slots);
+            if (size < least)
+                size = least;
+        }
         uint32_t end = y;
-        while (end < p->spec.height && !(p->have && p->have[end]) && end - y < per)
+        while (end < p->spec.height && !(p->have && p->have[end]) && end - y < size)
             end++;
+        left -= end - y;
         s->slabs[s->nslabs++] = (slab){.y0 = y, .y1 = end, .failed_on = -1};
         y = end;
     }

@@ -105,7 +105,8 @@ typedef struct {
     job_spec spec;
     const char *jobdir;
     const unsigned char *have; /**< rows already finished (resume), height entries; NULL = none */
-    int slab_rows;             /**< rows per slab; 0 = about 4 slabs per slot */
+    int slab_rows;             /**< rows per slab; 0 = slabs that shrink toward the end (the rows left over
+                                    twice the slots, at least a sixteenth of the rows per slot) */
     int max_attempts;          /**< failed attempts per slab before giving up */
     int max_host_failures;     /**< failures in a row before a host is dropped */
     volatile sig_atomic_t *stop; /**< set asynchronously (SIGINT): stop and keep what is done; may be NULL */

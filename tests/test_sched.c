@@ -183,6 +183,38 @@ static void test_plain(void)
     teardown(r);
 }
 
+/* Without --slab-rows, slabs shrink toward the end: each is the rows left
+ * over twice the slots (ceiling), at least a sixteenth of the rows per
+ * slot; 64 rows over 2 slots: 16 12 9 7 5 4 3 2 2 2 2. */
+static void test_guided(void)
+{
+    run *r = setup(64, 0);
+    host(r, "a", 1, (fake_script){0});
+    host(r, "b", 1, (fake_script){0});
+    go(r);
+    CHECK(r->rc == 0, "guided run failed: %s", r->err.msg);
+    static const uint32_t want[] = {16, 12, 9, 7, 5, 4, 3, 2, 2, 2, 2};
+    CHECK(r->st.slabs == 11, "%d slabs, expected 11", r->st.slabs);
+    uint32_t y = 0;
+    for (int k = 0; k < 11; k++) {
+        int found = 0;
+        for (int i = 0; i < r->nev; i++)
+            if (r->ev[i].kind == SCHED_SLAB_DONE && r->ev[i].y0 == y) {
+                CHECK(r->ev[i].y1 - y == want[k], "slab %d at row %u: %u rows, expected %u", k, y, r->ev[i].y1 - y,
+                      want[k]);
+                y = r->ev[i].y1;
+                found = 1;
+                break;
+            }
+        CHECK(found, "no slab starts at row %u", y);
+        if (!found)
+            break;
+    }
+    CHECK(y == 64, "the slabs end at row %u", y);
+    CHECK(stitched_ok(r), "stitched rows are not the fake pixels");
+    teardown(r);
+}
+
 /* One slow slab on a, one started later on a: once the queue is empty, b
  * copies the one that has run longest, and its copy wins. */
 static void test_straggler(void)
@@ -568,6 +600,7 @@ static void test_pending_without_hook(void)
 int main(void)
 {
     test_plain();
+    test_guided();
     test_straggler();
     test_drop_failing_host();
     test_shrink_slots();
