@@ -119,17 +119,32 @@ static float remap0(float f) { return f != 0.0f ? f : 1.0f; }
  * the vertex after one is reached with this density times its cosine. */
 static float disk_pdf(const fr_scene *s) { return 1.0f / (FM_PI * s->world.radius * s->world.radius); }
 
+/* Whether a light path of distant light vertex l can reach point p: its
+ * rays start on the disk of the world's radius one radius back from the
+ * centre, so p must lie within that radius of the axis through the centre
+ * and in front of the disk (with a little slack for rounding).  A point
+ * of an unbounded plane far out is reached by no light path: its density
+ * from the light is 0, so the strategies that would need one do not count
+ * (weighing them as if they could made such points too dark). */
+static int disk_reaches(const fr_scene *s, const vert *l, vec3 p)
+{
+    vec3 q = v3_sub(p, s->world.center);
+    float along = -v3_dot(q, l->wo), r = s->world.radius * 1.001f;
+    return along >= -r && v3_len2(q) - along * along <= r * r;
+}
+
 /* The density of the step from vertex `from` to vertex `to`, given as a
  * solid-angle pdf at `from`, in the measure of `to`: area (times the
  * cosine at `to` over the squared distance), or solid angle when `to` is
  * a distant light; after a distant light, the disk's density times the
- * cosine at `to` (pdf unused). */
+ * cosine at `to` (pdf unused), 0 where no ray from the disk reaches. */
 static float to_area(const fr_scene *s, float pdf, const vert *from, const vert *to)
 {
     if (to->distant)
         return pdf;
     if (from->distant)
-        return disk_pdf(s) * (on_surface(to) ? fabsf(v3_dot(to->ng, from->wo)) : 1.0f);
+        return disk_reaches(s, from, to->p) ? disk_pdf(s) * (on_surface(to) ? fabsf(v3_dot(to->ng, from->wo)) : 1.0f)
+                                            : 0.0f;
     vec3 d = v3_sub(to->p, from->p);
     float d2 = v3_len2(d);
     if (!(d2 > 0.0f))
@@ -260,7 +275,9 @@ static int set_rev_back(const fr_scene *s, vert *path, int i, const vert *v, flo
         a--;
     at[1] = &path[a];
     save[1] = path[a].pdf_rev;
-    path[a].pdf_rev = chain_pdf(s, pdf, v, &path[a], path[a + 1].wo);
+    /* From a distant light, the chain starts at prev: the disk must reach it. */
+    path[a].pdf_rev = v->distant && !disk_reaches(s, v, prev->p) ? 0.0f
+                                                                : chain_pdf(s, pdf, v, &path[a], path[a + 1].wo);
     return 2;
 }
 

@@ -15,6 +15,8 @@
  *   tracing of the ball in double precision.  Under a small round lamp,
  *   light tracing and the camera path hitting the lamp through the ball
  *   agree, MIS agrees with both and is about as good as light tracing.
+ * - An unbounded plane under the sky and a sun: BDPT agrees with path
+ *   tracing out to the horizon, beyond the disk that light paths start on.
  * - Scenes with media are refused, with a message.
  *
  * Standard errors come from each pixel's spread of sample values, and for
@@ -725,6 +727,33 @@ static void distant_lights(void)
     scn_free(&s);
 }
 
+/* An unbounded plane under the sky and a sun: light paths from distant
+ * lights start on a disk the size of the world's bounds, so the far
+ * ground is reached only by camera paths (and light sampling from them).
+ * The strategies that would need a light path there must not count, or
+ * the ground toward the horizon comes out too dark. */
+static void unbounded_plane(void)
+{
+    fr_scene s;
+    test_scene("{\"image\": {\"width\": 12, \"height\": 9, \"spp\": 1, \"max_depth\": 6},"
+               " \"camera\": {\"position\": [-6.5, 1.6, 1.2], \"target\": [0, 0.55, 0.2], \"fov\": 40},"
+               " \"environment\": {\"color\": [0.4, 0.45, 0.6]},"
+               " \"materials\": {\"ground\": {\"type\": \"lambert\", \"albedo\": [0.6, 0.6, 0.55]},"
+               "   \"glass\": {\"type\": \"glass\", \"ior\": 1.5},"
+               "   \"white\": {\"type\": \"lambert\", \"albedo\": [0.8, 0.8, 0.8]}},"
+               " \"shapes\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"ground\"},"
+               "   {\"type\": \"sphere\", \"center\": [0.2, 0.6, 0.2], \"radius\": 0.6, \"material\": \"glass\"},"
+               "   {\"type\": \"sphere\", \"center\": [-1.6, 0.3, 0.9], \"radius\": 0.3, \"material\": \"white\"}],"
+               " \"lights\": [{\"type\": \"sun\", \"direction\": [0.5, -1, 0.3], \"irradiance\": [3, 2.8, 2.5],"
+               " \"angle\": 2}]}",
+               &s);
+    blocks pt, bd;
+    render(&s, NULL, 4096, 3, &pt);
+    render(&s, &all, 512, 3, &bd);
+    agree("unbounded plane under the sky and a sun: BDPT vs path tracing", &bd, &pt, 4.5);
+    scn_free(&s);
+}
+
 /* Media are refused with a message, never rendered wrong. */
 static void media_refused(void)
 {
@@ -763,6 +792,7 @@ int main(void)
     RUN(caustic);
     RUN(caustic_weights);
     RUN(distant_lights);
+    RUN(unbounded_plane);
     RUN(cornell);
     RUN(spheres);
     return check_done();
