@@ -308,6 +308,9 @@ static int scene_binary(const render_args *a, const char *jobdir, char *path, si
     if (mkdir(jobdir, 0755) && errno != EEXIST)
         return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
     snprintf(path, cap, "%s/scene.fbin", jobdir);
+    /* What a compile of a render killed by SIGKILL left; the job lock
+     * keeps any other compile out of this directory. */
+    compile_child_sweep(path);
     /* In a child process, so that Ctrl-C stops a long compile at once. */
     compile_opts co = {a->camera, print_warning, (void *)"franja"};
     if (compile_child(a->scene, &co, path, &stop_flag, NULL, err))

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -102,6 +103,37 @@ static int wait_answer(int fd, answer *a, volatile sig_atomic_t *stop)
         got += (size_t)k;
     }
     return 1;
+}
+
+int compile_child_sweep(const char *out)
+{
+    const char *slash = strrchr(out, '/');
+    const char *base = slash ? slash + 1 : out;
+    char dirname_[4200], prefix[4200], path[4400];
+    int dirlen = slash ? (int)(slash - out) : 0;
+    if (snprintf(dirname_, sizeof dirname_, "%.*s", dirlen, slash ? out : ".") >= (int)sizeof dirname_ ||
+        snprintf(prefix, sizeof prefix, ".%s.compile-", base) >= (int)sizeof prefix)
+        return 0;
+    if (slash && dirlen == 0)
+        snprintf(dirname_, sizeof dirname_, "/");
+    DIR *d = opendir(dirname_);
+    if (!d)
+        return 0;
+    int n = 0;
+    struct dirent *e;
+    size_t plen = strlen(prefix);
+    while ((e = readdir(d)))
+        if (!strncmp(e->d_name, prefix, plen) && strlen(e->d_name) == plen + 6) {
+            struct stat sb;
+            snprintf(path, sizeof path, "%s/%s", dirname_, e->d_name);
+            /* Only a directory of this user's, never through a link. */
+            if (lstat(path, &sb) == 0 && S_ISDIR(sb.st_mode) && sb.st_uid == geteuid()) {
+                remove_dir(path);
+                n++;
+            }
+        }
+    closedir(d);
+    return n;
 }
 
 int compile_child(const char *scene, const compile_opts *o, const char *out, volatile sig_atomic_t *stop,

@@ -13,7 +13,8 @@
  * by SIGKILL.  The child then gets SIGKILL too (PR_SET_PDEATHSIG), so it
  * neither keeps what it inherited (a job lock) nor goes on compiling; its
  * private directory is left.  The caller must have no other threads
- * running (fork).
+ * running (fork).  compile_child_sweep removes such leftovers where the
+ * caller knows no other compile into the same output can be running.
  */
 #ifndef FRANJA_COMPILE_CHILD_H
 #define FRANJA_COMPILE_CHILD_H
@@ -40,5 +41,12 @@ typedef struct {
  * of the attempt is left on disk. */
 int compile_child(const char *scene, const compile_opts *o, const char *out, volatile sig_atomic_t *stop,
                   compile_child_stats *st, fr_error *err);
+
+/** Removes the private directories that compiles into `out` left beside
+ * it when their caller was killed (".NAME.compile-XXXXXX" next to NAME),
+ * with what they hold.  Only for a caller that excludes any other compile
+ * into `out` (a render holding its job directory's lock): a running
+ * compile's directory would go too.  Returns the number removed. */
+int compile_child_sweep(const char *out);
 
 #endif

@@ -117,6 +117,10 @@ else
     took=$(elapsed "$t0")
     ! running "$child" && ok || bad "render, SIGKILL: the compiling child $child is still running $took s later"
     less "$took" 1.5 && ok || bad "render, SIGKILL: the compiling child ended $took s after its parent"
+    # Its private directory is what a SIGKILL leaves; the next render of
+    # the image, holding the lock, removes it.
+    stale=$(ls -A "$T/k.png.franja-job" | grep '\.compile-')
+    [ -n "$stale" ] && ok || bad "render, SIGKILL: no private compile directory left to sweep"
     # A second render of the same image takes the job lock and compiles.
     "$F" render "$T/big.json" -o "$T/k.png" >"$T/out2" 2>"$T/err2" &
     pid2=$!
@@ -127,6 +131,8 @@ else
     done
     compiling_child $pid2 >/dev/null && ok || bad "render after SIGKILL: not compiling: $(cat "$T/err2")"
     ! grep -q "being rendered by another franja" "$T/err2" && ok || bad "render after SIGKILL: $(cat "$T/err2")"
+    [ -n "$stale" ] && [ ! -e "$T/k.png.franja-job/$stale" ] && ok ||
+        bad "render after SIGKILL: the killed compile's directory $stale is still there"
     kill -INT $pid2 2>/dev/null
     wait $pid2
 fi
