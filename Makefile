@@ -151,13 +151,14 @@ render: all
 	bin/franja render scenes/cornell.json -o cornell.png
 
 # The small Cycles renders in tests/data that tests/it_conventions.sh,
-# tests/it_envlight.sh and tests/it_cycles_rough.sh compare against, made
+# tests/it_envlight.sh and tests/it_cycles_*.sh compare against, made
 # again with Debian's blender (apt-get install blender).  The tests read the
 # committed files: only this target needs blender.
 refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
 	blender -b --factory-startup --python tests/refs/cycles_rough.py -- tests/data/cycles-rough.json tests/data
+	blender -b --factory-startup --python tests/refs/cycles_scene.py -- tests/data/cycles-metals.json tests/data cycles-metals 256
 	for s in glass fog; do blender -b --factory-startup --python tests/refs/cycles_noise.py -- \
 	    tests/bench/scenes/cornell-$$s.json tests/data/cycles-noise-$$s.pfm 1024 7; done
 
