@@ -157,8 +157,8 @@ render: all
 refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
-	blender -b --factory-startup --python tests/refs/cycles_rough.py -- tests/data/cycles-rough.json tests/data
-	blender -b --factory-startup --python tests/refs/cycles_scene.py -- tests/data/cycles-metals.json tests/data cycles-metals 256
+	for s in rough metals; do blender -b --factory-startup --python tests/refs/cycles_scene.py -- \
+	    tests/data/cycles-$$s.json tests/data cycles-$$s 256; done
 	for s in glass fog; do blender -b --factory-startup --python tests/refs/cycles_noise.py -- \
 	    tests/bench/scenes/cornell-$$s.json tests/data/cycles-noise-$$s.pfm 1024 7; done
 
