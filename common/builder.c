@@ -90,7 +90,7 @@ void bld_material_init(fr_material *m)
 {
     memset(m, 0, sizeof *m);
     m->tex_diffuse = m->tex_glossy = m->tex_specular = m->tex_transmit = m->tex_emission = FR_NONE;
-    m->tex_bump = m->tex_normal = m->tex_roughness = m->tex_metallic = FR_NONE;
+    m->tex_bump = m->tex_normal = m->tex_roughness = m->tex_metallic = m->tex_transmission = FR_NONE;
     m->ior = 1.5f;
     m->normal_strength = 1.0f;
 }

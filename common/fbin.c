@@ -176,7 +176,8 @@ static int validate_appearance(const fr_scene *s, const void *base, const uint64
         const fr_material *m = &s->materials[i];
         if (!tex_ref_ok(s, m->tex_diffuse) || !tex_ref_ok(s, m->tex_glossy) || !tex_ref_ok(s, m->tex_specular) ||
             !tex_ref_ok(s, m->tex_transmit) || !tex_ref_ok(s, m->tex_emission) || !tex_ref_ok(s, m->tex_bump) ||
-            !tex_ref_ok(s, m->tex_normal) || !tex_ref_ok(s, m->tex_roughness) || !tex_ref_ok(s, m->tex_metallic))
+            !tex_ref_ok(s, m->tex_normal) || !tex_ref_ok(s, m->tex_roughness) || !tex_ref_ok(s, m->tex_metallic) ||
+            !tex_ref_ok(s, m->tex_transmission))
             return fr_fail(err, "section materials, byte %zu: material %u: texture index out of range",
                            AT(&m->tex_diffuse), i);
         if (!isfinite(m->bump_strength) || !isfinite(m->normal_strength) || m->medium > s->n_media ||

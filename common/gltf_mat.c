@@ -338,8 +338,7 @@ void gmat_to_franja(gmat_ctx *c, const gmat_values *v, fr_material *m)
     m->tex_roughness = m->tex_metallic = v->t_metal_rough.tex;
     m->transmission = v->transmission;
     m->ior = v->ior;
-    if (v->t_transmission.tex != FR_NONE)
-        gdoc_warn(c->doc, "ttex", "transmissionTexture is not supported: the factor is used");
+    m->tex_transmission = v->t_transmission.tex;
     m->emission = v->emissive;
     if (!v3_is_zero(v->emissive))
         m->tex_emission = v->t_emissive.tex;

@@ -121,6 +121,7 @@ typedef struct {
                                     average Fresnel factor, untinted */
     uint32_t tex_roughness;    /**< times roughness: a grey texture, or the G channel of an RGB one (glTF) */
     uint32_t tex_metallic;     /**< times metallic: a grey texture, or the B channel of an RGB one (glTF) */
+    uint32_t tex_transmission; /**< times transmission: a grey texture, or the R channel of an RGB one (glTF) */
 } fr_material;
 
 /** A texture: an image of decoded linear texels stored in the scene, or a

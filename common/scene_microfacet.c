@@ -95,7 +95,7 @@ static int principled(scn_appear *a, const cJSON *o, const char *where, fr_mater
     if (only(o, where, "principled", principled_own, err) < 0 || surface(a, o, where, 1.0f, m, err) < 0 ||
         scn_colour(a, o, "base_color", where, 0, v3s(1.0f), &m->diffuse, &m->tex_diffuse, err) < 0 ||
         scn_scalar(a, o, "metallic", where, 1.0f, 0.0f, 1.0f, &m->metallic, &m->tex_metallic, err) < 0 ||
-        jv_number(o, "transmission", where, 0, 0.0f, &m->transmission, err) < 0 ||
+        scn_scalar(a, o, "transmission", where, 0.0f, 0.0f, 1.0f, &m->transmission, &m->tex_transmission, err) < 0 ||
         jv_number(o, "ior", where, 0, 1.5f, &m->ior, err) < 0 ||
         jv_choice(o, "coupling", where, couplings, 0, &coupling, err) < 0)
         return -1;

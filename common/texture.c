@@ -111,7 +111,7 @@ float tex_eval1(const fr_scene *s, uint32_t ti, vec2 uv)
 int tex_material_textured(const fr_material *m)
 {
     return (m->tex_diffuse & m->tex_glossy & m->tex_specular & m->tex_transmit & m->tex_emission & m->tex_bump &
-            m->tex_normal & m->tex_roughness & m->tex_metallic) != FR_NONE;
+            m->tex_normal & m->tex_roughness & m->tex_metallic & m->tex_transmission) != FR_NONE;
 }
 
 static vec3 clamp01(vec3 c)
@@ -213,6 +213,9 @@ const fr_material *tex_material(const fr_scene *s, const fr_material *m, fr_surf
         tmp->roughness = m->roughness * clamp01(tex_eval(s, m->tex_roughness, sf->uv)).y;
     if (m->tex_metallic != FR_NONE)
         tmp->metallic = m->metallic * clamp01(tex_eval(s, m->tex_metallic, sf->uv)).z;
+    /* glTF's transmissionTexture: the share in R. */
+    if (m->tex_transmission != FR_NONE)
+        tmp->transmission = m->transmission * clamp01(tex_eval(s, m->tex_transmission, sf->uv)).x;
     if (lobes)
         bsdf_lobe_probs(tmp);
     if (m->tex_bump != FR_NONE)

@@ -366,7 +366,8 @@ static int fake_image(const void *data, size_t len, const char *mime, scn_image 
 }
 
 /* Materials, each the principled model: emission with
- * KHR_materials_emissive_strength, transmission with KHR_materials_ior, a
+ * KHR_materials_emissive_strength, transmission (factor and texture) with
+ * KHR_materials_ior, a
  * base colour texture (sRGB-decoded) with its sampler and
  * KHR_texture_transform rewritten for Franja's flipped v, metallic and
  * roughness factors with the metallicRoughness texture (linear), glTF's
@@ -385,7 +386,7 @@ static void test_materials(void)
         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4}}},"
         "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"baseColorTexture\":{\"index\":0,"
         "\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.25,0.5],\"scale\":[2,4]}}}},"
-        "\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":0.75},"
+        "\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":0.75,\"transmissionTexture\":{\"index\":1}},"
         "\"KHR_materials_ior\":{\"ior\":1.3}}},"
         "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.6,0.3,1],\"metallicFactor\":0.75,"
         "\"roughnessFactor\":0.25,\"metallicRoughnessTexture\":{\"index\":1}}}],"
@@ -400,8 +401,9 @@ static void test_materials(void)
     fr_error e;
     bld_init(&b);
     T(gltf_import_mem(t, strlen(t), "t.gltf", &h, &o, &b, &r, &e) == 0);
-    T(b.materials.count == 4 && b.textures.count == 2);
-    if (b.materials.count == 4 && b.textures.count == 2) {
+    /* a texture per use: base colour, transmission, metallicRoughness */
+    T(b.materials.count == 4 && b.textures.count == 3);
+    if (b.materials.count == 4 && b.textures.count == 3) {
         const fr_material *m = b.materials.data;
         /* glTF's default material (the last primitive's): white, metallic 1, roughness 1 */
         for (int i = 0; i < 4; i++)
@@ -412,12 +414,14 @@ static void test_materials(void)
           v3_is_zero(m[3].emission) && m[3].ior == 1.5f && m[3].transmission == 0.0f);
         /* transmission and ior: the share of the dielectric that refracts */
         T(close3(m[1].diffuse, 0.5, 0.5, 0.5) && m[1].transmission == 0.75f && m[1].ior == 1.3f);
+        /* transmissionTexture: the factor scales its R channel, read linearly */
+        T(m[1].tex_transmission == 1 && m[0].tex_transmission == FR_NONE && m[2].tex_transmission == FR_NONE);
         T(m[1].tex_diffuse == 0 && m[1].tex_roughness == FR_NONE && m[1].tex_metallic == FR_NONE &&
           v3_is_zero(m[1].emission) && v3_is_zero(m[1].transmit));
         /* metallicRoughnessTexture: the factors scale its G (roughness) and
          * B (metallic) channels, read linearly (texture.c) */
         T(close3(m[2].diffuse, 0.9, 0.6, 0.3) && m[2].metallic == 0.75f && m[2].roughness == 0.25f &&
-          m[2].tex_diffuse == FR_NONE && m[2].tex_roughness == 1 && m[2].tex_metallic == 1 &&
+          m[2].tex_diffuse == FR_NONE && m[2].tex_roughness == 2 && m[2].tex_metallic == 2 &&
           m[2].transmission == 0.0f);
         const fr_texture *x = b.textures.data;
         T(x->kind == FR_TEX_IMAGE && x->width == 2 && x->channels == 3);
@@ -427,6 +431,7 @@ static void test_materials(void)
         T(fabsf(((const float *)b.texels.data)[x->first] - 0.2140411f) < 1e-4f); /* 0.5 sRGB-decoded */
         T(x[1].wrap == FR_WRAP_REPEAT && x[1].filter == FR_FILTER_BILINEAR && x[1].first != x[0].first);
         T(((const float *)b.texels.data)[x[1].first] == 0.5f); /* data: not decoded */
+        T(x[2].wrap == FR_WRAP_REPEAT && ((const float *)b.texels.data)[x[2].first] == 0.5f);
     }
     bld_free(&b);
     /* without a decoder, the texture is dropped with a warning */

@@ -53,7 +53,8 @@ static void refused(const char *what, const char *msg, const char *const *parts)
 }
 #define REFUSED(what, msg, ...) refused(what, msg, (const char *const[]){__VA_ARGS__, NULL})
 
-#define CHECKER "\"textures\": {\"mr\": {\"type\": \"checker\", \"colors\": [[0, 0.5, 0.25], [0, 1, 1]]}}"
+#define CHECKER "\"textures\": {\"mr\": {\"type\": \"checker\", \"colors\": [[0, 0.5, 0.25], [0, 1, 1]]}," \
+                " \"tr\": {\"type\": \"checker\", \"colors\": [[0.5, 0, 0], [1, 0, 0]]}}"
 
 static void test_syntax(void)
 {
@@ -152,7 +153,8 @@ static void test_textures(void)
                " \"camera\": {\"position\": [0, 0, 5], \"target\": [0, 0, 0], \"fov\": 40},"
                " " CHECKER ","
                " \"materials\": {\"m\": {\"type\": \"principled\", \"metallic\": {\"texture\": \"mr\", \"factor\": 0.8},"
-               "   \"roughness\": {\"texture\": \"mr\", \"factor\": 0.6}},"
+               "   \"roughness\": {\"texture\": \"mr\", \"factor\": 0.6},"
+               "   \"transmission\": {\"texture\": \"tr\", \"factor\": 0.9}},"
                "  \"lamp\": {\"type\": \"emitter\", \"emission\": [1, 1, 1]}},"
                " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"},"
                "   {\"type\": \"sphere\", \"center\": [0, 3, 0], \"radius\": 0.5, \"material\": \"lamp\"}]}",
@@ -168,10 +170,12 @@ static void test_textures(void)
     CHECK(fabsf(m->roughness - 0.3f) < 1e-6f && fabsf(m->metallic - 0.2f) < 1e-6f,
           "metallicRoughness texel (0, 0.5, 0.25): roughness %g (expected 0.3), metallic %g (expected 0.2)",
           m->roughness, m->metallic);
+    CHECK(fabsf(m->transmission - 0.45f) < 1e-6f, "transmission texel R 0.5: %g (expected 0.45)", m->transmission);
     sf.uv.u = 1.25f;
     m = tex_material(&s, &s.materials[0], &sf, &tmp);
     CHECK(fabsf(m->roughness - 0.6f) < 1e-6f && fabsf(m->metallic - 0.8f) < 1e-6f,
           "metallicRoughness texel (0, 1, 1): roughness %g, metallic %g", m->roughness, m->metallic);
+    CHECK(fabsf(m->transmission - 0.9f) < 1e-6f, "transmission texel R 1: %g (expected 0.9)", m->transmission);
     scn_free(&s);
 }
 
