@@ -69,8 +69,14 @@ code=$(curl -s -o /dev/null -w '%{http_code}' -X POST "$URL/state.json")
 curl -sf "$URL/image.png" -o "$T/now.png" && [ "$(head -c 8 "$T/now.png" | od -An -c | tr -d ' ')" = '211PNG\r\n032\n' ] &&
     ok || bad "image.png is not a PNG"
 
-# The page in a browser, after its script ran: what it shows.
-browse --dump-dom "$URL/" >"$T/dom.html"
+# The page in a browser, after its script ran: what it shows. Host good is
+# idle for a moment between two slabs; a page caught then is loaded again.
+i=0
+while :; do
+    browse --dump-dom "$URL/" >"$T/dom.html"
+    grep -q '<tr><td>good</td><td class="state">idle</td><td>0/1</td>' "$T/dom.html" && [ $i -lt 5 ] || break
+    i=$((i + 1))
+done
 grep -q 'id="status" class="rendering">rendering<' "$T/dom.html" && ok || bad "the page does not say rendering"
 grep -q 'id="imgrows">image: 24x24, [0-9]* rows rendered<' "$T/dom.html" && ok ||
     bad "the page's image is not loaded: $(grep -o 'id="imgrows">[^<]*' "$T/dom.html")"
@@ -79,7 +85,7 @@ rows=$(sed -n 's|.*id="rows">\([0-9]*\)/24<.*|\1|p' "$T/dom.html")
 [ -n "$rows" ] && [ "$rows" -ge "$before" ] && ok || bad "the page shows rows '$rows', fewer than $before"
 grep -Eq 'id="eta">[0-9hms]+<' "$T/dom.html" && ok || bad "no ETA on the page: $(grep -o 'id="eta">[^<]*' "$T/dom.html")"
 grep -q '<tr><td>good</td><td class="state">rendering</td><td>1/1</td>' "$T/dom.html" && ok ||
-    bad "host good is not shown rendering with 1/1 slots"
+    bad "host good is not shown rendering with 1/1 slots: $(grep -o '<tr><td>good</td>.*</tr>' "$T/dom.html")"
 grep -Eq '<tr><td>bad</td><td class="state down">dropped: [^<]*</td><td>0/1</td><td>0</td><td>0.00</td><td class="fail">3</td>' \
     "$T/dom.html" && ok || bad "host bad is not shown dropped with 3 failures: $(grep -o '<tr><td>bad</td>.*</tr>' "$T/dom.html")"
 grep -q '<li class="failed">[^<]*bad: rows [0-9]*:[0-9]* failed on bad' "$T/dom.html" && ok || bad "no failure event on the page"
