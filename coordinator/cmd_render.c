@@ -58,6 +58,10 @@ static const char usage[] =
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
     "                       (default: the scene's tonemap; HDR outputs .exr\n"
     "                       .hdr .pfm keep linear radiance)\n"
+    "  --exr-half           .exr output: half floats (default: 32-bit floats)\n"
+    "  --exr-compression C  .exr output: none, rle, zips, zip, piz, pxr24, b44, b44a,\n"
+    "                       dwaa or dwab (default zip)\n"
+    "  --jpeg-quality Q     .jpg output: quality 1..100 (default 98)\n"
     "  --tonemap CURVE      none or filmic (default: the scene's, else none)\n"
     "  --resume             keep the finished slabs of an interrupted render\n"
     "  --fresh              discard the finished slabs of an earlier render\n"
@@ -104,6 +108,7 @@ typedef struct {
     float noise_threshold;     /* --noise-threshold, 0 for the scene's */
     int json;                  /* --progress json */
     int crop, crop_output;     /* --crop given, --crop-output */
+    iio_options io;            /* --exr-half, --exr-compression, --jpeg-quality */
     crop_window win;
     int monitor;               /* --monitor given */
     uint32_t monitor_port;
@@ -116,7 +121,8 @@ typedef struct {
 enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
-    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT
+    OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -145,6 +151,9 @@ static int parse(int argc, char **argv, render_args *a)
         {"monitor", required_argument, NULL, OPT_MONITOR},
         {"crop", required_argument, NULL, OPT_CROP},
         {"crop-output", no_argument, NULL, OPT_CROP_OUTPUT},
+        {"exr-half", no_argument, NULL, OPT_EXR_HALF},
+        {"exr-compression", required_argument, NULL, OPT_EXR_COMPRESSION},
+        {"jpeg-quality", required_argument, NULL, OPT_JPEG_QUALITY},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -243,6 +252,22 @@ static int parse(int argc, char **argv, render_args *a)
         case OPT_CROP_OUTPUT:
             a->crop_output = 1;
             break;
+        case OPT_EXR_HALF:
+            a->io.half = 1;
+            break;
+        case OPT_EXR_COMPRESSION: {
+            static const char *const kinds[] = {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a",
+                                                "dwaa", "dwab", NULL};
+            bad = opt_choice(cmd, "--exr-compression", v, kinds) < 0;
+            a->io.compression = v;
+            break;
+        }
+        case OPT_JPEG_QUALITY: {
+            uint32_t q = 0;
+            bad = opt_uint(cmd, "--jpeg-quality", v, 1, 100, &q);
+            a->io.quality = (int)q;
+            break;
+        }
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;
@@ -841,7 +866,7 @@ int cmd_render(int argc, char **argv)
             out_spec.height = a.win.y1 - a.win.y0;
         }
     }
-    if (out_write(a.out, rgb, &out_spec, &tm, &err)) {
+    if (out_write_with(a.out, rgb, &out_spec, &tm, &a.io, &err)) {
         fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume to "
                 "write %s\n", err.msg, jobdir, a.out);
         goto done;

@@ -29,6 +29,12 @@ using namespace OIIO;
 extern "C" int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                           unsigned char **data, size_t *len, fr_error *err)
 {
+    return iio_encode_with(name, pixels, type, width, height, nullptr, data, len, err);
+}
+
+extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
+                               const iio_options *o, unsigned char **data, size_t *len, fr_error *err)
+{
     *data = nullptr;
     *len = 0;
     int fd = memfd_create("franja-image", MFD_CLOEXEC);
@@ -43,9 +49,14 @@ extern "C" int iio_encode(const char *name, const void *pixels, iio_type type, u
         if (!out) {
             rc = fr_fail(err, "%s: no image writer for this extension: %s", name, OIIO::geterror().c_str());
         } else {
-            ImageSpec spec((int)width, (int)height, 3, td);
+            // Half floats are stored from the float pixels (OpenImageIO converts).
+            ImageSpec spec((int)width, (int)height, 3, o && o->half && type == IIO_F32 ? TypeDesc::HALF : td);
             spec.attribute("oiio:ColorSpace", type == IIO_F32 ? "linear" : "sRGB");
             spec.attribute("Software", "franja");
+            if (o && o->compression)
+                spec.attribute("compression", o->compression);
+            if (o && o->quality > 0)
+                spec.attribute("compression", std::string("jpeg:") + std::to_string(o->quality));
             if (!out->open(mem, spec)) {
                 rc = fr_fail(err, "%s: encoding: %s", name, out->geterror().c_str());
             } else if (!out->write_image(td, pixels)) {

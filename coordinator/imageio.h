@@ -25,6 +25,19 @@ typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32 } iio_type;
 int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                unsigned char **data, size_t *len, fr_error *err);
 
+/** How iio_encode_with stores an image, where the format allows. */
+typedef struct {
+    int half;                  /**< float pixels stored as half floats (OpenEXR) */
+    const char *compression;   /**< OpenImageIO's "compression" name (OpenEXR: none, rle, zips, zip, piz,
+                                    pxr24, b44, b44a, dwaa, dwab); NULL: the writer's default */
+    int quality;               /**< JPEG quality 1..100; 0: the writer's default */
+} iio_options;
+
+/** iio_encode with options (NULL: none); options a format does not have
+ * are ignored by its writer. */
+int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
+                    const iio_options *o, unsigned char **data, size_t *len, fr_error *err);
+
 /** Reads the first image of `path` as floats: *pixels (malloc'd, the
  * caller frees) holds width*height*channels values, top row first, as
  * stored (integer formats scaled to [0, 1], no colour conversion).  Fails

@@ -77,6 +77,12 @@ static int encode_pfm(const char *path, const float *rgb, const job_spec *spec, 
 int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
                size_t *len, fr_error *err)
 {
+    return out_encode_with(path, rgb, spec, tm, NULL, data, len, err);
+}
+
+int out_encode_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
+                    const iio_options *o, unsigned char **data, size_t *len, fr_error *err)
+{
     /* Encoded in memory: OpenImageIO's writers do not all report a failed
      * write, and libjpeg's exits. */
     size_t n = (size_t)spec->width * spec->height * 3;
@@ -85,7 +91,7 @@ int out_encode(const char *path, const float *rgb, const job_spec *spec, const f
     if (is_ext(path, "pfm"))
         return encode_pfm(path, rgb, spec, data, len, err);
     if (is_ext(path, "exr") || is_ext(path, "hdr"))
-        return iio_encode(path, rgb, IIO_F32, spec->width, spec->height, data, len, err);
+        return iio_encode_with(path, rgb, IIO_F32, spec->width, spec->height, o, data, len, err);
     int wide = is_ext(path, "tif") || is_ext(path, "tiff");
     void *px = malloc(n * (wide ? 2 : 1));
     if (!px)
@@ -97,18 +103,24 @@ int out_encode(const char *path, const float *rgb, const job_spec *spec, const f
         else
             ((uint8_t *)px)[i] = (uint8_t)(v * 255.0f + 0.5f);
     }
-    int rc = iio_encode(path, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, data, len, err);
+    int rc = iio_encode_with(path, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, o, data, len, err);
     free(px);
     return rc;
 }
 
 int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err)
 {
+    return out_write_with(path, rgb, spec, tm, NULL, err);
+}
+
+int out_write_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
+                   const iio_options *o, fr_error *err)
+{
     /* file_write_atomic checks every write, the fsync and the close before
      * the rename. */
     unsigned char *data = NULL;
     size_t len = 0;
-    int rc = out_encode(path, rgb, spec, tm, &data, &len, err);
+    int rc = out_encode_with(path, rgb, spec, tm, o, &data, &len, err);
     if (rc == 0) {
         fr_error e;
         if (file_write_atomic(path, data, len, &e))

@@ -14,6 +14,7 @@
 #define FRANJA_OUTPUT_H
 
 #include "error.h"
+#include "imageio.h"
 #include "jobdir.h"
 #include "scene.h"
 
@@ -32,6 +33,14 @@ int out_check(const char *path, fr_error *err);
  * message; *data is then NULL. */
 int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
                size_t *len, fr_error *err);
+
+/** out_encode with the writer's options o (imageio.h; NULL: none). */
+int out_encode_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
+                    const iio_options *o, unsigned char **data, size_t *len, fr_error *err);
+
+/** out_write with the writer's options o (imageio.h; NULL: none). */
+int out_write_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
+                   const iio_options *o, fr_error *err);
 
 /** Writes rgb (width*height*3 linear floats, top row first) to path via a
  * temporary file in the same directory and a rename, so path is either the

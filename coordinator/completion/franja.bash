@@ -52,12 +52,15 @@ _franja()
     case $prev in
     --tonemap) COMPREPLY=($(compgen -W "none filmic" -- "$cur")); return 0 ;;
     --progress) COMPREPLY=($(compgen -W "auto json" -- "$cur")); return 0 ;;
+    --exr-compression)
+        COMPREPLY=($(compgen -W "none rle zips zip piz pxr24 b44 b44a dwaa dwab" -- "$cur")); return 0 ;;
     --hosts | --known-hosts | --ssh-config | --preview | -o)
         _franja_files "$cur" ""; return 0 ;;
     --job | --dist | --workdir | --shared-workdir)
         COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     --worker) _franja_files "$cur" ""; return 0 ;;
-    -j | --spp | --size | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every)
+    -j | --spp | --size | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
+        --monitor | --crop | --jpeg-quality | --noise-threshold)
         return 0 ;;
     esac
     if [[ $cur == -* ]]; then
