@@ -6,6 +6,7 @@
 #   make bench      benchmarks (see tests/bench/)
 #   make render     render scenes/cornell.json to cornell.png on this machine
 #   make install    bin/, man pages and bash completion under PREFIX (DESTDIR)
+#   make docs       the user guide and the API documentation (HTML) in build/docs
 #   make refs       the Cycles references in tests/data (needs blender)
 
 CC      ?= cc
@@ -54,7 +55,7 @@ LIB         = $(B)/libfranja.a
 WORKER_LIBS = $(CJSON_LIBS) -lm
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) -lstdc++ -lm -pthread
 
-.PHONY: all deps check test bench render clean docs fuzz static dist check-cross refs install uninstall
+.PHONY: all deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
 all: bin/franja-worker bin/franja
 
 $(B)/%.o: %.c
@@ -185,11 +186,18 @@ install: all
 uninstall:
 	rm -f $(INSTALLED:%='$(DESTDIR)%')
 
-# HTML API documentation of the headers, in build/docs/html (Doxygen).
-docs:
-	@mkdir -p $(B)/docs
-	doxygen coordinator/Doxyfile
-	@echo "API documentation: $(B)/docs/html/index.html"
+# make docs [DOCDIR=build/docs]: the user guide in DOCDIR/guide (the
+# READMEs and the manual pages as linked HTML pages, by pandoc:
+# coordinator/guide/build.sh) and the API documentation of the headers in
+# DOCDIR/html (Doxygen).  make guide builds the guide alone.
+DOCDIR ?= $(B)/docs
+docs: guide
+	@mkdir -p '$(DOCDIR)'
+	{ cat coordinator/Doxyfile; echo 'OUTPUT_DIRECTORY = $(DOCDIR)'; echo 'WARN_LOGFILE = $(DOCDIR)/warnings.log'; } | doxygen -
+	@echo "API documentation: $(DOCDIR)/html/index.html"
+
+guide:
+	sh coordinator/guide/build.sh '$(DOCDIR)/guide' '$(DOCDIR)/html'
 
 # Fully static workers, bin/static/<arch>/franja-worker: they run on any Linux
 # of their architecture.  Debian ships no static cJSON, so they are built with

@@ -8,7 +8,7 @@ apt-get install -y --no-install-recommends \
     build-essential pkg-config \
     libcjson-dev libxxhash-dev libassimp-dev libembree-dev clang libclang-rt-14-dev \
     libssh-dev libmicrohttpd-dev libopenimageio-dev openimageio-tools assimp-testmodels \
-    openssh-server openssh-client iproute2 procps doxygen man-db groff-base jq chromium curl \
+    openssh-server openssh-client iproute2 procps doxygen pandoc man-db groff-base jq chromium curl \
     slurmctld slurmd slurm-client munge \
     docker.io debootstrap qemu-user-static \
     gcc-aarch64-linux-gnu libc6-dev-arm64-cross
