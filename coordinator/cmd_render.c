@@ -538,7 +538,7 @@ static void on_admit(void *ctx, sched_host *hosts, int nhosts)
  * unless it is the only one). */
 static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
                      const char *jobdir, const unsigned char *have, int rows_job, int rows_missing,
-                     pg_reporter *pg, mon_server *mon, fr_error *err)
+                     pg_reporter *pg, mon_server *mon, char *used, size_t used_cap, fr_error *err)
 {
     int n = table->n;
     cl_host *cl = calloc((size_t)n, sizeof *cl);
@@ -605,6 +605,10 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         if (rep.drawn)
             fputc('\n', stderr);
         summary(sh, n, spec, &st, rows_missing, clk_now() - t0);
+        /* The hosts that rendered rows, for the image's metadata. */
+        for (int i = 0, k = 0; i < n && used_cap; i++)
+            if (sh[i].rows > 0 && k >= 0 && (size_t)k < used_cap)
+                k += snprintf(used + k, used_cap - (size_t)k, "%s%s", k ? "," : "", sh[i].name);
     }
     for (int i = 0; i < n; i++)
         if (sh[i].pending)
@@ -836,8 +840,9 @@ int cmd_render(int argc, char **argv)
         fprintf(stderr, "franja render: --preview: %s\n", err.msg);
         goto done;
     }
+    char used[1024] = "";
     int slabs_rc = rows_have < rows_job ? run_slabs(&a, &table, fbin, &spec, jobdir, have, rows_job,
-                                                    rows_job - rows_have, pg, mon, &err)
+                                                    rows_job - rows_have, pg, mon, used, sizeof used, &err)
                                         : 0;
     pv_stop(pv);
     if (slabs_rc) {
@@ -866,6 +871,9 @@ int cmd_render(int argc, char **argv)
             out_spec.height = a.win.y1 - a.win.y0;
         }
     }
+    out_meta meta;
+    out_meta_make(&meta, &spec, clk_now() - t0, used);
+    a.io.attrs = meta.attrs;
     if (out_write_with(a.out, rgb, &out_spec, &tm, &a.io, &err)) {
         fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume to "
                 "write %s\n", err.msg, jobdir, a.out);

@@ -124,7 +124,10 @@ int cmd_stitch(int argc, char **argv)
         fprintf(stderr, "franja stitch: %s\n", err.msg);
         goto done;
     }
-    if (out_write(out, rgb, &spec, &tm, &err)) {
+    out_meta meta;
+    out_meta_make(&meta, &spec, -1, NULL);
+    iio_options io = {.attrs = meta.attrs};
+    if (out_write_with(out, rgb, &spec, &tm, &io, &err)) {
         fprintf(stderr, "franja stitch: %s\n", err.msg);
         goto done;
     }

@@ -57,6 +57,8 @@ extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type ty
                 spec.attribute("compression", o->compression);
             if (o && o->quality > 0)
                 spec.attribute("compression", std::string("jpeg:") + std::to_string(o->quality));
+            for (const char *const *a = o ? o->attrs : nullptr; a && a[0] && a[1]; a += 2)
+                spec.attribute(a[0], a[1]);
             if (!out->open(mem, spec)) {
                 rc = fr_fail(err, "%s: encoding: %s", name, out->geterror().c_str());
             } else if (!out->write_image(td, pixels)) {

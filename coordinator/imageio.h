@@ -31,6 +31,10 @@ typedef struct {
     const char *compression;   /**< OpenImageIO's "compression" name (OpenEXR: none, rle, zips, zip, piz,
                                     pxr24, b44, b44a, dwaa, dwab); NULL: the writer's default */
     int quality;               /**< JPEG quality 1..100; 0: the writer's default */
+    const char *const *attrs;  /**< string attributes to store: name, value, name, value ..., NULL; or NULL.
+                                    "Software" and "ImageDescription" reach every format that has them
+                                    (PNG text chunks, TIFF tags, EXR, JPEG); other names (say
+                                    "franja:spp") only formats with free-form attributes (OpenEXR) */
 } iio_options;
 
 /** iio_encode with options (NULL: none); options a format does not have

@@ -16,6 +16,7 @@
 #include "file.h"
 #include "image.h"
 #include "imageio.h"
+#include "protocol.h"
 
 static const char *extension(const char *path)
 {
@@ -25,6 +26,53 @@ static const char *extension(const char *path)
 }
 
 static int is_ext(const char *path, const char *ext) { return !strcasecmp(extension(path), ext); }
+
+void out_meta_make(out_meta *m, const job_spec *spec, double seconds, const char *hosts)
+{
+    memset(m, 0, sizeof *m);
+    snprintf(m->software, sizeof m->software, "Franja %s", FRANJA_VERSION);
+    snprintf(m->scene, sizeof m->scene, "%016llx", (unsigned long long)spec->hash);
+    snprintf(m->spp, sizeof m->spp, "%u", spec->spp);
+    const char *integ = proto_integrator_name((int)spec->integrator);
+    snprintf(m->integrator, sizeof m->integrator, "%s", integ ? integ : "unknown");
+    if (seconds >= 0)
+        snprintf(m->seconds, sizeof m->seconds, "%.2f", seconds);
+    /* Whole names only: a list too long ends with ",...". */
+    size_t n = 0, cap = sizeof m->hosts - 5;
+    for (const char *h = hosts ? hosts : ""; *h;) {
+        size_t k = strcspn(h, ",");
+        if (k && n + (n > 0) + k > cap) {
+            strcpy(m->hosts + n, n ? ",..." : "...");
+            break;
+        }
+        if (k) {
+            if (n)
+                m->hosts[n++] = ',';
+            memcpy(m->hosts + n, h, k);
+            n += k;
+            m->hosts[n] = 0;
+        }
+        h += k + (h[k] == ',');
+    }
+    int len = snprintf(m->desc, sizeof m->desc, "%s render; scene %s; %s spp; integrator %s", m->software, m->scene,
+                       m->spp, m->integrator);
+    if (m->seconds[0] && len >= 0 && (size_t)len < sizeof m->desc)
+        len += snprintf(m->desc + len, sizeof m->desc - (size_t)len, "; render time %s s", m->seconds);
+    if (m->hosts[0] && len >= 0 && (size_t)len < sizeof m->desc)
+        snprintf(m->desc + len, sizeof m->desc - (size_t)len, "; hosts %s", m->hosts);
+    const char **a = m->attrs;
+    *a++ = "Software", *a++ = m->software;
+    *a++ = "ImageDescription", *a++ = m->desc;
+    *a++ = "franja:version", *a++ = FRANJA_VERSION;
+    *a++ = "franja:scene", *a++ = m->scene;
+    *a++ = "franja:spp", *a++ = m->spp;
+    *a++ = "franja:integrator", *a++ = m->integrator;
+    if (m->seconds[0])
+        *a++ = "franja:render_time", *a++ = m->seconds;
+    if (m->hosts[0])
+        *a++ = "franja:hosts", *a++ = m->hosts;
+    *a = NULL;
+}
 
 int out_check_type(const char *path, fr_error *err)
 {

@@ -18,6 +18,26 @@
 #include "jobdir.h"
 #include "scene.h"
 
+/** What a final image says about itself in its header (out_meta_make). */
+typedef struct {
+    char software[64];         /**< "Franja VERSION" */
+    char scene[24], spp[16], integrator[16], seconds[32];
+    char hosts[1024];          /**< host names, comma-separated */
+    char desc[1400];           /**< the figures above in one line, ImageDescription */
+    const char *attrs[17];     /**< name, value pairs, NULL-terminated: iio_options.attrs */
+} out_meta;
+
+/** Fills m with the metadata of a final image of spec: Software "Franja
+ * VERSION"; ImageDescription "Franja VERSION render; scene HASH; N spp;
+ * integrator NAME; render time S s; hosts A,B" (the time left out when
+ * seconds < 0, the hosts when hosts is NULL or empty); and the same
+ * figures as OpenEXR string attributes franja:version, franja:scene,
+ * franja:spp, franja:integrator, franja:render_time (seconds) and
+ * franja:hosts.  m->attrs points into m: pass m->attrs as
+ * iio_options.attrs while m lives.  Long host lists are cut at a name
+ * boundary with ",...". */
+void out_meta_make(out_meta *m, const job_spec *spec, double seconds, const char *hosts);
+
 /** Fails if no writer handles the path's extension. */
 int out_check_type(const char *path, fr_error *err);
 

@@ -11,6 +11,9 @@
 #                           ($T: the test's scratch directory).  Returns
 #                           non-zero when CMD succeeded
 #   need TOOL...            fails the whole test at once if a tool is missing
+#   same_pixels A B         succeeds when images A and B have the same size,
+#                           channels and values, whatever their headers say
+#                           (final images carry their render time); oiiotool
 #   summary                 prints "N passed, N failed"; returns non-zero on a
 #                           failure (the test's last command)
 
@@ -48,6 +51,10 @@ need() {
             exit 1
         fi
     done
+}
+
+same_pixels() {
+    oiiotool --fail 0 --failpercent 0 "$1" "$2" --diff 2>&1 | grep -q '^PASS'
 }
 
 summary() {

@@ -1,0 +1,58 @@
+#!/bin/sh
+# it_metadata.sh -- a final image says what made it: Franja's version
+# (Software), the scene's hash, the samples per pixel, the integrator, the
+# render time and the hosts that rendered rows (ImageDescription, and as
+# franja:* attributes in OpenEXR), read back with oiiotool from .png
+# (text chunks), .tif (tags), .exr and .jpg; franja stitch says the same
+# but for the time and the hosts, which it does not know.
+cd "$(dirname "$0")/.." || exit 1
+. tests/lib.sh
+need oiiotool
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+F="$(pwd)/bin/franja"
+"$F" compile scenes/cornell.json -o "$T/c.fbin" >"$T/compile" 2>&1 && ok || bad "compile failed: $(cat "$T/compile")"
+hash=$(sed -n 's/.*: scene \([0-9a-f]\{16\}\),.*/\1/p' "$T/compile")
+[ -n "$hash" ] && ok || bad "no scene hash in: $(cat "$T/compile")"
+version=$("$F" --version | awk '{print $2}')
+# Two hosts, both this machine, so that the list has two names.
+printf 'left  local - 1\nright local - 1\n' >"$T/two.hosts"
+
+info() { oiiotool --info -v "$1" 2>&1; }
+for ext in png tif exr jpg; do
+    "$F" render "$T/c.fbin" -o "$T/m.$ext" --size 32x32 --spp 3 --slab-rows 4 --hosts "$T/two.hosts" \
+        2>"$T/log" && ok || { bad "render to .$ext failed: $(tail -n 3 "$T/log")"; continue; }
+    info "$T/m.$ext" >"$T/i"
+    grep -q "Software: \"Franja $version\"" "$T/i" && ok || bad ".$ext: no Software \"Franja $version\": $(cat "$T/i")"
+    d=$(sed -n 's/^ *ImageDescription: "\(.*\)"$/\1/p' "$T/i")
+    for want in "Franja $version render" "scene $hash" "3 spp" "integrator path" "hosts left,right"; do
+        case $d in *"$want"*) ok ;; *) bad ".$ext: ImageDescription '$d' lacks '$want'" ;; esac
+    done
+    # The render time: a number of seconds, no more than the wall time of the run.
+    t=$(printf '%s\n' "$d" | sed -n 's/.*render time \([0-9.]*\) s.*/\1/p')
+    wall=$(sed -n 's/.* in \([0-9.]*\) s$/\1/p' "$T/log" | tail -n 1)
+    [ -n "$t" ] && [ -n "$wall" ] && awk -v t="$t" -v w="$wall" 'BEGIN { exit !(t > 0 && t <= w + 0.01) }' && ok ||
+        bad ".$ext: render time '$t' (the run says '$wall')"
+done
+# OpenEXR keeps each figure as its own attribute.
+info "$T/m.exr" >"$T/i"
+for kv in "franja:version: \"$version\"" "franja:scene: \"$hash\"" 'franja:spp: "3"' 'franja:integrator: "path"' \
+    'franja:hosts: "left,right"'; do
+    grep -qF "$kv" "$T/i" && ok || bad ".exr lacks $kv: $(cat "$T/i")"
+done
+grep -q 'franja:render_time: "[0-9.]*"' "$T/i" && ok || bad ".exr lacks franja:render_time"
+
+# The integrator named is the one that rendered.
+"$F" render "$T/c.fbin" -o "$T/b.exr" --size 16x16 --spp 1 -j 2 --integrator bdpt 2>"$T/log" && ok ||
+    bad "bdpt render failed: $(tail -n 3 "$T/log")"
+info "$T/b.exr" | grep -qF 'franja:integrator: "bdpt"' && ok || bad "a bdpt render is not marked bdpt"
+info "$T/b.exr" | grep -qF 'franja:hosts: "local"' && ok || bad "a local render does not name host local"
+
+# franja stitch: version, scene, spp, integrator; no time, no hosts.
+"$F" render "$T/c.fbin" -o "$T/k.png" --size 16x16 --spp 2 -j 2 --keep-job 2>"$T/log" && ok ||
+    bad "render --keep-job failed: $(tail -n 3 "$T/log")"
+"$F" stitch "$T/k.png.franja-job" -o "$T/s.tif" >"$T/log" 2>&1 && ok || bad "stitch failed: $(cat "$T/log")"
+info "$T/s.tif" >"$T/i"
+grep -q "ImageDescription: \"Franja $version render; scene $hash; 2 spp; integrator path\"" "$T/i" && ok ||
+    bad "stitch's .tif description: $(cat "$T/i")"
+summary
