@@ -46,6 +46,9 @@ static const char usage[] =
     "                       with --hosts or --slurm: at most N per host)\n"
     "  --spp N              samples per pixel (default: the scene's)\n"
     "  --size WxH           image size (default: the scene's)\n"
+    "  --scale S            image size as a fraction of the scene's: 50% or 0.5,\n"
+    "                       above 0 and at most 400%; each side rounded to the\n"
+    "                       nearest pixel, at least 1 (not with --size)\n"
     "  --crop X0:Y0:X1:Y1   render only the window [X0,X1) x [Y0,Y1) (pixels, y down\n"
     "                       from the top); the rest of the image is black\n"
     "  --crop-output        with --crop: write the window alone\n"
@@ -109,6 +112,7 @@ typedef struct {
     int json;                  /* --progress json */
     int crop, crop_output;     /* --crop given, --crop-output */
     iio_options io;            /* --exr-half, --exr-compression, --jpeg-quality */
+    double scale;              /* --scale, 0 when not given */
     crop_window win;
     int monitor;               /* --monitor given */
     uint32_t monitor_port;
@@ -122,7 +126,7 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -154,6 +158,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"exr-half", no_argument, NULL, OPT_EXR_HALF},
         {"exr-compression", required_argument, NULL, OPT_EXR_COMPRESSION},
         {"jpeg-quality", required_argument, NULL, OPT_JPEG_QUALITY},
+        {"scale", required_argument, NULL, OPT_SCALE},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -181,6 +186,9 @@ static int parse(int argc, char **argv, render_args *a)
             break;
         case OPT_SIZE:
             bad = opt_size(cmd, "--size", v, &a->width, &a->height);
+            break;
+        case OPT_SCALE:
+            bad = opt_scale(cmd, "--scale", v, &a->scale);
             break;
         case OPT_CAMERA:
             a->camera = v;
@@ -301,6 +309,10 @@ static int parse(int argc, char **argv, render_args *a)
     }
     if (a->preview && !strcmp(a->preview, a->out)) {
         fprintf(stderr, "franja render: --preview %s is the output itself; name another file\n", a->preview);
+        return 2;
+    }
+    if (a->scale > 0 && a->width) {
+        fprintf(stderr, "franja render: --scale and --size exclude each other (one image size at a time)\n");
         return 2;
     }
     if (a->crop_output && !a->crop) {
@@ -749,6 +761,21 @@ int cmd_render(int argc, char **argv)
                      a.spp ? a.spp : sc.settings.spp,
                      a.integrator ? (uint32_t)(a.integrator - 1) : sc.settings.integrator,
                      a.noise_threshold > 0.0f ? a.noise_threshold : sc.settings.noise_threshold};
+    if (a.scale > 0) {
+        spec.width = opt_scaled(sc.settings.width, a.scale);
+        spec.height = opt_scaled(sc.settings.height, a.scale);
+    }
+    char note[400];
+    if (a.width && opt_aspect_note(spec.width, spec.height, sc.settings.width, sc.settings.height, note, sizeof note))
+        fprintf(stderr, "franja render: warning: --size: %s\n", note);
+    if (spec.width > PROTO_MAX_SIZE || spec.height > PROTO_MAX_SIZE) {
+        fprintf(stderr, "franja render: --scale: %ux%u is over the largest size, %u pixels a side\n", spec.width,
+                spec.height, PROTO_MAX_SIZE);
+        scn_free(&sc);
+        hosts_free(&table);
+        slurm_close(&alloc);
+        return unlock_with(&lk, 2);
+    }
     if (spec.integrator == FR_INTEGRATOR_BDPT && a.noise_threshold > 0.0f) {
         fprintf(stderr, "franja render: --noise-threshold: adaptive sampling is for path tracing, not bdpt\n");
         scn_free(&sc);

@@ -2,6 +2,7 @@
 #include "opt.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -225,3 +226,49 @@ int opt_choice(const char *cmd, const char *opt, const char *v, const char *cons
     return -1;
 }
 
+
+int opt_scale(const char *cmd, const char *opt, const char *v, double *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    int pct = end != v && *end == '%' && end[1] == 0;
+    if (pct)
+        d /= 100.0;
+    if (!errno && end != v && (pct || !*end) && d > 0.0 && d <= OPT_SCALE_MAX) {
+        *out = d;
+        return 0;
+    }
+    fprintf(stderr, "franja %s: %s: '%s' is not a scale: a percentage above 0%% and at most %g%% (like 50%%), "
+            "or a factor above 0 and at most %g (like 0.5)\n", cmd, opt, v, OPT_SCALE_MAX * 100.0, OPT_SCALE_MAX);
+    return -1;
+}
+
+uint32_t opt_scaled(uint32_t n, double s)
+{
+    double x = floor((double)n * s + 0.5);
+    return x < 1.0 ? 1u : x > (double)UINT32_MAX ? UINT32_MAX : (uint32_t)x;
+}
+
+static uint32_t gcd(uint32_t a, uint32_t b)
+{
+    while (b) {
+        uint32_t t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
+int opt_aspect_note(uint32_t w, uint32_t h, uint32_t sw, uint32_t sh, char *buf, size_t cap)
+{
+    if (cap)
+        buf[0] = 0;
+    if (!w || !h || !sw || !sh || (uint64_t)w * sh == (uint64_t)h * sw)
+        return 0;
+    uint32_t g = gcd(w, h), sg = gcd(sw, sh);
+    snprintf(buf, cap, "%ux%u is %u:%u (%.3f), the scene's %ux%u is %u:%u (%.3f): the aspect ratio changes "
+             "(the vertical field of view stays, so the image shows more or less at the sides)",
+             w, h, w / g, h / g, (double)w / h, sw, sh, sw / sg, sh / sg, (double)sw / sh);
+    return 1;
+}

@@ -55,6 +55,23 @@ int opt_float(const char *cmd, const char *opt, const char *v, float lo, float h
  * what is expected and returns -1. */
 int opt_size(const char *cmd, const char *opt, const char *v, uint32_t *w, uint32_t *h);
 
+/** The largest --scale: 400%. */
+#define OPT_SCALE_MAX 4.0
+
+/** Parses a scale factor: a percentage ("50%") or a plain factor ("0.5"),
+ * above 0 and at most OPT_SCALE_MAX; otherwise prints what is allowed and
+ * returns -1. */
+int opt_scale(const char *cmd, const char *opt, const char *v, double *out);
+
+/** Scales a scene's side of n pixels by s: rounded to the nearest pixel
+ * (halves up), at least 1.  So 50% of 255 is 128, 10% of 4 is 1. */
+uint32_t opt_scaled(uint32_t n, double s);
+
+/** When w x h has another aspect ratio than the scene's sw x sh, writes a
+ * line saying so, naming both ratios ("2:1 (2.000)"), to buf[cap] and
+ * returns 1; otherwise returns 0 and leaves buf empty. */
+int opt_aspect_note(uint32_t w, uint32_t h, uint32_t sw, uint32_t sh, char *buf, size_t cap);
+
 /** Finds v among the NULL-terminated choices and returns its index;
  * otherwise prints "franja CMD: OPT: 'V' is not one of: A, B" and returns
  * -1. */

@@ -11,7 +11,8 @@
 # default D (the text after "default" or "default:" up to ";" or ")"), the
 # man entry says "default D" too and the README's default column is D, and
 # where it gives none, neither does.  The options named in franja --help
-# and in the SYNOPSIS sections must exist as well.
+# and in the SYNOPSIS sections must exist as well, and franja --help and
+# franja(1)'s SYNOPSIS list every option of every command.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 need awk
@@ -118,6 +119,15 @@ named <"$T/f.top" | while read -r opt; do
 done >"$T/top.extra"
 if [ -s "$T/top.extra" ]; then while IFS= read -r l; do bad "$l"; done <"$T/top.extra"; else ok; fi
 compare_sets franja franja "$T/f.opts" "$T/f.named" coordinator/man/franja.1 '`franja` option'
+# ... and the top-level usage (franja --help) and franja(1)'s SYNOPSIS list
+# every option of every command.
+named <"$T/f.top" >"$T/top.named"
+awk -f tests/manopts.awk coordinator/man/franja.1 | awk -F '\t' '$1 == "synopsis" { print $2 }' | sort -u >"$T/syn"
+cut -f1 "$T/f.opts" | while read -r opt; do
+    grep -qx -- "$opt" "$T/top.named" || echo "franja --help (the top-level usage) does not list $opt"
+    grep -qx -- "$opt" "$T/syn" || echo "franja(1): the SYNOPSIS does not list $opt"
+done >"$T/unlisted"
+if [ -s "$T/unlisted" ]; then while IFS= read -r l; do bad "$l"; done <"$T/unlisted"; else ok; fi
 
 # --- franja-worker ---
 bin/franja-worker --help >"$T/w.help" 2>&1 || bad "franja-worker --help exits non-zero"

@@ -116,6 +116,22 @@ static void values(void)
     CHECK(opt_size("t", "--size", "64", &w, &h) == -1, "64 as a size");
     CHECK(opt_choice("t", "--tonemap", "filmic", curves) == 1, "filmic");
     CHECK(opt_choice("t", "--tonemap", "aces", curves) == -1, "aces");
+    double sc;
+    CHECK(opt_scale("t", "--scale", "50%", &sc) == 0 && sc == 0.5, "50%%");
+    CHECK(opt_scale("t", "--scale", "0.25", &sc) == 0 && sc == 0.25, "0.25");
+    CHECK(opt_scale("t", "--scale", "400%", &sc) == 0 && sc == 4.0, "400%%");
+    static const char *const bad_scales[] = {"0", "0%", "-10%", "401%", "4.01", "%", "50 %", "50%x", "x", "", "inf"};
+    for (size_t i = 0; i < sizeof bad_scales / sizeof *bad_scales; i++)
+        CHECK(opt_scale("t", "--scale", bad_scales[i], &sc) == -1, "scale '%s' accepted", bad_scales[i]);
+    CHECK(opt_scaled(255, 0.5) == 128 && opt_scaled(101, 0.5) == 51, "50%% of 255, 101 (halves up)");
+    CHECK(opt_scaled(512, 0.333) == 170 && opt_scaled(4, 0.1) == 1 && opt_scaled(3, 0.0001) == 1,
+          "rounding and the 1-pixel floor");
+    char note[400];
+    CHECK(opt_aspect_note(64, 32, 512, 512, note, sizeof note) == 1 && strstr(note, "64x32 is 2:1 (2.000)") &&
+          strstr(note, "512x512 is 1:1 (1.000)"), "aspect note: '%s'", note);
+    CHECK(opt_aspect_note(256, 128, 1024, 512, note, sizeof note) == 0 && note[0] == 0, "same ratio: '%s'", note);
+    CHECK(opt_aspect_note(1920, 1080, 640, 480, note, sizeof note) == 1 && strstr(note, "16:9") &&
+          strstr(note, "4:3"), "16:9 against 4:3: '%s'", note);
     (void)null;
 }
 

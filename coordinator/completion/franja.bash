@@ -59,7 +59,7 @@ _franja()
     --job | --dist | --workdir | --shared-workdir)
         COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     --worker) _franja_files "$cur" ""; return 0 ;;
-    -j | --spp | --size | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
+    -j | --spp | --size | --scale | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
         --monitor | --crop | --jpeg-quality | --noise-threshold)
         return 0 ;;
     esac
