@@ -355,16 +355,34 @@ static int scene_binary(const render_args *a, const char *jobdir, char *path, si
     return fbin_load(path, sc, err);
 }
 
-static void summary(const sched_host *hs, int n, const job_spec *spec, const sched_stats *st, int rows_run,
-                    double wall)
+/* The end of a run: how it ended first when it did not finish (ended:
+ * "interrupted", "failed"), then what was rendered (rows_done of the
+ * rows_asked this run had to render; samples/s over those rows), the
+ * slabs, retries and second copies, and each host's share. */
+static void summary(const sched_host *hs, int n, const job_spec *spec, const sched_stats *st, int rows_done,
+                    int rows_asked, double wall, const char *ended)
 {
-    double samples = (double)rows_run * spec->width * spec->spp;
-    fprintf(stderr, "franja: %ux%u at %u spp in %.2f s: %.2f Msamples/s; %d slabs, %d retries, %d duplicates\n",
-            spec->width, spec->height, spec->spp, wall, wall > 0 ? samples / wall / 1e6 : 0.0, st->slabs,
-            st->retries, st->duplicates);
+    double samples = (double)rows_done * spec->width * spec->spp;
+    double rate = wall > 0 ? samples / wall / 1e6 : 0.0;
+    int slabs = 0;
+    for (int i = 0; i < n; i++)
+        slabs += hs[i].slabs;
+    if (ended)
+        fprintf(stderr, "franja: %s after %.2f s: %d of %d rows rendered (%ux%u at %u spp), %.2f Msamples/s over "
+                "them; %d of %d slabs, %d retries", ended, wall, rows_done, rows_asked, spec->width, spec->height,
+                spec->spp, rate, slabs, st->slabs, st->retries);
+    else
+        fprintf(stderr, "franja: %ux%u at %u spp in %.2f s: %.2f Msamples/s; %d slabs, %d retries", spec->width,
+                spec->height, spec->spp, wall, rate, st->slabs, st->retries);
+    /* Second copies of slow slabs run on idle slots only; the first
+     * result wins.  Not failures: said only when there were some. */
+    if (st->duplicates)
+        fprintf(stderr, ", %d second cop%s of slow slabs on idle slots", st->duplicates,
+                st->duplicates == 1 ? "y" : "ies");
+    fputc('\n', stderr);
     if (n == 0)
         return;
-    fprintf(stderr, "  %-16s %5s %6s %6s %8s %6s %8s  %s\n", "host", "slots", "slabs", "rows", "failures", "dups",
+    fprintf(stderr, "  %-16s %5s %6s %6s %8s %6s %8s  %s\n", "host", "slots", "slabs", "rows", "failures", "copies",
             "busy s", "state");
     for (int i = 0; i < n; i++) {
         const sched_host *h = &hs[i];
@@ -616,7 +634,8 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         draw(&rep, 1);
         if (rep.drawn)
             fputc('\n', stderr);
-        summary(sh, n, spec, &st, rows_missing, clk_now() - t0);
+        summary(sh, n, spec, &st, rep.done, rows_missing, clk_now() - t0,
+                rc == 0 ? NULL : stop_flag ? "interrupted" : "failed");
         /* The hosts that rendered rows, for the image's metadata. */
         for (int i = 0, k = 0; i < n && used_cap; i++)
             if (sh[i].rows > 0 && k >= 0 && (size_t)k < used_cap)

@@ -65,6 +65,11 @@ check "interrupted render writes no image" test ! -e int.pfm
 check "interrupted render says how to resume" grep -q "rerun with --resume" logi
 kept=$(ls int.pfm.franja-job | grep -c '^rows-.*\.pf$')
 check "finished slabs are kept" test "$kept" -ge 2
+# The summary says first that the render was interrupted, and counts the
+# rows it rendered, not the rows it was asked for.
+sline=$(grep '^franja: .* s: ' logi | tail -n 1)
+case $sline in "franja: interrupted after "*" s: $((kept * 4)) of 24 rows rendered"*) ok ;;
+*) bad "the summary of an interrupted render: '$sline' (expected 'interrupted after ...: $((kept * 4)) of 24 rows rendered')" ;; esac
 "$FRANJA" render scene.fbin -o int.pfm $SIZE --hosts t_slow --slab-rows 4 --resume 2>logr
 check "resumed render is byte-identical" cmp -s int.pfm ref.pfm
 check "resume reports what was kept" grep -q "resuming: $((kept * 4)) of 24 rows" logr
