@@ -67,7 +67,7 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
         fr_error e1;
         if (stage_sysinfo(h->tr, arch, os, &e1) || !os[0])
             snprintf(os, sizeof os, "%s", h->info.os);
-        char warn[160] = "";
+        char warn[400] = "";
         if (h->entry->arch[0] && strcmp(h->entry->arch, h->info.arch)) {
             snprintf(warn, sizeof warn, "  PROBLEM: the table says arch=%s", h->entry->arch);
             bad++;
@@ -85,6 +85,13 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
             snprintf(cache, sizeof cache, "unreadable");
         else
             snprintf(cache, sizeof cache, "%d scene%s, %.1f MB", files, files == 1 ? "" : "s", bytes / 1e6);
+        /* The scene reaches the host as render sends it (SFTP). */
+        fr_error e3;
+        if (stage_try_upload(h->tr, &e3)) {
+            size_t l = strlen(warn);
+            snprintf(warn + l, sizeof warn - l, "  PROBLEM: %s", e3.msg);
+            bad++;
+        }
         int cores = h->entry->cores ? h->entry->cores : h->info.cores;
         printf("%-16s %-6s %-8s %-9s %5d  %-36s %s%s\n", h->entry->name, "ok", h->info.arch, os, cores,
                h->info.version, cache, warn);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "fbin.h"
 
@@ -122,6 +123,45 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
                        "is the worker '%s' able to read this scene format?", tr_host_label(h), remote,
                        tr_host_worker(h));
     return 0;
+}
+
+/* `sh -c TRY_SCRIPT FILE`: prints the uploaded file and removes it. */
+static const char TRY_SCRIPT[] = "c=$(cat -- \"$0\") || exit 1; rm -f -- \"$0\"; printf '%s\\n' \"$c\"";
+static const char TRY_TEXT[] = "franja hosts check";
+
+int stage_try_upload(tr_host *h, fr_error *err)
+{
+    const char *wd = tr_host_workdir(h);
+    if (!wd[0])
+        return 0;
+    char local[] = "/tmp/franja-check-XXXXXX";
+    int fd = mkstemp(local);
+    if (fd < 0)
+        return fr_fail(err, "cannot make a local file to upload: %s", strerror(errno));
+    size_t n = strlen(TRY_TEXT);
+    int wrote = write(fd, TRY_TEXT, n) == (ssize_t)n;
+    if (close(fd) || !wrote) {
+        unlink(local);
+        return fr_fail(err, "cannot write a local file to upload: %s", strerror(errno));
+    }
+    char remote[1200];
+    snprintf(remote, sizeof remote, "%s/scenes/.check-%s", wd, strrchr(local, '-') + 1);
+    int rc = tr_upload(h, local, remote, 0600, err);
+    unlink(local);
+    if (rc)
+        return -1;
+    const char *argv[] = {"sh", "-c", TRY_SCRIPT, remote, NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    size_t len;
+    const char *out = (const char *)tr_proc_output(p, &len);
+    if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0)
+        rc = failed(h, p, "reading back an uploaded file", err);
+    else if (len != n + 1 || memcmp(out, TRY_TEXT, n))
+        rc = fr_fail(err, "%s: an uploaded file (%s) reads back as %zu other bytes", tr_host_label(h), remote, len);
+    tr_proc_free(p);
+    return rc;
 }
 
 int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err)

@@ -35,6 +35,13 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
 int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, int *uploaded,
                 fr_error *err);
 
+/** Checks that files reach the host's scene cache the way a render's scene
+ * does (tr_upload: SFTP for an SSH host): a small file is uploaded into
+ * WORKDIR/scenes, read back by a command on the host and removed.  Does
+ * nothing for a host that shares this machine's files (no work directory).
+ * Fails, naming the host, with the upload's or the read-back's reason. */
+int stage_try_upload(tr_host *h, fr_error *err);
+
 /** Counts the scenes in the host's cache (*files, *bytes; 0 and 0 for a
  * host without a work directory). */
 int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err);

@@ -113,5 +113,19 @@ cp known_full known_hosts
 fr render scene.fbin -o q.pfm --hosts t_q $SIZE 2>logq
 check "shell syntax in paths reaches the worker unharmed" cmp -s q.pfm ref.pfm
 check "scene stored under the literal path" cmp -s "$QDIR/scenes/$HASH.fbin" scene.fbin
+# ... and hosts check's trial upload goes there too, and leaves nothing.
+fr hosts check --hosts t_q >checkq.out 2>&1
+check "hosts check passes with shell syntax in the work directory" test $? -eq 0
+check "hosts check leaves no trial file" test -z "$(ls -A "$QDIR/scenes" | grep -v "^$HASH.fbin\$")"
+
+# A host whose SSH server has no SFTP: render cannot ship it the scene, and
+# hosts check says so instead of passing it.
+FH_SFTP=/bin/false fh_start nosftp 5 2
+tail -n 1 hosts >t_nosftp
+fr hosts check --hosts t_nosftp >checkn.out 2>&1
+check "hosts check fails a host without SFTP" test $? -eq 1
+check "hosts check says why" grep -qi "^nosftp .*PROBLEM: .*sftp" checkn.out
+fr render scene.fbin -o n.pfm --hosts t_nosftp $SIZE 2>logn
+check "render cannot use a host without SFTP either" test $? -ne 0
 
 summary

@@ -12,7 +12,8 @@
 #                             its line to $FH/hosts (WORKER: worker path;
 #                             FH_SSHD_EXTRA: lines that override sshd_config;
 #                             FH_ADDR: another address; FH_NETNS: run sshd
-#                             in that network namespace)
+#                             in that network namespace; FH_SFTP: the SFTP
+#                             server program, /bin/false for none)
 #   fh_pids NAME [WORD]       PIDs of the host: sshd, its sessions, its workers
 #                             (only those whose arguments include WORD)
 #   fh_kill NAME / fh_stop NAME / fh_cont NAME
@@ -69,7 +70,7 @@ KbdInteractiveAuthentication no
 UsePAM no
 StrictModes no
 PermitRootLogin prohibit-password
-Subsystem sftp /usr/lib/openssh/sftp-server
+Subsystem sftp ${FH_SFTP:-/usr/lib/openssh/sftp-server}
 MaxStartups 100:30:200
 MaxSessions 64
 UseDNS no
