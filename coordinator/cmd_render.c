@@ -233,11 +233,7 @@ static int parse(int argc, char **argv, render_args *a)
             break;
         }
         case OPT_NOISE:
-            bad = opt_float(cmd, "--noise-threshold", v, 0, 1, &a->noise_threshold);
-            if (!bad && !(a->noise_threshold > 0.0f)) {
-                fprintf(stderr, "franja render: --noise-threshold: expected a number in (0, 1], got '%s'\n", v);
-                bad = 1;
-            }
+            bad = opt_fraction(cmd, "--noise-threshold", v, &a->noise_threshold);
             break;
         case OPT_PROGRESS: {
             int k = opt_choice(cmd, "--progress", v, progress);

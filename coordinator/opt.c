@@ -203,6 +203,19 @@ int opt_float(const char *cmd, const char *opt, const char *v, float lo, float h
     return -1;
 }
 
+int opt_fraction(const char *cmd, const char *opt, const char *v, float *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    if (!errno && end != v && !*end && d > 0.0 && d <= 1.0) {
+        *out = (float)d;
+        return 0;
+    }
+    fprintf(stderr, "franja %s: %s: '%s' is not a number in (0, 1] (above 0, at most 1)\n", cmd, opt, v);
+    return -1;
+}
+
 int opt_size(const char *cmd, const char *opt, const char *v, uint32_t *w, uint32_t *h)
 {
     if (proto_parse_size(v, w, h) == 0)

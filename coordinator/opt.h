@@ -51,6 +51,11 @@ int opt_uint(const char *cmd, const char *opt, const char *v, uint32_t lo, uint3
  * prints the range and returns -1. */
 int opt_float(const char *cmd, const char *opt, const char *v, float lo, float hi, float *out);
 
+/** Parses an option's value as a number above 0 and at most 1; otherwise
+ * prints "franja CMD: OPT: 'V' is not a number in (0, 1] ..." and returns
+ * -1. */
+int opt_fraction(const char *cmd, const char *opt, const char *v, float *out);
+
 /** Parses an option's value as WxH (proto_parse_size); otherwise prints
  * what is expected and returns -1. */
 int opt_size(const char *cmd, const char *opt, const char *v, uint32_t *w, uint32_t *h);

@@ -12,7 +12,7 @@
 # man entry says "default D" too and the README's default column is D, and
 # where it gives none, neither does.  The options named in franja --help
 # and in the SYNOPSIS sections must exist as well, and franja --help and
-# franja(1)'s SYNOPSIS list every option of every command.
+# the SYNOPSIS of franja(1) and franja-worker(1) list every option.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 need awk
@@ -134,4 +134,9 @@ bin/franja-worker --help >"$T/w.help" 2>&1 || bad "franja-worker --help exits no
 named <"$T/w.help" >"$T/w.named"
 help_lines <"$T/w.help" >"$T/w.opts"
 compare_sets franja-worker franja-worker "$T/w.opts" "$T/w.named" coordinator/man/franja-worker.1 '`franja-worker` option'
+awk -f tests/manopts.awk coordinator/man/franja-worker.1 | awk -F '\t' '$1 == "synopsis" { print $2 }' | sort -u >"$T/wsyn"
+cut -f1 "$T/w.opts" | while read -r opt; do
+    grep -qx -- "$opt" "$T/wsyn" || echo "franja-worker(1): the SYNOPSIS does not list $opt"
+done >"$T/wunlisted"
+if [ -s "$T/wunlisted" ]; then while IFS= read -r l; do bad "$l"; done <"$T/wunlisted"; else ok; fi
 summary

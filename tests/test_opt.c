@@ -116,6 +116,11 @@ static void values(void)
     CHECK(opt_size("t", "--size", "64", &w, &h) == -1, "64 as a size");
     CHECK(opt_choice("t", "--tonemap", "filmic", curves) == 1, "filmic");
     CHECK(opt_choice("t", "--tonemap", "aces", curves) == -1, "aces");
+    CHECK(opt_fraction("t", "--noise-threshold", "0.05", &x) == 0 && x == 0.05f, "0.05 in (0, 1]");
+    CHECK(opt_fraction("t", "--noise-threshold", "1", &x) == 0 && x == 1.0f, "1 in (0, 1]");
+    CHECK(opt_fraction("t", "--noise-threshold", "0", &x) == -1, "0 in (0, 1]");
+    CHECK(opt_fraction("t", "--noise-threshold", "1.5", &x) == -1, "1.5 in (0, 1]");
+    CHECK(opt_fraction("t", "--noise-threshold", "nan", &x) == -1, "nan in (0, 1]");
     double sc;
     CHECK(opt_scale("t", "--scale", "50%", &sc) == 0 && sc == 0.5, "50%%");
     CHECK(opt_scale("t", "--scale", "0.25", &sc) == 0 && sc == 0.25, "0.25");
