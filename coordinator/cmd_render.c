@@ -15,6 +15,7 @@
 #include "cli.h"
 #include "opt.h"
 #include "clock.h"
+#include "cmd_frames.h"
 #include "cluster.h"
 #include "compile.h"
 #include "compile_child.h"
@@ -52,6 +53,10 @@ static const char usage[] =
     "  --crop X0:Y0:X1:Y1   render only the window [X0,X1) x [Y0,Y1) (pixels, y down\n"
     "                       from the top); the rest of the image is black\n"
     "  --crop-output        with --crop: write the window alone\n"
+    "  --frames LIST        render the frames LIST (1-240, 1-240:2, 1,5,9) of an\n"
+    "                       animation: # in SCENE, -o, --job and --preview stands\n"
+    "                       for the zero-padded frame number (f.####.json)\n"
+    "  --overwrite          with --frames: render frames whose output exists\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
@@ -117,6 +122,8 @@ typedef struct {
     int monitor;               /* --monitor given */
     uint32_t monitor_port;
     int resume, keep_job, fresh, no_lock;
+    const char *frames;        /* --frames LIST, or NULL */
+    int overwrite;             /* --overwrite */
     tr_options tr;
     cli_slurm slurm;
 } render_args;
@@ -126,7 +133,7 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -159,6 +166,8 @@ static int parse(int argc, char **argv, render_args *a)
         {"exr-compression", required_argument, NULL, OPT_EXR_COMPRESSION},
         {"jpeg-quality", required_argument, NULL, OPT_JPEG_QUALITY},
         {"scale", required_argument, NULL, OPT_SCALE},
+        {"frames", required_argument, NULL, OPT_FRAMES},
+        {"overwrite", no_argument, NULL, OPT_OVERWRITE},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -272,6 +281,12 @@ static int parse(int argc, char **argv, render_args *a)
             a->io.quality = (int)q;
             break;
         }
+        case OPT_FRAMES:
+            a->frames = v;
+            break;
+        case OPT_OVERWRITE:
+            a->overwrite = 1;
+            break;
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;
@@ -313,6 +328,10 @@ static int parse(int argc, char **argv, render_args *a)
     }
     if (a->crop_output && !a->crop) {
         fprintf(stderr, "franja render: --crop-output needs --crop X0:Y0:X1:Y1\n");
+        return 2;
+    }
+    if (a->overwrite && !a->frames) {
+        fprintf(stderr, "franja render: --overwrite is for --frames (a single render always writes its output)\n");
         return 2;
     }
     if (a->resume && a->fresh) {
@@ -697,6 +716,16 @@ int cmd_render(int argc, char **argv)
     free(args);
     if (pr)
         return pr == 1 ? 0 : 2;
+    static int in_frames; /* rendering one frame of --frames */
+    if (a.frames && !in_frames) {
+        frames_job fj = {a.frames, a.overwrite, a.scene, a.out, a.jobdir, a.preview};
+        in_frames = 1;
+        int rc = frames_run(argc, argv, &fj, cmd_render);
+        in_frames = 0;
+        return rc;
+    }
+    if (!a.frames && frames_check_plain(a.scene))
+        return 2;
     fr_error err;
     if (out_check(a.out, &err) || (a.preview && out_check_type(a.preview, &err))) {
         fprintf(stderr, "franja render: %s\n", err.msg);

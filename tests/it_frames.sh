@@ -1,0 +1,99 @@
+#!/bin/sh
+# it_frames.sh -- franja render PATTERN --frames LIST: a three-frame
+# animation (a sphere moving) gives, frame for frame, the bytes of three
+# single renders; outputs that exist are skipped unless --overwrite; an
+# interrupt keeps the frame's finished slabs and --resume goes on from
+# there; over SSH each frame's scene is uploaded once per host; bad
+# patterns and lists are refused before anything renders.
+. "$(dirname "$0")/coord/fakehosts.sh"
+fh_init
+cd "$FH" || exit 1
+SIZE="--size 24x16 --spp 2"
+
+for i in 1 2 3; do
+    sed "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [$((100 * i + 150)), 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+        "$ROOT/scenes/cornell.json" >"f.000$i.json"
+    "$FRANJA" render "f.000$i.json" -o "ref$i.pfm" $SIZE -j 1 2>/dev/null || bad "single render of frame $i failed"
+done
+check "the sphere moves: frames 1 and 2 differ" sh -c '! cmp -s ref1.pfm ref2.pfm'
+check "the sphere moves: frames 2 and 3 differ" sh -c '! cmp -s ref2.pfm ref3.pfm'
+
+mkdir out
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'out/f.####.pfm' $SIZE -j 2 2>log1
+check "the animation renders (status 0)" test $? -eq 0
+for i in 1 2 3; do
+    check "frame $i equals its single render" cmp -s "out/f.000$i.pfm" "ref$i.pfm"
+done
+check "the summary counts the frames" grep -q "frames: 3 of 3 done (3 rendered, 0 skipped" log1
+check "each frame is announced with its files" grep -q "frame 2 (2 of 3): f.0002.json -> out/f.0002.pfm" log1
+
+# Outputs that exist are skipped; --overwrite renders them again.
+printf 'not an image' >out/f.0002.pfm
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'out/f.####.pfm' $SIZE -j 2 2>log2
+check "an existing output is kept" grep -q "not an image" out/f.0002.pfm
+check "the skips are counted" grep -q "frames: 3 of 3 done (0 rendered, 3 skipped" log2
+"$FRANJA" render 'f.####.json' --frames 2 -o 'out/f.####.pfm' $SIZE -j 2 --overwrite 2>log3
+check "--overwrite renders it again" cmp -s out/f.0002.pfm ref2.pfm
+check "--overwrite counts it rendered" grep -q "frames: 1 of 1 done (1 rendered, 0 skipped" log3
+# A step list: frames 1 and 3 only.
+mkdir step
+"$FRANJA" render 'f.####.json' --frames 1-3:2 -o 'step/s.##.pfm' $SIZE 2>/dev/null
+check "1-3:2 renders frame 1" cmp -s step/s.01.pfm ref1.pfm
+check "1-3:2 renders frame 3" cmp -s step/s.03.pfm ref3.pfm
+check "1-3:2 skips frame 2" test ! -e step/s.02.pfm
+
+# Ctrl-C during frame 2, then --resume.
+mkdir -p loc slow
+printf 'here local - 1 worker=%s\n' "$(fh_wrapper loc slow)" >t_slow
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'slow/f.####.pfm' $SIZE --hosts t_slow --slab-rows 4 2>logi &
+FH_BG=$!
+fh_until fh_has_slabs slow/f.0002.pfm.franja-job 1
+kill -INT $FH_BG
+fr_wait
+check "the interrupted animation exits 130" test $rc -eq 130
+check "frame 1 was written before the interrupt" cmp -s slow/f.0001.pfm ref1.pfm
+check "frame 2 was not written" test ! -e slow/f.0002.pfm
+check "frame 3 was not started" test ! -e slow/f.0003.pfm.franja-job
+check "the interrupt names the frame" grep -q "interrupted at frame 2 (slow/f.0002.pfm)" logi
+kept=$(fh_slabs slow/f.0002.pfm.franja-job)
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'slow/f.####.pfm' $SIZE --hosts t_slow --slab-rows 4 --resume 2>logr
+check "the resumed animation succeeds" test $? -eq 0
+for i in 1 2 3; do
+    check "resumed frame $i equals its single render" cmp -s "slow/f.000$i.pfm" "ref$i.pfm"
+done
+check "frame 2 kept its finished slabs" grep -q "resuming: $((kept * 4)) of 16 rows" logr
+check "frame 1 is skipped on resume" grep -q "frame 1 (1 of 3): slow/f.0001.pfm exists, skipped" logr
+
+# Two SSH hosts: each frame's scene goes to each host once.
+fh_start a 2 1
+fh_start b 3 1
+mkdir ssh
+fr render 'f.####.json' --frames 1-3 -o 'ssh/f.####.pfm' $SIZE --hosts hosts 2>logs
+check "the SSH animation renders" test $? -eq 0
+for i in 1 2 3; do
+    check "SSH frame $i equals its single render" cmp -s "ssh/f.000$i.pfm" "ref$i.pfm"
+done
+for h in a b; do
+    n=$(grep -c "host $h: .*scene uploaded" logs)
+    check "host $h got 3 uploads, not $n" test "$n" -eq 3
+    n=$(ls $h/work/scenes | grep -c '\.fbin$')
+    check "host $h caches 3 scenes, not $n" test "$n" -eq 3
+done
+fr render 'f.####.json' --frames 1-3 -o 'ssh/f.####.pfm' $SIZE --hosts hosts --overwrite 2>logs2
+check "a second pass uploads nothing" sh -c "! grep -q 'scene uploaded' logs2"
+check "a second pass finds every scene cached" test "$(grep -c 'scene already there' logs2)" -eq 6
+
+# Bad command lines.
+expect_error "--frames without # in the scene" "the scene 'f.0001.json' has no #" \
+    "$FRANJA" render f.0001.json --frames 1-3 -o 'x.####.png'
+expect_error "--frames with one output" "the output (-o, else named after the scene) 'x.png' has no #" \
+    "$FRANJA" render 'f.####.json' --frames 1-3 -o x.png
+expect_error "--frames with one job directory" "--job 'j' has no #" \
+    "$FRANJA" render 'f.####.json' --frames 1-3 -o 'x.####.png' --job j
+expect_error "a pattern without --frames" "give --frames LIST" "$FRANJA" render 'f.####.json' -o x.png
+expect_error "a backward range" "the range 3-1 runs backwards" "$FRANJA" render 'f.####.json' --frames 3-1
+expect_error "a zero step" "at byte 2: expected N, A-B or A-B:S" "$FRANJA" render 'f.####.json' --frames 1,2-4:0
+expect_error "--overwrite alone" "--overwrite is for --frames" "$FRANJA" render f.0001.json --overwrite
+expect_error "a frame that fails is named" "frame 7 (f.0007.json -> x.0007.pfm) failed" \
+    "$FRANJA" render 'f.####.json' --frames 7 -o 'x.####.pfm'
+summary
