@@ -84,7 +84,24 @@ static int probe_and_stage(cl_host *h, int i, void *vctx, fr_error *err)
     open_ctx *c = vctx;
     if (stage_probe(h->tr, &h->info, err))
         return -1;
-    return c->scene ? stage_scene(h->tr, c->scene, c->hash, h->scene, sizeof h->scene, &h->uploaded, err) : 0;
+    if (!c->scene)
+        return 0;
+    if (stage_scene(h->tr, c->scene, c->hash, h->scene, sizeof h->scene, &h->uploaded, err))
+        return -1;
+    /* The cache stays bounded; a failure to trim it does not stop the render. */
+    uint64_t limit = h->entry->cache ? h->entry->cache : HOSTS_CACHE_DEFAULT, bytes;
+    int removed;
+    fr_error e;
+    if (stage_evict(h->tr, h->scene, limit, &removed, &bytes, &e))
+        tr_note(h->tr, "%s", e.msg);
+    else if (removed) {
+        char lim[32], gone[32];
+        hosts_format_size(limit, lim);
+        hosts_format_size(bytes, gone);
+        tr_note(h->tr, "scene cache over its limit (%s): removed %d least recently used scene%s (%s)", lim, removed,
+                removed == 1 ? "" : "s", gone);
+    }
+    return 0;
 }
 
 void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash)

@@ -11,9 +11,10 @@
  * slabs are kept for --resume). */
 int cmd_render(int argc, char **argv);
 
-/** `franja hosts check|list --hosts FILE`: 0 when every host is usable
- * (check) or the table parses (list), 1 when a host is not usable, 2 on a
- * bad table or usage error. */
+/** `franja hosts check|list|clean --hosts FILE`: 0 when every host is
+ * usable (check), the table parses (list) or every host's scene cache was
+ * cleaned (clean), 1 when a host is not usable or could not be cleaned, 2
+ * on a bad table or usage error. */
 int cmd_hosts(int argc, char **argv);
 
 /** `franja deploy --hosts FILE [--dist DIR]`: installs the worker build

@@ -12,8 +12,9 @@
 
 static const char usage[] =
     "usage: franja hosts check --hosts FILE [options]\n"
-    "       franja hosts check --slurm [options]\n"
+    "       franja hosts check|clean --slurm [options]\n"
     "       franja hosts list --hosts FILE | --slurm\n"
+    "       franja hosts clean --hosts FILE [options]\n"
     "\n"
     "check: connects to every host of the table, verifies its key against\n"
     "known_hosts, and reports its architecture, OS, cores, worker version and\n"
@@ -21,6 +22,8 @@ static const char usage[] =
     "host is usable.  With --slurm the hosts are the nodes of the allocation\n"
     "this runs in, reached with job steps, and cores are the CPUs allocated.\n"
     "list:  parses the table and prints it with the defaults filled in.\n"
+    "clean: empties each host's scene cache (scenes a running worker uses\n"
+    "       stay) and removes the temporary files of cut-off uploads.\n"
     "\n"
     "  --hosts FILE         host table (franja-hosts(5))\n"
     CLI_SLURM_HELP;
@@ -110,6 +113,47 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
     return bad ? 1 : 0;
 }
 
+static int clean_step(cl_host *h, int i, void *ctx, fr_error *err)
+{
+    return stage_clean(h->tr, &((stage_cleaned *)ctx)[i], err);
+}
+
+static int clean(const hosts_table *t, const tr_options *o)
+{
+    cl_host *cl = calloc((size_t)t->n, sizeof *cl);
+    stage_cleaned *done = calloc((size_t)t->n, sizeof *done);
+    if (!cl || !done) {
+        free(cl);
+        free(done);
+        return 1;
+    }
+    for (int i = 0; i < t->n; i++)
+        cl[i].entry = &t->v[i];
+    cl_each(cl, t->n, o, clean_step, done);
+    int bad = 0;
+    for (int i = 0; i < t->n; i++) {
+        const stage_cleaned *d = &done[i];
+        if (!cl[i].tr) {
+            bad++;
+            printf("%-16s FAIL %s\n", t->v[i].name, cl[i].err.msg);
+        } else if (hosts_is_local(&t->v[i])) {
+            printf("%-16s ok   local: no scene cache\n", t->v[i].name);
+        } else {
+            char size[32];
+            hosts_format_size(d->bytes, size);
+            printf("%-16s ok   removed %d scene%s (%s), %d temporary file%s", t->v[i].name, d->removed,
+                   d->removed == 1 ? "" : "s", size, d->temp, d->temp == 1 ? "" : "s");
+            if (d->in_use)
+                printf("; kept %d in use by a running worker", d->in_use);
+            printf("\n");
+        }
+    }
+    cl_close(cl, t->n);
+    free(cl);
+    free(done);
+    return bad ? 1 : 0;
+}
+
 int cmd_hosts(int argc, char **argv)
 {
     static const struct option longopts[] = {CLI_COMMON_LONGOPTS, CLI_SLURM_LONGOPTS, {NULL, 0, NULL, 0}};
@@ -129,11 +173,11 @@ int cmd_hosts(int argc, char **argv)
             r = cli_common_opt("hosts", c, optarg, usage, &o, &path);
     }
     for (int i = optind; r == CLI_TAKEN && i < argc; i++) {
-        if (!what && (!strcmp(args[i], "check") || !strcmp(args[i], "list")))
+        if (!what && (!strcmp(args[i], "check") || !strcmp(args[i], "list") || !strcmp(args[i], "clean")))
             what = args[i];
         else {
             fprintf(stderr, "franja hosts: unexpected '%s'%s (see franja hosts --help)\n", args[i],
-                    what ? "" : "; expected check or list");
+                    what ? "" : "; expected check, list or clean");
             r = CLI_BAD;
         }
     }
@@ -141,7 +185,7 @@ int cmd_hosts(int argc, char **argv)
     if (r != CLI_TAKEN)
         return r == CLI_HELP ? 0 : 2;
     if (!what || (!path && !sl.on)) {
-        fprintf(stderr, "franja hosts: expected 'check' or 'list' and --hosts FILE or --slurm "
+        fprintf(stderr, "franja hosts: expected 'check', 'list' or 'clean' and --hosts FILE or --slurm "
                         "(see franja hosts --help)\n");
         return 2;
     }
@@ -155,6 +199,8 @@ int cmd_hosts(int argc, char **argv)
     int rc = 0;
     if (!strcmp(what, "list"))
         list(&t);
+    else if (!strcmp(what, "clean"))
+        rc = clean(&t, &o);
     else
         rc = check(&t, &o, sl.on);
     hosts_free(&t);

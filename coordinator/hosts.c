@@ -92,14 +92,71 @@ static int parse_address(hosts_entry *h, const char *s, const char *path, int li
     return copy_field(h->address, sizeof h->address, host, path, line, "address", err);
 }
 
+int hosts_parse_size(const char *s, uint64_t *bytes)
+{
+    uint64_t v = 0;
+    const char *p = s;
+    if (*p < '0' || *p > '9')
+        return -1;
+    for (; *p >= '0' && *p <= '9'; p++) {
+        v = v * 10 + (uint64_t)(*p - '0');
+        if (v > (1ull << 60))
+            return -1;
+    }
+    static const char units[] = "kmgt";
+    const char *u = *p ? strchr(units, *p | 0x20) : NULL;
+    if (u) {
+        for (int i = 0; i <= u - units; i++) {
+            if (v > (1ull << 50))
+                return -1;
+            v <<= 10;
+        }
+        p++;
+        if ((*p | 0x20) == 'i' && p[1])
+            p++;
+        if ((*p | 0x20) == 'b')
+            p++;
+    } else if ((*p | 0x20) == 'b') {
+        p++;
+    }
+    if (*p || v == 0 || v > (1ull << 60))
+        return -1;
+    *bytes = v;
+    return 0;
+}
+
+void hosts_format_size(uint64_t bytes, char *out)
+{
+    static const char *const units[] = {"KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+    if (bytes < 1024) {
+        snprintf(out, 32, "%u B", (unsigned)bytes);
+        return;
+    }
+    double v = (double)bytes / 1024;
+    int u = 0;
+    while (v >= 1024 && u < 5) {
+        v /= 1024;
+        u++;
+    }
+    snprintf(out, 32, "%.1f %s", v, units[u]);
+}
+
 static int parse_option(hosts_entry *h, char *kv, const char *path, int line, fr_error *err)
 {
     char *eq = strchr(kv, '=');
     if (!eq || eq == kv)
-        return fr_fail(err, "%s:%d: '%s': expected key=value (identity, worker, workdir, arch, os)",
+        return fr_fail(err, "%s:%d: '%s': expected key=value (identity, worker, workdir, arch, os, cache)",
                        path, line, kv);
     *eq = 0;
     const char *key = kv, *val = eq + 1;
+    if (!strcmp(key, "cache")) {
+        if (h->cache)
+            return fr_fail(err, "%s:%d: cache= given twice", path, line);
+        if (hosts_parse_size(val, &h->cache))
+            return fr_fail(err, "%s:%d: cache='%s': expected a size such as 500M or 10G (K, M, G, T: "
+                           "powers of 1024), at least 1 byte", path, line, val);
+        return 0;
+    }
     struct { const char *key; char *dst; size_t cap; } keys[] = {
         {"identity", h->identity, sizeof h->identity},
         {"worker", h->worker, sizeof h->worker},
@@ -114,7 +171,7 @@ static int parse_option(hosts_entry *h, char *kv, const char *path, int line, fr
             return fr_fail(err, "%s:%d: %s= given twice", path, line, key);
         return copy_field(keys[i].dst, keys[i].cap, val, path, line, key, err);
     }
-    return fr_fail(err, "%s:%d: unknown key '%s': expected identity, worker, workdir, arch or os",
+    return fr_fail(err, "%s:%d: unknown key '%s': expected identity, worker, workdir, arch, os or cache",
                    path, line, key);
 }
 

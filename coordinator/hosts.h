@@ -14,10 +14,24 @@
 #ifndef FRANJA_HOSTS_H
 #define FRANJA_HOSTS_H
 
+#include <stdint.h>
+
 #include "error.h"
 
 /** Most worker processes one host may run (cores, and franja render -j). */
 #define HOSTS_MAX_CORES 4096
+
+/** The scene cache limit of a host whose line gives no cache= (10 GiB). */
+#define HOSTS_CACHE_DEFAULT (10ull << 30)
+
+/** Parses a size: decimal digits and an optional K, M, G or T (powers of
+ * 1024, any case, an optional trailing B or iB: "500M", "10GiB"), at least
+ * 1 and at most 2^60 bytes.  Returns -1 otherwise. */
+int hosts_parse_size(const char *s, uint64_t *bytes);
+
+/** Writes bytes as a short text into out[32]: "512 B", "6.8 KiB",
+ * "12.0 MiB", "1.5 GiB" (powers of 1024, like cache=). */
+void hosts_format_size(uint64_t bytes, char *out);
 
 /** One line of the host table.  Empty strings mean "not given". */
 typedef struct {
@@ -31,6 +45,7 @@ typedef struct {
     char workdir[512];   /**< work directory on the host, "" = .cache/franja (home-relative) */
     char arch[32];       /**< declared architecture (uname -m), "" = unknown */
     char os[64];         /**< declared operating system, "" = unknown */
+    uint64_t cache;      /**< scene cache limit in bytes (cache=SIZE), 0 = HOSTS_CACHE_DEFAULT */
     int line;            /**< line number in the file, for messages */
 } hosts_entry;
 

@@ -22,6 +22,28 @@ static const char CHECK_SCRIPT[] = "[ -e \"$2\" ] || exit 97; exec \"$0\" \"$@\"
 static const char CACHE_SCRIPT[] =
     "cd \"$0\" 2>/dev/null || exit 0; for f in *.fbin; do [ -f \"$f\" ] && wc -c <\"$f\"; done; exit 0";
 
+/* The names of the scenes (*.fbin) that the user's processes on the host
+ * have mapped, as " A B ... " in $u (Linux's /proc; elsewhere none). */
+#define IN_USE "u=\" $(cat /proc/[0-9]*/maps 2>/dev/null | grep -o '[^/ ]*\\.fbin$' | tr '\\n' ' ') \"; "
+
+/* `sh -c EVICT_SCRIPT DIR KEEP LIMIT`: newest first, every scene past the
+ * limit goes, unless it is KEEP or in use; prints "NAME SIZE" for each. */
+static const char EVICT_SCRIPT[] =
+    "cd \"$0\" 2>/dev/null || exit 0; touch -c -- \"$1\"; " IN_USE
+    "t=0; for f in $(ls -t); do case $f in *.fbin) ;; *) continue ;; esac; [ -f \"$f\" ] || continue; "
+    "s=$(wc -c <\"$f\") || continue; t=$((t + s)); "
+    "if [ \"$t\" -gt \"$2\" ] && [ \"$f\" != \"$1\" ]; then case $u in *\" $f \"*) continue ;; esac; "
+    "rm -f -- \"$f\" && t=$((t - s)) && echo \"$f $s\"; fi; done; exit 0";
+
+/* `sh -c CLEAN_SCRIPT DIR`: prints "REMOVED BYTES IN_USE TEMP". */
+static const char CLEAN_SCRIPT[] =
+    "cd \"$0\" 2>/dev/null || { echo 0 0 0 0; exit 0; }; " IN_USE
+    "n=0; b=0; k=0; p=0; for f in *.fbin; do [ -f \"$f\" ] || continue; "
+    "case $u in *\" $f \"*) k=$((k + 1)); continue ;; esac; "
+    "s=$(wc -c <\"$f\") && rm -f -- \"$f\" && n=$((n + 1)) && b=$((b + s)); done; "
+    "for f in $(find . -maxdepth 1 -type f \\( -name '*.part-*' -o -name '.check-*' \\) -mmin +10); do "
+    "rm -f -- \"$f\" && p=$((p + 1)); done; echo \"$n $b $k $p\"";
+
 static const char SYSINFO_SCRIPT[] = "uname -m && (cat /etc/os-release 2>/dev/null || true)";
 
 /* Runs a short command; *p is the finished process (TR_EXITED or
@@ -160,6 +182,65 @@ int stage_try_upload(tr_host *h, fr_error *err)
         rc = failed(h, p, "reading back an uploaded file", err);
     else if (len != n + 1 || memcmp(out, TRY_TEXT, n))
         rc = fr_fail(err, "%s: an uploaded file (%s) reads back as %zu other bytes", tr_host_label(h), remote, len);
+    tr_proc_free(p);
+    return rc;
+}
+
+int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint64_t *bytes, fr_error *err)
+{
+    *removed = 0;
+    *bytes = 0;
+    const char *wd = tr_host_workdir(h);
+    if (!wd[0])
+        return 0;
+    char dir[1024], lim[32];
+    snprintf(dir, sizeof dir, "%s/scenes", wd);
+    const char *name = strrchr(keep, '/');
+    name = name ? name + 1 : keep;
+    snprintf(lim, sizeof lim, "%llu", (unsigned long long)limit);
+    const char *argv[] = {"sh", "-c", EVICT_SCRIPT, dir, name, lim, NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    int rc = 0;
+    if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0) {
+        rc = failed(h, p, "keeping the scene cache within its limit", err);
+    } else {
+        size_t len;
+        const char *out = (const char *)tr_proc_output(p, &len);
+        for (size_t i = 0; i < len; i++)
+            if (out[i] == ' ') {
+                (*removed)++;
+                *bytes += strtoull(out + i + 1, NULL, 10);
+            }
+    }
+    tr_proc_free(p);
+    return rc;
+}
+
+int stage_clean(tr_host *h, stage_cleaned *out, fr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const char *wd = tr_host_workdir(h);
+    if (!wd[0])
+        return 0;
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/scenes", wd);
+    const char *argv[] = {"sh", "-c", CLEAN_SCRIPT, dir, NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    int rc = 0;
+    size_t len;
+    const char *text = (const char *)tr_proc_output(p, &len);
+    char buf[128];
+    unsigned long long b = 0;
+    snprintf(buf, sizeof buf, "%.*s", (int)(len < sizeof buf ? len : sizeof buf - 1), text ? text : "");
+    if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0)
+        rc = failed(h, p, "cleaning the scene cache", err);
+    else if (sscanf(buf, "%d %llu %d %d", &out->removed, &b, &out->in_use, &out->temp) != 4)
+        rc = fr_fail(err, "%s: unexpected answer cleaning the scene cache", tr_host_label(h));
+    out->bytes = b;
     tr_proc_free(p);
     return rc;
 }

@@ -42,6 +42,28 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
  * Fails, naming the host, with the upload's or the read-back's reason. */
 int stage_try_upload(tr_host *h, fr_error *err);
 
+/** Keeps the host's scene cache within limit bytes after the scene named
+ * keep (its path as stage_scene gave it) was staged: marks keep as just
+ * used (its modification time), then removes the least recently used
+ * scenes until the cache's scenes add up to limit or less.  Never removes
+ * keep, nor a scene that a process on the host has mapped (a running
+ * worker), so the cache may stay above the limit.  *removed and *bytes say
+ * what went.  Nothing to do for a host without a work directory. */
+int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint64_t *bytes, fr_error *err);
+
+/** What stage_clean did on one host. */
+typedef struct {
+    int removed;       /**< scenes removed */
+    uint64_t bytes;    /**< their size */
+    int in_use;        /**< scenes kept because a process has them mapped */
+    int temp;          /**< stale temporary files removed */
+} stage_cleaned;
+
+/** Empties the host's scene cache: removes every scene but those a
+ * process on the host has mapped (a running worker), and the temporary
+ * files of uploads that were cut off (unchanged for ten minutes). */
+int stage_clean(tr_host *h, stage_cleaned *out, fr_error *err);
+
 /** Counts the scenes in the host's cache (*files, *bytes; 0 and 0 for a
  * host without a work directory). */
 int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err);

@@ -35,12 +35,15 @@ fr render "$ROOT/scenes/cornell.json" -o out2.png --hosts hosts $SIZE 2>log2
 check "JSON scene renders to PNG over SSH" test -s out2.png
 check "no job directory left behind" test ! -e out2.png.franja-job
 
-# Second render: nothing uploaded again.
+# Second render: nothing uploaded again; the cached copy is the same file,
+# marked as just used (the cache's least-recently-used order).
 touch -d '2000-01-01' a/work/scenes/$HASH.fbin
+inode=$(stat -c %i a/work/scenes/$HASH.fbin)
 fr render scene.fbin -o out3.pfm --hosts hosts $SIZE 2>log3
 check "second render is byte-identical" cmp -s out3.pfm ref.pfm
 check "second render uploads nothing" test "$(grep -c 'scene already there' log3)" -eq 3
-check "cached copy untouched" test "$(stat -c %Y a/work/scenes/$HASH.fbin)" = 946684800
+check "cached copy not replaced" test "$(stat -c %i a/work/scenes/$HASH.fbin)" = "$inode"
+check "cached copy marked as used" test "$(stat -c %Y a/work/scenes/$HASH.fbin)" -gt 946684800
 
 # A damaged copy (same size, one byte changed) and a truncated one.
 printf 'X' | dd of=b/work/scenes/$HASH.fbin bs=1 seek=200 conv=notrunc 2>/dev/null

@@ -10,7 +10,7 @@
 #   franja render -<TAB>         render's options (likewise for every command)
 #   franja render <TAB>          scene files (.json .gltf .glb .fbin) and directories
 #   franja render --tonemap <TAB>  none filmic
-#   franja hosts <TAB>           check list
+#   franja hosts <TAB>           check list clean
 #   franja stitch <TAB>          directories (job directories)
 
 # _franja_opts PROGRAM [WORDS...]: the options that `PROGRAM WORDS --help` lists.
@@ -77,7 +77,7 @@ _franja()
     render) _franja_files "$cur" '*.@(json|gltf|glb|fbin)' ;;
     compile) _franja_files "$cur" '*.@(json|gltf|glb)' ;;
     hosts)
-        [ "$i" -eq $((COMP_CWORD - 1)) ] && COMPREPLY=($(compgen -W "check list" -- "$cur")) ;;
+        [ "$i" -eq $((COMP_CWORD - 1)) ] && COMPREPLY=($(compgen -W "check list clean" -- "$cur")) ;;
     stitch) COMPREPLY=($(compgen -d -- "$cur")) ;;
     help) COMPREPLY=($(compgen -W "render compile stitch hosts deploy" -- "$cur")) ;;
     esac
