@@ -2,6 +2,7 @@
  * frame, outputs that exist skipped. */
 #include "cmd_frames.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +42,32 @@ fail:
         free(v[i]);
     free(v);
     return NULL;
+}
+
+/* Creates the missing directories above the file at path (like mkdir -p of
+ * its directory, mode 0777 less the umask).  Returns 0, or -1 with errno. */
+static int make_parents(const char *path)
+{
+    char d[4096];
+    if (snprintf(d, sizeof d, "%s", path) >= (int)sizeof d) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    char *slash = strrchr(d, '/');
+    if (!slash || slash == d)
+        return 0;
+    *slash = '\0';
+    for (char *p = d + 1; ; p++) {
+        if (*p == '/' || !*p) {
+            char c = *p;
+            *p = '\0';
+            if (mkdir(d, 0777) && errno != EEXIST)
+                return -1;
+            *p = c;
+            if (!c)
+                return 0;
+        }
+    }
 }
 
 static void free_args(int argc, char **v)
@@ -106,6 +133,12 @@ int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn
             continue;
         }
         fprintf(stderr, "franja: frame %u (%zu of %zu): %s -> %s\n", f, i + 1, fl.n, scene, out);
+        if (make_parents(out)) {
+            fprintf(stderr, "franja render: frame %u: cannot make the directory of %s: %s\n", f, out, strerror(errno));
+            free_args(argc, v);
+            rc = 1;
+            break;
+        }
         rc = fn(argc, v);
         free_args(argc, v);
         if (!rc) {

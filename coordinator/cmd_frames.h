@@ -2,7 +2,8 @@
  * `franja render PATTERN --frames LIST`: renders an animation frame by
  * frame through the single-image render, each frame with its own output
  * and job directory (so --resume and the job lock work per frame), and
- * skips a frame whose output exists unless --overwrite.
+ * skips a frame whose output exists unless --overwrite.  The directories
+ * of a frame's output are made when missing.
  */
 #ifndef FRANJA_CMD_FRAMES_H
 #define FRANJA_CMD_FRAMES_H

@@ -36,11 +36,13 @@ check "the skips are counted" grep -q "frames: 3 of 3 done (0 rendered, 3 skippe
 check "--overwrite renders it again" cmp -s out/f.0002.pfm ref2.pfm
 check "--overwrite counts it rendered" grep -q "frames: 1 of 1 done (1 rendered, 0 skipped" log3
 # A step list: frames 1 and 3 only.
-mkdir step
-"$FRANJA" render 'f.####.json' --frames 1-3:2 -o 'step/s.##.pfm' $SIZE 2>/dev/null
+# The output's directories (here one a frame) are made.
+"$FRANJA" render 'f.####.json' --frames 1-3:2 -o 'step/s.##/s.##.pfm' $SIZE 2>/dev/null
+check "1-3:2 makes each frame's directory" test -d step/s.01 -a -d step/s.03
+mv step/s.01/s.01.pfm step/s.03/s.03.pfm step/
 check "1-3:2 renders frame 1" cmp -s step/s.01.pfm ref1.pfm
 check "1-3:2 renders frame 3" cmp -s step/s.03.pfm ref3.pfm
-check "1-3:2 skips frame 2" test ! -e step/s.02.pfm
+check "1-3:2 skips frame 2" test ! -e step/s.02.pfm -a ! -e step/s.02
 
 # Ctrl-C during frame 2, then --resume.
 mkdir -p loc slow
@@ -94,6 +96,9 @@ expect_error "a pattern without --frames" "give --frames LIST" "$FRANJA" render 
 expect_error "a backward range" "the range 3-1 runs backwards" "$FRANJA" render 'f.####.json' --frames 3-1
 expect_error "a zero step" "at byte 2: expected N, A-B or A-B:S" "$FRANJA" render 'f.####.json' --frames 1,2-4:0
 expect_error "--overwrite alone" "--overwrite is for --frames" "$FRANJA" render f.0001.json --overwrite
+touch nodir
+expect_error "a directory that cannot be made is named" "frame 1: cannot make the directory of nodir/x/f.0001.pfm" \
+    "$FRANJA" render 'f.####.json' --frames 1 -o 'nodir/x/f.####.pfm'
 expect_error "a frame that fails is named" "frame 7 (f.0007.json -> x.0007.pfm) failed" \
     "$FRANJA" render 'f.####.json' --frames 7 -o 'x.####.pfm'
 summary
