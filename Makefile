@@ -152,14 +152,17 @@ render: all
 	bin/franja render scenes/cornell.json -o cornell.png
 
 # The small Cycles renders in tests/data that tests/it_conventions.sh,
-# tests/it_envlight.sh and tests/it_cycles_*.sh compare against, made
-# again with Debian's blender (apt-get install blender).  The tests read the
+# tests/it_envlight.sh, tests/it_cycles_*.sh and tests/it_lightunits.sh
+# compare against (and the glTF files Blender's exporter writes for the
+# last), made again with Debian's blender (apt-get install blender
+# python3-numpy: its glTF exporter needs numpy).  The tests read the
 # committed files: only this target needs blender.
 refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
 	for s in rough metals; do blender -b --factory-startup --python tests/refs/cycles_scene.py -- \
 	    tests/data/cycles-$$s.json tests/data cycles-$$s 256; done
+	blender -b --factory-startup --python tests/refs/cycles_lights.py -- tests/data
 	for s in glass fog; do blender -b --factory-startup --python tests/refs/cycles_noise.py -- \
 	    tests/bench/scenes/cornell-$$s.json tests/data/cycles-noise-$$s.pfm 1024 7; done
 

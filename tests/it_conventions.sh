@@ -16,13 +16,22 @@
 #              on a 64x32 image, covers the rows (columns) it should.
 #   right      scenes/README.md: with +y up and the view along +z, image
 #              right is world -x (or +x).
+#   roughness  scenes/README.md: alpha = roughness^2 (or roughness^p as the
+#              roughness row says).  A conductor plane without Fresnel
+#              factor, seen head-on by a camera of 0.5 degrees under a sun
+#              straight behind the camera: the radiance is
+#              D(n) G(n, n) / 4 = 1 / (4 pi alpha^2) (GGX at its peak, no
+#              masking head-on), measured at roughness 0.3 and 0.5.
+#
+#   sh tests/it_conventions.sh [DOC]    (default scenes/README.md: the
+#                                        statements may be read from a copy)
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 need awk oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 W=bin/franja-worker IS=bin/tools/imgstat
-DOC=scenes/README.md
+DOC=${1:-scenes/README.md}
 
 # near A B TOL: |A - B| <= TOL.
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; exit !(a != "" && (d < 0 ? -d : d) <= t) }'; }
@@ -125,5 +134,34 @@ JSON
     if [ "$side" = -x ]; then lit=$right dark=$left; else lit=$left dark=$right; fi
     near "$lit" 1 0.001 && near "$dark" 0 0.001 && ok ||
         bad "$DOC:${rline%%:*}: image right is world $side, but an emitter at world -x lights the left half $left, the right half $right"
+fi
+# --- roughness: alpha = roughness^p -----------------------------------
+rrow=$(grep -n '^| `roughness` |' $DOC | head -n 1)
+p=""
+case "$rrow" in
+*'α = roughness²'*) p=2 ;;
+*'α = roughness,'* | *'α = roughness '* | *'α = roughness;'*) p=1 ;;
+esac
+if [ -z "$p" ]; then
+    bad "$DOC: the roughness row no longer says 'α = roughness²' (or how α follows roughness; this test reads it)"
+else
+    for r in 0.3 0.5; do
+        cat >"$T/rough.json" <<JSON
+{"image": {"width": 8, "height": 8, "spp": 16, "max_depth": 1},
+ "camera": {"position": [0, 10, 0], "target": [0, 0, 0], "up": [0, 0, 1], "fov": 0.5},
+ "materials": {"m": {"type": "conductor", "roughness": $r, "fresnel": "none", "reflectance": [1, 1, 1]}},
+ "lights": [{"type": "sun", "direction": [0, -1, 0], "irradiance": [1, 1, 1]}],
+ "shapes": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "m"}]}
+JSON
+        if $W --scene "$T/rough.json" --rows 0:8 -o "$T/rough.pfm" 2>"$T/err"; then
+            m=$(mean_of "$T/rough.pfm")
+            want=$(awk -v r=$r -v p=$p 'BEGIN { a = r ^ p; print 1 / (4 * 3.14159265358979 * a * a) }')
+            tol=$(awk -v w="$want" 'BEGIN { print w * 0.01 }')
+            near "$m" "$want" "$tol" && ok ||
+                bad "$DOC:${rrow%%:*}: α = roughness^$p: a conductor of roughness $r seen head-on under a sun behind the camera gives $m, 1 / (4π α²) = $want"
+        else
+            bad "roughness render: $(cat "$T/err")"
+        fi
+    done
 fi
 summary
