@@ -100,6 +100,11 @@ bin/tools/%: tests/tools/%.c $(LIB)
 	@mkdir -p bin/tools
 	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm
 
+# nolockfs, a FUSE file system that refuses locks (tests/it_joblock.sh).
+bin/tools/nolockfs: tests/tools/nolockfs.c
+	@mkdir -p bin/tools
+	$(CC) $(CSTD) $(CFLAGS) $(shell $(PKG) --cflags fuse3) -o $@ $< $(shell $(PKG) --libs fuse3 2>/dev/null || echo -lfuse3)
+
 # Benchmark programs; only these link Embree (the reference they measure against).
 bin/bench/%: tests/bench/%.c $(LIB)
 	@mkdir -p bin/bench

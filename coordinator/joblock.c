@@ -137,6 +137,11 @@ int jlk_acquire(const char *dir, const char *what, const char *cmdline, int unlo
             if (e == ENOLCK || e == EOPNOTSUPP || e == EINVAL || e == ENOSYS) {
                 if (!unlocked_ok) {
                     close(fd);
+                    /* Refused: what this call made goes again. */
+                    if (lk->created) {
+                        unlink(lk->path);
+                        rmdir(dir);
+                    }
                     fr_fail(err, "%s: the file system refuses locks (%s), so two renders of one output "
                             "could not be kept apart; use a local job directory (--job DIR), or "
                             "--no-lock to go on without the lock", dir, strerror(e));

@@ -43,8 +43,9 @@ int jlk_check_dir(const char *dir, fr_error *err);
  * `what` names the render's output in the busy message ("OUT is being
  * rendered by another franja (pid P on host H, since T)"); cmdline is
  * recorded in the lock file.  Where the file system refuses locks:
- * JLK_NOLOCKS, unless unlocked_ok, in which case the directory is used
- * without a lock (the caller warns).  On 0, lk must be given to
+ * JLK_NOLOCKS (a directory this call created is removed again), unless
+ * unlocked_ok, in which case the directory is used without a lock (the
+ * caller warns).  On 0, lk must be given to
  * jlk_release. */
 int jlk_acquire(const char *dir, const char *what, const char *cmdline, int unlocked_ok, job_lock *lk,
                 fr_error *err);

@@ -1,11 +1,15 @@
 /* test_file.c -- files written atomically (common/file.h): the target is
  * the old file or the whole new one, temporary files keep the extension,
- * never follow a planted link and never stay behind. */
+ * never follow a planted link and never stay behind; writers in different
+ * processes (the final image and the preview of two renders) never share a
+ * temporary file, nor does a process of another machine with the same pid
+ * on a shared file system. */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "check.h"
@@ -102,6 +106,111 @@ static void test_planted_links(void)
     unlink(victim);
 }
 
+/* Four processes open temporary files for the same target at once: four
+ * different files (names and inodes), each committed whole. */
+static void test_processes(void)
+{
+    enum { K = 4 };
+    char path[128];
+    snprintf(path, sizeof path, "%s/shared.png", dir);
+    int up[2], go[2];
+    CHECK(pipe(up) == 0 && pipe(go) == 0, "pipe");
+    pid_t kids[K];
+    for (int k = 0; k < K; k++) {
+        kids[k] = fork();
+        if (kids[k] == 0) {
+            close(up[0]);
+            close(go[1]);
+            file_out o;
+            fr_error err;
+            char line[4500] = "";
+            struct stat st;
+            if (file_out_open(path, &o, &err) == 0 && fstat(o.fd, &st) == 0)
+                snprintf(line, sizeof line, "%lu %s\n", (unsigned long)st.st_ino, o.tmp);
+            else
+                snprintf(line, sizeof line, "0 failed\n");
+            /* One line, written at once: the pipe keeps it whole. */
+            if (write(up[1], line, strlen(line)) < 0)
+                _exit(1);
+            char c;
+            if (read(go[0], &c, 1) != 1)
+                _exit(1);
+            char body[32];
+            int n = snprintf(body, sizeof body, "writer %d", k);
+            _exit(file_out_write(&o, body, (size_t)n, &err) || file_out_commit(&o, path, &err) ? 1 : 0);
+        }
+    }
+    close(up[1]);
+    close(go[0]);
+    /* Every child holds its temporary file open before any commits. */
+    char buf[K * 4600];
+    size_t got = 0;
+    int lines = 0;
+    while (lines < K && got < sizeof buf - 1) {
+        ssize_t n = read(up[0], buf + got, sizeof buf - 1 - got);
+        if (n <= 0)
+            break;
+        for (ssize_t i = 0; i < n; i++)
+            lines += buf[got + (size_t)i] == '\n';
+        got += (size_t)n;
+    }
+    buf[got] = 0;
+    close(up[0]);
+    CHECK(lines == K, "%d of %d writers reported a temporary file", lines, K);
+    char names[K][4500];
+    unsigned long inos[K];
+    char *p = buf;
+    for (int k = 0; k < K && lines == K; k++) {
+        CHECK(sscanf(p, "%lu %4499s", &inos[k], names[k]) == 2 && inos[k] != 0, "writer line: %s", p);
+        p = strchr(p, '\n') + 1;
+        for (int j = 0; j < k; j++) {
+            CHECK(strcmp(names[j], names[k]) != 0, "two processes got the temporary name %s", names[k]);
+            CHECK(inos[j] != inos[k], "two processes got the same temporary file (inode %lu)", inos[k]);
+        }
+    }
+    CHECK(entries() == K, "%d files while %d writers hold theirs", entries(), K);
+    if (write(go[1], "gggg", K) != K)
+        CHECK(0, "cannot release the writers");
+    close(go[1]);
+    for (int k = 0; k < K; k++) {
+        int st;
+        CHECK(waitpid(kids[k], &st, 0) == kids[k] && WIFEXITED(st) && WEXITSTATUS(st) == 0, "writer %d failed", k);
+    }
+    int whole = 0;
+    for (int k = 0; k < K; k++) {
+        char body[32];
+        snprintf(body, sizeof body, "writer %d", k);
+        whole += has(path, body);
+    }
+    CHECK(whole == 1, "the target is not one writer's whole file");
+    CHECK(entries() == 1, "%d files after every commit, expected the target alone", entries());
+    unlink(path);
+}
+
+/* A regular file at this process's next temporary name, as a process of
+ * another machine with the same pid would make on a shared file system:
+ * skipped, and left as it is. */
+static void test_same_pid_elsewhere(void)
+{
+    char path[128];
+    snprintf(path, sizeof path, "%s/t.exr", dir);
+    fr_error err;
+    file_out probe;
+    CHECK(file_out_open(path, &probe, &err) == 0, "open: %s", err.msg);
+    char *dash = strrchr(probe.tmp, '-');
+    unsigned n = (unsigned)strtoul(dash + 1, NULL, 10);
+    char theirs[4500];
+    snprintf(theirs, sizeof theirs, "%.*s-%u.exr", (int)(dash - probe.tmp), probe.tmp, n + 1);
+    file_out_abort(&probe);
+    FILE *f = fopen(theirs, "wx");
+    CHECK(f && fputs("theirs", f) >= 0 && fclose(f) == 0, "cannot plant %s", theirs);
+    CHECK(file_write_atomic(path, "ours", 4, &err) == 0, "write beside their file: %s", err.msg);
+    CHECK(has(theirs, "theirs"), "the other machine's temporary file was touched");
+    CHECK(has(path, "ours"), "content written past their file");
+    unlink(theirs);
+    unlink(path);
+}
+
 static void test_failures(void)
 {
     fr_error err = {{0}};
@@ -131,6 +240,8 @@ int main(void)
     test_write_and_replace();
     test_temporary_name();
     test_planted_links();
+    test_processes();
+    test_same_pid_elsewhere();
     test_failures();
     rmdir(dir);
     return check_done();
