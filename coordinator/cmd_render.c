@@ -946,8 +946,15 @@ int cmd_render(int argc, char **argv)
     out_meta_make(&meta, &spec, clk_now() - t0, used);
     a.io.attrs = meta.attrs;
     if (out_write_with(a.out, rgb, &out_spec, &tm, &a.io, &err)) {
-        fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume to "
-                "write %s\n", err.msg, jobdir, a.out);
+        /* Said only once checked: the rows are still there. */
+        if (job_rows_present(jobdir) >= rows_job) {
+            fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
+                    "to write %s\n", err.msg, jobdir, a.out);
+        } else {
+            char kept[4400];
+            job_kept_note(jobdir, kept, sizeof kept);
+            fprintf(stderr, "franja render: %s\nfranja render: %s\n", err.msg, kept);
+        }
         goto done;
     }
     pg_stop(pg, "ok");

@@ -228,7 +228,7 @@ void job_kept_note(const char *dir, char *out, size_t cap)
     }
     int rows = job_rows_present(dir);
     if (rows == 0)
-        snprintf(out, cap, "no slab had finished, so nothing was kept");
+        snprintf(out, cap, "no finished slab is in %s, so nothing was kept", dir);
     else
         snprintf(out, cap, "%d finished rows are kept in %s; rerun with --resume", rows, dir);
 }

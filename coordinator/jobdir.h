@@ -85,8 +85,9 @@ int job_gather(const char *dir, const job_spec *spec, float *rgb, unsigned char 
 int job_rows_present(const char *dir);
 
 /** Says truthfully what a failed render leaves in dir, checked now: "N rows
- * are kept in DIR; rerun with --resume", that nothing finished, or that the
- * directory was removed by another process.  Written to out[cap]. */
+ * are kept in DIR; rerun with --resume", that no finished slab is there, or
+ * that the directory was removed by another process.  Written to
+ * out[cap]. */
 void job_kept_note(const char *dir, char *out, size_t cap);
 
 /** Deletes the job directory and what franja put in it. */
