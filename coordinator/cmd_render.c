@@ -71,10 +71,16 @@ static const char usage[] =
     "                       dwaa or dwab (default zip)\n"
     "  --jpeg-quality Q     .jpg output: quality 1..100 (default 98)\n"
     "  --tonemap CURVE      none or filmic (default: the scene's, else none)\n"
-    "  --resume             keep the finished slabs of an interrupted render\n"
+    "  --time-limit T       render in passes over the whole image, each doubling\n"
+    "                       the samples per pixel (1, 2, 4 ... up to --spp), and\n"
+    "                       stop at T (90s, 10m, 1.5h; from the start of the\n"
+    "                       command), writing the last complete pass\n"
+    "  --resume             keep the finished slabs of an interrupted render; with\n"
+    "                       a larger --spp, add samples to a job kept by --keep-job\n"
     "  --fresh              discard the finished slabs of an earlier render\n"
     "  --job DIR            job directory (default OUT.franja-job)\n"
-    "  --keep-job           keep the job directory after success\n"
+    "  --keep-job           keep the job directory after success (with each\n"
+    "                       pixel's sample sums, to add samples later)\n"
     "  --no-lock            use a job directory on a file system without locks\n"
     "  --slab-rows N        rows per slab (default: shrinking toward the end)\n"
     "  --retries N          attempts per slab before giving up (default 5)\n"
@@ -124,6 +130,7 @@ typedef struct {
     int resume, keep_job, fresh, no_lock;
     const char *frames;        /* --frames LIST, or NULL */
     int overwrite;             /* --overwrite */
+    double time_limit;         /* --time-limit, seconds; 0 when not given */
     tr_options tr;
     cli_slurm slurm;
 } render_args;
@@ -133,7 +140,7 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -168,6 +175,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"scale", required_argument, NULL, OPT_SCALE},
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
+        {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -287,6 +295,9 @@ static int parse(int argc, char **argv, render_args *a)
         case OPT_OVERWRITE:
             a->overwrite = 1;
             break;
+        case OPT_TIME_LIMIT:
+            bad = opt_duration(cmd, "--time-limit", v, &a->time_limit);
+            break;
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;
@@ -377,7 +388,7 @@ static int scene_binary(const render_args *a, const char *jobdir, char *path, si
 static void summary(const sched_host *hs, int n, const job_spec *spec, const sched_stats *st, int rows_done,
                     int rows_asked, double wall, const char *ended)
 {
-    double samples = (double)rows_done * spec->width * spec->spp;
+    double samples = st->samples;
     double rate = wall > 0 ? samples / wall / 1e6 : 0.0;
     int slabs = 0;
     for (int i = 0; i < n; i++)
@@ -394,6 +405,11 @@ static void summary(const sched_host *hs, int n, const job_spec *spec, const sch
     if (st->duplicates)
         fprintf(stderr, ", %d second cop%s of slow slabs on idle slots", st->duplicates,
                 st->duplicates == 1 ? "y" : "ies");
+    if (st->continued)
+        fprintf(stderr, "; %d slab%s went on from kept sample sums", st->continued, st->continued == 1 ? "" : "s");
+    if (st->fresh_instead)
+        fprintf(stderr, " (%d attempt%s rendered every sample: the sums could not be sent)", st->fresh_instead,
+                st->fresh_instead == 1 ? "" : "s");
     fputc('\n', stderr);
     if (n == 0)
         return;
@@ -577,14 +593,124 @@ static void on_admit(void *ctx, sched_host *hosts, int nhosts)
     join_hosts(r->join, hosts, 0);
 }
 
+/* The passes of a render.  Without --time-limit there is one, to the
+ * samples asked for.  With it, each pass brings every row the render needs
+ * to twice the fewest samples kept for a row (1 at first; never fewer than
+ * the most kept for a row; at most the samples asked for), adding samples
+ * to the kept sums, and the image of each complete pass is kept in memory:
+ * when the limit stops a pass, that image is written. */
+typedef struct {
+    const render_args *a;
+    const char *jobdir;
+    job_spec spec;             /* the pass being planned or run (spp) */
+    uint32_t cap;              /* the samples per pixel asked for */
+    int crop_rows;             /* only the rows of a's --crop window */
+    unsigned char *have;       /* rows the pass does not render (done, or outside a crop) */
+    uint32_t *base;            /* samples with sums that each row goes on from (job_scan) */
+    int rows_job, rows_missing;
+    int rows_kept;             /* rows the job directory holds at spec.spp, needed or not */
+    double deadline;           /* clk_now() time of --time-limit; 0 = none */
+    float *rgb;                /* --time-limit: the image of the last complete pass */
+    unsigned char *scratch;    /* height bytes */
+    uint32_t reached;          /* the samples per pixel of rgb; 0 = none yet */
+    int npass;                 /* passes run */
+    uint32_t stopped;          /* the samples per pixel of the pass the limit stopped; 0 = none */
+    sched_stats total;         /* over the passes */
+} passes;
+
+static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_window *win, float *rgb,
+                       unsigned char *have, fr_error *err);
+
+/* Whether the render needs row y (a crop needs its window's). */
+static int needed(const passes *ps, uint32_t y)
+{
+    return !ps->crop_rows || (y >= ps->a->win.y0 && y < ps->a->win.y1);
+}
+
+/* What a pass to spp samples per pixel renders: the rows the job
+ * directory does not hold with spp samples, each from the most samples
+ * kept for it with their sums. */
+static int plan(passes *ps, uint32_t spp, fr_error *err)
+{
+    ps->spec.spp = spp;
+    int sums = job_sums(&ps->spec);
+    ps->rows_kept = job_scan(ps->jobdir, &ps->spec, ps->have, sums ? ps->base : NULL, &ps->a->tr.notes, err);
+    if (ps->rows_kept < 0)
+        return -1;
+    if (!sums)
+        memset(ps->base, 0, ps->spec.height * sizeof *ps->base);
+    ps->rows_missing = 0;
+    for (uint32_t y = 0; y < ps->spec.height; y++) {
+        if (!needed(ps, y))
+            ps->have[y] = 1; /* not rendered */
+        ps->rows_missing += !ps->have[y];
+    }
+    return 0;
+}
+
+/* The fewest and the most samples per pixel kept for a needed row (with
+ * their sums, or the samples asked for), from a plan to ps->cap. */
+static void kept_range(const passes *ps, uint32_t *lo, uint32_t *hi)
+{
+    *lo = UINT32_MAX;
+    *hi = 0;
+    for (uint32_t y = 0; y < ps->spec.height; y++) {
+        if (!needed(ps, y))
+            continue;
+        uint32_t k = ps->have[y] ? ps->cap : ps->base[y];
+        *lo = k < *lo ? k : *lo;
+        *hi = k > *hi ? k : *hi;
+    }
+    if (*lo == UINT32_MAX)
+        *lo = ps->cap;
+}
+
+/* The samples per pixel of the next pass of a --time-limit render, 0 when
+ * every needed row has the samples asked for. */
+static int next_pass(passes *ps, uint32_t *spp, fr_error *err)
+{
+    if (plan(ps, ps->cap, err))
+        return -1;
+    uint32_t lo, hi;
+    kept_range(ps, &lo, &hi);
+    *spp = 0;
+    if (lo >= ps->cap)
+        return 0;
+    uint32_t twice = lo == 0 ? 1 : lo > ps->cap / 2 ? ps->cap : 2 * lo;
+    *spp = twice > hi ? twice : hi;
+    return 0;
+}
+
+/* The image of the pass just planned and complete into ps->rgb. */
+static int pass_image(passes *ps, fr_error *err)
+{
+    if (ps->crop_rows)
+        return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->scratch, err);
+    return job_stitch(ps->jobdir, &ps->spec, ps->rgb, &ps->a->tr.notes, err);
+}
+
+static void add_stats(sched_stats *to, const sched_stats *st)
+{
+    to->slabs += st->slabs;
+    to->retries += st->retries;
+    to->duplicates += st->duplicates;
+    to->wall_s += st->wall_s;
+    to->samples += st->samples;
+    to->continued += st->continued;
+    to->fresh_instead += st->fresh_instead;
+    to->timed_out |= st->timed_out;
+}
+
 /* Connects the hosts and runs the slabs not yet in the job directory.  The
  * render starts as soon as one host is ready; the others join when they
  * are (a host that accepts a connection and never answers costs nothing
  * unless it is the only one). */
-static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, const job_spec *spec,
-                     const char *jobdir, const unsigned char *have, int rows_job, int rows_missing,
+static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, passes *ps,
                      pg_reporter *pg, mon_server *mon, char *used, size_t used_cap, fr_error *err)
 {
+    const job_spec *spec = &ps->spec;
+    const char *jobdir = ps->jobdir;
+    int rows_job = ps->rows_job, rows_missing = ps->rows_missing;
     int n = table->n;
     cl_host *cl = calloc((size_t)n, sizeof *cl);
     sched_host *sh = calloc((size_t)n, sizeof *sh);
@@ -631,25 +757,82 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         for (int i = 0; i < n; i++)
             if (sh[i].pending && sh[i].slots < 1)
                 sh[i].slots = guess;
-        sched_params p = {.spec = *spec,
-                          .jobdir = jobdir,
-                          .have = have,
-                          .slab_rows = (int)a->slab_rows,
-                          .max_attempts = (int)a->retries,
-                          .max_host_failures = 3,
-                          .stop = &stop_flag,
-                          /* An SSH channel closed (a losing copy, a dropped
-                           * host, this process gone) ends the worker, even
-                           * where signals do not reach it (worker/lifeline.h). */
-                          .lifeline = !a->slurm.on,
-                          .hooks = {.event = on_event, .progress = on_progress, .admit = on_admit, .ctx = &rep}};
-        sched_stats st;
         double t0 = clk_now();
-        rc = sched_run(&p, sh, n, &st, err);
+        sched_stats st;
+        memset(&ps->total, 0, sizeof ps->total);
+        for (;;) {
+            uint32_t spp = ps->cap;
+            if (ps->deadline > 0) {
+                if (next_pass(ps, &spp, err)) {
+                    rc = -1;
+                    break;
+                }
+                if (spp == 0)
+                    break;
+                if (ps->reached && clk_now() >= ps->deadline) {
+                    ps->stopped = spp;
+                    break;
+                }
+                if (plan(ps, spp, err)) {
+                    rc = -1;
+                    break;
+                }
+                ps->npass++;
+                clear_line(&rep);
+                fprintf(stderr, "franja: pass %d: %u samples per pixel, %d rows to render\n", ps->npass, spp,
+                        ps->rows_missing);
+                pg_pass(pg, ps->npass, spp);
+            } else if (ps->npass++ > 0) {
+                break;
+            }
+            rows_missing = ps->rows_missing;
+            rep.total = rows_missing;
+            rep.done = 0;
+            rep.rows_before = rows_job - rows_missing;
+            sched_params p = {.spec = *spec,
+                              .jobdir = jobdir,
+                              .have = ps->have,
+                              .base = ps->base,
+                              .sums = job_sums(spec),
+                              /* The first pass of a --time-limit render
+                               * always ends: it is the least image there is. */
+                              .stop_at = ps->deadline > 0 && ps->reached ? ps->deadline : 0,
+                              .slab_rows = (int)a->slab_rows,
+                              .max_attempts = (int)a->retries,
+                              .max_host_failures = 3,
+                              .stop = &stop_flag,
+                              /* An SSH channel closed (a losing copy, a dropped
+                               * host, this process gone) ends the worker, even
+                               * where signals do not reach it (worker/lifeline.h). */
+                              .lifeline = !a->slurm.on,
+                              .hooks = {.event = on_event, .progress = on_progress, .admit = on_admit, .ctx = &rep}};
+            rc = sched_run(&p, sh, n, &st, err);
+            add_stats(&ps->total, &st);
+            if (rc && st.timed_out && !stop_flag) {
+                /* The pass in flight is given up; its finished slabs stay. */
+                ps->stopped = spp;
+                rc = 0;
+                break;
+            }
+            if (rc || ps->deadline <= 0)
+                break;
+            if (pass_image(ps, err)) {
+                rc = -1;
+                break;
+            }
+            ps->reached = spp;
+            draw(&rep, 1);
+            clear_line(&rep);
+            fprintf(stderr, "franja: pass %d done: %u samples per pixel at %.2f s\n", ps->npass, spp,
+                    clk_now() - t0);
+        }
         draw(&rep, 1);
         if (rep.drawn)
             fputc('\n', stderr);
-        summary(sh, n, spec, &st, rep.done, rows_missing, clk_now() - t0,
+        job_spec shown = *spec;
+        if (ps->deadline > 0 && ps->reached)
+            shown.spp = ps->reached;
+        summary(sh, n, &shown, &ps->total, rep.done, rows_missing, clk_now() - t0,
                 rc == 0 ? NULL : stop_flag ? "interrupted" : "failed");
         /* The hosts that rendered rows, for the image's metadata. */
         for (int i = 0, k = 0; i < n && used_cap; i++)
@@ -762,6 +945,20 @@ int cmd_render(int argc, char **argv)
         }
     }
 
+    if (a.resume && !a.frames) {
+        /* Nothing to go on from: the render finished and its job
+         * directory went with it. */
+        char jf[4200];
+        struct stat st;
+        snprintf(jf, sizeof jf, "%s/job", jobdir);
+        if (stat(jf, &st) != 0 && stat(a.out, &st) == 0) {
+            fprintf(stderr, "franja render: --resume: nothing to resume: %s is finished and its job directory %s "
+                    "is gone (a render removes it when done, unless --keep-job); render again without --resume "
+                    "(from the first sample), and with --keep-job to add samples to it later\n", a.out, jobdir);
+            return unlock_with(&lk, 2);
+        }
+    }
+
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -836,6 +1033,17 @@ int cmd_render(int argc, char **argv)
         slurm_close(&alloc);
         return unlock_with(&lk, a.integrator ? 2 : 1);
     }
+    if (a.time_limit > 0 && !job_sums(&spec)) {
+        fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
+                "only path tracing without adaptive sampling keeps (this render %s)\n",
+                spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"
+                : a.noise_threshold > 0.0f        ? "has --noise-threshold"
+                                                  : "has the scene's noise_threshold");
+        scn_free(&sc);
+        hosts_free(&table);
+        slurm_close(&alloc);
+        return unlock_with(&lk, 2);
+    }
     if (a.crop && crop_check(&a.win, spec.width, spec.height, &err)) {
         fprintf(stderr, "franja render: --crop %s\n", err.msg);
         scn_free(&sc);
@@ -861,36 +1069,64 @@ int cmd_render(int argc, char **argv)
     scn_free(&sc);
 
     unsigned char *have = calloc(spec.height, 1);
+    uint32_t *base = calloc(spec.height, sizeof *base);
     float *rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *rgb);
     int rc = 1;
     pg_reporter *pg = NULL;
     mon_server *mon = NULL;
-    if (!have || !rgb) {
+    passes ps = {.a = &a, .jobdir = jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows, .have = have,
+                 .base = base, .rgb = rgb, .scratch = NULL};
+    if (!have || !base || !rgb || !(ps.scratch = calloc(spec.height, 1))) {
         fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
     }
-    if (job_open(jobdir, &spec, a.resume, &err)) {
+    int jr = job_open(jobdir, &spec, a.resume, &err);
+    if (jr) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        if (jr == JOB_REFUSED)
+            rc = 2;
+        goto done;
+    }
+    /* What the job directory holds toward the samples asked for. */
+    if (plan(&ps, spec.spp, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    int rows_have = 0;
-    if (a.resume) {
-        rows_have = job_scan(jobdir, &spec, have, &a.tr.notes, &err);
-        if (rows_have < 0) {
-            fprintf(stderr, "franja render: %s\n", err.msg);
-            goto done;
+    int rows_have = 0, rows_base = 0;
+    uint32_t lo, hi, blo = UINT32_MAX, bhi = 0;
+    for (uint32_t y = 0; y < spec.height; y++) {
+        rows_have += have[y] && needed(&ps, y);
+        if (base[y] > 0 && needed(&ps, y)) {
+            rows_base++;
+            blo = base[y] < blo ? base[y] : blo;
+            bhi = base[y] > bhi ? base[y] : bhi;
         }
-        fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", rows_have, spec.height, jobdir);
     }
-    /* The rows this render needs (a crop's window), and those of them done. */
+    kept_range(&ps, &lo, &hi);
+    if (a.resume)
+        fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", ps.rows_kept, spec.height, jobdir);
+    if (rows_base && a.time_limit <= 0)
+        fprintf(stderr, "franja: adding samples: %d rows go on from the %u%s samples per pixel kept with their sums to "
+                "%u\n", rows_base, blo, blo != bhi ? " or more" : "", spec.spp);
+    /* The rows this render needs (a crop's window). */
     int rows_job = crop_rows ? (int)(a.win.y1 - a.win.y0) : (int)spec.height;
-    if (crop_rows) {
-        rows_have = 0;
-        for (uint32_t y = 0; y < spec.height; y++) {
-            int inside = y >= a.win.y0 && y < a.win.y1;
-            rows_have += inside && have[y];
-            if (!inside)
-                have[y] = 1; /* not rendered */
+    ps.rows_job = rows_job;
+    if (a.time_limit > 0) {
+        ps.deadline = t0 + a.time_limit;
+        /* A complete image kept at one sample count is where the passes
+         * start, and what is written if the first of them does not end. */
+        if (lo == hi && lo > 0 && lo < spec.spp) {
+            if (plan(&ps, lo, &err) || pass_image(&ps, &err)) {
+                fprintf(stderr, "franja render: %s\n", err.msg);
+                goto done;
+            }
+            ps.reached = lo;
+            fprintf(stderr, "franja: the job holds a whole image with %u samples per pixel; passes go on from it\n",
+                    lo);
+            if (plan(&ps, spec.spp, &err)) {
+                fprintf(stderr, "franja render: %s\n", err.msg);
+                goto done;
+            }
         }
     }
     if (a.json && !(pg = pg_start(stdout, a.out, jobdir, &spec, (uint32_t)rows_job, &err))) {
@@ -912,16 +1148,22 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     char used[1024] = "";
-    int slabs_rc = rows_have < rows_job ? run_slabs(&a, &table, fbin, &spec, jobdir, have, rows_job,
-                                                    rows_job - rows_have, pg, mon, used, sizeof used, &err)
-                                        : 0;
+    int slabs_rc = rows_have < rows_job ? run_slabs(&a, &table, fbin, &ps, pg, mon, used, sizeof used, &err) : 0;
     pv_stop(pv);
     if (slabs_rc) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (crop_rows ? crop_stitch(jobdir, &spec, &a.win, rgb, have, &err)
-                  : job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err)) {
+    if (a.time_limit > 0 && ps.reached) {
+        /* The image of the last complete pass is in rgb. */
+        spec.spp = ps.reached;
+        if (ps.stopped)
+            fprintf(stderr, "franja: time limit of %g s reached: %u samples per pixel (the pass to %u was stopped)\n",
+                    a.time_limit, ps.reached, ps.stopped);
+        else
+            fprintf(stderr, "franja: every %u samples per pixel within the time limit\n", ps.reached);
+    } else if (crop_rows ? crop_stitch(jobdir, &spec, &a.win, rgb, have, &err)
+                         : job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
@@ -957,25 +1199,29 @@ int cmd_render(int argc, char **argv)
         }
         goto done;
     }
-    pg_stop(pg, "ok");
+    pg_stop(pg, "ok", spec.spp);
     pg = NULL;
     mon_status(mon, "done");
     mon_stop(mon);
     mon = NULL;
     if (!a.keep_job)
         job_remove(jobdir);
+    else if (job_sums(&spec))
+        job_prune(jobdir, &spec); /* rows kept with more samples make the fewer useless */
     jlk_release(&lk, !a.keep_job);
     fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, out_spec.width, out_spec.height, spec.spp,
             clk_now() - t0);
     rc = 0;
 done:
-    pg_stop(pg, stop_flag ? "interrupted" : "failed");
+    pg_stop(pg, stop_flag ? "interrupted" : "failed", spec.spp);
     mon_stop(mon);
     if (rc)
         unlock_with(&lk, rc);
     if (rc && stop_flag)
         rc = 130;
     free(have);
+    free(base);
+    free(ps.scratch);
     free(rgb);
     hosts_free(&table);
     slurm_close(&alloc);

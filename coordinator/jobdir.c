@@ -14,14 +14,25 @@
 #include "scene.h"
 #include "splat.h"
 
-int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
-                      uint32_t y1, fr_error *err)
+int job_sums(const job_spec *spec)
+{
+    return spec->integrator == FR_INTEGRATOR_PATH && !(spec->noise_threshold > 0.0f);
+}
+
+/* A partial checked against the render (scene, size, rows, splats for its
+ * own sample count) whatever its sample count; *out says what it holds. */
+static int check_slab(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0, uint32_t y1,
+                      img_partial_info *out, float **pixels, fr_error *err)
 {
     img_partial_info info;
     float *rgb = NULL;
     if (img_read_partial(buf, len, &info, &rgb, err))
         return -1;
-    free(rgb);
+    if (pixels)
+        *pixels = rgb;
+    else
+        free(rgb);
+    rgb = NULL;
     if (info.scene != spec->hash)
         return fr_fail(err, "scene hash %016llx, expected %016llx", (unsigned long long)info.scene,
                        (unsigned long long)spec->hash);
@@ -30,19 +41,46 @@ int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec
                        spec->height);
     if (info.y0 != y0 || info.y1 != y1)
         return fr_fail(err, "rows %u:%u, expected %u:%u", info.y0, info.y1, y0, y1);
-    if (info.spp != spec->spp)
-        return fr_fail(err, "%u samples per pixel, expected %u", info.spp, spec->spp);
-    uint64_t paths = spec->integrator == FR_INTEGRATOR_BDPT ? (uint64_t)spec->width * (y1 - y0) * spec->spp : 0;
+    uint64_t paths = spec->integrator == FR_INTEGRATOR_BDPT ? (uint64_t)spec->width * (y1 - y0) * info.spp : 0;
     if (info.splat_paths != paths)
         return paths ? fr_fail(err, "%llu light subpaths splatted, expected %llu (one per pixel sample of its rows)",
                                (unsigned long long)info.splat_paths, (unsigned long long)paths)
                      : fr_fail(err, "light-tracing splats in a path-traced render");
+    *out = info;
+    return 0;
+}
+
+/* check_slab that frees the pixels it hands back when the slab fails. */
+static int read_slab(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0, uint32_t y1,
+                     img_partial_info *out, float **pixels, fr_error *err)
+{
+    *pixels = NULL;
+    if (check_slab(buf, len, spec, y0, y1, out, pixels, err)) {
+        free(*pixels);
+        *pixels = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+int job_check_partial(const unsigned char *buf, size_t len, const job_spec *spec, uint32_t y0,
+                      uint32_t y1, int sums, fr_error *err)
+{
+    img_partial_info info;
+    if (check_slab(buf, len, spec, y0, y1, &info, NULL, err))
+        return -1;
+    if (info.spp != spec->spp)
+        return fr_fail(err, "%u samples per pixel, expected %u", info.spp, spec->spp);
+    if (sums && !info.sums_offset)
+        return fr_fail(err, "no sample sums (a path-traced slab keeps them, for adding samples later)");
     return 0;
 }
 
 size_t job_max_partial(const job_spec *spec, uint32_t y0, uint32_t y1)
 {
     size_t n = 4096 + (size_t)spec->width * (y1 - y0) * 12;
+    if (job_sums(spec))
+        n += (size_t)spec->width * (y1 - y0) * 24;
     if (spec->integrator == FR_INTEGRATOR_BDPT)
         n += (size_t)spec->width * spec->height * 24;
     return n;
@@ -104,6 +142,38 @@ static int remove_one(const char *dir, const char *name, uint32_t y0, uint32_t y
     return 0;
 }
 
+/* The samples per pixel a slab file's header names (its second line), 0
+ * when the header cannot be read; nothing else is checked. */
+static uint32_t header_spp(const char *path)
+{
+    char head[512];
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    size_t n = fread(head, 1, sizeof head - 1, f);
+    fclose(f);
+    head[n] = 0;
+    const char *line = strchr(head, '\n');
+    unsigned long long scene;
+    unsigned y0, y1, spp = 0;
+    if (!line || sscanf(line + 1, "# franja scene=%16llx rows=%u:%u spp=%u", &scene, &y0, &y1, &spp) != 4)
+        return 0;
+    return spp;
+}
+
+/* The most samples per pixel of the slab files in a directory (by their
+ * headers). */
+static int max_spp_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *ctx)
+{
+    (void)y0, (void)y1;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    uint32_t spp = header_spp(path), *max = ctx;
+    if (spp > *max)
+        *max = spp;
+    return 0;
+}
+
 int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
 {
     char want[256], path[4200];
@@ -117,12 +187,41 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
         size_t len;
         fr_error e2;
         if (file_read(path, &have, &len, &e2) == 0) {
-            int same = len == strlen(want) && !memcmp(have, want, len);
+            /* The same render, maybe with another sample count. */
+            job_spec old;
+            int known = job_read_spec(dir, &old, &e2) == 0;
+            job_spec same = *spec;
+            if (known)
+                same.spp = old.spp;
+            char was[256];
+            spec_text(&same, was, sizeof was);
+            int ok = known && len == strlen(was) && !memcmp(have, was, len);
             free(have);
-            if (!same)
-                return fr_fail(err, "%s: this job directory belongs to another render (different scene, "
-                               "size, samples, integrator or noise threshold); remove it or render without --resume", dir);
-            return 0;
+            if (!ok) {
+                fr_fail(err, "%s: this job directory belongs to another render (different scene, "
+                        "size, integrator or noise threshold); remove it or render without --resume", dir);
+                return JOB_REFUSED;
+            }
+            if (old.spp != spec->spp && !job_sums(spec)) {
+                fr_fail(err, "%s: holds a render with %u samples per pixel; %s cannot be continued to %u "
+                        "exactly (only path tracing without --noise-threshold keeps each pixel's sample "
+                        "sums): render with --fresh, or with --spp %u", dir, old.spp,
+                        spec->integrator == FR_INTEGRATOR_BDPT ? "a bidirectional render"
+                                                               : "an adaptive render",
+                        spec->spp, old.spp);
+                return JOB_REFUSED;
+            }
+            uint32_t max = 0;
+            fr_error ignore;
+            each_slab(dir, max_spp_one, &max, &ignore);
+            if (max > spec->spp) {
+                fr_fail(err, "%s holds rows rendered with %u samples per pixel, more than the %u asked for; "
+                        "samples cannot be taken away: render with --spp %u or more, or with --fresh to "
+                        "discard them", dir, max, spec->spp, max);
+                return JOB_REFUSED;
+            }
+            if (old.spp == spec->spp)
+                return 0;
         }
     } else {
         fr_error ignore;
@@ -131,14 +230,23 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
     return file_write_atomic(path, want, strlen(want), err);
 }
 
+/* What a pass over the slab files does with each (scan_ctx.mode). */
+enum {
+    SCAN,                      /* job_scan: rows at the render's samples; lower counts with sums as bases */
+    STITCH,                    /* job_stitch: the rows at the render's samples into rgb */
+    GATHER                     /* job_gather: each row from the slab with the most samples, up to the render's */
+};
+
 typedef struct {
     const job_spec *spec;
     unsigned char *have;
-    float *rgb;                /* job_stitch and job_gather only */
+    uint32_t *best;            /* per row: SCAN, the most samples below spec->spp with sums (NULL: not
+                                  wanted); GATHER, the samples of the row in rgb */
+    float *rgb;                /* STITCH and GATHER */
     int rows;
     const note_sink *notes;
-    int keep;                  /* job_gather: skip bad slabs, silently, and keep them */
-    int skipped;
+    int mode;
+    int skipped;               /* GATHER: slab files that did not check out, kept */
 } scan_ctx;
 
 static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
@@ -149,22 +257,41 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     char *text;
     size_t len;
     fr_error e;
+    img_partial_info info;
+    float *rows = NULL;
     int bad = file_read(path, &text, &len, &e);
     if (!bad) {
-        const unsigned char *buf = (const unsigned char *)text;
-        bad = job_check_partial(buf, len, c->spec, y0, y1, &e);
-        if (!bad && c->rgb) {
-            img_partial_info info;
-            float *rows;
-            if ((bad = img_read_partial(buf, len, &info, &rows, &e)) == 0) {
-                memcpy(c->rgb + (size_t)y0 * c->spec->width * 3, rows,
-                       (size_t)(y1 - y0) * c->spec->width * 3 * sizeof(float));
-                free(rows);
-            }
+        bad = read_slab((const unsigned char *)text, len, c->spec, y0, y1, &info, &rows, &e);
+        if (!c->rgb) {
+            free(rows);
+            rows = NULL;
         }
         free(text);
     }
-    if (bad && c->keep) {
+    if (!bad && info.spp != c->spec->spp) {
+        /* Another sample count: more is never this render's (the slab is
+         * left alone); fewer is a base to add samples to, when it has its
+         * sums, or a row of the image so far. */
+        int use = 0;
+        if (info.spp < c->spec->spp && c->mode == GATHER) {
+            use = 1;
+        } else if (info.spp < c->spec->spp && c->mode == SCAN && !info.sums_offset) {
+            bad = 1;
+            snprintf(e.msg, sizeof e.msg, "%u samples per pixel, expected %u, and no sample sums to add to",
+                     info.spp, c->spec->spp);
+        } else if (info.spp < c->spec->spp && c->mode == SCAN && c->best) {
+            for (uint32_t y = y0; y < y1; y++)
+                if (c->best[y] < info.spp)
+                    c->best[y] = info.spp;
+        } else if (c->mode == GATHER) {
+            c->skipped++;
+        }
+        if (!use && !bad) {
+            free(rows);
+            return 0;
+        }
+    }
+    if (bad && c->mode == GATHER) {
         c->skipped++;
         return 0;
     }
@@ -173,19 +300,35 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
         unlink(path);
         return 0;
     }
+    size_t row = (size_t)c->spec->width * 3;
     for (uint32_t y = y0; y < y1; y++) {
+        if (c->mode == GATHER) {
+            if (c->have[y] && c->best[y] >= info.spp)
+                continue;
+            c->best[y] = info.spp;
+        }
+        if (rows)
+            memcpy(c->rgb + y * row, rows + (y - y0) * row, row * sizeof(float));
         c->rows += !c->have[y];
         c->have[y] = 1;
     }
+    free(rows);
     return 0;
 }
 
-int job_scan(const char *dir, const job_spec *spec, unsigned char *have, const note_sink *notes, fr_error *err)
+int job_scan(const char *dir, const job_spec *spec, unsigned char *have, uint32_t *base, const note_sink *notes,
+             fr_error *err)
 {
-    scan_ctx c = {spec, have, NULL, 0, notes, 0, 0};
+    scan_ctx c = {spec, have, base, NULL, 0, notes, SCAN, 0};
     memset(have, 0, spec->height);
+    if (base)
+        memset(base, 0, spec->height * sizeof *base);
     if (each_slab(dir, scan_one, &c, err))
         return -1;
+    if (base)
+        for (uint32_t y = 0; y < spec->height; y++)
+            if (have[y])
+                base[y] = 0;
     return c.rows;
 }
 
@@ -217,6 +360,154 @@ int job_rows_present(const char *dir)
             rows += seen[y];
     free(seen);
     return rows;
+}
+
+/* Rows of slab files by their headers' sample counts (job_rows_at,
+ * job_prune). */
+typedef struct {
+    uint32_t spp;              /* the count looked for */
+    unsigned char *seen;       /* rows of files with at least spp (job_rows_at), exactly spp (job_prune) */
+    int exact;
+} rows_at_ctx;
+
+static int rows_at_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
+{
+    rows_at_ctx *c = vctx;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    uint32_t spp = header_spp(path);
+    if (c->exact ? spp == c->spp : spp >= c->spp)
+        for (uint32_t y = y0; y < y1 && y < PROTO_MAX_SIZE; y++)
+            c->seen[y] = 1;
+    return 0;
+}
+
+int job_rows_at(const char *dir, uint32_t spp)
+{
+    rows_at_ctx c = {spp, calloc(PROTO_MAX_SIZE, 1), 0};
+    if (!c.seen)
+        return 0;
+    fr_error ignore;
+    int rows = 0;
+    if (each_slab(dir, rows_at_one, &c, &ignore) == 0)
+        for (uint32_t y = 0; y < PROTO_MAX_SIZE; y++)
+            rows += c.seen[y];
+    free(c.seen);
+    return rows;
+}
+
+static int prune_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
+{
+    rows_at_ctx *c = vctx;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    uint32_t spp = header_spp(path);
+    if (spp == 0 || spp >= c->spp)
+        return 0;
+    for (uint32_t y = y0; y < y1; y++)
+        if (y >= PROTO_MAX_SIZE || !c->seen[y])
+            return 0;
+    unlink(path);
+    return 0;
+}
+
+void job_prune(const char *dir, const job_spec *spec)
+{
+    rows_at_ctx c = {spec->spp, calloc(PROTO_MAX_SIZE, 1), 1};
+    if (!c.seen)
+        return;
+    fr_error ignore;
+    if (each_slab(dir, rows_at_one, &c, &ignore) == 0)
+        each_slab(dir, prune_one, &c, &ignore);
+    free(c.seen);
+}
+
+/* The sums of rows [y0, y1) at spp samples, gathered from slab files. */
+typedef struct {
+    const job_spec *spec;
+    uint32_t y0, y1, spp;
+    unsigned char *got;        /* y1 - y0 rows */
+    float *rgb;
+    double *sums;
+} cont_ctx;
+
+static int cont_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
+{
+    cont_ctx *c = vctx;
+    uint32_t a = y0 > c->y0 ? y0 : c->y0, b = y1 < c->y1 ? y1 : c->y1;
+    int needed = 0;
+    for (uint32_t y = a; y < b; y++)
+        needed |= !c->got[y - c->y0];
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (!needed || header_spp(path) != c->spp)
+        return 0;
+    char *text;
+    size_t len;
+    fr_error e;
+    if (file_read(path, &text, &len, &e))
+        return 0;
+    const unsigned char *buf = (const unsigned char *)text;
+    img_partial_info info;
+    float *rows;
+    if (read_slab(buf, len, c->spec, y0, y1, &info, &rows, &e) == 0 && info.spp == c->spp && info.sums_offset) {
+        size_t row = (size_t)c->spec->width * 3;
+        double *sums = malloc((y1 - y0) * row * sizeof *sums);
+        if (sums) {
+            img_sums_get(buf, &info, sums);
+            for (uint32_t y = a; y < b; y++) {
+                memcpy(c->rgb + (y - c->y0) * row, rows + (y - y0) * row, row * sizeof *rows);
+                memcpy(c->sums + (y - c->y0) * row, sums + (y - y0) * row, row * sizeof *sums);
+                c->got[y - c->y0] = 1;
+            }
+            free(sums);
+        }
+        free(rows);
+    }
+    free(text);
+    return 0;
+}
+
+int job_cont_build(const char *dir, const job_spec *spec, uint32_t y0, uint32_t y1, uint32_t spp, char *path,
+                   size_t cap, fr_error *err)
+{
+    size_t n = (size_t)spec->width * (y1 - y0) * 3;
+    cont_ctx c = {spec, y0, y1, spp, calloc(y1 - y0, 1), malloc(n * sizeof(float)), malloc(n * sizeof(double))};
+    char *buf = NULL;
+    size_t len = 0;
+    int rc = 0;
+    if (!c.got || !c.rgb || !c.sums) {
+        rc = fr_fail(err, "out of memory for the sums of rows %u:%u", y0, y1);
+        goto out;
+    }
+    if (each_slab(dir, cont_one, &c, err)) {
+        rc = -1;
+        goto out;
+    }
+    for (uint32_t y = y0; y < y1; y++)
+        if (!c.got[y - y0]) {
+            rc = fr_fail(err, "%s: row %u with %u samples per pixel and their sums is no longer there", dir, y, spp);
+            goto out;
+        }
+    img_partial_info info = {spec->hash, y0, y1, spp, spec->width, spec->height, 0, 0, 0, 0};
+    FILE *f = open_memstream(&buf, &len);
+    if (!f) {
+        rc = fr_fail(err, "out of memory for the sums of rows %u:%u", y0, y1);
+        goto out;
+    }
+    rc = img_write_sums(f, &info, c.rgb, c.sums, err);
+    if (fclose(f) && rc == 0)
+        rc = fr_fail(err, "out of memory for the sums of rows %u:%u", y0, y1);
+    if (rc == 0 && snprintf(path, cap, "%s/.cont-%05u-%05u-%u.tmp-sums", dir, y0, y1, spp) >= (int)cap)
+        rc = fr_fail(err, "%s: path too long", dir);
+    if (rc == 0)
+        rc = file_write_atomic(path, buf, len, err);
+out:
+    free(buf);
+    free(c.got);
+    free(c.rgb);
+    free(c.sums);
+    return rc;
 }
 
 void job_kept_note(const char *dir, char *out, size_t cap)
@@ -334,7 +625,7 @@ static int stitch_splats(const char *dir, const job_spec *spec, float *rgb, fr_e
         if (file_read(path, &text, &len, err))
             goto out;
         const unsigned char *buf = (const unsigned char *)text;
-        if (job_check_partial(buf, len, spec, sf->y0, sf->y1, err) ||
+        if (job_check_partial(buf, len, spec, sf->y0, sf->y1, 0, err) ||
             img_read_partial(buf, len, &info, &rows, err)) {
             fr_error e2 = *err;
             fr_fail(err, "%s: %s", path, e2.msg);
@@ -361,7 +652,7 @@ int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sin
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, spec->integrator == FR_INTEGRATOR_BDPT ? NULL : rgb, 0, notes, 0, 0};
+    scan_ctx c = {spec, have, NULL, spec->integrator == FR_INTEGRATOR_BDPT ? NULL : rgb, 0, notes, STITCH, 0};
     int rc = each_slab(dir, scan_one, &c, err);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];
@@ -377,9 +668,13 @@ int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sin
 int job_gather(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped,
                fr_error *err)
 {
-    scan_ctx c = {spec, have, rgb, 0, NULL, 1, 0};
+    uint32_t *best = calloc(spec->height, sizeof *best);
+    if (!best)
+        return fr_fail(err, "out of memory");
+    scan_ctx c = {spec, have, best, rgb, 0, NULL, GATHER, 0};
     memset(have, 0, spec->height);
     int rc = each_slab(dir, scan_one, &c, err);
+    free(best);
     if (skipped)
         *skipped = c.skipped;
     return rc ? -1 : c.rows;

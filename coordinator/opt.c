@@ -257,6 +257,27 @@ int opt_scale(const char *cmd, const char *opt, const char *v, double *out)
     return -1;
 }
 
+int opt_duration(const char *cmd, const char *opt, const char *v, double *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    double unit = 1.0;
+    if (end != v && *end && !end[1]) {
+        unit = *end == 's' ? 1.0 : *end == 'm' ? 60.0 : *end == 'h' ? 3600.0 : 0.0;
+        end++;
+    }
+    /* Digits only: no "inf", "nan", hexadecimal or exponent forms. */
+    int plain = strspn(v, "0123456789.") == strlen(v) - (*v && strchr("smh", v[strlen(v) - 1]) ? 1 : 0);
+    if (!errno && end != v && !*end && plain && unit > 0.0 && d * unit > 0.0 && d * unit <= OPT_DURATION_MAX) {
+        *out = d * unit;
+        return 0;
+    }
+    fprintf(stderr, "franja %s: %s: '%s' is not a duration: a number above 0 followed by s (seconds, the default), "
+            "m (minutes) or h (hours), like 90s, 10m or 1.5h, at most %g h\n", cmd, opt, v, OPT_DURATION_MAX / 3600.0);
+    return -1;
+}
+
 uint32_t opt_scaled(uint32_t n, double s)
 {
     double x = floor((double)n * s + 0.5);

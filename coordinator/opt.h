@@ -68,6 +68,15 @@ int opt_size(const char *cmd, const char *opt, const char *v, uint32_t *w, uint3
  * returns -1. */
 int opt_scale(const char *cmd, const char *opt, const char *v, double *out);
 
+/** The longest --time-limit: a week, in seconds. */
+#define OPT_DURATION_MAX (7.0 * 24 * 3600)
+
+/** Parses a duration: a number above 0 with an optional unit, s (the
+ * default), m or h ("90", "90s", "1.5m", "2h"), at most OPT_DURATION_MAX;
+ * writes seconds to *out.  Otherwise prints what is allowed and returns
+ * -1. */
+int opt_duration(const char *cmd, const char *opt, const char *v, double *out);
+
 /** Scales a scene's side of n pixels by s: rounded to the nearest pixel
  * (halves up), at least 1.  So 50% of 255 is 128, 10% of 4 is 1. */
 uint32_t opt_scaled(uint32_t n, double s);

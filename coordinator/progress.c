@@ -15,8 +15,10 @@ struct pg_reporter {
     job_spec spec;
     uint32_t total;            /* rows the render needs */
     double t0;
-    int rows0;                 /* rows done when this run started */
+    double tp;                 /* when this pass started (t0 without passes) */
+    int rows0;                 /* rows done when this run (pass) started */
     int rows;                  /* last count printed */
+    uint32_t spp;              /* rows count with this many samples (under lock) */
     pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t wake;
@@ -40,13 +42,19 @@ void pg_json_string(FILE *out, const char *s)
 /* Prints a progress event if the count of finished rows changed. */
 static void poll_once(pg_reporter *r)
 {
-    int rows = job_rows_present(r->dir);
-    if (rows == r->rows || rows < 0)
+    pthread_mutex_lock(&r->lock);
+    uint32_t spp = r->spp;
+    pthread_mutex_unlock(&r->lock);
+    int rows = job_rows_at(r->dir, spp);
+    flockfile(r->out);
+    if (rows == r->rows || rows < 0 || spp != r->spp) {
+        funlockfile(r->out);
         return;
+    }
     r->rows = rows;
     double t = clk_now() - r->t0;
-    flockfile(r->out);
-    double rate = t > 0 ? (rows - r->rows0) / t : 0;
+    double tp = clk_now() - r->tp;
+    double rate = tp > 0 ? (rows - r->rows0) / tp : 0;
     fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
                     "\"eta_s\":",
             rows, r->total, t, rate);
@@ -111,8 +119,9 @@ pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_
     r->out = out;
     r->spec = *spec;
     r->total = rows;
-    r->t0 = clk_now();
-    r->rows0 = r->rows = job_rows_present(dir);
+    r->t0 = r->tp = clk_now();
+    r->spp = spec->spp;
+    r->rows0 = r->rows = job_rows_at(dir, spec->spp);
     fputs("{\"event\":\"start\",\"output\":", out);
     pg_json_string(out, output);
     fprintf(out, ",\"width\":%u,\"height\":%u,\"spp\":%u,\"rows\":%u,\"rows_done\":%d,\"time\":%lld}\n",
@@ -136,7 +145,24 @@ pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_
     return r;
 }
 
-void pg_stop(pg_reporter *r, const char *status)
+void pg_pass(pg_reporter *r, int k, uint32_t spp)
+{
+    if (!r)
+        return;
+    int rows = job_rows_at(r->dir, spp);
+    flockfile(r->out);
+    pthread_mutex_lock(&r->lock);
+    r->spp = spp;
+    pthread_mutex_unlock(&r->lock);
+    r->tp = clk_now();
+    r->rows0 = r->rows = rows;
+    fprintf(r->out, "{\"event\":\"pass\",\"pass\":%d,\"spp\":%u,\"rows_done\":%d,\"elapsed_s\":%.3f}\n", k, spp, rows,
+            clk_now() - r->t0);
+    fflush(r->out);
+    funlockfile(r->out);
+}
+
+void pg_stop(pg_reporter *r, const char *status, uint32_t spp)
 {
     if (!r)
         return;
@@ -150,13 +176,13 @@ void pg_stop(pg_reporter *r, const char *status)
         double t = clk_now() - r->t0;
         fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%u,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
                         "\"eta_s\":0}\n",
-                r->total, r->total, t, t > 0 ? (r->total - (uint32_t)r->rows0) / t : 0.0);
+                r->total, r->total, t, clk_now() > r->tp ? (r->total - (uint32_t)r->rows0) / (clk_now() - r->tp) : 0.0);
         r->rows = (int)r->total;
     } else if (strcmp(status, "ok")) {
         poll_once(r);
     }
-    fprintf(r->out, "{\"event\":\"done\",\"status\":\"%s\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n", status,
-            r->rows, r->total, clk_now() - r->t0);
+    fprintf(r->out, "{\"event\":\"done\",\"status\":\"%s\",\"spp\":%u,\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n",
+            status, spp, r->rows, r->total, clk_now() - r->t0);
     fflush(r->out);
     pthread_cond_destroy(&r->wake);
     pthread_mutex_destroy(&r->lock);

@@ -7,11 +7,17 @@
  *     {"event":"start","output":OUT,"width":W,"height":H,"spp":N,"rows":N,"rows_done":R,"time":T}
  *     {"event":"progress","rows_done":R,"rows":N,"elapsed_s":S,"rows_per_s":V,"eta_s":E}
  *     {"event":"host","what":W,"host":NAME,"elapsed_s":S[,"y0":Y0,"y1":Y1],"text":LINE}
- *     {"event":"done","status":"ok"|"failed"|"interrupted","rows_done":R,"rows":N,"elapsed_s":S}
+ *     {"event":"pass","pass":K,"spp":N,"rows_done":R,"elapsed_s":S}
+ *     {"event":"done","status":"ok"|"failed"|"interrupted","spp":N,"rows_done":R,"rows":N,"elapsed_s":S}
  *
  * "progress" comes when the count of finished rows changes (checked every
  * half second); N is the number of rows the render needs (H, or the rows
- * of a --crop window); eta_s is null until a row has been rendered in this run.
+ * of a --crop window); a row counts once a slab with the samples per pixel
+ * of the render (of its pass, with --time-limit) holds it; eta_s is null
+ * until a row has been rendered in this run (pass).  "pass" starts pass K
+ * (1, 2 ...) of a --time-limit render, to N samples per pixel.  "done"
+ * says the samples per pixel of the image written ("ok"), which with
+ * --time-limit are those of the last complete pass.
  * "host" events say what happened to a host: W is "ready", "unused" (it
  * could not be prepared), "failed" (an attempt at rows Y0:Y1 failed),
  * "copy" (a second copy of rows Y0:Y1 started there), "dropped", "shrunk"
@@ -36,10 +42,14 @@ typedef struct pg_reporter pg_reporter;
 pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_spec *spec, uint32_t rows,
                       fr_error *err);
 
+/** Prints the pass event of pass k to spp samples per pixel; from then on
+ * rows count when they have spp samples.  r NULL: nothing. */
+void pg_pass(pg_reporter *r, int k, uint32_t spp);
+
 /** Stops the thread, prints the last progress (if the count changed) and
- * the done event with status ("ok", "failed", "interrupted"), and frees r
- * (NULL: nothing). */
-void pg_stop(pg_reporter *r, const char *status);
+ * the done event with status ("ok", "failed", "interrupted") and spp, the
+ * samples per pixel of the image written, and frees r (NULL: nothing). */
+void pg_stop(pg_reporter *r, const char *status, uint32_t spp);
 
 /** Prints a host event (see above) from the calling thread; lines of
  * the reporter's thread and of this one never mix.  r NULL: nothing. */

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "clock.h"
 #include "protocol.h"
@@ -19,12 +20,15 @@ typedef struct {
     int *failed_hosts;         /* the distinct hosts it failed on, nfailed of them */
     int nfailed;
     char last_error[300];
+    uint32_t base;             /* samples per pixel its rows continue from; 0 = none */
+    char *cont;                /* the sums file for the workers (job_cont_build), NULL until made */
 } slab;
 
 typedef struct {
     int slab, host;
     tr_proc *proc;
     double start;
+    uint32_t from;             /* samples the attempt continues from */
 } attempt;
 
 typedef struct {
@@ -105,11 +109,12 @@ static int make_slabs(sched *s)
             if (size < least)
                 size = least;
         }
-        uint32_t end = y;
-        while (end < p->spec.height && !(p->have && p->have[end]) && end - y < size)
+        uint32_t end = y, base = p->base ? p->base[y] : 0;
+        while (end < p->spec.height && !(p->have && p->have[end]) && end - y < size &&
+               (p->base ? p->base[end] : 0) == base)
             end++;
         left -= end - y;
-        s->slabs[s->nslabs++] = (slab){.y0 = y, .y1 = end, .failed_on = -1};
+        s->slabs[s->nslabs++] = (slab){.y0 = y, .y1 = end, .failed_on = -1, .base = base};
         y = end;
     }
     s->rows_total = (int)missing;
@@ -201,21 +206,92 @@ static int pick(sched *s, int host_i)
     return best;
 }
 
+/* `sh -c CONT_SCRIPT WORKER FILE ARGS...`: the worker reads the uploaded
+ * sums through descriptor 3 (--continue /dev/fd/3), and the file is gone
+ * from the host's disk before the worker starts, however it ends. */
+static const char CONT_SCRIPT[] = "exec 3<\"$1\" || exit 97; rm -f -- \"$1\"; shift; exec \"$0\" \"$@\"";
+
+/* Where slab sl's sums go on a host with a work directory: beside the
+ * scene, a name no other attempt or coordinator uses. */
+static void remote_name(const sched *s, const sched_host *h, const slab *sl, char *out, size_t cap)
+{
+    static unsigned counter;
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", h->scene);
+    char *slash = strrchr(dir, '/');
+    if (slash)
+        slash[1] = 0;
+    else
+        dir[0] = 0;
+    snprintf(out, cap, "%scont-%016llx-%u-%u-%u-%ld-%.0f-%u.pf", dir, (unsigned long long)s->p->spec.hash, sl->y0,
+             sl->y1, sl->base, (long)getpid(), clk_now() * 1e3, counter++);
+}
+
+/* The sums file of slab sl, made once; NULL when it cannot be made: the
+ * slab is then rendered from its first sample (the same bits). */
+static const char *cont_file(sched *s, slab *sl)
+{
+    if (!sl->base)
+        return NULL;
+    if (!sl->cont) {
+        char path[4400];
+        fr_error e;
+        if (job_cont_build(s->p->jobdir, &s->p->spec, sl->y0, sl->y1, sl->base, path, sizeof path, &e) ||
+            !(sl->cont = strdup(path))) {
+            sl->base = 0;
+            return NULL;
+        }
+    }
+    return sl->cont;
+}
+
+static void cont_drop(slab *sl)
+{
+    if (sl->cont)
+        unlink(sl->cont);
+    free(sl->cont);
+    sl->cont = NULL;
+}
+
 static int start(sched *s, int host_i, int slab_i, fr_error *err)
 {
     sched_host *h = &s->hosts[host_i];
     slab *sl = &s->slabs[slab_i];
     const job_spec *sp = &s->p->spec;
     proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline,
-                      1 + (int)sp->integrator, sp->noise_threshold, 0, NULL};
+                      1 + (int)sp->integrator, sp->noise_threshold, s->p->sums, NULL};
+    const char *cont = cont_file(s, sl);
+    char remote[1400];
+    int sent = 0;
+    if (cont && !*tr_host_workdir(h->tr)) {
+        req.continue_from = cont; /* the host sees this machine's files */
+    } else if (cont && tr_host_busy_upload(h->tr)) {
+        fr_error e;
+        remote_name(s, h, sl, remote, sizeof remote);
+        if (tr_upload(h->tr, cont, remote, 0600, &e) == 0) {
+            req.continue_from = "/dev/fd/3";
+            sent = 1;
+        }
+    }
+    if (sl->base && !req.continue_from)
+        s->st->fresh_instead++;
     proto_argv pa;
     if (proto_slab_argv(&req, &pa, err))
         return -1;
-    const char *argv[sizeof pa.argv / sizeof *pa.argv + 1] = {tr_host_worker(h->tr)};
+    const char *argv[sizeof pa.argv / sizeof *pa.argv + 6] = {tr_host_worker(h->tr)};
+    int k = 1;
+    if (sent) {
+        argv[0] = "sh";
+        argv[k++] = "-c";
+        argv[k++] = CONT_SCRIPT;
+        argv[k++] = tr_host_worker(h->tr);
+        argv[k++] = remote;
+    }
     for (int i = 0; pa.argv[i]; i++)
-        argv[i + 1] = pa.argv[i];
-    /* The partial image: its header (well under 4 KB), 12 bytes a pixel and
-     * the splats of a bidirectional render. */
+        argv[k++] = pa.argv[i];
+    argv[k] = NULL;
+    /* The partial image: its header (well under 4 KB), 12 bytes a pixel,
+     * the sums or the splats of a bidirectional render. */
     size_t max_out = job_max_partial(sp, sl->y0, sl->y1);
     tr_proc *proc;
     if (tr_spawn(h->tr, argv, max_out, &proc, err))
@@ -236,7 +312,7 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
         emit(s, SCHED_COPY, host_i, sl, "rows %u:%u still running; starting a second copy on %s", sl->y0, sl->y1,
              h->name);
     }
-    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now(s)};
+    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now(s), req.continue_from ? sl->base : 0};
     sl->copies++;
     h->running++;
     return 0;
@@ -339,7 +415,7 @@ static int accept_attempt(sched *s, int r, fr_error *err)
     size_t len;
     const unsigned char *out = tr_proc_output(a.proc, &len);
     fr_error why;
-    if (job_check_partial(out, len, &s->p->spec, sl->y0, sl->y1, &why)) {
+    if (job_check_partial(out, len, &s->p->spec, sl->y0, sl->y1, s->p->sums, &why)) {
         char msg[600];
         snprintf(msg, sizeof msg, "bad partial image: %s", why.msg);
         return fail_attempt(s, r, msg, err);
@@ -355,6 +431,8 @@ static int accept_attempt(sched *s, int r, fr_error *err)
     s->acc_s += dt;
     s->acc_rows += (int)(sl->y1 - sl->y0);
     sl->done = 1;
+    s->st->samples += (double)(sl->y1 - sl->y0) * s->p->spec.width * (s->p->spec.spp - a.from);
+    s->st->continued += a.from > 0;
     h->slabs++;
     h->rows += (int)(sl->y1 - sl->y0);
     h->busy_s += dt;
@@ -366,6 +444,7 @@ static int accept_attempt(sched *s, int r, fr_error *err)
             tr_proc_kill(s->run[k].proc);
             finish(s, k);
         }
+    cont_drop(sl);
     emit(s, SCHED_SLAB_DONE, a.host, sl, "rows %u:%u from %s in %.2f s (%d/%d rows)", sl->y0, sl->y1, h->name, dt,
          s->rows_done, s->rows_total);
     return 0;
@@ -476,6 +555,11 @@ static int loop(sched *s, fr_error *err)
             rc = fr_fail(err, "interrupted");
             break;
         }
+        if (s->p->stop_at > 0 && now(s) >= s->p->stop_at) {
+            s->st->timed_out = 1;
+            rc = fr_fail(err, "the time limit was reached");
+            break;
+        }
         admit(s);
         for (int i = 0; i < s->nhosts; i++) {
             sched_host *h = &s->hosts[i];
@@ -577,8 +661,10 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         fr_fail(err, "%s; rows %s not rendered (%s)", why, missing, kept);
     }
     st->wall_s = now(&s) - s.t0;
-    for (int i = 0; i < s.nslabs; i++)
+    for (int i = 0; i < s.nslabs; i++) {
         free(s.slabs[i].failed_hosts);
+        cont_drop(&s.slabs[i]);
+    }
     free(s.slabs);
     free(s.run);
     return rc;

@@ -25,6 +25,12 @@
  *   when possible; the first valid copy wins and the others are killed.
  *   Slabs are bit-identical wherever they run, so this is safe.
  * - Each accepted slab is saved in the job directory at once.
+ * - A slab whose rows have sums kept in the job directory (sched_params.base)
+ *   renders only the samples they lack: the coordinator gathers those sums
+ *   into one file (job_cont_build), which a local worker reads where it is
+ *   and a remote one gets by upload (tr_upload, next to the host's scene;
+ *   the file is unlinked there as the worker starts, and read through an
+ *   open descriptor).
  *
  * Nothing here prints: what happens is reported through sched_hooks, and
  * the clock and the wait for activity can be replaced (tests drive the
@@ -105,6 +111,14 @@ typedef struct {
     job_spec spec;
     const char *jobdir;
     const unsigned char *have; /**< rows already finished (resume), height entries; NULL = none */
+    const uint32_t *base;      /**< per row (height entries), the samples per pixel kept with their sums in
+                                    the job directory that the row continues from (job_scan); 0 = from
+                                    the first sample; NULL = every row from the first sample.  A slab
+                                    never spans rows of two bases */
+    int sums;                  /**< workers keep each pixel's sample sums (--sums), and a partial without
+                                    them does not check out (job_sums) */
+    double stop_at;            /**< on the hooks' clock: stop there, as when stop is set, with
+                                    sched_stats.timed_out; 0 = no limit */
     int slab_rows;             /**< rows per slab; 0 = slabs that shrink toward the end (the rows left over
                                     twice the slots, at least a sixteenth of the rows per slot) */
     int max_attempts;          /**< failed attempts per slab before giving up */
@@ -122,6 +136,12 @@ typedef struct {
     int retries;               /**< failed attempts */
     int duplicates;            /**< straggler copies started */
     double wall_s;
+    double samples;            /**< pixel samples rendered into accepted slabs (added samples only, for
+                                    continued rows) */
+    int continued;             /**< accepted slabs that continued from kept sums */
+    int fresh_instead;         /**< attempts that rendered a continuable slab from its first sample
+                                    (its sums could not be made or sent): the same bits, more work */
+    int timed_out;             /**< stopped at stop_at */
 } sched_stats;
 
 /** Renders every row not in p->have on hosts[0..nhosts).  Returns 0 when

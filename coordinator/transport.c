@@ -131,6 +131,8 @@ const char *tr_host_worker(const tr_host *h) { return h->place.worker; }
 
 const char *tr_host_workdir(const tr_host *h) { return h->place.workdir; }
 
+int tr_host_busy_upload(const tr_host *h) { return h->place.busy_upload; }
+
 void tr_note(tr_host *h, const char *fmt, ...)
 {
     char msg[900];

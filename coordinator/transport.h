@@ -115,6 +115,12 @@ const char *tr_host_worker(const tr_host *h);
  * (a local host: scenes are used where they are). */
 const char *tr_host_workdir(const tr_host *h);
 
+/** Whether tr_upload works while every slot of the host runs a worker:
+ * SSH (SFTP) and a Slurm shared work directory (a copy on this machine);
+ * not a Slurm node's own disk (sbcast needs a step, which waits for a CPU
+ * of its own). */
+int tr_host_busy_upload(const tr_host *h);
+
 /** Hands a remark about host h to the person (tr_options.notes), prefixed
  * with the host's label once connect has set it. */
 void tr_note(tr_host *h, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

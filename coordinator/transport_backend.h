@@ -37,6 +37,8 @@ typedef struct {
     char worker[1100];         /**< the worker program (argv[0] of a worker) */
     char workdir[600];         /**< work directory; "" = the host sees this
                                     machine's files (nothing is uploaded) */
+    int busy_upload;           /**< an upload works while every slot of the host runs a worker (it
+                                    starts no process that needs a slot of its own) */
 } tr_place;
 
 /** The operations of one backend.  `impl` is the backend's state for one

@@ -41,10 +41,14 @@ check "stderr line then exit: the worker's message is reported" grep -q "cannot 
 
 # A worker whose partial image is well formed but holds a NaN (or a
 # negative value): refused, the host blamed, the rows rendered elsewhere.
+# The value goes into the last pixels, before the sample sums that follow
+# them (W x rows x 24 bytes, when the header says sums=).
 poison() {
     f="$FH/$1/p"
     printf '"%s" "$@" >"%s.$$" || exit 1\n' "$WORKER" "$f"
-    printf 'printf %s | dd of="%s.$$" bs=1 seek=$(($(stat -c %%s "%s.$$") - %s)) conv=notrunc 2>/dev/null\n' "'$2'" "$f" "$f" "$3"
+    printf 'h=$(head -c 300 "%s.$$" | sed -n 2p); s=0\n' "$f"
+    printf 'case $h in *" sums="*) s=$(echo "$h" | sed "s/.* rows=\\([0-9]*\\):\\([0-9]*\\) .* size=\\([0-9]*\\)x.*/\\3 * (\\2 - \\1) * 24/") ;; esac\n'
+    printf 'printf %s | dd of="%s.$$" bs=1 seek=$(($(stat -c %%s "%s.$$") - $(($s)) - %s)) conv=notrunc 2>/dev/null\n' "'$2'" "$f" "$f" "$3"
     printf 'cat "%s.$$"; rm -f "%s.$$"\n' "$f" "$f"
 }
 : >hosts

@@ -128,6 +128,22 @@ static void values(void)
     static const char *const bad_scales[] = {"0", "0%", "-10%", "401%", "4.01", "%", "50 %", "50%x", "x", "", "inf"};
     for (size_t i = 0; i < sizeof bad_scales / sizeof *bad_scales; i++)
         CHECK(opt_scale("t", "--scale", bad_scales[i], &sc) == -1, "scale '%s' accepted", bad_scales[i]);
+    static const struct {
+        const char *v;
+        double s;
+    } durations[] = {{"90", 90}, {"90s", 90}, {"10m", 600}, {"1.5h", 5400}, {"0.5s", 0.5}, {"168h", 604800}};
+    for (size_t i = 0; i < sizeof durations / sizeof *durations; i++) {
+        double d = -1;
+        CHECK(opt_duration("t", "--time-limit", durations[i].v, &d) == 0 && d == durations[i].s,
+              "duration '%s': %g, want %g", durations[i].v, d, durations[i].s);
+    }
+    static const char *const bad_durations[] = {"0", "0s", "-1m", "10x", "1e3", "m", "", "inf", "nan", "10 m",
+                                                "10mm", "168.1h", "0x10", "1,5h"};
+    for (size_t i = 0; i < sizeof bad_durations / sizeof *bad_durations; i++) {
+        double d;
+        CHECK(opt_duration("t", "--time-limit", bad_durations[i], &d) == -1, "duration '%s' accepted",
+              bad_durations[i]);
+    }
     CHECK(opt_scaled(255, 0.5) == 128 && opt_scaled(101, 0.5) == 51, "50%% of 255, 101 (halves up)");
     CHECK(opt_scaled(512, 0.333) == 170 && opt_scaled(4, 0.1) == 1 && opt_scaled(3, 0.0001) == 1,
           "rounding and the 1-pixel floor");

@@ -431,7 +431,7 @@ static void test_interrupt(void)
     CHECK(count(r, SCHED_SLAB_DONE, -1) == 2, "%d slabs done, expected 2", count(r, SCHED_SLAB_DONE, -1));
     unsigned char have[16];
     fr_error err;
-    CHECK(job_scan(r->jobdir, &r->p.spec, have, NULL, &err) == 4, "the job directory does not keep the 4 rows done");
+    CHECK(job_scan(r->jobdir, &r->p.spec, have, NULL, NULL, &err) == 4, "the job directory does not keep the 4 rows done");
     int killed = 0;
     for (int i = 0; i < r->world.nspawn; i++)
         killed += r->world.spawn[i].killed;
