@@ -114,6 +114,22 @@ render logs -N3 -n6 "$FRANJA" render scene.fbin -o sh.pfm $SIZE --slurm --shared
 check "a shared work directory gives the same bytes" cmp -s sh.pfm ref.pfm
 check "the scene is in the shared directory" test "$(ls "$T/shared/scenes" | grep -c '\.fbin$')" -eq 1
 
+# More samples later: a job kept at 2 samples goes on to 4.  Into a shared
+# work directory the sums are sent (and gone once the workers opened
+# them); to the nodes' own disks they are not (sbcast would wait for a
+# CPU that every worker holds), so those slabs render every sample again.
+render logk1 -N3 -n6 "$FRANJA" render scene.fbin -o more.pfm --size 40x30 --spp 2 --slurm --shared-workdir "$T/shared" \
+    --keep-job
+render logk2 -N3 -n6 "$FRANJA" render scene.fbin -o more.pfm $SIZE --slurm --shared-workdir "$T/shared" --resume \
+    --slab-rows 7
+check "2 then 4 samples in a shared work directory: the bytes of 4 at once ($(tail -n 3 logk2))" cmp -s more.pfm ref.pfm
+check "the slabs went on from the kept sums" grep -q "slabs\{0,1\} went on from kept sample sums" logk2
+check "no sums are left in the shared directory" sh -c "! ls '$T/shared/scenes' | grep -q cont-"
+render logk3 -N3 -n6 "$FRANJA" render scene.fbin -o more2.pfm --size 40x30 --spp 2 --slurm --workdir "$WD" --keep-job
+render logk4 -N3 -n6 "$FRANJA" render scene.fbin -o more2.pfm $SIZE --slurm --workdir "$WD" --resume --slab-rows 7
+check "2 then 4 samples on the nodes' own disks: the bytes of 4 at once ($(tail -n 3 logk4))" cmp -s more2.pfm ref.pfm
+check "those slabs rendered every sample, and the summary says so" grep -q "rendered every sample: the sums could not be sent" logk4
+
 # A node whose worker is another version is dropped, by name.
 render logv -N3 -n6 "$FRANJA" render scene.fbin -o v.pfm $SIZE --slurm --workdir "$WD" --worker "$(wrapper version n2)"
 check "a wrong worker version on n2 does not stop the render" cmp -s v.pfm ref.pfm
