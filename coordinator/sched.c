@@ -29,6 +29,7 @@ typedef struct {
     tr_proc *proc;
     double start;
     uint32_t from;             /* samples the attempt continues from */
+    char *remote;              /* the sums uploaded for it, NULL if none */
 } attempt;
 
 typedef struct {
@@ -276,8 +277,12 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     if (sl->base && !req.continue_from)
         s->st->fresh_instead++;
     proto_argv pa;
-    if (proto_slab_argv(&req, &pa, err))
+    fr_error ignore;
+    if (proto_slab_argv(&req, &pa, err)) {
+        if (sent)
+            tr_remove(h->tr, remote, &ignore);
         return -1;
+    }
     const char *argv[sizeof pa.argv / sizeof *pa.argv + 6] = {tr_host_worker(h->tr)};
     int k = 1;
     if (sent) {
@@ -294,8 +299,11 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
      * the sums or the splats of a bidirectional render. */
     size_t max_out = job_max_partial(sp, sl->y0, sl->y1);
     tr_proc *proc;
-    if (tr_spawn(h->tr, argv, max_out, &proc, err))
+    if (tr_spawn(h->tr, argv, max_out, &proc, err)) {
+        if (sent)
+            tr_remove(h->tr, remote, &ignore);
         return -1;
+    }
     if (s->nrun == s->caprun) {
         int cap = s->caprun ? s->caprun * 2 : 16;
         attempt *r = realloc(s->run, (size_t)cap * sizeof *r);
@@ -312,16 +320,25 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
         emit(s, SCHED_COPY, host_i, sl, "rows %u:%u still running; starting a second copy on %s", sl->y0, sl->y1,
              h->name);
     }
-    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now(s), req.continue_from ? sl->base : 0};
+    s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now(s), req.continue_from ? sl->base : 0,
+                                  sent ? strdup(remote) : NULL};
     sl->copies++;
     h->running++;
     return 0;
 }
 
-/* Ends attempt r (its process is finished or killed) and removes it. */
+/* Ends attempt r (its process is finished or killed) and removes it.  The
+ * sums uploaded for it leave the host: the worker's shell removes them as
+ * it starts, but an attempt killed or lost before that leaves them. */
 static void finish(sched *s, int r)
 {
     attempt *a = &s->run[r];
+    if (a->remote) {
+        fr_error ignore;
+        if (tr_proc_state(a->proc) != TR_EXITED || tr_proc_status(a->proc) != 0)
+            tr_remove(s->hosts[a->host].tr, a->remote, &ignore);
+        free(a->remote);
+    }
     if (--s->slabs[a->slab].copies == 0 && !s->slabs[a->slab].done && a->slab < s->next)
         s->next = a->slab; /* back in the queue */
     s->hosts[a->host].running--;

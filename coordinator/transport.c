@@ -94,6 +94,13 @@ int tr_upload(tr_host *h, const char *local_path, const char *remote, int mode, 
     return h->be->upload(h->impl, local_path, remote, mode, err);
 }
 
+int tr_remove(tr_host *h, const char *remote, fr_error *err)
+{
+    if (!h->place.workdir[0] || !h->be->remove)
+        return fr_fail(err, "%s: nothing was uploaded there to remove", h->place.label);
+    return h->be->remove(h->impl, remote, err);
+}
+
 int tr_pollfds(tr_host *h, struct pollfd *pfd, int max) { return h->be->pollfds(h->impl, h->procs, pfd, max); }
 
 int tr_service(tr_host *h, fr_error *err)

@@ -83,6 +83,12 @@ int tr_run(tr_host *h, const char *const *argv, size_t max_out, int timeout_s, t
  * file, for a host that shares this machine's files (tr_host_workdir ""). */
 int tr_upload(tr_host *h, const char *local_path, const char *remote, int mode, fr_error *err);
 
+/** Removes the file `remote` from the host (one that tr_upload put there
+ * and nothing consumed); a file already gone is no error.  Fails for a host
+ * that shares this machine's files, and on a Slurm node's own disk, which
+ * this machine reaches only through a job step. */
+int tr_remove(tr_host *h, const char *remote, fr_error *err);
+
 /** Fills up to `max` poll descriptors that signal activity on the host;
  * returns how many (possibly 0: then the caller's poll time-out paces the
  * loop). */

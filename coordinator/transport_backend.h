@@ -65,6 +65,10 @@ struct tr_backend {
      * rename (see tr_upload); checks the size that arrived. */
     int (*upload)(void *impl, const char *local_path, const char *remote, int mode, fr_error *err);
 
+    /** Removes the file `remote` that upload put on the host; a file that
+     * is not there is no error.  NULL for a backend that uploads nothing. */
+    int (*remove)(void *impl, const char *remote, fr_error *err);
+
     /** Writes up to max descriptors whose readiness means news for procs;
      * returns the count. */
     int (*pollfds)(void *impl, tr_proc *procs, struct pollfd *pfd, int max);

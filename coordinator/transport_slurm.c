@@ -354,11 +354,23 @@ static int slurm_upload(void *impl, const char *local_path, const char *remote, 
     return slurm_copy(s->h, s->a, s->node, local_path, remote, mode, err);
 }
 
+/* Only a shared work directory is reachable from here without a step. */
+static int slurm_remove(void *impl, const char *remote, fr_error *err)
+{
+    slurm_host *s = impl;
+    if (!s->a->shared)
+        return fr_fail(err, "%s: a node's own disk is reached only through a job step", tr_host_label(s->h));
+    if (unlink(remote) && errno != ENOENT)
+        return fr_fail(err, "%s: cannot remove '%s': %s", tr_host_label(s->h), remote, strerror(errno));
+    return 0;
+}
+
 const tr_backend tr_slurm_backend = {
     .name = "slurm",
     .connect = slurm_connect,
     .spawn = slurm_spawn,
     .upload = slurm_upload,
+    .remove = slurm_remove,
     .pollfds = slurm_pollfds,
     .service = slurm_service,
     .kill = slurm_kill,

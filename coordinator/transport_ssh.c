@@ -559,11 +559,24 @@ static void ssh_close_host(void *impl)
     free(h);
 }
 
+static int ssh_remove(void *impl, const char *remote, fr_error *err)
+{
+    ssh_host *h = impl;
+    if (sftp_ready(h, err))
+        return -1;
+    int rc = 0;
+    if (sftp_unlink(h->sftp, remote) != SSH_OK && sftp_get_error(h->sftp) != SSH_FX_NO_SUCH_FILE)
+        rc = fr_fail(err, "%s: cannot remove '%s': %s", h->label, remote, ssh_get_error(h->s));
+    sftp_done(h);
+    return rc;
+}
+
 const tr_backend tr_ssh_backend = {
     .name = "ssh",
     .connect = ssh_connect_host,
     .spawn = ssh_spawn,
     .upload = ssh_upload,
+    .remove = ssh_remove,
     .pollfds = ssh_pollfds,
     .service = ssh_service,
     .kill = ssh_kill,

@@ -85,6 +85,17 @@ for h in a b c; do
 done
 check "more than one host went on from sums" test "$(grep -Ec '^  [abc] +[0-9]+ +[1-9]' logs2)" -ge 2
 
+# A host that takes fewer channels than it claims cores (sshd's
+# MaxSessions 3, 4 cores): the sums of the start that finds no channel left
+# were uploaded already, and are removed again.
+: >hosts
+FH_SSHD_EXTRA="MaxSessions 3" fh_start narrow 5 4
+fr render scene.fbin -o n.pfm --hosts hosts $SIZE --spp 8 --slab-rows 2 --keep-job 2>logn1
+fr render scene.fbin -o n.pfm --hosts hosts $SIZE --spp 32 --slab-rows 3 --resume 2>logn2
+check "a narrow host goes on to 32 samples: the bytes of 32 at once" cmp -s n.pfm ref32.pfm
+check "its slots were lowered ($(grep -c 'cannot start more' logn2) times)" grep -q "host narrow: cannot start more than" logn2
+check "and it keeps no sums file" sh -c "! find narrow/work -name 'cont-*' | grep -q ."
+
 # Interrupted while adding samples: rows of two sample counts, and rows
 # never rendered, then resumed elsewhere with another split.  A worker that
 # never answers for rows at or below the row in the file "gate" holds the
