@@ -405,9 +405,12 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
 
 static int camera_subpath(const fr_scene *s, fr_sampler *smp, uint32_t x, uint32_t y, vert *cam, int maxv)
 {
-    float px, py, lx, ly, pdf_dir;
+    float px, py, lx = 0.0f, ly = 0.0f, pdf_dir;
     smp_2d(smp, &px, &py);
-    smp_2d(smp, &lx, &ly);
+    if (s->camera.aperture > 0.0f)
+        smp_2d(smp, &lx, &ly);
+    else
+        smp_skip(smp);         /* a pinhole has no lens to sample */
     fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
     cam_importance(s, ray.o, ray.d, &pdf_dir, NULL, NULL);
     vert *c = &cam[0];

@@ -107,9 +107,12 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
 {
     fr_sampler smp;
     smp_start(&smp, x, y, index, s->settings.seed);
-    float px, py, lx, ly;
+    float px, py, lx = 0.0f, ly = 0.0f;
     smp_2d(&smp, &px, &py);
-    smp_2d(&smp, &lx, &ly);
+    if (s->camera.aperture > 0.0f)
+        smp_2d(&smp, &lx, &ly);
+    else
+        smp_skip(&smp);        /* a pinhole has no lens to sample */
     fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
 
     vec3 L = v3s(0.0f), beta = v3s(1.0f);

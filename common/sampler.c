@@ -14,10 +14,33 @@ uint32_t smp_hash(uint32_t x)
 static inline uint32_t reverse_bits(uint32_t x)
 {
     x = __builtin_bswap32(x);
-    x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
-    x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
-    x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
+    x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+    x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
     return x;
+}
+
+/* Both halves of x bit-reversed and swapped: two 32-bit reversals for the
+ * price of one. */
+static inline uint64_t reverse_bits2(uint64_t x)
+{
+    x = __builtin_bswap64(x);
+    x = ((x & 0x0f0f0f0f0f0f0f0full) << 4) | ((x >> 4) & 0x0f0f0f0f0f0f0f0full);
+    x = ((x & 0x3333333333333333ull) << 2) | ((x >> 2) & 0x3333333333333333ull);
+    x = ((x & 0x5555555555555555ull) << 1) | ((x >> 1) & 0x5555555555555555ull);
+    return x;
+}
+
+/* A 64-bit bijective mix with full avalanche (the finalizer of Steele,
+ * Lea and Flood's SplitMix64): 64 random bits for two multiplications. */
+static inline uint64_t mix64(uint64_t z)
+{
+    z ^= z >> 30;
+    z *= 0xbf58476d1ce4e5b9ull;
+    z ^= z >> 27;
+    z *= 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return z;
 }
 
 /* Laine-Karras permutation of a bit-reversed 32-bit fraction: each bit is
@@ -25,7 +48,7 @@ static inline uint32_t reverse_bits(uint32_t x)
  * fraction), which adding a seed and xor-ing with multiples by even
  * constants affect only upward.  reverse(lk(reverse(x))) is Owen
  * scrambling of x (Laine and Karras 2011; constants from Burley 2020). */
-static uint32_t lk_permute(uint32_t x, uint32_t seed)
+static inline uint32_t lk_permute(uint32_t x, uint32_t seed)
 {
     x += seed;
     x ^= x * 0x6c50b47cu;
@@ -40,7 +63,7 @@ static uint32_t lk_permute(uint32_t x, uint32_t seed)
  * mod 2: digit r of the value is the xor of the index bits k with
  * k & r == r (Lucas' theorem).  That superset sum over GF(2) takes five
  * shift-and-xor steps, one per bit of the digit position. */
-static uint32_t sobol1_rev(uint32_t i)
+static inline uint32_t sobol1_rev(uint32_t i)
 {
     i ^= (i >> 1) & 0x55555555u;
     i ^= (i >> 2) & 0x33333333u;
@@ -50,30 +73,46 @@ static uint32_t sobol1_rev(uint32_t i)
     return i;
 }
 
-static float to_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+static inline float to_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+
+/* The odd 64-bit constant of the golden ratio: consecutive dimension
+ * pairs land far apart before mixing. */
+#define GOLDEN64 0x9e3779b97f4a7c15ull
 
 void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t seed)
 {
-    s->pixel = smp_hash(x ^ smp_hash(y ^ smp_hash(seed + 0x9e3779b9u)));
+    s->pixel = (uint64_t)smp_hash(x ^ smp_hash(y ^ smp_hash(seed + 0x9e3779b9u))) << 32;
     s->index = index;
+    s->rindex = reverse_bits(index);
     s->dim = 0;
 }
 
 void smp_2d(fr_sampler *s, float *u, float *v)
 {
     /* Owen-scramble the index to shuffle the order per dimension pair, take
-     * the point of the 2D Sobol sequence, Owen-scramble both coordinates.
-     * The first Sobol dimension is the bit reversal of the index, so its
-     * scrambling needs one reversal, not three. */
-    uint32_t seed = smp_hash(s->pixel ^ smp_hash(s->dim++));
-    uint32_t i = reverse_bits(lk_permute(reverse_bits(s->index), seed));
-    *u = to_unit(reverse_bits(lk_permute(i, smp_hash(seed + 1))));
-    *v = to_unit(reverse_bits(lk_permute(sobol1_rev(i), smp_hash(seed + 2))));
+     * the point of the 2D Sobol sequence, Owen-scramble both coordinates
+     * (the first Sobol dimension is the bit reversal of the index, so its
+     * scrambling needs one reversal, not three).  The three scrambling
+     * seeds come from two 64-bit mixes of (pixel, pair): the key
+     * pixel * 2^32 + pair * GOLDEN64 differs for every pixel and pair
+     * below 2^32, and mix64 is a bijection.  The index's bit reversal is
+     * made once per sample (smp_start), and the two coordinates are
+     * reversed together in one 64-bit word. */
+    uint64_t h = mix64(s->pixel + s->dim++ * GOLDEN64);
+    uint32_t sv = (uint32_t)mix64(h ^ GOLDEN64);
+    uint32_t i = reverse_bits(lk_permute(s->rindex, (uint32_t)h));
+    uint64_t r = reverse_bits2((uint64_t)lk_permute(sobol1_rev(i), sv) << 32 | lk_permute(i, (uint32_t)(h >> 32)));
+    *u = to_unit((uint32_t)(r >> 32));
+    *v = to_unit((uint32_t)r);
 }
 
 float smp_random(fr_sampler *s)
 {
-    return to_unit(smp_hash(s->pixel ^ smp_hash(s->index ^ smp_hash(s->dim++ + 0x85ebca6bu))));
+    /* The pair's mix, offset by the index and mixed again: not stratified,
+     * and unrelated to every smp_2d number (those are mixes of keys, not of
+     * mixes plus an index). */
+    uint64_t h = mix64(s->pixel + s->dim++ * GOLDEN64);
+    return to_unit((uint32_t)(mix64(h + (uint64_t)(s->index + 1) * 0xd6e8feb86659fd93ull) >> 32));
 }
 
 float smp_1d(fr_sampler *s)

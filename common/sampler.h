@@ -19,8 +19,9 @@
 
 /** Where a pixel sample is in its sequence of random numbers. */
 typedef struct {
-    uint32_t pixel;            /**< hash of pixel and seed */
+    uint64_t pixel;            /**< hash of pixel and seed, in the high half */
     uint32_t index;            /**< sample index within the pixel */
+    uint32_t rindex;           /**< the index, bit-reversed */
     uint32_t dim;              /**< next dimension pair */
 } fr_sampler;
 
@@ -33,6 +34,10 @@ void smp_2d(fr_sampler *s, float *u, float *v);
 float smp_random(fr_sampler *s);
 /** Next number in [0, 1) (uses a whole dimension pair). */
 float smp_1d(fr_sampler *s);
+/** Pass over the next dimension pair without computing it: for a pair
+ * that this sample does not use (the lens of a pinhole camera), so that
+ * the pairs after it keep their numbers. */
+static inline void smp_skip(fr_sampler *s) { s->dim++; }
 
 /** A 32-bit integer hash with good avalanche (used for seeds). */
 uint32_t smp_hash(uint32_t x);
