@@ -5,6 +5,18 @@
 
 int bsdf_has_smooth(const fr_material *m) { return m->p_lobe[1] > 0.0f; }
 
+int bsdf_needs_lobe(const fr_material *m)
+{
+    if (m->model != FR_MAT_LOBES)
+        return 1;
+    if (m->p_lobe[0] >= 1.0f)
+        return 0;               /* diffuse only, the common case */
+    int lobes = m->p_lobe[0] > 0.0f;
+    for (int i = 1; i < 4; i++)
+        lobes += m->p_lobe[i] > m->p_lobe[i - 1];
+    return lobes > 1;
+}
+
 void bsdf_lobe_probs(fr_material *m)
 {
     if (m->model != FR_MAT_LOBES) {

@@ -54,6 +54,11 @@ float bsdf_adjoint_scale(const fr_material *m, const fr_surface *sf, vec3 wo, ve
 int bsdf_sample(const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe, float u1, float u2,
                 fr_bsdf_sample *out);
 
+/** 1 if bsdf_sample reads its lobe number ulobe: a microfacet model, or a
+ * lobe material with two lobes or more.  A material with one lobe (or
+ * none) takes any ulobe in [0, 1) alike, so a path need not draw it. */
+int bsdf_needs_lobe(const fr_material *m);
+
 /** 1 if the material has a smooth lobe, so light sampling can help. */
 int bsdf_has_smooth(const fr_material *m);
 

@@ -38,6 +38,20 @@ uint32_t lgt_pick(const fr_scene *s, float u)
     return lo;
 }
 
+int lgt_pick_reuse(const fr_scene *s, float *u)
+{
+    if (s->n_lights == 0)
+        return 1;
+    uint32_t li = lgt_pick(s, *u);
+    float lo = li ? s->lights[li - 1].cdf : 0.0f, hi = s->lights[li].cdf, w = hi - lo;
+    if (!(w >= 0x1p-8f))
+        return 0;
+    float r = (*u - lo) / w;
+    /* Rounding can reach 1 (or, past the last cdf, above it). */
+    *u = r < 0.0f ? 0.0f : r < 1.0f ? r : 0x1.fffffep-1f;
+    return 1;
+}
+
 static int is_distant(const fr_light *l) { return l->kind == FR_LIGHT_SUN || l->kind == FR_LIGHT_ENV; }
 
 uint32_t lgt_n_distant(const fr_scene *s)

@@ -42,6 +42,15 @@ typedef struct {
 /** The light that lgt_sample picks with number u (the scene has lights). */
 uint32_t lgt_pick(const fr_scene *s, float u);
 
+/** Reuse the number u that picked a light (lgt_pick) as the first number
+ * of the point on it: on success *u becomes (u - the light's lower cdf) /
+ * its pick probability, uniform in [0, 1) again and as well stratified
+ * as u was, and the function returns 1.  It returns 0 (u unchanged) when
+ * the picked light's probability is below 2^-8, where the rescaled number
+ * would keep fewer than 16 significant bits; the caller then draws a fresh
+ * number for the point.  A scene without lights returns 1, u unchanged. */
+int lgt_pick_reuse(const fr_scene *s, float *u);
+
 /** Number of distant lights: lights[0 .. n) are the sun and environment lights. */
 uint32_t lgt_n_distant(const fr_scene *s);
 

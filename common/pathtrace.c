@@ -33,6 +33,18 @@ static int roulette(fr_sampler *smp, uint32_t depth, vec3 *beta)
     return 1;
 }
 
+/* The numbers of a light sample: one stratified pair whose first number
+ * picks the light and, rescaled, places the point on it too
+ * (lgt_pick_reuse); a second pair for the point only where the picked
+ * light is too unlikely for that. */
+static void light_numbers(const fr_scene *s, fr_sampler *smp, float *upick, float *u1, float *u2)
+{
+    smp_2d(smp, u1, u2);
+    *upick = *u1;
+    if (!lgt_pick_reuse(s, u1))
+        smp_2d(smp, u1, u2);
+}
+
 fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly)
 {
     const fr_camera *c = &s->camera;
@@ -133,16 +145,15 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
             L = v3_add(L, escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta));
         if (kind == VTX_ESCAPED || kind == VTX_LOST)
             break;
-        /* Each vertex draws three pairs: light pick and lobe, light
-         * point, scattered direction (a medium vertex leaves the lobe
-         * number unused). */
-        float upick, ulobe, u1, u2, v1, v2;
+        /* Each vertex draws a pair for the light (light_numbers), one for
+         * the scattered direction, and before them one for the lobe
+         * choice where the material has lobes to choose from. */
+        float upick, ulobe = 0.5f, u1, u2, v1, v2;
         vtx_direct d;
         if (kind == VTX_MEDIUM) {
             if (depth >= max_depth)
                 break;
-            smp_2d(&smp, &upick, &ulobe);
-            smp_2d(&smp, &u1, &u2);
+            light_numbers(s, &smp, &upick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
             if (light_sampling && vtx_direct_medium(s, &v, medium, beta, mis, upick, u1, u2, &d))
                 L = v3_add(L, d.L);
@@ -160,8 +171,11 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
                                        prev_medium));
             if (depth >= max_depth)
                 break;
-            smp_2d(&smp, &upick, &ulobe);
-            smp_2d(&smp, &u1, &u2);
+            if (bsdf_needs_lobe(m)) {
+                float unused;
+                smp_2d(&smp, &ulobe, &unused);
+            }
+            light_numbers(s, &smp, &upick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
             if (light_sampling && vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, upick, u1, u2, &d))
                 L = v3_add(L, d.L);

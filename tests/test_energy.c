@@ -66,7 +66,10 @@ static void furnace_box(float rho, float le)
              rho, rho, rho, le, le, le);
     fr_scene s;
     test_scene(json, &s);
-    vec3 L = mean_radiance(&s, PT_MIS, 2048);
+    /* 8192 samples a pixel: the mean's standard error is about 0.15 %,
+     * so the 0.5 % bound holds at three of them whatever the sampler's
+     * seeds (at 2048, one seed in six fell just outside it). */
+    vec3 L = mean_radiance(&s, PT_MIS, 8192);
     float expect = le / (1.0f - rho);
     CHECK(fabsf(L.x - expect) / expect < 0.005f, "box furnace rho=%g: %g, expected %g", rho, L.x, expect);
     scn_free(&s);
