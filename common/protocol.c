@@ -1,6 +1,8 @@
 /* protocol.c -- the worker protocol (see protocol.h). */
 #include "protocol.h"
 
+#include "suggest.h"
+
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -175,6 +177,12 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         } else if (!strcmp(a, "--continue")) {
             r->slab.continue_from = argv[++i];
         } else {
+            static const char *const known[] = {"help",       "version",         "check",    "lifeline", "sums",
+                                                "scene",      "rows",            "spp",      "size",     "format",
+                                                "integrator", "noise-threshold", "continue", "o",        "h"};
+            char near[64];
+            if (a[0] == '-' && sug_option(a, known, sizeof known / sizeof *known, near, sizeof near) == 0)
+                return fr_fail(err, "unknown argument '%s' (did you mean %s? see --help)", a, near);
             return fr_fail(err, "unknown argument '%s' (see --help)", a);
         }
     }

@@ -9,6 +9,7 @@
 #include <strings.h>
 
 #include "protocol.h"
+#include "suggest.h"
 
 /* A decimal integer in [lo, hi], no sign, nothing after it. */
 static int parse_uint(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
@@ -43,75 +44,22 @@ int opt_default_output(const char *scene, const char *ext, char *buf, size_t cap
     return len < 0 || (size_t)len >= cap ? -1 : 0;
 }
 
-/* Levenshtein distance of a[0..na) and b[0..nb), capped at 32 characters. */
-static int edits(const char *a, size_t na, const char *b, size_t nb)
-{
-    if (na > 32 || nb > 32)
-        return 99;
-    int row[33];
-    for (size_t j = 0; j <= nb; j++)
-        row[j] = (int)j;
-    for (size_t i = 1; i <= na; i++) {
-        int diag = row[0];
-        row[0] = (int)i;
-        for (size_t j = 1; j <= nb; j++) {
-            int up = row[j];
-            int best = diag + (a[i - 1] != b[j - 1]);
-            if (row[j] + 1 < best)
-                best = row[j] + 1;
-            if (row[j - 1] + 1 < best)
-                best = row[j - 1] + 1;
-            diag = up;
-            row[j] = best;
-        }
-    }
-    return row[nb];
-}
-
 int opt_suggest(const char *typed, const char *shortopts, const struct option *longopts, char *buf, size_t cap)
 {
-    /* What people coming from other renderers type, and what franja calls it. */
-    static const char *const synonyms[][2] = {
-        {"samples", "spp"},   {"spp-count", "spp"}, {"resolution", "size"}, {"res", "size"},
-        {"threads", "j"},     {"jobs", "j"},        {"output", "o"},        {"out", "o"},
-        {"host", "hosts"},    {"hostfile", "hosts"}, {"curve", "tonemap"},  {"tone-map", "tonemap"},
-        {"continue", "resume"}, {"ev", "exposure"},
-    };
-    const char *name = typed;
-    while (*name == '-')
-        name++;
-    size_t n = strcspn(name, "=");
-    if (n == 0)
-        return -1;
-    const char *best = NULL;
-    for (size_t i = 0; i < sizeof synonyms / sizeof *synonyms && !best; i++)
-        if (strlen(synonyms[i][0]) == n && !strncmp(name, synonyms[i][0], n))
-            best = synonyms[i][1];
-    if (best) {
-        /* A synonym counts only if the command has what it stands for. */
-        int have = strlen(best) == 1 ? strchr(shortopts, best[0]) != NULL : 0;
-        for (const struct option *o = longopts; o->name && !have; o++)
-            have = !strcmp(o->name, best);
-        if (!have)
-            best = NULL;
-    }
-    /* Otherwise the nearest long option within a few edits (fewer for
-     * short names, where a few edits make anything of anything). */
-    int limit = n <= 3 ? 1 : n <= 6 ? 2 : 3;
-    const char *nearest = NULL;
-    for (const struct option *o = longopts; o->name && !best; o++) {
-        int d = edits(name, n, o->name, strlen(o->name));
-        if (d <= limit) {
-            limit = d - 1;
-            nearest = o->name;
+    /* The command's names as sug_option takes them: a one-letter string for
+     * each short option, then the long ones. */
+    char shorts[64][2];
+    const char *names[192];
+    size_t count = 0, k = 0;
+    for (const char *c = shortopts; *c && k < 64; c++)
+        if (*c != ':') {
+            shorts[k][0] = *c;
+            shorts[k][1] = 0;
+            names[count++] = shorts[k++];
         }
-    }
-    if (!best)
-        best = nearest;
-    if (!best)
-        return -1;
-    int len = snprintf(buf, cap, strlen(best) == 1 ? "-%s" : "--%s", best);
-    return len < 0 || (size_t)len >= cap ? -1 : 0;
+    for (const struct option *o = longopts; o->name && count < 192; o++)
+        names[count++] = o->name;
+    return sug_option(typed, names, count, buf, cap);
 }
 
 char **opt_copy(int argc, char **argv)

@@ -101,7 +101,14 @@ static void test_parse_errors(void)
         {{"--rows", "0:1"}, "--scene is required"},
         {{"--scene", "s"}, "--rows is required"},
         {{"--scene"}, "--scene needs a value"},
-        {{"--scene", "s", "--rows", "0:1", "--bogus"}, "unknown argument '--bogus'"},
+        {{"--scene", "s", "--rows", "0:1", "--bogus"}, "unknown argument '--bogus' (see --help)"},
+        {{"--scene", "s", "--rows", "0:1", "--sp", "4"}, "unknown argument '--sp' (did you mean --spp? see --help)"},
+        {{"--scene", "s", "--rows", "0:1", "--samples", "4"}, "'--samples' (did you mean --spp?"},
+        {{"--scene", "s", "--rows", "0:1", "--output", "x"}, "'--output' (did you mean -o?"},
+        {{"--scene", "s", "--rows", "0:1", "--integratr", "bdpt"}, "(did you mean --integrator?"},
+        {{"--scene", "s", "--rows", "0:1", "--noise-treshold", "0.1"}, "(did you mean --noise-threshold?"},
+        {{"--scene", "s", "--rows", "0:1", "--resume"}, "'--resume' (see --help)"},
+        {{"--scene", "s", "--rows", "0:1", "stray"}, "unknown argument 'stray' (see --help)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char *argv[10] = {"franja-worker"};
