@@ -70,6 +70,8 @@ static const char usage[] =
     "  --exr-compression C  .exr output: none, rle, zips, zip, piz, pxr24, b44, b44a,\n"
     "                       dwaa or dwab (default zip)\n"
     "  --jpeg-quality Q     .jpg output: quality 1..100 (default 98)\n"
+    "  --reproducible       leave the render time and the hosts out of the\n"
+    "                       output's metadata: equal pixels, equal files\n"
     "  --tonemap CURVE      none or filmic (default: the scene's, else none)\n"
     "  --time-limit T       render in passes over the whole image, each doubling\n"
     "                       the samples per pixel (1, 2, 4 ... up to --spp), and\n"
@@ -130,6 +132,7 @@ typedef struct {
     int resume, keep_job, fresh, no_lock;
     const char *frames;        /* --frames LIST, or NULL */
     int overwrite;             /* --overwrite */
+    int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
     tr_options tr;
     cli_slurm slurm;
@@ -140,8 +143,19 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
+    OPT_REPRODUCIBLE
 };
+
+/* --reproducible's DateTime: SOURCE_DATE_EPOCH when it is a number of
+ * seconds (the convention of reproducible builds), else 0 (1970). */
+static long long reproducible_epoch(void)
+{
+    const char *v = getenv("SOURCE_DATE_EPOCH");
+    char *end;
+    long long e = v && *v ? strtoll(v, &end, 10) : 0;
+    return v && *v && !*end ? e : 0;
+}
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
 static int parse(int argc, char **argv, render_args *a)
@@ -173,6 +187,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"exr-compression", required_argument, NULL, OPT_EXR_COMPRESSION},
         {"jpeg-quality", required_argument, NULL, OPT_JPEG_QUALITY},
         {"scale", required_argument, NULL, OPT_SCALE},
+        {"reproducible", no_argument, NULL, OPT_REPRODUCIBLE},
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
@@ -232,6 +247,9 @@ static int parse(int argc, char **argv, render_args *a)
             break;
         case OPT_NO_LOCK:
             a->no_lock = 1;
+            break;
+        case OPT_REPRODUCIBLE:
+            a->reproducible = 1;
             break;
         case OPT_SLAB_ROWS:
             bad = opt_uint(cmd, "--slab-rows", v, 1, PROTO_MAX_SIZE, &a->slab_rows);
@@ -1185,7 +1203,9 @@ int cmd_render(int argc, char **argv)
         }
     }
     out_meta meta;
-    out_meta_make(&meta, &spec, clk_now() - t0, used);
+    out_meta_make(&meta, &spec, a.reproducible ? -1 : clk_now() - t0, a.reproducible ? NULL : used);
+    if (a.reproducible)
+        out_meta_set_time(&meta, reproducible_epoch());
     a.io.attrs = meta.attrs;
     if (out_write_with(a.out, rgb, &out_spec, &tm, &a.io, &err)) {
         /* Said only once checked: the rows are still there. */

@@ -12,7 +12,7 @@ static const char usage[] =
     "                     [--size WxH | --scale S] [--crop X0:Y0:X1:Y1 [--crop-output]]\n"
     "                     [--camera NAME] [--integrator path|bdpt] [--noise-threshold E]\n"
     "                     [--exposure E] [--tonemap none|filmic] [--exr-half]\n"
-    "                     [--exr-compression C] [--jpeg-quality Q]\n"
+    "                     [--exr-compression C] [--jpeg-quality Q] [--reproducible]\n"
     "                     [--frames LIST [--overwrite]] [--time-limit T]\n"
     "                     [--resume | --fresh]\n"
     "                     [--job DIR] [--keep-job] [--no-lock] [--slab-rows N]\n"

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "file.h"
@@ -71,6 +72,21 @@ void out_meta_make(out_meta *m, const job_spec *spec, double seconds, const char
         *a++ = "franja:render_time", *a++ = m->seconds;
     if (m->hosts[0])
         *a++ = "franja:hosts", *a++ = m->hosts;
+    *a = NULL;
+}
+
+void out_meta_set_time(out_meta *m, long long epoch)
+{
+    if (epoch < 0 || epoch > 253402300799LL)
+        epoch = 0;
+    time_t t = (time_t)epoch;
+    struct tm tm;
+    gmtime_r(&t, &tm);
+    strftime(m->datetime, sizeof m->datetime, "%Y:%m:%d %H:%M:%S", &tm);
+    const char **a = m->attrs;
+    while (*a)
+        a++;
+    *a++ = "DateTime", *a++ = m->datetime;
     *a = NULL;
 }
 

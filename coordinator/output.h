@@ -24,7 +24,8 @@ typedef struct {
     char scene[24], spp[16], integrator[16], seconds[32];
     char hosts[1024];          /**< host names, comma-separated */
     char desc[1400];           /**< the figures above in one line, ImageDescription */
-    const char *attrs[17];     /**< name, value pairs, NULL-terminated: iio_options.attrs */
+    char datetime[24];         /**< DateTime "YYYY:MM:DD HH:MM:SS", UTC; "" = the time of the write */
+    const char *attrs[19];     /**< name, value pairs, NULL-terminated: iio_options.attrs */
 } out_meta;
 
 /** Fills m with the metadata of a final image of spec: Software "Franja
@@ -37,6 +38,11 @@ typedef struct {
  * iio_options.attrs while m lives.  Long host lists are cut at a name
  * boundary with ",...". */
 void out_meta_make(out_meta *m, const job_spec *spec, double seconds, const char *hosts);
+
+/** Gives m a fixed DateTime (TIFF and OpenEXR headers, which otherwise
+ * get the time of the write): `epoch` seconds since 1970, UTC; a value
+ * out of the years 1970..9999 gives 1970:01:01 00:00:00. */
+void out_meta_set_time(out_meta *m, long long epoch);
 
 /** Fails if no writer handles the path's extension. */
 int out_check_type(const char *path, fr_error *err);

@@ -55,4 +55,22 @@ info "$T/b.exr" | grep -qF 'franja:hosts: "local"' && ok || bad "a local render 
 info "$T/s.tif" >"$T/i"
 grep -q "ImageDescription: \"Franja $version render; scene $hash; 2 spp; integrator path\"" "$T/i" && ok ||
     bad "stitch's .tif description: $(cat "$T/i")"
+# --reproducible: no time, no hosts, and two renders split differently on
+# other hosts write the same bytes in every format.
+printf 'a local - 2\nb local - 1\n' >"$T/other.hosts"
+for ext in png tif exr jpg; do
+    "$F" render "$T/c.fbin" -o "$T/r1.$ext" --size 32x32 --spp 3 --slab-rows 4 --hosts "$T/two.hosts" \
+        --reproducible 2>"$T/log" && ok || bad "--reproducible .$ext failed: $(tail -n 3 "$T/log")"
+    "$F" render "$T/c.fbin" -o "$T/r2.$ext" --size 32x32 --spp 3 --slab-rows 7 --hosts "$T/other.hosts" \
+        --reproducible 2>"$T/log" && ok || bad "--reproducible .$ext failed: $(tail -n 3 "$T/log")"
+    cmp -s "$T/r1.$ext" "$T/r2.$ext" && ok || bad ".$ext with --reproducible: two renders write other bytes"
+    d=$(info "$T/r1.$ext" | sed -n 's/^ *ImageDescription: "\(.*\)"$/\1/p')
+    [ "$d" = "Franja $version render; scene $hash; 3 spp; integrator path" ] && ok ||
+        bad ".$ext with --reproducible: ImageDescription '$d'"
+done
+info "$T/r1.exr" | grep -q 'franja:render_time\|franja:hosts' && bad ".exr with --reproducible keeps a time or hosts" || ok
+info "$T/r1.tif" | grep -q 'DateTime: "1970:01:01 00:00:00"' && ok || bad ".tif with --reproducible: $(info "$T/r1.tif" | grep DateTime)"
+SOURCE_DATE_EPOCH=1700000000 "$F" render "$T/c.fbin" -o "$T/e.exr" --size 8x8 --spp 1 --reproducible 2>"$T/log" && ok ||
+    bad "--reproducible with SOURCE_DATE_EPOCH failed: $(tail -n 3 "$T/log")"
+info "$T/e.exr" | grep -q 'DateTime: "2023:11:14 22:13:20"' && ok || bad "SOURCE_DATE_EPOCH: $(info "$T/e.exr" | grep DateTime)"
 summary
