@@ -35,8 +35,11 @@ COMMON_OBJ  = $(COMMON_SRC:%.c=$(B)/%.o)
 WORKER_SRC  = $(wildcard worker/*.c)
 WORKER_OBJ  = $(WORKER_SRC:%.c=$(B)/%.o)
 COORD_SRC   = $(wildcard coordinator/*.c)
-COORD_CXX   = $(wildcard coordinator/*.cpp)
-COORD_OBJ   = $(COORD_SRC:%.c=$(B)/%.o) $(COORD_CXX:%.cpp=$(B)/%.o)
+COORD_OBJ   = $(COORD_SRC:%.c=$(B)/%.o)
+# OpenImageIO's bridge, a plug-in that franja loads when it first reads or
+# writes an image other than PFM (coordinator/imageio_load.c).
+IIO_PLUGIN  = bin/franja-imageio.so
+IIO_OBJ     = $(B)/pic/coordinator/imageio.o $(B)/pic/common/error.o
 # The coordinator's modules (all but main.c) as a library that the tests link.
 COORD_LIB_OBJ = $(filter-out $(B)/coordinator/main.o,$(COORD_OBJ))
 COORD_LIB   = $(B)/libfranja-coord.a
@@ -53,18 +56,26 @@ BENCH_BIN   = $(BENCH_SRC:tests/bench/%.c=bin/bench/%)
 LIB         = $(B)/libfranja.a
 
 WORKER_LIBS = $(CJSON_LIBS) -lm
-COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(OIIO_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) -lstdc++ -lm -pthread
+COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) -ldl -lm -pthread
 
 .PHONY: all deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
-all: bin/franja-worker bin/franja
+all: bin/franja-worker bin/franja $(IIO_PLUGIN)
 
 $(B)/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -MMD -MP -c $< -o $@
 
-$(B)/%.o: %.cpp
+$(B)/pic/%.o: %.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXSTD) $(CFLAGS) $(OIIO_CFLAGS) -MMD -MP -c $< -o $@
+	$(CXX) $(CXXSTD) $(CFLAGS) $(OIIO_CFLAGS) -fPIC -MMD -MP -c $< -o $@
+
+$(B)/pic/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CSTD) $(CFLAGS) -fPIC -MMD -MP -c $< -o $@
+
+$(IIO_PLUGIN): $(IIO_OBJ)
+	@mkdir -p bin
+	$(CXX) $(CFLAGS) -shared -Wl,-z,defs -o $@ $(IIO_OBJ) $(OIIO_LIBS) -lstdc++ -lm
 
 $(LIB): $(COMMON_OBJ)
 	@mkdir -p $(dir $@)
@@ -171,21 +182,25 @@ refs:
 	for s in glass fog; do blender -b --factory-startup --python tests/refs/cycles_noise.py -- \
 	    tests/bench/scenes/cornell-$$s.json tests/data/cycles-noise-$$s.pfm 1024 7; done
 
-# make install [PREFIX=/usr/local] [DESTDIR=staging]: the two programs, their
+# make install [PREFIX=/usr/local] [DESTDIR=staging]: the two programs, the image plug-in, their
 # manual pages and bash completion; make uninstall removes exactly those files.
 # franja finds the franja-worker installed beside it.
 PREFIX     ?= /usr/local
 BINDIR     ?= $(PREFIX)/bin
+# franja finds its image plug-in in ../lib/franja from its own directory.
+PLUGINDIR   = $(BINDIR)/../lib/franja
 MANDIR     ?= $(PREFIX)/share/man
 BASHCOMPDIR ?= $(PREFIX)/share/bash-completion/completions
 MAN1 = $(wildcard coordinator/man/*.1)
 MAN5 = $(wildcard coordinator/man/*.5)
-INSTALLED = $(BINDIR)/franja $(BINDIR)/franja-worker $(MAN1:coordinator/man/%=$(MANDIR)/man1/%) \
+INSTALLED = $(BINDIR)/franja $(BINDIR)/franja-worker $(PLUGINDIR)/franja-imageio.so $(MAN1:coordinator/man/%=$(MANDIR)/man1/%) \
 	    $(MAN5:coordinator/man/%=$(MANDIR)/man5/%) $(BASHCOMPDIR)/franja $(BASHCOMPDIR)/franja-worker
 
 install: all
 	install -d '$(DESTDIR)$(BINDIR)' '$(DESTDIR)$(MANDIR)/man1' '$(DESTDIR)$(MANDIR)/man5' '$(DESTDIR)$(BASHCOMPDIR)'
 	install -m 755 bin/franja bin/franja-worker '$(DESTDIR)$(BINDIR)/'
+	install -d '$(DESTDIR)$(PLUGINDIR)'
+	install -m 644 $(IIO_PLUGIN) '$(DESTDIR)$(PLUGINDIR)/'
 	install -m 644 $(MAN1) '$(DESTDIR)$(MANDIR)/man1/'
 	install -m 644 $(MAN5) '$(DESTDIR)$(MANDIR)/man5/'
 	install -m 644 coordinator/completion/franja.bash '$(DESTDIR)$(BASHCOMPDIR)/franja'
@@ -238,4 +253,4 @@ check-cross: all static
 clean:
 	rm -rf $(B) bin
 
--include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d) $(TESTSUP_OBJ:.o=.d)
+-include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d) $(TESTSUP_OBJ:.o=.d) $(IIO_OBJ:.o=.d)

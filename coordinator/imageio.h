@@ -2,6 +2,12 @@
  * The coordinator's bridge to OpenImageIO (imageio.cpp, the one C++ file):
  * encodes a finished image in the format its file name's extension names,
  * and reads images (textures).
+ *
+ * imageio.cpp is built as the plug-in franja-imageio.so, which franja
+ * loads on the first call of a function below (imageio_load.c), so that a
+ * run that needs no image library does not load OpenImageIO's 250 shared
+ * libraries.  Where the plug-in is missing or does not load, every
+ * function fails (iio_can_write returns 0) and iio_unavailable says why.
  */
 #ifndef FRANJA_IMAGEIO_H
 #define FRANJA_IMAGEIO_H
@@ -58,5 +64,9 @@ int iio_read_mem(const void *data, size_t len, const char *mime, float **pixels,
 
 /** Returns 1 if OpenImageIO has a writer for the file name's extension. */
 int iio_can_write(const char *path);
+
+/** NULL when the plug-in is loaded (loading it if need be), else a
+ * sentence saying why it cannot be (not installed, not loadable). */
+const char *iio_unavailable(void);
 
 #endif

@@ -92,7 +92,12 @@ void out_meta_set_time(out_meta *m, long long epoch)
 
 int out_check_type(const char *path, fr_error *err)
 {
-    if (!is_ext(path, "pfm") && !(*extension(path) && iio_can_write(path)))
+    if (is_ext(path, "pfm"))
+        return 0;
+    const char *why = iio_unavailable();
+    if (why)
+        return fr_fail(err, "%s: only .pfm can be written: %s", path, why);
+    if (!(*extension(path) && iio_can_write(path)))
         return fr_fail(err, "%s: unknown image type '%s': expected .png, .exr, .tif, .jpg, .hdr, .ppm, .bmp, "
                        ".tga or .pfm", path, extension(path));
     return 0;

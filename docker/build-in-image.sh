@@ -2,7 +2,8 @@
 # build-in-image.sh OUT -- run inside a docker/Dockerfile.* image, in a copy of
 # the source tree: builds franja-worker for amd64 (native) and arm64 (Debian's
 # cross compiler, against the image's libcjson-dev:arm64), and franja for
-# amd64 when the image has its libraries.  Binaries land in OUT/amd64 and
+# amd64 (with its image plug-in, franja-imageio.so, which it finds beside it)
+# when the image has its libraries.  Binaries land in OUT/amd64 and
 # OUT/arm64, with BUILDINFO files naming the OS and compiler.
 set -eu
 out=$1
@@ -13,8 +14,8 @@ mkdir -p "$out/amd64" "$out/arm64"
 make -j"$jobs" B=build/amd64 bin/franja-worker
 cp bin/franja-worker "$out/amd64/"
 if pkg-config --exists libcjson libssh OpenImageIO assimp; then
-    make -j"$jobs" B=build/amd64 bin/franja
-    cp bin/franja "$out/amd64/"
+    make -j"$jobs" B=build/amd64 bin/franja bin/franja-imageio.so
+    cp bin/franja bin/franja-imageio.so "$out/amd64/"
 fi
 rm -rf bin
 
