@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "clock.h"
@@ -45,6 +46,11 @@ typedef struct {
     int acc_rows;              /* their rows */
     sched_stats *st;
     double t0;
+    struct leftover {          /* uploaded sums that could not be removed yet */
+        int host;
+        char *remote;
+    } *left;
+    int nleft;
 } sched;
 
 static double now(const sched *s)
@@ -246,6 +252,44 @@ static const char *cont_file(sched *s, slab *sl)
     return sl->cont;
 }
 
+/* Removes the sums uploaded as `remote` to host_i; when that fails (the
+ * host has no channel free for SFTP this instant: it refused a worker a
+ * moment ago) the name is kept for sched_run's end, when no worker holds
+ * a channel.  Takes remote. */
+static void remove_remote(sched *s, int host_i, char *remote)
+{
+    fr_error ignore;
+    if (!remote)
+        return;
+    if (tr_remove(s->hosts[host_i].tr, remote, &ignore) == 0) {
+        free(remote);
+        return;
+    }
+    struct leftover *l = realloc(s->left, (size_t)(s->nleft + 1) * sizeof *l);
+    if (!l) {
+        free(remote);
+        return;
+    }
+    s->left = l;
+    s->left[s->nleft++] = (struct leftover){host_i, remote};
+}
+
+/* At the end of a run: the leftovers, a few tries each, 200 ms apart (a
+ * host frees a closed channel a moment after it is closed). */
+static void remove_leftovers(sched *s)
+{
+    for (int i = 0; i < s->nleft; i++) {
+        sched_host *h = &s->hosts[s->left[i].host];
+        fr_error ignore;
+        for (int k = 0; tr_remove(h->tr, s->left[i].remote, &ignore) && k < 4 && !h->dropped; k++)
+            nanosleep(&(struct timespec){0, 200000000}, NULL);
+        free(s->left[i].remote);
+    }
+    free(s->left);
+    s->left = NULL;
+    s->nleft = 0;
+}
+
 static void cont_drop(slab *sl)
 {
     if (sl->cont)
@@ -277,10 +321,9 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     if (sl->base && !req.continue_from)
         s->st->fresh_instead++;
     proto_argv pa;
-    fr_error ignore;
     if (proto_slab_argv(&req, &pa, err)) {
         if (sent)
-            tr_remove(h->tr, remote, &ignore);
+            remove_remote(s, host_i, strdup(remote));
         return -1;
     }
     const char *argv[sizeof pa.argv / sizeof *pa.argv + 6] = {tr_host_worker(h->tr)};
@@ -301,7 +344,7 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     tr_proc *proc;
     if (tr_spawn(h->tr, argv, max_out, &proc, err)) {
         if (sent)
-            tr_remove(h->tr, remote, &ignore);
+            remove_remote(s, host_i, strdup(remote));
         return -1;
     }
     if (s->nrun == s->caprun) {
@@ -334,10 +377,10 @@ static void finish(sched *s, int r)
 {
     attempt *a = &s->run[r];
     if (a->remote) {
-        fr_error ignore;
         if (tr_proc_state(a->proc) != TR_EXITED || tr_proc_status(a->proc) != 0)
-            tr_remove(s->hosts[a->host].tr, a->remote, &ignore);
-        free(a->remote);
+            remove_remote(s, a->host, a->remote);
+        else
+            free(a->remote);
     }
     if (--s->slabs[a->slab].copies == 0 && !s->slabs[a->slab].done && a->slab < s->next)
         s->next = a->slab; /* back in the queue */
@@ -668,6 +711,7 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         tr_proc_kill(s.run[r].proc);
         finish(&s, r);
     }
+    remove_leftovers(&s);
     progress(&s);
     if (rc) {
         char missing[400], why[sizeof err->msg];
