@@ -176,7 +176,7 @@ render: all
 refs:
 	blender -b --factory-startup --python tests/refs/cycles_furnace.py -- tests/data
 	blender -b --factory-startup --python tests/refs/cycles_env.py -- scenes/textures/sky.hdr tests/data
-	for s in rough metals; do blender -b --factory-startup --python tests/refs/cycles_scene.py -- \
+	for s in rough metals principled; do blender -b --factory-startup --python tests/refs/cycles_scene.py -- \
 	    tests/data/cycles-$$s.json tests/data cycles-$$s 256; done
 	blender -b --factory-startup --python tests/refs/cycles_lights.py -- tests/data
 	for s in glass fog; do blender -b --factory-startup --python tests/refs/cycles_noise.py -- \

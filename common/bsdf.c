@@ -147,8 +147,10 @@ static void micro_lobe(const fr_material *m, mf_lobe *l)
                            m->transmit, m->transmit, comp};
         l->d = d;
     } else {
-        mf_principled p = {a, masking, (m->mf_flags & FR_MF_GLTF_COUPLING) ? MF_COUPLE_GLTF : MF_COUPLE_ALBEDO,
-                           m->diffuse, m->metallic, m->transmission, m->ior, comp};
+        uint32_t coupling = (m->mf_flags & FR_MF_CYCLES_COUPLING) ? MF_COUPLE_CYCLES
+                            : (m->mf_flags & FR_MF_GLTF_COUPLING)  ? MF_COUPLE_GLTF
+                                                                   : MF_COUPLE_ALBEDO;
+        mf_principled p = {a, masking, coupling, m->diffuse, m->metallic, m->transmission, m->ior, comp, m->roughness};
         l->p = p;
     }
 }

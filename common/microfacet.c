@@ -379,7 +379,38 @@ typedef struct {
     float f0;                          /* the specular layer's */
     float es_o, es_avg;                /* its albedo at mu_o and average (MF_COUPLE_ALBEDO) */
     float spec, cosine, refract, sum;  /* sampling weights: GGX reflection, cosine, dielectric */
+    vec3 cspec0;                       /* MF_COUPLE_CYCLES: the specular colour at normal incidence */
 } principled_ctx;
+
+/* Cycles' interpolation weight: the dielectric Fresnel factor rescaled from
+ * [F0, 1] to [0, 1]. */
+static float cycles_fresnel_weight(float ior, float f0, float cos_h)
+{
+    float unused;
+    return f0 < 1.0f ? (mf_fresnel_dielectric(cos_h, ior, &unused) - f0) / (1.0f - f0) : 1.0f;
+}
+
+static principled_ctx cycles_setup(const mf_principled *p, principled_ctx c, vec3 wo)
+{
+    float m = c.wm;
+    c.cspec0 = v3_add(v3s(c.f0 * (1.0f - m)), v3_scale(p->base, m));
+    float w = cycles_fresnel_weight(p->ior, c.f0, wo.z), lum = fmaxf(0.0f, v3_luma(c.cspec0));
+    c.spec = (1.0f - c.wt) * (lum * (1.0f - w) + w);
+    c.cosine = c.wd * fmaxf(0.0f, v3_luma(p->base));
+    c.refract = c.wt;
+    c.sum = c.spec + c.cosine + c.refract;
+    return c;
+}
+
+/* Disney's diffuse with retro-reflection, as Cycles 3.4 evaluates it,
+ * without the base colour and 1/pi. */
+static float disney_diffuse(float roughness, vec3 wo, vec3 wi)
+{
+    float a = 1.0f - wo.z, b = 1.0f - wi.z;
+    float fv = a * a * a * a * a, fl = b * b * b * b * b;
+    float rr = roughness * (v3_dot(wo, wi) + 1.0f);
+    return (1.0f - 0.5f * fv) * (1.0f - 0.5f * fl) + rr * (fl + fv + fl * fv * (rr - 1.0f));
+}
 
 static principled_ctx principled_setup(const mf_principled *p, vec3 wo)
 {
@@ -389,6 +420,9 @@ static principled_ctx principled_setup(const mf_principled *p, vec3 wo)
     c.wd = (1.0f - c.wm) - c.wt;
     c.f0 = mf_f0_from_ior(p->ior);
     c.es_o = c.es_avg = 0.0f;
+    c.cspec0 = v3s(0.0f);
+    if (p->coupling == MF_COUPLE_CYCLES)
+        return cycles_setup(p, c, wo);
     float fs = mf_fresnel_schlick(v3s(c.f0), wo.z).x, through;
     if (p->coupling == MF_COUPLE_GLTF) {
         through = 1.0f - fs;
@@ -406,6 +440,8 @@ static principled_ctx principled_setup(const mf_principled *p, vec3 wo)
 static mf_dielectric principled_dielectric(const mf_principled *p)
 {
     mf_dielectric d = {p->alpha, p->masking, MF_DIELECTRIC_MICRO, v3s(1.0f), p->base, p->compensate};
+    if (p->coupling == MF_COUPLE_CYCLES)
+        d.fresnel_at = MF_DIELECTRIC_MACRO;
     return d;
 }
 
@@ -418,22 +454,29 @@ static vec3 principled_eval(const mf_principled *p, const principled_ctx *c, flo
         vec3 h = v3_norm(v3_add(wo, wi));
         float oh = v3_dot(wo, h), d = mf_D(p->alpha, h);
         float spec = d * mf_G2(p->alpha, p->masking, wo, wi) / (4.0f * wo.z * wi.z);
-        /* metal: Schlick with F0 = base colour */
-        vec3 metal = v3_scale(mf_fresnel_schlick(p->base, oh), spec);
-        if (p->compensate && c->wm > 0.0f) {
-            vec3 favg = mf_fresnel_average(MF_FRESNEL_SCHLICK, p->base, v3s(0.0f), v3s(0.0f));
-            metal = v3_mul(metal, ms_scale(favg, mf_albedo(p->alpha, p->masking, wo.z)));
-        }
-        /* dielectric: the specular layer over Lambert */
-        float fs = mf_fresnel_schlick(v3s(c->f0), oh).x, through;
-        if (p->coupling == MF_COUPLE_GLTF) {
-            through = 1.0f - fs;
+        if (p->coupling == MF_COUPLE_CYCLES) {
+            float w = cycles_fresnel_weight(p->ior, c->f0, oh);
+            vec3 fc = v3_add(v3_scale(c->cspec0, 1.0f - w), v3s(w));
+            f = v3_add(v3_scale(fc, (1.0f - c->wt) * spec),
+                       v3_scale(p->base, c->wd * disney_diffuse(p->roughness, wo, wi) * FM_INV_PI));
         } else {
-            float unused, es_i = mf_albedo_schlick(p->alpha, p->masking, c->f0, wi.z, &unused);
-            through = c->es_avg < 1.0f ? (1.0f - c->es_o) * (1.0f - es_i) / (1.0f - c->es_avg) : 0.0f;
+            /* metal: Schlick with F0 = base colour */
+            vec3 metal = v3_scale(mf_fresnel_schlick(p->base, oh), spec);
+            if (p->compensate && c->wm > 0.0f) {
+                vec3 favg = mf_fresnel_average(MF_FRESNEL_SCHLICK, p->base, v3s(0.0f), v3s(0.0f));
+                metal = v3_mul(metal, ms_scale(favg, mf_albedo(p->alpha, p->masking, wo.z)));
+            }
+            /* dielectric: the specular layer over Lambert */
+            float fs = mf_fresnel_schlick(v3s(c->f0), oh).x, through;
+            if (p->coupling == MF_COUPLE_GLTF) {
+                through = 1.0f - fs;
+            } else {
+                float unused, es_i = mf_albedo_schlick(p->alpha, p->masking, c->f0, wi.z, &unused);
+                through = c->es_avg < 1.0f ? (1.0f - c->es_o) * (1.0f - es_i) / (1.0f - c->es_avg) : 0.0f;
+            }
+            vec3 diel = v3_add(v3s(fs * spec), v3_scale(p->base, through * FM_INV_PI));
+            f = v3_add(v3_scale(metal, c->wm), v3_scale(diel, c->wd));
         }
-        vec3 diel = v3_add(v3s(fs * spec), v3_scale(p->base, through * FM_INV_PI));
-        f = v3_add(v3_scale(metal, c->wm), v3_scale(diel, c->wd));
         pd = c->spec * mf_G1(p->alpha, wo) * d / (4.0f * wo.z) + c->cosine * wi.z * FM_INV_PI;
     }
     if (c->refract > 0.0f) {

@@ -211,6 +211,7 @@ int mf_dielectric_sample(const mf_dielectric *d, float eta, vec3 wo, float uc, f
 enum {
     MF_COUPLE_ALBEDO = 0, /**< base times (1 - E_s(mu_o)) (1 - E_s(mu_i)) / (1 - E_s,avg): reciprocal, never gains energy (default) */
     MF_COUPLE_GLTF = 1,   /**< base times 1 - F(wo.h): glTF's fresnel_mix as written; gains energy at grazing angles */
+    MF_COUPLE_CYCLES = 2, /**< Cycles 3.4's Principled BSDF (GGX): see mf_principled */
 };
 
 /** glTF 2.0's metallic-roughness material: a mix of a conductor (Schlick,
@@ -228,7 +229,19 @@ enum {
  *  dielectric by refraction through a rough dielectric boundary of the
  *  given ior (exact Fresnel, its own reflection untinted and transmission
  *  tinted by the base colour: a closed solid, not glTF's thin-walled
- *  default).  Compensation scales the metal and the refraction. */
+ *  default).  Compensation scales the metal and the refraction.
+ *
+ *  MF_COUPLE_CYCLES computes what Cycles 3.4's Principled BSDF (GGX, the
+ *  Specular input 0.08 F0 of ior, other inputs at their defaults) does:
+ *  one specular lobe of weight 1 - transmission (1 - metallic) whose
+ *  colour is C (1 - w) + w, C = F0 (1 - metallic) + base metallic, w =
+ *  (F(wo.h) - F0) / (1 - F0) with F the exact dielectric Fresnel of ior;
+ *  added to it, not weighted by it, a Disney diffuse base of weight
+ *  (1 - metallic)(1 - transmission) with retro-reflection, base / pi
+ *  ((1 - FV/2)(1 - FL/2) + R (FL + FV + FL FV (R - 1))), F = (1 - mu)^5,
+ *  R = roughness (1 + wo.wi); and the refraction with Fresnel once with
+ *  the shading normal (MF_DIELECTRIC_MACRO).  Reciprocal, but it may
+ *  reflect more than it receives.  @p compensate is ignored. */
 typedef struct {
     mf_alpha alpha;
     uint32_t masking;   /**< MF_SMITH_* */
@@ -238,6 +251,7 @@ typedef struct {
     float transmission; /**< [0, 1], KHR_materials_transmission */
     float ior;          /**< KHR_materials_ior, 1.5 by default */
     int compensate;
+    float roughness;    /**< MF_COUPLE_CYCLES: the diffuse's retro-reflection (not alpha) */
 } mf_principled;
 
 /** f(wo, wi) and the sampling pdf.  @p eta is the relative index for

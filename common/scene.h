@@ -75,7 +75,8 @@ enum {
     FR_MF_COMPENSATE = 2,    /**< multiple-scattering energy compensation */
     FR_MF_MACRO_FRESNEL = 4, /**< dielectric: Fresnel once with the shading normal (Cycles 3.4's Glass) */
     FR_MF_GLTF_COUPLING = 8, /**< principled: glTF's fresnel_mix as written instead of albedo coupling */
-    FR_MF_ALL = 15
+    FR_MF_CYCLES_COUPLING = 16, /**< principled: Cycles 3.4's Principled BSDF (Disney diffuse added) */
+    FR_MF_ALL = 31
 };
 
 /** A material is a weighted set of lobes (model FR_MAT_LOBES), one of

@@ -89,7 +89,7 @@ static int conductor(scn_appear *a, const cJSON *o, const char *where, fr_materi
 
 static int principled(scn_appear *a, const cJSON *o, const char *where, fr_material *m, fr_error *err)
 {
-    static const char *const couplings[] = {"albedo", "gltf", NULL};
+    static const char *const couplings[] = {"albedo", "gltf", "cycles", NULL};
     int coupling;
     /* glTF's defaults: white, metallic 1, roughness 1. */
     if (only(o, where, "principled", principled_own, err) < 0 || surface(a, o, where, 1.0f, m, err) < 0 ||
@@ -102,8 +102,13 @@ static int principled(scn_appear *a, const cJSON *o, const char *where, fr_mater
     if (!(m->transmission >= 0.0f && m->transmission <= 1.0f))
         return fr_fail(err, "%s.transmission: expected a number in [0, 1]", where);
     m->model = FR_MAT_PRINCIPLED;
-    if (coupling)
+    if (coupling == 1)
         m->mf_flags |= FR_MF_GLTF_COUPLING;
+    if (coupling == 2) {
+        if (m->mf_flags & FR_MF_COMPENSATE)
+            return fr_fail(err, "%s.compensate: \"coupling\": \"cycles\" has no energy compensation", where);
+        m->mf_flags |= FR_MF_CYCLES_COUPLING;
+    }
     return 0;
 }
 

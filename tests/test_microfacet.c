@@ -368,16 +368,20 @@ static void test_chi2_principled(void)
         {0.3f, 0.0f, 0.0f, 1.5f, 30}, {0.5f, 1.0f, 0.0f, 1.5f, 70}, {0.6f, 0.5f, 0.0f, 1.5f, 10},
         {0.2f, 0.3f, 0.6f, 1.5f, 50}, {0.4f, 0.0f, 1.0f, 1.0f / 1.45f, 20}, {0.8f, 0.7f, 0.2f, 1.5f, 80},
         {0.1f, 0.0f, 0.0f, 1.5f, 85}, {0.7f, 0.2f, 0.0f, 1.5f, 60},
+        /* Cycles' Principled BSDF */
+        {0.35f, 0.5f, 0.0f, 1.5f, 40}, {0.5f, 0.0f, 1.0f, 1.45f, 30}, {0.9f, 0.0f, 0.0f, 1.5f, 75},
+        {0.3f, 0.2f, 0.5f, 1.0f / 1.5f, 60},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        mf_principled p = {mf_alpha_iso(cases[i].rough), (uint32_t)(i / 2 & 1), (uint32_t)(i >= 6),
-                           v3(0.8f, 0.5f, 0.2f), cases[i].metal, cases[i].trans, 1.5f, (int)(i & 1)};
+        uint32_t coupling = i >= 8 ? MF_COUPLE_CYCLES : i >= 6 ? MF_COUPLE_GLTF : MF_COUPLE_ALBEDO;
+        mf_principled p = {mf_alpha_iso(cases[i].rough), (uint32_t)(i / 2 & 1), coupling, v3(0.8f, 0.5f, 0.2f),
+                           cases[i].metal, cases[i].trans, 1.5f, (int)(i & 1) && i < 8, cases[i].rough};
         md.prin = p;
         md.eta = cases[i].eta;
         vec3 wo = incident(cases[i].theta);
         snprintf(name, sizeof name, "principled r=%.1f metal=%.1f transm=%.1f eta=%.2f theta=%.0f%s%s",
                  cases[i].rough, cases[i].metal, cases[i].trans, cases[i].eta, cases[i].theta,
-                 p.compensate ? " comp" : "", p.coupling ? " glTF" : "");
+                 p.compensate ? " comp" : "", p.coupling == MF_COUPLE_GLTF ? " glTF" : p.coupling ? " Cycles" : "");
         chi2_model(name, &md, wo, v3(-wo.x, -wo.y, wo.z), refract_axis(wo, cases[i].eta), lobe_width(p.alpha), 1,
                    300000);
     }
@@ -544,8 +548,8 @@ static void test_reciprocity(void)
                 worst_t = fmaxf(worst_t, rel(ft.x, fr.x / (eta * eta)));
             }
         }
-        mf_principled pr = {mf_alpha_iso(rough), masking, (uint32_t)(i >> 1 & 1), v3(0.8f, 0.6f, 0.3f), rnd(),
-                            0.0f, 1.3f + rnd(), 0};
+        mf_principled pr = {mf_alpha_iso(rough), masking, (uint32_t)((i >> 1) % 3), v3(0.8f, 0.6f, 0.3f), rnd(),
+                            0.0f, 1.3f + rnd(), 0, rough};
         fab = mf_principled_eval(&pr, 1.5f, a, b, &p);
         fba = mf_principled_eval(&pr, 1.5f, b, a, &p);
         worst_p = fmaxf(worst_p, rel(fab.y, fba.y));
@@ -659,7 +663,7 @@ static void test_dielectric_energy(void)
         for (int t = 0; t < 4; t++)
             for (int k = 0; k < 4; k++) {
                 mf_principled p = {mf_alpha_iso(ROUGH[r]), MF_SMITH_CORRELATED, k == 3, v3s(1), k == 1 ? 1.0f : 0.0f,
-                                   k == 2 ? 1.0f : 0.0f, 1.5f, 1};
+                                   k == 2 ? 1.0f : 0.0f, 1.5f, 1, ROUGH[r]};
                 mp.prin = p;
                 mp.eta = 1.5f;
                 double wmax, e = albedo(&mp, incident(THETA[t]), 50000, &wmax);

@@ -137,6 +137,11 @@ static void test_syntax(void)
     REFUSED("principled ior 1", parse("", "{\"type\": \"principled\", \"ior\": 1}", NULL), "materials.m.ior", "not 1");
     REFUSED("coupling", parse("", "{\"type\": \"principled\", \"coupling\": \"disney\"}", NULL), "materials.m.coupling",
             "albedo");
+    REFUSED("Cycles coupling compensated",
+            parse("", "{\"type\": \"principled\", \"coupling\": \"cycles\", \"compensate\": true}", NULL),
+            "materials.m.compensate", "cycles");
+    e = parse("", "{\"type\": \"principled\", \"coupling\": \"cycles\", \"masking\": \"separable\"}", &m);
+    CHECK(!e[0] && m.mf_flags == (FR_MF_CYCLES_COUPLING | FR_MF_SEPARABLE), "Cycles coupling: %s", e);
     REFUSED("base colour", parse("", "{\"type\": \"principled\", \"base_color\": [1, -1, 1]}", NULL), "materials.m",
             ">= 0");
     REFUSED("unknown type", parse("", "{\"type\": \"metal\"}", NULL), "materials.m.type", "conductor", "principled");

@@ -14,8 +14,9 @@
 # Materials: lambert -> Diffuse BSDF (roughness 0); conductor without
 # Fresnel -> Glossy BSDF, GGX (Cycles 3.4: separable masking, no Fresnel
 # factor); rough glass -> Glass BSDF, GGX (Fresnel once with the shading
-# normal); principled -> Principled BSDF, GGX (a different model: Disney
-# diffuse; tests/bench/showcase.sh uses it only to measure noise).  Max bounces N = max_depth - 1 for every kind (NOTES: Franja's
+# normal); principled -> Principled BSDF, GGX, Specular from ior (the same
+# model with "coupling": "cycles" and separable masking; otherwise Franja's
+# model differs, and tests/bench/showcase.sh uses it only to measure noise).  Max bounces N = max_depth - 1 for every kind (NOTES: Franja's
 # max_depth = Cycles' N + 1); no clamping, denoising, adaptive sampling or
 # glossy filter; a box pixel filter of width 1.  An emitter is an Emission
 # shader of strength 1 and the emission as colour (radiance); Cycles' mesh
@@ -98,16 +99,23 @@ for name, m in js["materials"].items():
         bsdf.inputs["Color"].default_value = tuple(m.get("tint", [1, 1, 1])) + (1,)
         bsdf.inputs["Roughness"].default_value = m["roughness"]
         bsdf.inputs["IOR"].default_value = m["ior"]
-    elif kind == "principled" and m.get("transmission", 0) == 0 and all(
-            isinstance(m.get(k, 0), (int, float)) for k in ("roughness", "metallic")):
-        # Not the same model (Cycles' Principled has Disney diffuse): only
-        # for the noise benches, which compare each renderer with itself.
+    elif kind == "principled" and all(isinstance(m.get(k, 0), (int, float))
+                                      for k in ("roughness", "metallic", "transmission")) and (
+            m.get("coupling") == "cycles" or m.get("transmission", 0) == 0):
+        # With "coupling": "cycles" and separable masking this is the same
+        # model (Principled BSDF, GGX: Disney diffuse, Fresnel interpolated
+        # from the dielectric's, glass with Fresnel on the shading normal);
+        # otherwise only for the noise benches, which compare each renderer
+        # with itself.
         bsdf = nodes.new("ShaderNodeBsdfPrincipled")
         bsdf.distribution = "GGX"
         bsdf.inputs["Base Color"].default_value = tuple(m.get("base_color", [1, 1, 1])) + (1,)
         bsdf.inputs["Metallic"].default_value = m.get("metallic", 1)
         bsdf.inputs["Roughness"].default_value = m.get("roughness", 1)
+        bsdf.inputs["Transmission"].default_value = m.get("transmission", 0)
         ior = m.get("ior", 1.5)
+        bsdf.inputs["IOR"].default_value = ior
+        # Cycles' specular layer: F0 = 0.08 * Specular (0.5: F0 0.04, ior 1.5)
         bsdf.inputs["Specular"].default_value = ((ior - 1) / (ior + 1)) ** 2 / 0.08
     elif kind == "emitter" and m.get("two_sided"):
         bsdf = nodes.new("ShaderNodeEmission")
