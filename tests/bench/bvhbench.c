@@ -4,11 +4,13 @@
  *
  * Loads a compiled scene, takes its triangles, and measures single-threaded:
  *   - BVH build time: bvh_build versus rtcCommitScene (Embree device with
- *     threads=1, default build quality);
+ *     threads=1) at Embree's default build quality and at
+ *     RTC_BUILD_QUALITY_HIGH (its spatial-split builder);
  *   - closest-hit (trace_closest / rtcIntersect1) and any-hit
  *     (trace_occluded / rtcOccluded1) throughput for primary rays (one per
  *     pixel through the scene camera) and diffuse bounce rays (cosine
- *     directions from the primary hits, incoherent);
+ *     directions from the primary hits, incoherent), against both Embree
+ *     trees;
  *   - with --worker: worker start-up, from process start to its first pixel
  *     written (a 1x1-pixel, 1-sample render of the scene);
  *   - the binary scene's bytes per triangle.
@@ -104,9 +106,10 @@ static void fill_builder(fr_builder *b, const fr_scene *s)
     }
 }
 
-static RTCScene embree_scene(RTCDevice dev, const tri_mesh *m)
+static RTCScene embree_scene(RTCDevice dev, const tri_mesh *m, enum RTCBuildQuality q)
 {
     RTCScene sc = rtcNewScene(dev);
+    rtcSetSceneBuildQuality(sc, q);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m->vert, 0, 12, m->n_vert);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->idx, 0, 12, m->n_tri);
@@ -167,14 +170,37 @@ static void to_embree(const fr_ray *r, struct RTCRayHit *rh)
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
 }
 
-typedef struct { double franja, embree; } pair;
+typedef struct { double franja, embree, high; } trio;
 
-/* Mrays/s of closest-hit (any = 0) or any-hit queries on rays[0..n). */
-static pair throughput(const fr_scene *s, RTCScene es, const fr_ray *rays, uint32_t n, int any, int reps,
+/* Seconds of CPU time for Embree scene es to answer rays[0..n). */
+static double embree_pass(RTCScene es, const fr_ray *rays, uint32_t n, int any, volatile uint32_t *sink)
+{
+    struct RTCIntersectContext ctx;
+    uint32_t acc = 0;
+    double t0 = now();
+    for (uint32_t i = 0; i < n; i++) {
+        struct RTCRayHit rh;
+        to_embree(&rays[i], &rh);
+        rtcInitIntersectContext(&ctx);
+        if (any) {
+            rtcOccluded1(es, &ctx, &rh.ray);
+            acc += rh.ray.tfar < 0.0f;
+        } else {
+            rtcIntersect1(es, &ctx, &rh);
+            acc += rh.hit.primID;
+        }
+    }
+    double t = now() - t0;
+    *sink += acc;
+    return t;
+}
+
+/* Mrays/s of closest-hit (any = 0) or any-hit queries on rays[0..n):
+ * Franja, Embree default (es) and Embree high quality (eh), interleaved. */
+static trio throughput(const fr_scene *s, RTCScene es, RTCScene eh, const fr_ray *rays, uint32_t n, int any, int reps,
                        volatile uint32_t *sink)
 {
-    double tf[64], te[64];
-    struct RTCIntersectContext ctx;
+    double tf[64], te[64], th[64];
     for (int k = 0; k < reps; k++) {
         uint32_t acc = 0;
         double t0 = now();
@@ -190,24 +216,10 @@ static pair throughput(const fr_scene *s, RTCScene es, const fr_ray *rays, uint3
         }
         tf[k] = now() - t0;
         *sink += acc;
-        acc = 0;
-        t0 = now();
-        for (uint32_t i = 0; i < n; i++) {
-            struct RTCRayHit rh;
-            to_embree(&rays[i], &rh);
-            rtcInitIntersectContext(&ctx);
-            if (any) {
-                rtcOccluded1(es, &ctx, &rh.ray);
-                acc += rh.ray.tfar < 0.0f;
-            } else {
-                rtcIntersect1(es, &ctx, &rh);
-                acc += rh.hit.primID;
-            }
-        }
-        te[k] = now() - t0;
-        *sink += acc;
+        te[k] = embree_pass(es, rays, n, any, sink);
+        th[k] = embree_pass(eh, rays, n, any, sink);
     }
-    return (pair){n / median(tf, reps) / 1e6, n / median(te, reps) / 1e6};
+    return (trio){n / median(tf, reps) / 1e6, n / median(te, reps) / 1e6, n / median(th, reps) / 1e6};
 }
 
 /* Rays where Embree and Franja disagree (hit/miss, triangle, or t). */
@@ -283,7 +295,7 @@ int main(int argc, char **argv)
            s.blob_size, (double)s.blob_size / m.n_tri, s.n_nodes, s.n_leaves);
 
     /* Build times. */
-    double bf[64], be[64];
+    double bf[64], be[64], bh[64];
     RTCDevice dev = rtcNewDevice("threads=1");
     if (!dev) {
         fprintf(stderr, "bvhbench: rtcNewDevice failed\n");
@@ -302,23 +314,31 @@ int main(int argc, char **argv)
         free(nodes.data);
         free(leaves.data);
         bld_free(&b);
-        RTCScene es = embree_scene(dev, &m);
+        RTCScene es = embree_scene(dev, &m, RTC_BUILD_QUALITY_MEDIUM);
         t0 = now();
         rtcCommitScene(es);
         be[k] = now() - t0;
         rtcReleaseScene(es);
+        es = embree_scene(dev, &m, RTC_BUILD_QUALITY_HIGH);
+        t0 = now();
+        rtcCommitScene(es);
+        bh[k] = now() - t0;
+        rtcReleaseScene(es);
     }
-    double mbf = median(bf, reps), mbe = median(be, reps);
-    printf("build      franja %8.1f ms (%5.2f Mtri/s)   embree %8.1f ms (%5.2f Mtri/s)   ratio %.2f\n", mbf * 1e3,
-           m.n_tri / mbf / 1e6, mbe * 1e3, m.n_tri / mbe / 1e6, mbe / mbf);
+    double mbf = median(bf, reps), mbe = median(be, reps), mbh = median(bh, reps);
+    printf("build      franja %8.1f ms   embree %8.1f ms   embree-high %8.1f ms   franja/embree %.2f   "
+           "franja/embree-high %.2f (time ratios: lower is better)\n",
+           mbf * 1e3, mbe * 1e3, mbh * 1e3, mbf / mbe, mbf / mbh);
 
-    RTCScene es = embree_scene(dev, &m);
+    RTCScene es = embree_scene(dev, &m, RTC_BUILD_QUALITY_MEDIUM);
     rtcCommitScene(es);
+    RTCScene eh = embree_scene(dev, &m, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(eh);
     uint32_t np, nb;
     fr_ray *rays = make_rays(&s, w, h, &np, &nb);
-    uint32_t bad = disagreements(&s, es, &m, rays, np + nb);
-    printf("rays       %u primary (%ux%u), %u diffuse bounces; Embree disagrees on %u (%.3f %%)\n", np, w, h, nb, bad,
-           100.0 * bad / (np + nb));
+    uint32_t bad = disagreements(&s, es, &m, rays, np + nb), badh = disagreements(&s, eh, &m, rays, np + nb);
+    printf("rays       %u primary (%ux%u), %u diffuse bounces; Embree disagrees on %u (%.3f %%), high quality on %u\n",
+           np, w, h, nb, bad, 100.0 * bad / (np + nb), badh);
     volatile uint32_t sink = 0;
     const char *names[4] = {"primary closest", "primary any    ", "bounce closest ", "bounce any     "};
     for (int q = 0; q < 4; q++) {
@@ -326,9 +346,9 @@ int main(int argc, char **argv)
         uint32_t n = q < 2 ? np : nb;
         if (n == 0)
             continue;
-        pair p = throughput(&s, es, r, n, q & 1, reps, &sink);
-        printf("%s franja %6.2f Mrays/s   embree %6.2f Mrays/s   ratio %.2f\n", names[q], p.franja, p.embree,
-               p.franja / p.embree);
+        trio p = throughput(&s, es, eh, r, n, q & 1, reps, &sink);
+        printf("%s franja %6.2f Mrays/s   embree %6.2f   embree-high %6.2f   ratio %.2f   ratio-high %.2f\n", names[q],
+               p.franja, p.embree, p.high, p.franja / p.embree, p.franja / p.high);
     }
     if (worker) {
         double ms = startup_ms(worker, path, reps);
@@ -337,6 +357,7 @@ int main(int argc, char **argv)
         printf("start-up   %s: %.1f ms from process start to first pixel\n", worker, ms);
     }
     rtcReleaseScene(es);
+    rtcReleaseScene(eh);
     rtcReleaseDevice(dev);
     free(rays);
     scn_free(&s);

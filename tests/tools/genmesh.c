@@ -5,6 +5,7 @@
  *   genmesh knot    [--tris N] [--p P] [--q Q] -o FILE.obj   torus knot tube
  *   genmesh sphere  [--tris N] [--seed S]       -o FILE.obj   displaced sphere
  *   genmesh terrain [--tris N] [--seed S]       -o FILE.obj   heightfield
+ *   genmesh thin    [--tris N] [--seed S]       -o FILE.obj   long thin slivers
  *
  * --tris is the approximate triangle count (default 100000, up to ~20 M).
  * --flat leaves out vertex normals, --no-uv texture coordinates;
@@ -132,6 +133,20 @@ static void make_terrain(grid *g, const options *o)
         }
 }
 
+/* A wavy sheet of slivers (cells about 300 times longer than wide: 0.17
+ * by 5e-4 at 100 k triangles), turned 45 degrees about y and tilted so
+ * they lie diagonal to every axis: boxes far larger than their triangles,
+ * the case spatial splits are for. */
+static void make_thin(grid *g, const options *o)
+{
+    for (int i = 0; i < g->nu; i++)
+        for (int j = 0; j < g->nv; j++) {
+            float s = 2.0f * (float)i / (float)(g->nu - 1) - 1.0f, t = 2.0f * (float)j / (float)(g->nv - 1) - 1.0f;
+            float h = 0.3f * fbm(v3(s * 4.0f, 0.5f, t * 2.0f), 6, o->seed);
+            g->pos[i * g->nv + j] = v3((s - t) * 0.70710678f, h + 0.3f * t, (s + t) * 0.70710678f);
+        }
+}
+
 /* Index of grid vertex (i, j), wrapping where the grid wraps. */
 static int at(const grid *g, int i, int j)
 {
@@ -209,7 +224,7 @@ static int write_obj(const grid *g, const options *o, int flip)
 }
 
 static const char usage[] =
-    "usage: genmesh knot|sphere|terrain [--tris N] [--p P] [--q Q] [--seed S]\n"
+    "usage: genmesh knot|sphere|terrain|thin [--tris N] [--p P] [--q Q] [--seed S]\n"
     "               [--flat] [--no-uv] [--material NAME] -o FILE.obj\n";
 
 int main(int argc, char **argv)
@@ -250,6 +265,9 @@ int main(int argc, char **argv)
         flip = 1;
     } else if (!strcmp(o.kind, "terrain")) {
         g.nu = g.nv = (int)sqrt(cells) + 2;
+    } else if (!strcmp(o.kind, "thin")) {
+        g.nv = (int)sqrt(cells / 400.0) + 2;
+        g.nu = (int)(cells / (g.nv - 1)) + 2;
     } else {
         fprintf(stderr, "genmesh: unknown kind '%s'\n%s", o.kind, usage);
         return 2;
@@ -262,7 +280,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(o.kind, "knot")) make_knot(&g, &o);
     else if (!strcmp(o.kind, "sphere")) make_sphere(&g, &o);
-    else make_terrain(&g, &o);
+    else if (!strcmp(o.kind, "terrain")) make_terrain(&g, &o);
+    else make_thin(&g, &o);
     grid_normals(&g, flip);
     int rc = write_obj(&g, &o, flip);
     free(g.pos);
