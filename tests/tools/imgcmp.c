@@ -2,6 +2,7 @@
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
  *          [--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]]
+ *          [--clamp-pct P]
  *
  * IMAGE is box-downsampled to the reference's size when it is an integer
  * multiple of it; with --down, both are then box-downsampled by D (which
@@ -16,7 +17,11 @@
  * also the RMSE inside that rectangle of pixels and outside it, both off
  * the light; with --mask (a PFM of the reference's size, before --down),
  * the pixels where the mask has a channel above 0 are not in the region
- * (they count as outside it). */
+ * (they count as outside it).  With --clamp-pct P (0 < P < 100), also the
+ * RMSE off the light after clamping both images' channels to the P-th
+ * percentile of the reference's channel values off the light: a measure of
+ * noise that rare bright outliers (fireflies) do not rule. */
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -71,14 +76,51 @@ static void box_down(image *im, int f)
     im->h = h;
 }
 
+static int cmp_float(const void *x, const void *y)
+{
+    float a = *(const float *)x, b = *(const float *)y;
+    return (a > b) - (a < b);
+}
+
+/* RMSE off the light of a against r with every channel clamped to the
+ * pct-th percentile of r's channels off the light (in *at); -1 when
+ * memory runs out or nothing is off the light. */
+static double clamped_rmse(const image *a, const image *r, double pct, double *at)
+{
+    size_t n = (size_t)r->w * r->h, m = 0;
+    float *v = malloc(n * 3 * sizeof *v);
+    if (!v) return -1;
+    for (size_t i = 0; i < n; i++) {
+        const float *q = r->px + i * 3;
+        if (q[0] < 10 && q[1] < 10 && q[2] < 10)
+            for (int ch = 0; ch < 3; ch++) v[m++] = q[ch];
+    }
+    if (!m) { free(v); return -1; }
+    qsort(v, m, sizeof *v, cmp_float);
+    size_t idx = (size_t)(pct / 100.0 * (double)(m - 1) + 0.5);
+    double t = v[idx < m ? idx : m - 1], se = 0;
+    free(v);
+    for (size_t i = 0; i < n; i++) {
+        const float *q = r->px + i * 3, *p = a->px + i * 3;
+        if (q[0] >= 10 || q[1] >= 10 || q[2] >= 10) continue;
+        for (int ch = 0; ch < 3; ch++) {
+            double d = fmin(p[ch], t) - fmin(q[ch], t);
+            se += d * d;
+        }
+    }
+    *at = t;
+    return sqrt(se / (double)m);
+}
+
 int main(int argc, char **argv)
 {
-    double max_rmse = -1, max_rel = -1, max_block = -1, reg[4] = {-1, -1, -1, -1};
+    double max_rmse = -1, max_rel = -1, max_block = -1, reg[4] = {-1, -1, -1, -1}, clamp_pct = -1;
     const char *mask_path = NULL;
     int bs = 64, down = 1;
     if (argc < 3) {
         fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y] "
-                        "[--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]]\n");
+                        "[--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]] "
+                        "[--clamp-pct P]\n");
         return 2;
     }
     for (int i = 3; i + 1 < argc; i += 2) {
@@ -88,6 +130,13 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--block")) bs = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--down")) down = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--mask")) mask_path = argv[i + 1];
+        else if (!strcmp(argv[i], "--clamp-pct")) {
+            clamp_pct = atof(argv[i + 1]);
+            if (!(clamp_pct > 0 && clamp_pct < 100)) {
+                fprintf(stderr, "imgcmp: --clamp-pct: expected a percentile between 0 and 100\n");
+                return 2;
+            }
+        }
         else if (!strcmp(argv[i], "--region")) {
             char tail;
             if (sscanf(argv[i + 1], "%lf,%lf,%lf,%lf%c", &reg[0], &reg[1], &reg[2], &reg[3], &tail) != 4 ||
@@ -171,6 +220,11 @@ int main(int argc, char **argv)
         }
     }
     printf("rmse %.5f over %ld pixels off the light\n", rmse, off);
+    if (clamp_pct > 0) {
+        double at, c = clamped_rmse(&a, &r, clamp_pct, &at);
+        if (c < 0) { fprintf(stderr, "imgcmp: --clamp-pct: no pixel off the light, or out of memory\n"); return 2; }
+        printf("clamped rmse %.5f (both clamped at %.5f, the reference's %gth percentile)\n", c, at, clamp_pct);
+    }
     if (reg[0] >= 0)
         printf("rmse in region %.5f over %ld pixels, outside %.5f over %ld pixels\n",
                n_in ? sqrt(se_in / (3.0 * n_in)) : 0.0, n_in, n_out ? sqrt(se_out / (3.0 * n_out)) : 0.0, n_out);
