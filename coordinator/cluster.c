@@ -86,7 +86,8 @@ static int probe_and_stage(cl_host *h, int i, void *vctx, fr_error *err)
         return -1;
     if (!c->scene)
         return 0;
-    if (stage_scene(h->tr, c->scene, c->hash, h->scene, sizeof h->scene, &h->uploaded, err))
+    if (stage_scene(h->tr, c->scene, c->hash, h->scene, sizeof h->scene, h->lease, sizeof h->lease,
+                    &h->uploaded, err))
         return -1;
     /* The cache stays bounded; a failure to trim it does not stop the render. */
     uint64_t limit = h->entry->cache ? h->entry->cache : HOSTS_CACHE_DEFAULT, bytes;

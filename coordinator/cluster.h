@@ -18,6 +18,7 @@ typedef struct {
     tr_host *tr;               /**< NULL if the host could not be made ready */
     proto_host info;           /**< what the host reported (cl_open; valid when tr) */
     char scene[1024];          /**< path of the scene on the host (when staged) */
+    char lease[1200];          /**< the render's lease on it (stage_scene), "" if none; remove it at the end */
     int uploaded;              /**< the scene was sent during this run */
     double ready_s;            /**< seconds it took */
     fr_error err;              /**< why the host is not usable (tr == NULL) */

@@ -591,6 +591,8 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
         s->tr = h.tr;
         s->slots = slots > 0 ? slots : 1;
         snprintf(s->scene, sizeof s->scene, "%s", h.scene);
+        snprintf(s->lease, sizeof s->lease, "%s", h.lease);
+        s->lease_t = clk_now();
         if (table || !isatty(2))
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", s->name, h.info.os,
                     h.info.arch, s->slots, h.info.version,
@@ -860,6 +862,12 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     for (int i = 0; i < n; i++)
         if (sh[i].pending)
             fprintf(stderr, "franja: host %s was not ready before the render ended\n", table->v[i].name);
+    /* The render no longer needs its scenes: other renders may evict them. */
+    for (int i = 0; i < n; i++)
+        if (cl[i].tr && cl[i].lease[0]) {
+            fr_error e;
+            tr_remove(cl[i].tr, cl[i].lease, &e);
+        }
     cl_close(cl, n);
     /* A host still being prepared is not waited for (its time-out would
      * add to the render), except under Slurm, whose shared state goes with

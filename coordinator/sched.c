@@ -605,6 +605,28 @@ static void missing_text(sched *s, char *out, size_t cap)
     free(have);
 }
 
+/* Seconds between two renewals of a host's lease on its scene: well within
+ * the ten minutes after which a lease is stale (stage.h). */
+enum { LEASE_RENEW_S = 60 };
+
+/* Renews host i's lease when it is due; frees a renewal that has ended. */
+static void lease_tick(sched *s, int i)
+{
+    sched_host *h = &s->hosts[i];
+    if (h->lease_proc && tr_proc_state(h->lease_proc) != TR_RUNNING) {
+        tr_proc_free(h->lease_proc);
+        h->lease_proc = NULL;
+    }
+    double t = clk_now();
+    if (!h->lease[0] || h->lease_proc || h->dropped || h->pending || t - h->lease_t < LEASE_RENEW_S)
+        return;
+    h->lease_t = t;
+    const char *argv[] = {"touch", "-c", "--", h->lease, NULL};
+    fr_error e;
+    if (tr_spawn(h->tr, argv, 256, &h->lease_proc, &e))
+        h->lease_proc = NULL; /* tried again in a minute; a running worker has the scene mapped meanwhile */
+}
+
 static int loop(sched *s, fr_error *err)
 {
     struct pollfd *pfd = NULL;
@@ -623,7 +645,11 @@ static int loop(sched *s, fr_error *err)
         admit(s);
         for (int i = 0; i < s->nhosts; i++) {
             sched_host *h = &s->hosts[i];
-            while (!h->dropped && !h->pending && h->running < h->slots && now(s) >= h->retry_at) {
+            lease_tick(s, i);
+            /* A renewal holds a channel for a moment: a worker started then
+             * could be refused one on a host that takes just its slots. */
+            while (!h->dropped && !h->pending && !h->lease_proc && h->running < h->slots &&
+                   now(s) >= h->retry_at) {
                 int si = pick(s, i);
                 if (si < 0)
                     break;
@@ -710,6 +736,10 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
     for (int r = s.nrun - 1; r >= 0; r--) {
         tr_proc_kill(s.run[r].proc);
         finish(&s, r);
+    }
+    for (int i = 0; i < nhosts; i++) {
+        tr_proc_free(hosts[i].lease_proc); /* a renewal cut short is no harm: the lease is a minute old at most */
+        hosts[i].lease_proc = NULL;
     }
     remove_leftovers(&s);
     progress(&s);

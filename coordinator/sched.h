@@ -51,6 +51,11 @@ typedef struct {
     tr_host *tr;               /**< connected transport (owned by the caller) */
     const char *name;
     char scene[1024];          /**< path of the binary scene on the host */
+    char lease[1200];          /**< the render's lease on that scene (stage_scene), "" if none: the
+                                    scheduler renews it about every minute (no new worker starts on
+                                    the host during the renewal's moment) */
+    double lease_t;            /**< clk_now() of its last renewal (or taking) */
+    tr_proc *lease_proc;       /**< private: the renewal running now, NULL if none */
     int slots;                 /**< worker processes at once (lowered when the host refuses more) */
     /* statistics */
     int running;               /**< processes running now */

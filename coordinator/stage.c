@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "fbin.h"
@@ -19,6 +20,21 @@ enum { ABSENT = 97 };
  * copy if there is one. */
 static const char CHECK_SCRIPT[] = "[ -e \"$2\" ] || exit 97; exec \"$0\" \"$@\"";
 
+/* `sh -c LEASE_CHECK_SCRIPT LEASE WORKER --scene PATH --check`: takes (or
+ * renews) the render's lease on the scene first, then checks the copy. */
+static const char LEASE_CHECK_SCRIPT[] =
+    "(set -C; : >\"$0\") 2>/dev/null || touch -c -- \"$0\"; [ -e \"$3\" ] || exit 97; exec \"$@\"";
+
+/* A lease younger than this many minutes keeps its scene (stage.h). */
+#define LEASE_MIN "10"
+
+/* `leased F` succeeds when a render holds a live lease on scene F (a file
+ * F.lease-* changed within LEASE_MIN minutes); stale leases go. */
+#define LEASED                                                                                                    \
+    "leased() { r=1; for l in \"$1\".lease-*; do [ -f \"$l\" ] || continue; "                                      \
+    "if [ -n \"$(find \"$l\" -mmin -" LEASE_MIN " 2>/dev/null)\" ]; then r=0; else rm -f -- \"$l\"; fi; done; "    \
+    "return $r; }; "
+
 static const char CACHE_SCRIPT[] =
     "cd \"$0\" 2>/dev/null || exit 0; for f in *.fbin; do [ -f \"$f\" ] && wc -c <\"$f\"; done; exit 0";
 
@@ -27,21 +43,23 @@ static const char CACHE_SCRIPT[] =
 #define IN_USE "u=\" $(cat /proc/[0-9]*/maps 2>/dev/null | grep -o '[^/ ]*\\.fbin$' | tr '\\n' ' ') \"; "
 
 /* `sh -c EVICT_SCRIPT DIR KEEP LIMIT`: newest first, every scene past the
- * limit goes, unless it is KEEP or in use; prints "NAME SIZE" for each. */
+ * limit goes, unless it is KEEP, in use or leased; prints "NAME SIZE" for
+ * each. */
 static const char EVICT_SCRIPT[] =
-    "cd \"$0\" 2>/dev/null || exit 0; touch -c -- \"$1\"; " IN_USE
+    "cd \"$0\" 2>/dev/null || exit 0; touch -c -- \"$1\"; " IN_USE LEASED
     "t=0; for f in $(ls -t); do case $f in *.fbin) ;; *) continue ;; esac; [ -f \"$f\" ] || continue; "
     "s=$(wc -c <\"$f\") || continue; t=$((t + s)); "
-    "if [ \"$t\" -gt \"$2\" ] && [ \"$f\" != \"$1\" ]; then case $u in *\" $f \"*) continue ;; esac; "
+    "if [ \"$t\" -gt \"$2\" ] && [ \"$f\" != \"$1\" ]; then case $u in *\" $f \"*) continue ;; esac; leased \"$f\" && continue; "
     "rm -f -- \"$f\" && t=$((t - s)) && echo \"$f $s\"; fi; done; exit 0";
 
 /* `sh -c CLEAN_SCRIPT DIR`: prints "REMOVED BYTES IN_USE TEMP". */
 static const char CLEAN_SCRIPT[] =
-    "cd \"$0\" 2>/dev/null || { echo 0 0 0 0; exit 0; }; " IN_USE
+    "cd \"$0\" 2>/dev/null || { echo 0 0 0 0; exit 0; }; " IN_USE LEASED
     "n=0; b=0; k=0; p=0; for f in *.fbin; do [ -f \"$f\" ] || continue; "
-    "case $u in *\" $f \"*) k=$((k + 1)); continue ;; esac; "
+    "case $u in *\" $f \"*) k=$((k + 1)); continue ;; esac; if leased \"$f\"; then k=$((k + 1)); continue; fi; "
     "s=$(wc -c <\"$f\") && rm -f -- \"$f\" && n=$((n + 1)) && b=$((b + s)); done; "
-    "for f in $(find . -maxdepth 1 -type f \\( -name '*.part-*' -o -name '.check-*' \\) -mmin +10); do "
+    "for f in $(find . -maxdepth 1 -type f \\( -name '*.part-*' -o -name '.check-*' -o -name '*.fbin.lease-*' \\) "
+    "-mmin +" LEASE_MIN "); do "
     "rm -f -- \"$f\" && p=$((p + 1)); done; echo \"$n $b $k $p\"";
 
 static const char SYSINFO_SCRIPT[] = "uname -m && (cat /etc/os-release 2>/dev/null || true)";
@@ -88,11 +106,14 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err)
 
 /* 1 when the cached copy at path checks out, 0 when there is none, 2 when
  * it is damaged (or unreadable for this worker), -1 on error. */
-static int cached(tr_host *h, const char *path, uint64_t hash, fr_error *err)
+static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash, fr_error *err)
 {
     const char *check[4];
     proto_check_argv(path, check);
-    const char *argv[] = {"sh", "-c", CHECK_SCRIPT, tr_host_worker(h), check[0], check[1], check[2], NULL};
+    const char *plain[] = {"sh", "-c", CHECK_SCRIPT, tr_host_worker(h), check[0], check[1], check[2], NULL};
+    const char *leased[] = {"sh", "-c", LEASE_CHECK_SCRIPT, lease, tr_host_worker(h), check[0], check[1], check[2],
+                            NULL};
+    const char *const *argv = lease[0] ? leased : plain;
     tr_proc *p;
     if (run(h, argv, &p, err))
         return -1;
@@ -111,10 +132,27 @@ static int cached(tr_host *h, const char *path, uint64_t hash, fr_error *err)
     return rc;
 }
 
-int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, int *uploaded,
-                fr_error *err)
+/* The name of this render's lease on the scene at `remote`: this machine,
+ * this process and the time, so that no other render shares it. */
+static int lease_name(const char *remote, char *lease, size_t cap)
+{
+    char host[64] = "";
+    gethostname(host, sizeof host - 1);
+    for (char *c = host; *c; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '-'))
+            *c = '_';
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return snprintf(lease, cap, "%s.lease-%s-%ld-%lld%03ld", remote, host, (long)getpid(), (long long)ts.tv_sec,
+                    ts.tv_nsec / 1000000) >= (int)cap;
+}
+
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
+                size_t lease_cap, int *uploaded, fr_error *err)
 {
     *uploaded = 0;
+    if (lease_cap)
+        lease[0] = 0;
     const char *wd = tr_host_workdir(h);
     if (!wd[0]) {
         char abs[PATH_MAX];
@@ -129,7 +167,12 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
     fbin_hash_hex(hash, hex);
     if (snprintf(remote, cap, "%s/scenes/%s.fbin", wd, hex) >= (int)cap)
         return fr_fail(err, "%s: work directory path too long", tr_host_label(h));
-    int ok = cached(h, remote, hash, err);
+    /* A Slurm job step per renewal would wait for a CPU: leases are for
+     * SSH hosts, where a short command costs a channel for a moment. */
+    if (lease_cap && !strcmp(tr_host_backend(h), "ssh") && lease_name(remote, lease, lease_cap))
+        return fr_fail(err, "%s: work directory path too long", tr_host_label(h));
+    const char *mine = lease_cap ? lease : "";
+    int ok = cached(h, remote, mine, hash, err);
     if (ok < 0 || ok == 1)
         return ok < 0 ? -1 : 0;
     if (ok == 2)
@@ -137,7 +180,7 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
     if (tr_upload(h, local_path, remote, 0644, err))
         return -1;
     *uploaded = 1;
-    ok = cached(h, remote, hash, err);
+    ok = cached(h, remote, mine, hash, err); /* takes the lease if the directory was new */
     if (ok < 0)
         return -1;
     if (ok != 1)

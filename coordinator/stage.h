@@ -31,9 +31,20 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
 /** Makes the binary scene at local_path (content hash `hash`) available on
  * the host and writes the path its worker must be given into remote[cap].
  * *uploaded says whether the file was sent.  A damaged cached copy is
- * noted (tr_options.notes) and replaced. */
-int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, int *uploaded,
-                fr_error *err);
+ * noted (tr_options.notes) and replaced.
+ *
+ * The lease: on an SSH host with a scene cache, and when lease_cap is not
+ * 0, the render takes a lease on the scene before looking for it: an empty
+ * file beside it, SCENE.lease-MACHINE-PID-TIME, whose path goes into
+ * lease[lease_cap] ("" where there is none).  While a lease has changed
+ * within the last ten minutes, stage_evict and stage_clean of any render
+ * leave its scene alone, even when no worker has it mapped (between two
+ * slabs or passes of a long render); so the render renews it (`touch -c`)
+ * every minute or so and removes it at its end (tr_remove).  The lease of
+ * a render that died goes stale in ten minutes and is then removed by the
+ * next eviction or clean. */
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
+                size_t lease_cap, int *uploaded, fr_error *err);
 
 /** Checks that files reach the host's scene cache the way a render's scene
  * does (tr_upload: SFTP for an SSH host): a small file is uploaded into
@@ -47,7 +58,8 @@ int stage_try_upload(tr_host *h, fr_error *err);
  * used (its modification time), then removes the least recently used
  * scenes until the cache's scenes add up to limit or less.  Never removes
  * keep, nor a scene that a process on the host has mapped (a running
- * worker), so the cache may stay above the limit.  *removed and *bytes say
+ * worker) or a live render holds a lease on (stage_scene), so the cache may
+ * stay above the limit.  *removed and *bytes say
  * what went.  Nothing to do for a host without a work directory. */
 int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint64_t *bytes, fr_error *err);
 
@@ -55,13 +67,15 @@ int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint
 typedef struct {
     int removed;       /**< scenes removed */
     uint64_t bytes;    /**< their size */
-    int in_use;        /**< scenes kept because a process has them mapped */
+    int in_use;        /**< scenes kept because a process has them mapped or a render a live lease */
     int temp;          /**< stale temporary files removed */
 } stage_cleaned;
 
 /** Empties the host's scene cache: removes every scene but those a
- * process on the host has mapped (a running worker), and the temporary
- * files of uploads that were cut off (unchanged for ten minutes). */
+ * process on the host has mapped (a running worker) or a live render holds
+ * a lease on, and the temporary files of uploads that were cut off and the
+ * leases of renders that ended without removing theirs (unchanged for ten
+ * minutes). */
 int stage_clean(tr_host *h, stage_cleaned *out, fr_error *err);
 
 /** Counts the scenes in the host's cache (*files, *bytes; 0 and 0 for a

@@ -137,6 +137,7 @@ const char *tr_host_label(const tr_host *h) { return h->place.label[0] ? h->plac
 const char *tr_host_worker(const tr_host *h) { return h->place.worker; }
 
 const char *tr_host_workdir(const tr_host *h) { return h->place.workdir; }
+const char *tr_host_backend(const tr_host *h) { return h->be->name; }
 
 int tr_host_busy_upload(const tr_host *h) { return h->place.busy_upload; }
 

@@ -121,6 +121,9 @@ const char *tr_host_worker(const tr_host *h);
  * (a local host: scenes are used where they are). */
 const char *tr_host_workdir(const tr_host *h);
 
+/** The backend that serves the host: "local", "ssh" or "slurm". */
+const char *tr_host_backend(const tr_host *h);
+
 /** Whether tr_upload works while every slot of the host runs a worker:
  * SSH (SFTP) and a Slurm shared work directory (a copy on this machine);
  * not a Slurm node's own disk (sbcast needs a step, which waits for a CPU

@@ -1,8 +1,10 @@
 #!/bin/sh
 # it_cache.sh -- the scene cache of SSH hosts stays bounded: with cache=SIZE
 # in the host table, staging a scene removes the least recently used ones
-# until the cache fits, keeping the scene just used and any scene a running
-# worker has mapped; `franja hosts clean` empties the cache (scenes in use
+# until the cache fits, keeping the scene just used, any scene a running
+# worker has mapped and any scene a live render holds a lease on (between
+# its slabs, when no worker has it mapped); a lease left by a render that
+# died goes stale; `franja hosts clean` empties the cache (scenes in use
 # stay) and removes cut-off uploads; a bad cache= is refused with its line.
 . "$(dirname "$0")/coord/fakehosts.sh"
 fh_init
@@ -79,6 +81,52 @@ check "a second clean empties the cache" test "$(ls "$C" | grep -c '\.fbin$')" -
 check "a second clean removes the scene no longer in use" grep -Eq "^a +ok +removed 1 scene " clean2
 fr hosts clean --hosts hosts >clean3 2>&1
 check "cleaning an empty cache is fine" grep -Eq "^a +ok +removed 0 scenes " clean3
+
+# Leases: one changed within ten minutes keeps its scene, an older one (a
+# render that died) does not, and goes too.
+fr render s1.fbin -o o1d.pfm --hosts hosts.lim $SIZE 2>/dev/null
+fr render s2.fbin -o o2d.pfm --hosts hosts.lim $SIZE 2>/dev/null
+check "a finished render leaves no lease" sh -c "! ls '$C' | grep -q lease"
+: >"$C/$H1.fbin.lease-dead-1-1"
+touch -d '20 minutes ago' "$C/$H1.fbin.lease-dead-1-1"
+: >"$C/$H2.fbin.lease-live-1-1"
+fr render s3.fbin -o o3d.pfm --hosts hosts.tiny $SIZE 2>log6 && ok || bad "render s3 beside leases: $(cat log6)"
+check "a scene with a live lease stays" test -f "$C/$H2.fbin"
+check "a scene whose lease is stale goes" test ! -e "$C/$H1.fbin"
+check "its stale lease goes with it" test ! -e "$C/$H1.fbin.lease-dead-1-1"
+fr hosts clean --hosts hosts >clean5 2>&1
+check "hosts clean keeps a leased scene" test -f "$C/$H2.fbin"
+check "hosts clean counts it in use" grep -Eq "^a +ok +removed 1 scene .*kept 1 in use" clean5
+rm -f "$C/$H2.fbin.lease-live-1-1"
+
+# A real render between two slabs: its worker for rows of s1 waits for
+# "go" before it starts (so nothing has s1 mapped), while a render of s2
+# on the same host, with room for one scene only, trims the cache.  s1
+# stays, and the first render ends with the right image.
+cat >gate.sh <<SH
+#!/bin/sh
+case " \$* " in *" --rows "*"$H1.fbin"*|*"$H1.fbin"*" --rows "*)
+    : >"$FH/held"
+    while [ ! -e "$FH/go" ]; do sleep 0.05; done ;;
+esac
+exec "$WORKER" "\$@"
+SH
+chmod +x gate.sh
+fh_start g 4 1 "$FH/gate.sh"
+G=g/work/scenes
+grep '^g ' hosts | sed "s/\$/ cache=1K/" >hosts.g
+fr_bg render s1.fbin -o o1g.pfm --hosts hosts.g $SIZE
+fh_until test -e held
+check "the gated render is between slabs" test -e held
+check "it holds a lease on its scene" sh -c "ls '$G' | grep -q '^$H1.fbin.lease-'"
+fr render s2.fbin -o o2g.pfm --hosts hosts.g $SIZE 2>log7 && ok || bad "render s2 beside a leased scene: $(cat log7)"
+check "the scene of the render between slabs stays" test -f "$G/$H1.fbin"
+: >go
+fr_wait
+check "the render between slabs finishes" test "$rc" -eq 0
+check "with the image of s1" cmp -s o1g.pfm o1.pfm
+check "and both renders removed their leases" sh -c "! ls '$G' | grep -q lease"
+sed -i '/^g /d' hosts
 
 # An unreachable host: status 1 and its reason.
 echo "gone 127.0.0.9:9 $FH_USER 1 identity=$FH/client_key workdir=$FH/gone" >>hosts
