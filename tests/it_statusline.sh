@@ -8,7 +8,17 @@ need script stty
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 F="$(pwd)/bin/franja"
-R="$F render scenes/cornell.json -o $T/out.png --size 48x48 --spp 64 -j 2 --slab-rows 1"
+# Each slab's worker waits 0.1 s first, so the render lasts a few seconds
+# however fast the machine is and the line (drawn every 0.25 s) is drawn
+# while rows remain, where it shows an ETA.
+cat >"$T/slow.sh" <<SH
+#!/bin/sh
+case " \$* " in *" --rows "*) sleep 0.1 ;; esac
+exec "$(pwd)/bin/franja-worker" "\$@"
+SH
+chmod +x "$T/slow.sh"
+printf 'local local - 2 worker=%s\n' "$T/slow.sh" >"$T/hosts"
+R="$F render scenes/cornell.json -o $T/out.pfm --size 48x48 --spp 16 --hosts $T/hosts --slab-rows 1"
 
 # widest LOG: the longest progress line drawn (the pieces between carriage
 # returns, without the erase sequence), and how many there were.
