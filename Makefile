@@ -107,7 +107,7 @@ bin/tests/%: tests/%.c $(TESTSUP_LIB) $(COORD_LIB) $(LIB)
 	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -Icoordinator -Itests -o $@ $< $(TESTSUP_LIB) $(COORD_LIB) $(LIB) \
 	    -Wl,--as-needed $(COORD_LIBS)
 
-bin/tools/%: tests/tools/%.c $(LIB)
+bin/tools/%: tests/tools/%.c tests/tools/pfmread.h $(LIB)
 	@mkdir -p bin/tools
 	$(CC) $(CSTD) $(CFLAGS) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm
 

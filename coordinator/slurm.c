@@ -2,50 +2,13 @@
  * (see slurm.h). */
 #include "slurm.h"
 
-#include <poll.h>
 #include <pwd.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "clock.h"
 #include "transport_backend.h"
-
-/* Runs a local command for at most timeout_s seconds and returns its
- * standard output (NUL-terminated, at most 1 MB, caller frees) in *out. */
-static int capture(const char *const *argv, int timeout_s, char **out, fr_error *err)
-{
-    tr_proc p;
-    memset(&p, 0, sizeof p);
-    p.out_max = (size_t)1 << 20;
-    *out = NULL;
-    if (tr_pipe_spawn(&p, argv, err))
-        return -1;
-    double end = clk_now() + timeout_s;
-    while (p.state == TR_RUNNING && clk_now() < end) {
-        struct pollfd pfd[2];
-        int n = tr_pipe_pollfds(&p, pfd, 2);
-        poll(pfd, (nfds_t)n, 50);
-        tr_pipe_service(&p);
-    }
-    int rc = 0;
-    if (p.state == TR_RUNNING)
-        rc = fr_fail(err, "%s did not answer within %d s", argv[0], timeout_s);
-    else if (p.state == TR_FAILED)
-        rc = fr_fail(err, "%s: %s", argv[0], p.why);
-    else if (p.status)
-        rc = fr_fail(err, "%s failed (status %d): %s", argv[0], p.status, p.err);
-    else if (!(*out = malloc(p.out_len + 1)))
-        rc = fr_fail(err, "out of memory");
-    else {
-        memcpy(*out, p.out, p.out_len);
-        (*out)[p.out_len] = 0;
-    }
-    tr_pipe_release(&p);
-    free(p.out);
-    return rc;
-}
 
 int slurm_parse_cpus(const char *s, int n, int *cpus, fr_error *err)
 {
@@ -105,7 +68,7 @@ static int nodes_from(const char *list, int timeout_s, slurm_alloc *a, fr_error 
     const char *argv[] = {"scontrol", "show", "hostnames", list, NULL};
     char *text;
     fr_error e;
-    if (capture(argv, timeout_s, &text, &e))
+    if (tr_pipe_run(argv, timeout_s, &text, &e))
         return fr_fail(err, "cannot expand SLURM_JOB_NODELIST='%s': %s", list, e.msg);
     int n = 0;
     for (const char *c = text; *c; c++)
@@ -185,7 +148,7 @@ int slurm_job_ended(slurm_alloc *a, int ask)
     const char *argv[] = {"squeue", "--noheader", "--jobs", a->job, "--format", "%T", NULL};
     char *text;
     fr_error e;
-    if (capture(argv, a->timeout_s, &text, &e)) {
+    if (tr_pipe_run(argv, a->timeout_s, &text, &e)) {
         /* squeue fails for a job the controller no longer knows. */
         ended = strstr(e.msg, "Invalid job id") != NULL;
     } else {

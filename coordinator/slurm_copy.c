@@ -180,7 +180,7 @@ int slurm_copy(tr_host *h, slurm_alloc *a, const char *node, const char *local_p
         const char *bcast[] = {"sbcast", "--force", "--timeout", to, "--jobid", stepid, local_path, tmp, NULL};
         /* As long as the copy takes: a big scene on a slow link is no hang. */
         fr_error e;
-        rc = tr_pipe_run(bcast, 3600, &e);
+        rc = tr_pipe_run(bcast, 3600, NULL, &e);
         if (rc)
             fr_fail(err, "%s: sbcast to the node failed: %s", tr_host_label(h), e.msg);
     }

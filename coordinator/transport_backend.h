@@ -156,9 +156,11 @@ void tr_pipe_release(tr_proc *p);
 /** Like tr_pipe_release, but neither kills nor waits: returns the PID of
  * a child still to be reaped (the caller waits for it), or 0. */
 int tr_pipe_detach(tr_proc *p);
-/** Runs a local command to completion (at most timeout_s), discarding its
- * stdout; fails with its status and the tail of its stderr. */
-int tr_pipe_run(const char *const *argv, int timeout_s, fr_error *err);
+/** Runs a local command to completion (at most timeout_s); fails with its
+ * status and the tail of its stderr.  With out, its standard output (at
+ * most 1 MB, NUL-terminated, the caller frees it) is returned in *out (NULL
+ * on failure); without, it is discarded. */
+int tr_pipe_run(const char *const *argv, int timeout_s, char **out, fr_error *err);
 /** @} */
 
 #endif

@@ -268,11 +268,13 @@ void tr_pipe_release(tr_proc *p)
     p->impl = NULL;
 }
 
-int tr_pipe_run(const char *const *argv, int timeout_s, fr_error *err)
+int tr_pipe_run(const char *const *argv, int timeout_s, char **out, fr_error *err)
 {
     tr_proc p;
     memset(&p, 0, sizeof p);
     p.out_max = (size_t)1 << 20;
+    if (out)
+        *out = NULL;
     if (tr_pipe_spawn(&p, argv, err))
         return -1;
     double end = clk_now() + timeout_s;
@@ -281,7 +283,8 @@ int tr_pipe_run(const char *const *argv, int timeout_s, fr_error *err)
         int n = tr_pipe_pollfds(&p, pfd, 2);
         poll(pfd, (nfds_t)n, 50);
         tr_pipe_service(&p);
-        p.out_len = 0; /* stdout is not wanted */
+        if (!out)
+            p.out_len = 0; /* stdout is not wanted */
     }
     int rc = 0;
     if (p.state == TR_RUNNING)
@@ -290,6 +293,12 @@ int tr_pipe_run(const char *const *argv, int timeout_s, fr_error *err)
         rc = fr_fail(err, "%s: %s", argv[0], p.why);
     else if (p.status)
         rc = fr_fail(err, "%s failed (status %d): %s", argv[0], p.status, p.err);
+    else if (out && !(*out = malloc(p.out_len + 1)))
+        rc = fr_fail(err, "out of memory");
+    else if (out) {
+        memcpy(*out, p.out, p.out_len);
+        (*out)[p.out_len] = 0;
+    }
     tr_pipe_release(&p);
     free(p.out);
     return rc;

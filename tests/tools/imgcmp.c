@@ -27,37 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct { int w, h; float *px; } image;
-
-static int read_pfm(const char *path, image *im)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) { perror(path); return -1; }
-    char magic[3] = {0};
-    double scale;
-    int c;
-    if (fscanf(f, "%2s", magic) != 1 || strcmp(magic, "PF") != 0) goto bad;
-    /* Skip comment lines between the header fields. */
-    while ((c = fgetc(f)) == '\n' || c == ' ' || c == '#')
-        if (c == '#') while ((c = fgetc(f)) != '\n' && c != EOF) {}
-    ungetc(c, f);
-    if (fscanf(f, "%d %d %lf", &im->w, &im->h, &scale) != 3 || fgetc(f) != '\n' || im->w <= 0 || im->h <= 0 ||
-        scale >= 0 || im->w > 65536 || im->h > 65536)
-        goto bad;
-    size_t n = (size_t)im->w * im->h * 3;
-    im->px = malloc(n * sizeof(float));
-    float *raw = malloc(n * sizeof(float));
-    if (!im->px || !raw || fread(raw, sizeof(float), n, f) != n) { free(raw); goto bad; }
-    for (int y = 0; y < im->h; y++) /* PFM rows are bottom to top */
-        memcpy(im->px + (size_t)y * im->w * 3, raw + (size_t)(im->h - 1 - y) * im->w * 3, (size_t)im->w * 12);
-    free(raw);
-    fclose(f);
-    return 0;
-bad:
-    fprintf(stderr, "%s: not a little-endian RGB PFM\n", path);
-    fclose(f);
-    return -1;
-}
+#include "pfmread.h"
 
 /* Box-downsample im by f in place (f divides its sides). */
 static void box_down(image *im, int f)
@@ -150,11 +120,11 @@ int main(int argc, char **argv)
     if (bs < 1 || bs > 65536) { fprintf(stderr, "imgcmp: bad block size\n"); return 2; }
     if (down < 1 || down > 65536) { fprintf(stderr, "imgcmp: bad --down\n"); return 2; }
     image a, r;
-    if (read_pfm(argv[1], &a) < 0 || read_pfm(argv[2], &r) < 0) return 2;
+    if (read_pfm("imgcmp", argv[1], &a) < 0 || read_pfm("imgcmp", argv[2], &r) < 0) return 2;
     image m = {0, 0, NULL};
     if (mask_path) {
         if (reg[0] < 0) { fprintf(stderr, "imgcmp: --mask needs --region\n"); return 2; }
-        if (read_pfm(mask_path, &m) < 0) return 2;
+        if (read_pfm("imgcmp", mask_path, &m) < 0) return 2;
         if (m.w != r.w || m.h != r.h) {
             fprintf(stderr, "imgcmp: the mask is %dx%d, the reference %dx%d\n", m.w, m.h, r.w, r.h);
             return 2;

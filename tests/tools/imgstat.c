@@ -17,50 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct {
-    int w, h;
-    float *px; /* top row first, RGB */
-} image;
-
-static int read_pfm(const char *path, image *im)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        perror(path);
-        return -1;
-    }
-    char magic[3] = {0};
-    double scale;
-    int c;
-    float *raw = NULL;
-    im->px = NULL;
-    if (fscanf(f, "%2s", magic) != 1 || strcmp(magic, "PF") != 0)
-        goto bad;
-    /* Comment lines (the worker's header) may come between the fields. */
-    while ((c = fgetc(f)) == '\n' || c == ' ' || c == '#')
-        if (c == '#')
-            while ((c = fgetc(f)) != '\n' && c != EOF) {}
-    ungetc(c, f);
-    if (fscanf(f, "%d %d %lf", &im->w, &im->h, &scale) != 3 || fgetc(f) != '\n' || im->w <= 0 || im->h <= 0 ||
-        scale >= 0 || im->w > 65536 || im->h > 65536)
-        goto bad;
-    size_t n = (size_t)im->w * im->h * 3;
-    im->px = malloc(n * sizeof(float));
-    raw = malloc(n * sizeof(float));
-    if (!im->px || !raw || fread(raw, sizeof(float), n, f) != n)
-        goto bad;
-    for (int y = 0; y < im->h; y++) /* PFM rows are bottom to top */
-        memcpy(im->px + (size_t)y * im->w * 3, raw + (size_t)(im->h - 1 - y) * im->w * 3, (size_t)im->w * 12);
-    free(raw);
-    fclose(f);
-    return 0;
-bad:
-    fprintf(stderr, "imgstat: %s: not a little-endian RGB PFM\n", path);
-    free(raw);
-    free(im->px);
-    fclose(f);
-    return -1;
-}
+#include "pfmread.h"
 
 static int number(const char *s, int *out)
 {
@@ -103,10 +60,10 @@ int main(int argc, char **argv)
         return 2;
     }
     image a, b = {0, 0, NULL};
-    if (read_pfm(path, &a) < 0)
+    if (read_pfm("imgstat", path, &a) < 0)
         return 2;
     if (other) {
-        if (read_pfm(other, &b) < 0)
+        if (read_pfm("imgstat", other, &b) < 0)
             return 2;
         if (b.w != a.w || b.h != a.h) {
             fprintf(stderr, "imgstat: %s is %dx%d, %s is %dx%d\n", path, a.w, a.h, other, b.w, b.h);
