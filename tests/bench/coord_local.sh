@@ -1,6 +1,16 @@
 #!/bin/sh
 # Parallel efficiency of local mode: the same render with -j 1 and with one
 # worker per core.  efficiency = T(1) / (N * T(N)); 1.0 is perfect.
+#
+# Wall time on a shared machine says little when other work takes the
+# cores, so the script also splits the loss into parts that such load
+# disturbs less, each a median over the -j N runs:
+# - occupancy: the seconds the workers of accepted slabs ran (the summary's
+#   "busy s"), over N times the render's seconds: 1.0 when no slot is ever
+#   idle (start-up before the first slab, gaps between slabs, the tail);
+# - CPU ratio: CPU seconds (user + system, franja and its workers) of -j 1
+#   over -j N: below 1.0 when N processes at once each run slower (shared
+#   caches, memory, hyper-threads, straggler copies that are thrown away).
 cd "$(dirname "$0")/../.." || exit 1
 . tests/coord/bench_common.sh
 N=$(nproc)
@@ -13,4 +23,29 @@ bin/franja render "$SCENE" -o "$T/warm.pfm" $ARGS -j "$N" >/dev/null 2>&1
 compare "bin/franja render $SCENE -o $T/a.pfm $ARGS -j 1" "bin/franja render $SCENE -o $T/b.pfm $ARGS -j $N" || exit 1
 cmp -s "$T/a.pfm" "$T/b.pfm" || { echo "-j 1 and -j $N images differ"; exit 1; }
 echo "local -j 1: $TA s, -j $N: $TB s; speed-up $(calc "$TA / $TB"), parallel efficiency $(calc "$TA / ($N * $TB)")"
+
+# One render: prints "CPU-s occupancy" (see above).  The shell's children
+# times (fields 16 and 17 of its /proc stat, in clock ticks) hold franja's
+# and, through franja's waits, its workers'.
+parts() {
+    sh -c "bin/franja render $SCENE -o $T/p.pfm $ARGS -j $1 2>$T/log >/dev/null; cat /proc/\$\$/stat" >"$T/stat" ||
+        return 1
+    hz=$(getconf CLK_TCK)
+    cpu=$(awk -v hz="$hz" '{ sub(/.*\) /, ""); printf "%.3f", ($14 + $15) / hz }' "$T/stat")
+    occ=$(awk -v n="$1" '/ spp in [0-9.]+ s:/ { for (i = 1; i < NF; i++) if ($i == "in") t = $(i + 1) }
+        $1 == "local" { busy = $(NF - 1) } END { if (t > 0) printf "%.4f", busy / (n * t) }' "$T/log")
+    echo "$cpu $occ"
+}
+c1="" cn="" occs=""
+i=0
+while [ $i -lt "$RUNS" ]; do
+    set -- $(parts 1) || exit 1
+    c1="$c1 $1"
+    set -- $(parts "$N") || exit 1
+    cn="$cn $1" occs="$occs $2"
+    i=$((i + 1))
+done
+C1=$(median $c1) CN=$(median $cn) OCC=$(median $occs)
+echo "CPU seconds, -j 1:$c1 (median $C1); -j $N:$cn (median $CN); CPU ratio $(calc "$C1 / $CN")"
+echo "occupancy of the $N slots (busy seconds / ($N x render seconds)):$occs; median $OCC"
 echo "machine after: load $(cut -d' ' -f1-3 /proc/loadavg)"
