@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "simd4.h"
+
 float geo_sphere(const fr_sphere *s, const fr_ray *r, float tmax)
 {
     /* With f = o - c, the discriminant is computed as r^2 - |f - (f.d/d.d) d|^2,
@@ -176,28 +178,6 @@ vec3 geo_plane_point(const fr_plane *p, const fr_ray *r, float t, vec3 *err)
     return v3_add(r->o, dt);
 }
 
-/* The neighbouring floats of x toward +infinity and -infinity. */
-static float next_up(float x)
-{
-    if (x == INFINITY)
-        return x;
-    if (x == 0.0f)
-        return 0x1p-149f;
-    uint32_t i;
-    memcpy(&i, &x, 4);
-    i = x > 0.0f ? i + 1 : i - 1;
-    memcpy(&x, &i, 4);
-    return x;
-}
-
-static float next_down(float x) { return -next_up(-x); }
-
-static float push(float p, float step)
-{
-    float o = p + step;
-    return step > 0.0f ? next_up(o) : step < 0.0f ? next_down(o) : o;
-}
-
 vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
 {
     float d = fabsf(ng.x) * err.x + fabsf(ng.y) * err.y + fabsf(ng.z) * err.z;
@@ -206,5 +186,25 @@ vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
         return p;
     if (v3_dot(ng, dir) < 0.0f)
         d = -d;
-    return v3(push(p.x, ng.x * d), push(p.y, ng.y * d), push(p.z, ng.z * d));
+    /* Each coordinate: p + step, then one float further along the sign of
+     * step (next_up or next_down of the sum; the sum itself when step is
+     * 0).  Done on the bit patterns, three coordinates at once, with masks
+     * instead of branches, since the step's sign follows the ray's random
+     * direction: moving away from zero adds one to the pattern, toward
+     * zero takes one; a zero becomes the smallest subnormal of the step's
+     * sign, an infinity moving outward stays, and a NaN loses one as
+     * next_up's general case does. */
+    f4 step = (f4){ng.x, ng.y, ng.z, 0.0f} * f4_set1(d);
+    f4 o = (f4){p.x, p.y, p.z, 0.0f} + step;
+    i4 i = (i4)o, zero4 = i4_set1(0);
+    i4 mag = i & i4_set1(0x7fffffff), neg = i < zero4;
+    i4 up = step > f4_set1(0.0f), down = step < f4_set1(0.0f), move = up | down;
+    i4 out = (neg & down) | (~neg & up);                       /* away from zero */
+    i4 nan = mag > i4_set1(0x7f800000), stay = (mag == i4_set1(0x7f800000)) & out;
+    i4 delta = ((out & ~nan) & i4_set1(2)) - i4_set1(1);       /* +1 or -1 */
+    delta &= move & ~stay;
+    i4 zero = (mag == zero4) & move;
+    i4 r = ((i + delta) & ~zero) | (((down & i4_set1(INT32_MIN)) | i4_set1(1)) & zero);
+    f4 q = (f4)r;
+    return v3(q[0], q[1], q[2]);
 }

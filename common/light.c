@@ -25,17 +25,21 @@ static vec3 textured(const fr_scene *s, const fr_material *m, uint32_t prim, vec
     return tex_emission(s, m, sf.uv);
 }
 
+/* The first light whose cdf exceeds u (the last light when none does, or
+ * u is NaN), by a binary search whose steps depend only on the number of
+ * lights: each step selects instead of branching, since u is random and
+ * a branch on it is mispredicted half the time. */
 uint32_t lgt_pick(const fr_scene *s, float u)
 {
-    uint32_t lo = 0, hi = s->n_lights - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (u < s->lights[mid].cdf)
-            hi = mid;
-        else
-            lo = mid + 1;
+    uint32_t base = 0, len = s->n_lights - 1;
+    if (len == 0)
+        return 0;
+    while (len > 1) {
+        uint32_t half = len / 2;
+        base = !(u < s->lights[base + half].cdf) ? base + half : base;
+        len -= half;
     }
-    return lo;
+    return base + !(u < s->lights[base].cdf);
 }
 
 int lgt_pick_reuse(const fr_scene *s, float *u)
@@ -43,7 +47,10 @@ int lgt_pick_reuse(const fr_scene *s, float *u)
     if (s->n_lights == 0)
         return 1;
     uint32_t li = lgt_pick(s, *u);
-    float lo = li ? s->lights[li - 1].cdf : 0.0f, hi = s->lights[li].cdf, w = hi - lo;
+    /* The cdf below light li, 0 below the first (an arithmetic select: li
+     * is random; cdfs are finite and at least 0). */
+    uint32_t above_first = li != 0;
+    float lo = s->lights[li - above_first].cdf * (float)above_first, hi = s->lights[li].cdf, w = hi - lo;
     if (!(w >= 0x1p-8f))
         return 0;
     float r = (*u - lo) / w;

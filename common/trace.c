@@ -59,31 +59,37 @@ typedef struct {
     int found;
 } hit_state;
 
-static int max_axis(vec3 v)
-{
-    float x = fabsf(v.x), y = fabsf(v.y), z = fabsf(v.z);
-    return x > y ? (x > z ? 0 : 2) : (y > z ? 1 : 2);
-}
+/* The axes of the watertight triangle test's frame for a ray direction:
+ * kz is the axis of the largest |d| (the first of x, y, z on ties), kx
+ * and ky follow it cyclically, swapped when d along kz is negative to keep
+ * the winding.  Indexed by kz and that sign. */
+static const uint8_t frame_axes[3][2][2] = {{{1, 2}, {2, 1}}, {{2, 0}, {0, 2}}, {{0, 1}, {1, 0}}};
 
+/* Written without branches on the direction (selects, a table): a ray's
+ * direction is random, so a branch on it is mispredicted half the time. */
 static void ray_setup(ray4 *R, const fr_ray *r)
 {
-    R->ox = f4_set1(r->o.x); R->oy = f4_set1(r->o.y); R->oz = f4_set1(r->o.z);
-    R->ix = f4_set1(1.0f / r->d.x); R->iy = f4_set1(1.0f / r->d.y); R->iz = f4_set1(1.0f / r->d.z);
+    const float d[3] = {r->d.x, r->d.y, r->d.z}, o[3] = {r->o.x, r->o.y, r->o.z};
+    const float inv[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
+    R->ox = f4_set1(o[0]); R->oy = f4_set1(o[1]); R->oz = f4_set1(o[2]);
+    R->ix = f4_set1(inv[0]); R->iy = f4_set1(inv[1]); R->iz = f4_set1(inv[2]);
     /* 1/-0 is -inf: the sign bit picks the planes, as it must. */
-    int neg[3] = {signbit(r->d.x) != 0, signbit(r->d.y) != 0, signbit(r->d.z) != 0};
     for (int a = 0; a < 3; a++) {
-        R->near[a] = (size_t)(a + 3 * neg[a]) * FR_BVH_WIDTH;
-        R->far[a] = (size_t)(a + 3 * !neg[a]) * FR_BVH_WIDTH;
+        size_t neg = signbit(d[a]) != 0;
+        R->near[a] = ((size_t)a + 3 * neg) * FR_BVH_WIDTH;
+        R->far[a] = ((size_t)a + 3 * (1 - neg)) * FR_BVH_WIDTH;
     }
-    int kz = max_axis(r->d);
-    int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
-    float dz = v3_get(r->d, kz);
-    if (dz < 0.0f) { int t = kx; kx = ky; ky = t; }
+    float x = fabsf(d[0]), y = fabsf(d[1]), z = fabsf(d[2]);
+    int xy = x > y, gt = (xy ? x : y) > z;
+    int kz = 2 - gt - (gt & xy);   /* x > y ? (x > z ? 0 : 2) : (y > z ? 1 : 2) */
+    float dz = d[kz];
+    const uint8_t *k = frame_axes[kz][dz < 0.0f];
+    int kx = k[0], ky = k[1];
     R->kx = (size_t)kx * 4; R->ky = (size_t)ky * 4; R->kz = (size_t)kz * 4;
-    R->okx = f4_set1(v3_get(r->o, kx)); R->oky = f4_set1(v3_get(r->o, ky)); R->okz = f4_set1(v3_get(r->o, kz));
-    R->sx = f4_set1(v3_get(r->d, kx) / dz);
-    R->sy = f4_set1(v3_get(r->d, ky) / dz);
-    R->sz = f4_set1(1.0f / dz);
+    R->okx = f4_set1(o[kx]); R->oky = f4_set1(o[ky]); R->okz = f4_set1(o[kz]);
+    R->sx = f4_set1(d[kx] / dz);
+    R->sy = f4_set1(d[ky] / dz);
+    R->sz = f4_set1(inv[kz]);   /* 1 / dz, the very division above */
 }
 
 /* Entry distances tn[] of the ray into the boxes of node n, and which of

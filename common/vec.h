@@ -46,9 +46,9 @@ static inline float v3_luma(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0
 
 /** An orthonormal basis (t, b, n) around unit vector n, without branches on
  * near-parallel cases (Duff et al. 2017, "Building an orthonormal basis,
- * revisited"). */
+ * revisited"), nor on the sign of n.z (n is often a random direction). */
 static inline void v3_basis(vec3 n, vec3 *t, vec3 *b) {
-    float sign = n.z >= 0.0f ? 1.0f : -1.0f;
+    float sign = 1.0f - 2.0f * (float)!(n.z >= 0.0f);
     float a = -1.0f / (sign + n.z);
     float c = n.x * n.y * a;
     *t = v3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);

@@ -3,6 +3,7 @@
  * avoidance at several scene scales. */
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "check.h"
 #include "geom.h"
@@ -287,6 +288,85 @@ static void test_offset_small(void)
     CHECK(bad.x == p.x && bad.y == p.y && bad.z == p.z, "NaN normal: origin unchanged");
 }
 
+
+/* geo_offset's push, written on the bit pattern without branches, against
+ * its definition: the sum, then next_up or next_down of it by the step's
+ * sign (both written the plain way here), bit for bit, on random points of
+ * every magnitude and on zeros, subnormals, the largest floats and
+ * infinities, for steps of either sign and none. */
+static float ref_next_up(float x)
+{
+    if (x == INFINITY)
+        return x;
+    if (x == 0.0f)
+        return 0x1p-149f;
+    uint32_t i;
+    memcpy(&i, &x, 4);
+    i = x > 0.0f ? i + 1 : i - 1;
+    memcpy(&x, &i, 4);
+    return x;
+}
+
+static float ref_push(float p, float step)
+{
+    float o = p + step;
+    return step > 0.0f ? ref_next_up(o) : step < 0.0f ? -ref_next_up(-o) : o;
+}
+
+static vec3 ref_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
+{
+    float d = fabsf(ng.x) * err.x + fabsf(ng.y) * err.y + fabsf(ng.z) * err.z;
+    if (!(d < INFINITY))
+        return p;
+    if (v3_dot(ng, dir) < 0.0f)
+        d = -d;
+    return v3(ref_push(p.x, ng.x * d), ref_push(p.y, ng.y * d), ref_push(p.z, ng.z * d));
+}
+
+static int same_bits(float a, float b) { return memcmp(&a, &b, 4) == 0; }
+
+static void test_offset_bits(void)
+{
+    const float special[] = {0.0f, -0.0f, 0x1p-149f, -0x1p-149f, 0x1p-126f, -0x1p-126f, 1.0f, -1.0f,
+                             0x1.fffffep127f, -0x1.fffffep127f, INFINITY, -INFINITY, 548.8f, -559.2f, NAN, -NAN};
+    const int ns = (int)(sizeof special / sizeof special[0]);
+    uint32_t st = 11;
+    int bad = 0, n = 0;
+    for (int k = 0; k < 200000; k++) {
+        vec3 p, err, ng, dir;
+        float c[12];
+        for (int j = 0; j < 12; j++) {
+            float u = rnd(&st), e = (float)((int)(rnd(&st) * 80.0f) - 40);
+            c[j] = (u < 0.5f ? -1.0f : 1.0f) * rnd(&st) * ldexpf(1.0f, (int)e);
+        }
+        p = v3(c[0], c[1], c[2]);
+        if (k % 4 == 1)
+            p = v3(special[k % ns], special[(k / 3) % ns], special[(k / 7) % ns]);
+        err = v3(fabsf(c[3]) * 1e-3f, fabsf(c[4]) * 1e-3f, fabsf(c[5]) * 1e-3f);
+        if (k % 5 == 2)
+            err = v3(0.0f, 0x1p-149f, 1e-30f);
+        ng = v3_norm(v3(c[6], c[7], c[8]));
+        if (k % 6 == 3)
+            ng = v3(0.0f, k % 12 == 3 ? 1.0f : -1.0f, 0.0f);
+        dir = v3(c[9], c[10], c[11]);
+        if (k % 7 == 4) {
+            /* A sum that comes out zero: p.y is minus the step. */
+            float e = fabsf(c[4]) + 0x1p-140f, sgn = dir.y < 0.0f ? -1.0f : 1.0f;
+            ng = v3(0.0f, 1.0f, 0.0f);
+            err = v3(0.0f, e, 0.0f);
+            p.y = -sgn * e;
+        }
+        vec3 a = geo_offset(p, err, ng, dir), b = ref_offset(p, err, ng, dir);
+        n++;
+        if (!same_bits(a.x, b.x) || !same_bits(a.y, b.y) || !same_bits(a.z, b.z)) {
+            if (bad++ < 5)
+                CHECK(0, "offset of (%a %a %a) by err (%a %a %a) along (%a %a %a): (%a %a %a), expected (%a %a %a)",
+                      p.x, p.y, p.z, err.x, err.y, err.z, ng.x, ng.y, ng.z, a.x, a.y, a.z, b.x, b.y, b.z);
+        }
+    }
+    CHECK(bad == 0, "geo_offset differs from its definition on %d of %d points", bad, n);
+}
+
 int main(void)
 {
     test_sphere();
@@ -295,5 +375,6 @@ int main(void)
     test_watertight();
     test_offset();
     test_offset_small();
+    test_offset_bits();
     return check_done();
 }

@@ -394,12 +394,50 @@ static void json_errors(void)
     bld_free(&b);
 }
 
+/* lgt_pick against its definition, the first light whose cdf exceeds u
+ * (the last when none does), for 1 to 9 lights with repeated cdfs (lights
+ * of no power), at every cdf, next to it, and at 0, 1, above 1 and NaN. */
+static void pick_definition(void)
+{
+    fr_light lights[9];
+    int bad = 0;
+    for (uint32_t n = 1; n <= 9; n++) {
+        for (uint32_t i = 0; i < n; i++) {
+            lights[i] = (fr_light){0};
+            lights[i].cdf = i + 1 == n ? 1.0f : (float)((i + 1) / 2 * 2) / (float)n;
+        }
+        fr_scene s = {0};
+        s.lights = lights;
+        s.n_lights = n;
+        float us[40];
+        int nu = 0;
+        us[nu++] = 0.0f; us[nu++] = 1.0f; us[nu++] = 1.5f; us[nu++] = NAN; us[nu++] = 0.4999f;
+        for (uint32_t i = 0; i < n; i++) {
+            us[nu++] = lights[i].cdf;
+            us[nu++] = nextafterf(lights[i].cdf, 0.0f);
+            us[nu++] = nextafterf(lights[i].cdf, 2.0f);
+        }
+        for (int k = 0; k < nu; k++) {
+            uint32_t want = n - 1;
+            for (uint32_t i = 0; i < n; i++)
+                if (us[k] < lights[i].cdf) {
+                    want = i;
+                    break;
+                }
+            if (lgt_pick(&s, us[k]) != want && bad++ < 5)
+                CHECK(0, "%u lights, u = %a: light %u, expected %u", n, us[k], lgt_pick(&s, us[k]), want);
+        }
+    }
+    CHECK(bad == 0, "lgt_pick differs from its definition %d times", bad);
+}
+
 int main(void)
 {
     sun_on_plane();
     spot_falloff();
     emission();
     many_area_lights();
+    pick_definition();
     textured_area_lights();
     json_errors();
     return check_done();
