@@ -5,6 +5,11 @@
 # downsample.  Reports wall seconds, samples per CPU-second and RMSE; the
 # figures to beat are Cycles' on the same kind of machine: 14.7 s wall on 2
 # cores, 0.59 M samples per CPU-second, RMSE 0.0031.
+#
+# BASE=path/to/franja-worker times another build of the worker (the one
+# before a change) in the same run: each run renders the image with it right
+# after this build's render, so both see the same load, and the medians and
+# their ratio are reported side by side.
 cd "$(dirname "$0")/../.." || exit 1
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
@@ -12,22 +17,29 @@ N=$(nproc)
 W=${W:-512} H=${H:-512} SPP=${SPP:-64} SLABS=16 RUNS=${RUNS:-3}
 echo "== render: scenes/cornell.json ${W}x${H} ${SPP} spp, $N worker processes"
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
-echo "reproduce: sh tests/bench/render.sh"
+echo "reproduce: ${BASE:+BASE=$BASE }sh tests/bench/render.sh"
 i=0
 while [ $i -lt $SLABS ]; do
     echo "$((i * H / SLABS)) $(((i + 1) * H / SLABS))"
     i=$((i + 1))
 done >"$T/slabs"
-runs="" cpus=""
-for run in $(seq $RUNS); do
+# render WORKER OUTDIR: one timed render over the slabs; appends the wall
+# and CPU seconds to the variables named by $3 and $4.
+render() {
     start=$(date +%s.%N)
     # The workers' own CPU time (user + system, which xargs collects from
     # them): other work on the machine hardly changes it, unlike wall time.
     /usr/bin/time -f '%U %S' -o "$T/cpu" xargs -P "$N" -n 2 -a "$T/slabs" sh -c \
-        'bin/franja-worker --scene scenes/cornell.json --size '"${W}x${H}"' --spp '"$SPP"' --rows $0:$1 -o '"$T"'/slab-$0.pfm'
+        "$1"' --scene scenes/cornell.json --size '"${W}x${H}"' --spp '"$SPP"' --rows $0:$1 -o '"$2"'/slab-$0.pfm'
     end=$(date +%s.%N)
-    runs="$runs $(awk "BEGIN { printf \"%.2f\", $end - $start }")"
-    cpus="$cpus $(awk '{ printf "%.2f", $1 + $2 }' "$T/cpu")"
+    eval "$3=\"\$$3 $(awk "BEGIN { printf \"%.2f\", $end - $start }")\""
+    eval "$4=\"\$$4 $(awk '{ printf "%.2f", $1 + $2 }' "$T/cpu")\""
+}
+runs="" cpus="" bruns="" bcpus=""
+mkdir -p "$T/base"
+for run in $(seq $RUNS); do
+    render bin/franja-worker "$T" runs cpus
+    [ -n "$BASE" ] && render "$BASE" "$T/base" bruns bcpus
 done
 # Stitch: PFM stores the bottom row first, so the last slab comes first.
 {
@@ -47,3 +59,11 @@ awk "BEGIN { printf \"samples per CPU-second: %.3f M (wall x cores: %.3f M)\\n\"
 awk "BEGIN { printf \"Cycles 3.4 takes 14.7 s wall on 2 cores: ratio Cycles/Franja %.2f (above 1: Franja is faster)\\n\", 14.7 / $median }"
 bin/tools/imgcmp "$T/full.pfm" tests/data/cornell-ref-256.pfm | sed 's/^/  /'
 echo "  (Cycles at 64 spp: RMSE 0.0031; goal <= 0.0067)"
+if [ -n "$BASE" ]; then
+    bmedian=$(echo $bruns | tr " " "\n" | sort -g | awk "{ v[NR] = \$1 } END { print v[int((NR + 1) / 2)] }")
+    bcmedian=$(echo $bcpus | tr " " "\n" | sort -g | awk "{ v[NR] = \$1 } END { print v[int((NR + 1) / 2)] }")
+    echo "base build $BASE, each run right after this build's:"
+    echo "  wall seconds ($RUNS runs):$bruns; median $bmedian"
+    echo "  CPU seconds ($RUNS runs):$bcpus; median $bcmedian"
+    awk "BEGIN { printf \"  samples per CPU-second: %.3f M; this build is %.3fx as fast in CPU seconds, %.3fx in wall seconds\\n\", $W * $H * $SPP / $bcmedian / 1e6, $bcmedian / $cmedian, $bmedian / $median }"
+fi

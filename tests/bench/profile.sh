@@ -1,0 +1,63 @@
+#!/bin/sh
+# Where a Cornell box sample's time goes, in instructions (callgrind counts
+# them exactly, whatever else loads the machine): scenes/cornell.json at
+# 64x64 and 16 spp in one worker process, the cost of each function (with
+# the code inlined into it) summed by part and divided by the number of
+# samples, the branch mispredictions of callgrind's branch simulator per
+# sample beside it, and the rays a sample traces (calls of trace_closest and
+# trace_occluded).  WORKER=path profiles another build of the worker (the
+# one before a change, say); SIZE and SPP change the slab.
+cd "$(dirname "$0")/../.." || exit 1
+command -v valgrind >/dev/null || { echo "profile: valgrind is not installed" >&2; exit 1; }
+W=${WORKER:-bin/franja-worker} SIZE=${SIZE:-64} SPP=${SPP:-16}
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+bin/franja compile scenes/cornell.json -o "$T/cornell.fbin" >/dev/null || exit 1
+valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$T/cg" "$W" --scene "$T/cornell.fbin" \
+    --size "${SIZE}x$SIZE" --spp "$SPP" --rows "0:$SIZE" -o /dev/null 2>"$T/log" || { cat "$T/log" >&2; exit 1; }
+N=$((SIZE * SIZE * SPP))
+echo "== profile: scenes/cornell.json ${SIZE}x$SIZE, $SPP spp, $W (callgrind, $N samples)"
+echo "reproduce: WORKER=$W sh tests/bench/profile.sh"
+# Exclusive cost per function: Ir, then the branch columns (Bc Bcm Bi Bim),
+# a '.' where a count is 0; the function is the first field naming a file.
+callgrind_annotate --auto=no --threshold=100 "$T/cg" 2>/dev/null | awk -v n=$N '
+/PROGRAM TOTALS/ { t = $1; gsub(",", "", t); total = t; next }
+/^ *[0-9,]+ \(/ {
+    line = $0; gsub(/\([^)]*\)/, "", line); k = split(line, v, " +")
+    if (v[1] == "") for (i = 1; i < k; i++) v[i] = v[i + 1]
+    f = ""; for (i = 1; i <= k; i++) if (v[i] ~ /[a-z]:[A-Za-z_]/) { f = v[i]; break }
+    if (f == "") next
+    ir = v[1]; gsub(",", "", ir); bm = v[3]; gsub(",", "", bm); if (bm !~ /^[0-9]+$/) bm = 0
+    fn = f; sub(/^.*:/, "", fn)
+    if (fn ~ /^(trace_closest|trace_occluded|ray_setup|walk|node_hits|leaf_test|block_test)/)
+        p = "1|BVH traversal (trace_closest, trace_occluded, ray_setup)"
+    else if (fn ~ /^(trace_surface|geo_|push|bsdf_|mf_|smooth_eval|micro_|tex_|med_)/)
+        p = "2|hit points and BSDFs (trace_surface, geo_*, bsdf_*, mf_*, tex_*)"
+    else if (fn ~ /^smp_/)
+        p = "3|sampler (smp_*)"
+    else if (fn ~ /^(lgt_|vtx_direct|prim_point|aim|textured)/)
+        p = "4|light sampling (lgt_*, vtx_direct_*)"
+    else if (fn ~ /^(pt_|vtx_|roulette|light_numbers|emission|escaped)/)
+        p = "5|integrator and camera (pt_*, vtx_next, vtx_scatter_*)"
+    else if (fn ~ /^fm_/)
+        p = "6|own math (fm_*)"
+    else
+        p = "7|start-up, output and the rest"
+    ins[p] += ir; mis[p] += bm; all += bm
+}
+END {
+    printf "| part | instructions per sample | share | mispredicted branches per sample |\n|---|---|---|---|\n"
+    for (p in ins) {
+        name = p; sub(/^[0-9]\|/, "", name)
+        printf "%s|| %s | %d | %.1f %% | %.2f |\n", substr(p, 1, 1), name, ins[p] / n, 100 * ins[p] / total, mis[p] / n | "sort | cut -c3-"
+    }
+    close("sort | cut -c3-")
+    printf "| total | %d | | %.2f |\n", total / n, all / n
+}'
+# Rays: calls of the two traversal entry points, summed from the raw
+# profile's call records (cfn= names the callee, compressed to "(id)" after
+# its first mention in an fn= or cfn= line; calls= follows with the count).
+awk -v n=$N '
+/^c?fn=/ { id = $1; sub(/^c?fn=/, "", id); if (NF > 1) name[id] = $2; if ($1 ~ /^cfn/) callee = name[id]; next }
+/^calls=/ { c = $1; sub(/^calls=/, "", c); calls[callee] += c }
+END { printf "rays per sample: %.2f closest-hit, %.2f shadow (any-hit)\n", calls["trace_closest"] / n, calls["trace_occluded"] / n }' "$T/cg"
