@@ -13,6 +13,7 @@
 #include "protocol.h"
 
 typedef struct {
+    int frame;                 /* index into sched.frames */
     uint32_t y0, y1;
     int done;
     int attempts;              /* failed attempts so far */
@@ -33,12 +34,30 @@ typedef struct {
     char *remote;              /* the sums uploaded for it, NULL if none */
 } attempt;
 
+/* One host's copy of a frame's scene (the stage hook's). */
+typedef struct {
+    int staged;
+    char scene[1024];
+    char lease[1200];          /* "" = none */
+    double lease_t;
+} frame_host;
+
+typedef struct {
+    sched_frame f;
+    int rows_total, rows_done;
+    int done;                  /* every row saved, frame_done told */
+    frame_host *fh;            /* per host, with the stage hook; NULL otherwise */
+} frame;
+
 typedef struct {
     const sched_params *p;
     sched_host *hosts;
     int nhosts;
+    frame *frames;
+    int nframes, capframes;
+    int fed_all;               /* no frame is left to ask for */
     slab *slabs;
-    int nslabs, next;          /* next: first slab that may still be queued */
+    int nslabs, capslabs, next; /* next: first slab that may still be queued */
     attempt *run;
     int nrun, caprun;
     int rows_total, rows_done;
@@ -72,7 +91,7 @@ static void emit(sched *s, sched_event_kind kind, int host, const slab *sl, cons
     va_start(ap, fmt);
     vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
-    sched_event ev = {kind, now(s) - s->t0, host, sl ? sl->y0 : 0, sl ? sl->y1 : 0, text};
+    sched_event ev = {kind, now(s) - s->t0, host, sl ? sl->frame : 0, sl ? sl->y0 : 0, sl ? sl->y1 : 0, text};
     k->event(k->ctx, &ev);
 }
 
@@ -83,9 +102,36 @@ static void progress(sched *s)
         k->progress(k->ctx, now(s) - s->t0, s->rows_done, s->rows_total);
 }
 
-static int make_slabs(sched *s)
+/* "rows A:B" of slab sl, with its frame's label before them when it has
+ * one ("frame 12 rows A:B"). */
+static const char *rows_of(const sched *s, const slab *sl, char *buf, size_t cap)
 {
-    const sched_params *p = s->p;
+    const char *label = s->frames[sl->frame].f.label;
+    snprintf(buf, cap, "%s%srows %u:%u", label ? label : "", label ? " " : "", sl->y0, sl->y1);
+    return buf;
+}
+
+static int frame_done(sched *s, int fi, fr_error *err);
+
+/* Adds frame f's slabs to the queue (frame index s->nframes). */
+static int add_frame(sched *s, const sched_frame *f)
+{
+    const sched_frame *p = f;
+    if (s->nframes == s->capframes) {
+        int cap = s->capframes ? 2 * s->capframes : 4;
+        frame *nf = realloc(s->frames, (size_t)cap * sizeof *nf);
+        if (!nf)
+            return -1;
+        s->frames = nf;
+        s->capframes = cap;
+    }
+    int fi = s->nframes;
+    frame *fr = &s->frames[fi];
+    memset(fr, 0, sizeof *fr);
+    fr->f = *f;
+    if (s->p->hooks.stage && !(fr->fh = calloc((size_t)(s->nhosts > 0 ? s->nhosts : 1), sizeof *fr->fh)))
+        return -1;
+    s->nframes++;
     int slots = 0;
     for (int i = 0; i < s->nhosts; i++)
         if (!s->hosts[i].dropped)
@@ -98,13 +144,18 @@ static int make_slabs(sched *s)
      * twice the slots, at least a sixteenth per slot of the whole, so the
      * first are large (few worker starts) and the last small (the slots
      * finish close together). */
-    uint32_t per = p->slab_rows > 0 ? (uint32_t)p->slab_rows : 0, n_slots = (uint32_t)(slots > 0 ? slots : 1);
+    uint32_t per = s->p->slab_rows > 0 ? (uint32_t)s->p->slab_rows : 0, n_slots = (uint32_t)(slots > 0 ? slots : 1);
     uint32_t least = (missing + 16 * n_slots - 1) / (16 * n_slots), left = missing;
     if (least < 1)
         least = 1;
-    s->slabs = calloc(missing ? missing : 1, sizeof *s->slabs);
-    if (!s->slabs)
-        return -1;
+    if ((size_t)s->nslabs + missing > (size_t)s->capslabs) {
+        size_t cap = (size_t)s->nslabs + missing + (size_t)s->capslabs;
+        slab *ns = realloc(s->slabs, cap * sizeof *ns);
+        if (!ns)
+            return -1;
+        s->slabs = ns;
+        s->capslabs = (int)cap;
+    }
     for (uint32_t y = 0; y < p->spec.height;) {
         if (p->have && p->have[y]) {
             y++;
@@ -121,10 +172,39 @@ static int make_slabs(sched *s)
                (p->base ? p->base[end] : 0) == base)
             end++;
         left -= end - y;
-        s->slabs[s->nslabs++] = (slab){.y0 = y, .y1 = end, .failed_on = -1, .base = base};
+        s->slabs[s->nslabs++] = (slab){.frame = fi, .y0 = y, .y1 = end, .failed_on = -1, .base = base};
+        s->st->slabs++;
         y = end;
     }
-    s->rows_total = (int)missing;
+    fr->rows_total = (int)missing;
+    s->rows_total += (int)missing;
+    s->st->frames++;
+    return 0;
+}
+
+/* Asks the next_frame hook for one more frame and queues its slabs; a
+ * frame with nothing to render is done at once.  0 when a frame came (or
+ * none is left: fed_all), -1 with err. */
+static int feed(sched *s, fr_error *err)
+{
+    const sched_hooks *k = &s->p->hooks;
+    while (!s->fed_all) {
+        sched_frame f;
+        memset(&f, 0, sizeof f);
+        int r = k->next_frame ? k->next_frame(k->ctx, s->nframes, &f, err) : 1;
+        if (r < 0)
+            return -1;
+        if (r > 0) {
+            s->fed_all = 1;
+            return 0;
+        }
+        if (add_frame(s, &f))
+            return fr_fail(err, "out of memory");
+        if (s->frames[s->nframes - 1].rows_total > 0)
+            return 0;
+        if (frame_done(s, s->nframes - 1, err))
+            return -1;
+    }
     return 0;
 }
 
@@ -183,15 +263,25 @@ enum { MAX_COPIES = 3 };
  * the fewest copies, the one that has run longest; else, only when no slab
  * runs elsewhere, a second copy here of this host's own oldest slab (a
  * stuck process is overtaken even on a single host).  -1 if nothing. */
-static int pick(sched *s, int host_i)
+static int pick(sched *s, int host_i, fr_error *err)
 {
-    while (s->next < s->nslabs && (s->slabs[s->next].done || s->slabs[s->next].copies))
-        s->next++;
     int others = other_host_alive(s, host_i);
-    for (int i = s->next; i < s->nslabs; i++) {
-        const slab *sl = &s->slabs[i];
-        if (!sl->done && !sl->copies && !(others && sl->failed_on == host_i))
-            return i;
+    for (;;) {
+        while (s->next < s->nslabs && (s->slabs[s->next].done || s->slabs[s->next].copies))
+            s->next++;
+        for (int i = s->next; i < s->nslabs; i++) {
+            const slab *sl = &s->slabs[i];
+            if (!sl->done && !sl->copies && !(others && sl->failed_on == host_i))
+                return i;
+        }
+        /* Nothing queued for this slot: the next frame's slabs, if any. */
+        if (s->fed_all)
+            break;
+        int before = s->nslabs;
+        if (feed(s, err))
+            return -2;
+        if (s->nslabs == before)
+            break;
     }
     int best = -1, best_here = 1, best_copies = MAX_COPIES;
     double best_t = 0;
@@ -218,19 +308,27 @@ static int pick(sched *s, int host_i)
  * from the host's disk before the worker starts, however it ends. */
 static const char CONT_SCRIPT[] = "exec 3<\"$1\" || exit 97; rm -f -- \"$1\"; shift; exec \"$0\" \"$@\"";
 
+/* The path of slab sl's scene on host_i: the host's, or its frame's copy
+ * there. */
+static const char *scene_on(const sched *s, int host_i, const slab *sl)
+{
+    const frame *fr = &s->frames[sl->frame];
+    return fr->fh ? fr->fh[host_i].scene : s->hosts[host_i].scene;
+}
+
 /* Where slab sl's sums go on a host with a work directory: beside the
  * scene, a name no other attempt or coordinator uses. */
-static void remote_name(const sched *s, const sched_host *h, const slab *sl, char *out, size_t cap)
+static void remote_name(const sched *s, int host_i, const slab *sl, char *out, size_t cap)
 {
     static unsigned counter;
     char dir[1024];
-    snprintf(dir, sizeof dir, "%s", h->scene);
+    snprintf(dir, sizeof dir, "%s", scene_on(s, host_i, sl));
     char *slash = strrchr(dir, '/');
     if (slash)
         slash[1] = 0;
     else
         dir[0] = 0;
-    snprintf(out, cap, "%scont-%016llx-%u-%u-%u-%ld-%.0f-%u.pf", dir, (unsigned long long)s->p->spec.hash, sl->y0,
+    snprintf(out, cap, "%scont-%016llx-%u-%u-%u-%ld-%.0f-%u.pf", dir, (unsigned long long)s->frames[sl->frame].f.spec.hash, sl->y0,
              sl->y1, sl->base, (long)getpid(), clk_now() * 1e3, counter++);
 }
 
@@ -243,7 +341,8 @@ static const char *cont_file(sched *s, slab *sl)
     if (!sl->cont) {
         char path[4400];
         fr_error e;
-        if (job_cont_build(s->p->jobdir, &s->p->spec, sl->y0, sl->y1, sl->base, path, sizeof path, &e) ||
+        const sched_frame *f = &s->frames[sl->frame].f;
+        if (job_cont_build(f->jobdir, &f->spec, sl->y0, sl->y1, sl->base, path, sizeof path, &e) ||
             !(sl->cont = strdup(path))) {
             sl->base = 0;
             return NULL;
@@ -298,13 +397,32 @@ static void cont_drop(slab *sl)
     sl->cont = NULL;
 }
 
+/* Puts slab sl's frame's scene on host_i when it is not there yet (the
+ * stage hook).  -1 with err when it cannot be. */
+static int stage(sched *s, int host_i, const slab *sl, fr_error *err)
+{
+    frame *fr = &s->frames[sl->frame];
+    if (!fr->fh || fr->fh[host_i].staged)
+        return 0;
+    frame_host *fh = &fr->fh[host_i];
+    const sched_hooks *k = &s->p->hooks;
+    fh->lease[0] = 0;
+    if (k->stage(k->ctx, sl->frame, &s->hosts[host_i], host_i, fh->scene, sizeof fh->scene, fh->lease,
+                 sizeof fh->lease, err))
+        return -1;
+    fh->staged = 1;
+    fh->lease_t = clk_now();
+    return 0;
+}
+
 static int start(sched *s, int host_i, int slab_i, fr_error *err)
 {
     sched_host *h = &s->hosts[host_i];
     slab *sl = &s->slabs[slab_i];
-    const job_spec *sp = &s->p->spec;
-    proto_slab req = {h->scene, sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-", s->p->lifeline,
-                      1 + (int)sp->integrator, sp->noise_threshold, s->p->sums, NULL};
+    const sched_frame *f = &s->frames[sl->frame].f;
+    const job_spec *sp = &f->spec;
+    proto_slab req = {scene_on(s, host_i, sl), sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-",
+                      s->p->lifeline, 1 + (int)sp->integrator, sp->noise_threshold, f->sums, NULL};
     const char *cont = cont_file(s, sl);
     char remote[1400];
     int sent = 0;
@@ -312,7 +430,7 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
         req.continue_from = cont; /* the host sees this machine's files */
     } else if (cont && tr_host_busy_upload(h->tr)) {
         fr_error e;
-        remote_name(s, h, sl, remote, sizeof remote);
+        remote_name(s, host_i, sl, remote, sizeof remote);
         if (tr_upload(h->tr, cont, remote, 0600, &e) == 0) {
             req.continue_from = "/dev/fd/3";
             sent = 1;
@@ -358,10 +476,11 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
         s->caprun = cap;
     }
     if (sl->copies) {
+        char rows[200];
         s->st->duplicates++;
         h->duplicates++;
-        emit(s, SCHED_COPY, host_i, sl, "rows %u:%u still running; starting a second copy on %s", sl->y0, sl->y1,
-             h->name);
+        emit(s, SCHED_COPY, host_i, sl, "%s still running; starting a second copy on %s",
+             rows_of(s, sl, rows, sizeof rows), h->name);
     }
     s->run[s->nrun++] = (attempt){slab_i, host_i, proc, now(s), req.continue_from ? sl->base : 0,
                                   sent ? strdup(remote) : NULL};
@@ -447,8 +566,9 @@ static int fail_attempt(sched *s, int r, const char *why, fr_error *err)
     h->streak++;
     s->st->retries++;
     snprintf(sl->last_error, sizeof sl->last_error, "%s: %s", h->name, why);
-    emit(s, SCHED_SLAB_FAILED, a.host, sl, "rows %u:%u failed on %s (attempt %d of %d): %s", sl->y0, sl->y1,
-         h->name, sl->attempts, s->p->max_attempts, why);
+    char rows[200];
+    emit(s, SCHED_SLAB_FAILED, a.host, sl, "%s failed on %s (attempt %d of %d): %s",
+         rows_of(s, sl, rows, sizeof rows), h->name, sl->attempts, s->p->max_attempts, why);
     if (note_failed_host(sl, a.host))
         return fr_fail(err, "out of memory");
     /* A slab is given up once it has failed max_attempts times, unless
@@ -457,7 +577,7 @@ static int fail_attempt(sched *s, int r, const char *why, fr_error *err)
      * are ready first must not doom the render before a good one joins. */
     if (sl->attempts >= s->p->max_attempts && !sl->copies &&
         (sl->nfailed >= s->p->max_attempts || !untried_host(s, sl)))
-        return fr_fail(err, "rows %u:%u failed %d times, last on %s", sl->y0, sl->y1, sl->attempts,
+        return fr_fail(err, "%s failed %d times, last on %s", rows_of(s, sl, rows, sizeof rows), sl->attempts,
                        sl->last_error);
     if (h->streak >= s->p->max_host_failures) {
         char msg[320];
@@ -472,10 +592,11 @@ static int accept_attempt(sched *s, int r, fr_error *err)
     attempt a = s->run[r];
     sched_host *h = &s->hosts[a.host];
     slab *sl = &s->slabs[a.slab];
+    frame *fr = &s->frames[sl->frame];
     size_t len;
     const unsigned char *out = tr_proc_output(a.proc, &len);
     fr_error why;
-    if (job_check_partial(out, len, &s->p->spec, sl->y0, sl->y1, s->p->sums, &why)) {
+    if (job_check_partial(out, len, &fr->f.spec, sl->y0, sl->y1, fr->f.sums, &why)) {
         char msg[600];
         snprintf(msg, sizeof msg, "bad partial image: %s", why.msg);
         return fail_attempt(s, r, msg, err);
@@ -485,18 +606,19 @@ static int accept_attempt(sched *s, int r, fr_error *err)
         finish(s, r);
         return 0;
     }
-    if (job_save(s->p->jobdir, sl->y0, sl->y1, out, len, err))
+    if (job_save(fr->f.jobdir, sl->y0, sl->y1, out, len, err))
         return -1;
     double dt = now(s) - a.start;
     s->acc_s += dt;
     s->acc_rows += (int)(sl->y1 - sl->y0);
     sl->done = 1;
-    s->st->samples += (double)(sl->y1 - sl->y0) * s->p->spec.width * (s->p->spec.spp - a.from);
+    s->st->samples += (double)(sl->y1 - sl->y0) * fr->f.spec.width * (fr->f.spec.spp - a.from);
     s->st->continued += a.from > 0;
     h->slabs++;
     h->rows += (int)(sl->y1 - sl->y0);
     h->busy_s += dt;
     s->rows_done += (int)(sl->y1 - sl->y0);
+    fr->rows_done += (int)(sl->y1 - sl->y0);
     finish(s, r);
     /* First valid copy wins: the others are killed, without blame. */
     for (int k = s->nrun - 1; k >= 0; k--)
@@ -505,8 +627,12 @@ static int accept_attempt(sched *s, int r, fr_error *err)
             finish(s, k);
         }
     cont_drop(sl);
-    emit(s, SCHED_SLAB_DONE, a.host, sl, "rows %u:%u from %s in %.2f s (%d/%d rows)", sl->y0, sl->y1, h->name, dt,
-         s->rows_done, s->rows_total);
+    char rows[200];
+    emit(s, SCHED_SLAB_DONE, a.host, sl, "%s from %s in %.2f s (%d/%d rows)", rows_of(s, sl, rows, sizeof rows),
+         h->name, dt, s->rows_done, s->rows_total);
+    int fi = sl->frame;
+    if (s->frames[fi].rows_done == s->frames[fi].rows_total)
+        return frame_done(s, fi, err);
     return 0;
 }
 
@@ -589,19 +715,30 @@ static int alive_hosts(sched *s)
     return n;
 }
 
-static void missing_text(sched *s, char *out, size_t cap)
+/* The first frame not done (0 when every one is). */
+static int first_open_frame(const sched *s)
 {
-    unsigned char *have = calloc(s->p->spec.height, 1);
+    for (int i = 0; i < s->nframes; i++)
+        if (!s->frames[i].done)
+            return i;
+    return 0;
+}
+
+/* The rows frame fi lacks, as job_missing_rows says them. */
+static void missing_text(sched *s, int fi, char *out, size_t cap)
+{
+    const sched_frame *f = &s->frames[fi].f;
+    unsigned char *have = calloc(f->spec.height, 1);
     if (!have) {
         snprintf(out, cap, "(unknown)");
         return;
     }
-    for (uint32_t y = 0; y < s->p->spec.height; y++)
-        have[y] = s->p->have && s->p->have[y];
+    for (uint32_t y = 0; y < f->spec.height; y++)
+        have[y] = f->have && f->have[y];
     for (int i = 0; i < s->nslabs; i++)
-        if (s->slabs[i].done)
+        if (s->slabs[i].done && s->slabs[i].frame == fi)
             memset(have + s->slabs[i].y0, 1, s->slabs[i].y1 - s->slabs[i].y0);
-    job_missing_rows(have, s->p->spec.height, out, cap);
+    job_missing_rows(have, f->spec.height, out, cap);
     free(have);
 }
 
@@ -609,7 +746,8 @@ static void missing_text(sched *s, char *out, size_t cap)
  * the ten minutes after which a lease is stale (stage.h). */
 enum { LEASE_RENEW_S = 60 };
 
-/* Renews host i's lease when it is due; frees a renewal that has ended. */
+/* Renews a lease of host i that is due (the host's own, or one of a frame
+ * not done), one at a time; frees a renewal that has ended. */
 static void lease_tick(sched *s, int i)
 {
     sched_host *h = &s->hosts[i];
@@ -618,13 +756,57 @@ static void lease_tick(sched *s, int i)
         h->lease_proc = NULL;
     }
     double t = clk_now();
-    if (!h->lease[0] || h->lease_proc || h->dropped || h->pending || t - h->lease_t < LEASE_RENEW_S)
+    if (h->lease_proc || h->dropped || h->pending)
         return;
-    h->lease_t = t;
-    const char *argv[] = {"touch", "-c", "--", h->lease, NULL};
+    const char *lease = NULL;
+    double *lease_t = NULL;
+    if (h->lease[0] && t - h->lease_t >= LEASE_RENEW_S)
+        lease = h->lease, lease_t = &h->lease_t;
+    for (int f = 0; !lease && f < s->nframes; f++) {
+        frame_host *fh = s->frames[f].fh ? &s->frames[f].fh[i] : NULL;
+        if (fh && !s->frames[f].done && fh->staged && fh->lease[0] && t - fh->lease_t >= LEASE_RENEW_S)
+            lease = fh->lease, lease_t = &fh->lease_t;
+    }
+    if (!lease)
+        return;
+    *lease_t = t;
+    const char *argv[] = {"touch", "-c", "--", lease, NULL};
     fr_error e;
     if (tr_spawn(h->tr, argv, 256, &h->lease_proc, &e))
         h->lease_proc = NULL; /* tried again in a minute; a running worker has the scene mapped meanwhile */
+}
+
+/* Removes the leases frame fi took on the hosts (stage hook): the run no
+ * longer needs its scenes. */
+static void release_leases(sched *s, int fi)
+{
+    frame *fr = &s->frames[fi];
+    for (int i = 0; fr->fh && i < s->nhosts; i++) {
+        frame_host *fh = &fr->fh[i];
+        fr_error ignore;
+        if (fh->staged && fh->lease[0] && !s->hosts[i].dropped && s->hosts[i].tr)
+            tr_remove(s->hosts[i].tr, fh->lease, &ignore); /* one left behind goes stale in ten minutes */
+        fh->lease[0] = 0;
+    }
+}
+
+/* Every row of frame fi is saved: its leases go and the caller is told. */
+static int frame_done(sched *s, int fi, fr_error *err)
+{
+    frame *fr = &s->frames[fi];
+    if (fr->done)
+        return 0;
+    fr->done = 1;
+    s->st->frames_done++;
+    release_leases(s, fi);
+    const sched_hooks *k = &s->p->hooks;
+    return k->frame_done ? k->frame_done(k->ctx, fi, err) : 0;
+}
+
+/* Every frame asked for and every row saved. */
+static int all_done(const sched *s)
+{
+    return s->fed_all && s->rows_done >= s->rows_total;
 }
 
 static int loop(sched *s, fr_error *err)
@@ -632,7 +814,7 @@ static int loop(sched *s, fr_error *err)
     struct pollfd *pfd = NULL;
     int cap_pfd = 0;
     int rc = 0;
-    while (s->rows_done < s->rows_total) {
+    while (!all_done(s)) {
         if (s->p->stop && *s->p->stop) {
             rc = fr_fail(err, "interrupted");
             break;
@@ -648,12 +830,19 @@ static int loop(sched *s, fr_error *err)
             lease_tick(s, i);
             /* A renewal holds a channel for a moment: a worker started then
              * could be refused one on a host that takes just its slots. */
-            while (!h->dropped && !h->pending && !h->lease_proc && h->running < h->slots &&
+            while (!rc && !h->dropped && !h->pending && !h->lease_proc && h->running < h->slots &&
                    now(s) >= h->retry_at) {
-                int si = pick(s, i);
+                int si = pick(s, i, err);
+                if (si == -2)
+                    rc = -1;
                 if (si < 0)
                     break;
                 fr_error e2;
+                if (stage(s, i, &s->slabs[si], &e2)) {
+                    h->failures++;
+                    drop_host(s, i, e2.msg);
+                    break;
+                }
                 if (start(s, i, si, &e2) == 0) {
                     h->start_streak = 0;
                     continue;
@@ -677,6 +866,10 @@ static int loop(sched *s, fr_error *err)
                 break;
             }
         }
+        if (rc)
+            break;
+        if (all_done(s))
+            break; /* the last frames came with nothing to render */
         int waiting = pending_hosts(s) > 0;
         for (int i = 0; i < s->nhosts; i++)
             waiting |= !s->hosts[i].dropped && s->hosts[i].retry_at > now(s);
@@ -719,6 +912,19 @@ static int loop(sched *s, fr_error *err)
     return rc;
 }
 
+static void free_all(sched *s)
+{
+    for (int i = 0; i < s->nslabs; i++) {
+        free(s->slabs[i].failed_hosts);
+        cont_drop(&s->slabs[i]);
+    }
+    for (int i = 0; i < s->nframes; i++)
+        free(s->frames[i].fh);
+    free(s->frames);
+    free(s->slabs);
+    free(s->run);
+}
+
 int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats *st, fr_error *err)
 {
     sched s;
@@ -729,10 +935,15 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
     s.nhosts = nhosts;
     s.st = st;
     s.t0 = now(&s);
-    if (make_slabs(&s))
+    sched_frame first = {p->spec, p->jobdir, p->have, p->base, p->sums, p->label};
+    if (add_frame(&s, &first)) {
+        free_all(&s);
         return fr_fail(err, "out of memory");
-    st->slabs = s.nslabs;
-    int rc = loop(&s, err);
+    }
+    s.fed_all = !p->hooks.next_frame;
+    int rc = s.frames[0].rows_total ? 0 : frame_done(&s, 0, err);
+    if (!rc)
+        rc = loop(&s, err);
     for (int r = s.nrun - 1; r >= 0; r--) {
         tr_proc_kill(s.run[r].proc);
         finish(&s, r);
@@ -742,21 +953,20 @@ int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats 
         hosts[i].lease_proc = NULL;
     }
     remove_leftovers(&s);
+    for (int f = 0; f < s.nframes; f++)
+        release_leases(&s, f);
     progress(&s);
     if (rc) {
         char missing[400], why[sizeof err->msg];
         snprintf(why, sizeof why, "%s", err->msg);
-        missing_text(&s, missing, sizeof missing);
+        int fi = first_open_frame(&s);
+        const char *label = s.frames[fi].f.label;
+        missing_text(&s, fi, missing, sizeof missing);
         char kept[4400];
-        job_kept_note(p->jobdir, kept, sizeof kept);
-        fr_fail(err, "%s; rows %s not rendered (%s)", why, missing, kept);
+        job_kept_note(s.frames[fi].f.jobdir, kept, sizeof kept);
+        fr_fail(err, "%s; %s%srows %s not rendered (%s)", why, label ? label : "", label ? " " : "", missing, kept);
     }
     st->wall_s = now(&s) - s.t0;
-    for (int i = 0; i < s.nslabs; i++) {
-        free(s.slabs[i].failed_hosts);
-        cont_drop(&s.slabs[i]);
-    }
-    free(s.slabs);
-    free(s.run);
+    free_all(&s);
     return rc;
 }

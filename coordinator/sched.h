@@ -32,6 +32,17 @@
  *   the file is unlinked there as the worker starts, and read through an
  *   open descriptor).
  *
+ * - Several frames (an animation) run as one stream of slabs over the same
+ *   hosts (sched_hooks.next_frame): when every slab queued so far has
+ *   started and a slot is free, the next frame is asked for and its slabs
+ *   join the queue, so the slots that finish one frame's last slabs start
+ *   the next frame's at once.  Earlier frames' slabs go first (a retry of
+ *   frame 1 passes frame 2), straggler copies only once no frame is left.
+ *   Each frame has its own job directory, spec and rows; its scene is put
+ *   on a host (sched_hooks.stage) when the host first starts one of its
+ *   slabs, once per host and frame; sched_hooks.frame_done is told as soon
+ *   as all of a frame's rows are saved, so frames end as they complete.
+ *
  * Nothing here prints: what happens is reported through sched_hooks, and
  * the clock and the wait for activity can be replaced (tests drive the
  * scheduler with a fake backend and a virtual clock).
@@ -72,6 +83,19 @@ typedef struct {
     double busy_s;             /**< sum of the run time of accepted slabs */
 } sched_host;
 
+/** One frame of a run: the image to render and where its slabs go.  The
+ * first frame is the one sched_params names; a run with the next_frame
+ * hook asks for more.  The pointers must stay valid until the frame is
+ * done (frame_done) or the run ends. */
+typedef struct {
+    job_spec spec;
+    const char *jobdir;
+    const unsigned char *have; /**< rows already finished (resume), height entries; NULL = none */
+    const uint32_t *base;      /**< as sched_params.base */
+    int sums;                  /**< as sched_params.sums */
+    const char *label;         /**< what messages call it ("frame 12"), NULL for a single image */
+} sched_frame;
+
 /** What happened (sched_event.kind). */
 typedef enum {
     SCHED_SLAB_DONE,           /**< a slab was accepted and saved */
@@ -87,6 +111,7 @@ typedef struct {
     sched_event_kind kind;
     double t;                  /**< seconds since sched_run began */
     int host;                  /**< index into the hosts array */
+    int frame;                 /**< the slab's frame: 0 for the first (sched_params'), 1 for the next... */
     uint32_t y0, y1;           /**< the slab (SLAB_*, COPY); 0 and 0 otherwise */
     const char *text;          /**< one line saying what happened, for a log */
 } sched_event;
@@ -108,6 +133,25 @@ typedef struct {
      * with pending hosts and no admit hook waits for nothing: they are
      * dropped at once. */
     void (*admit)(void *ctx, sched_host *hosts, int nhosts);
+    /** Frames after the first: called when every slab queued so far has
+     * started and a slot is free, with the index the frame will have (1,
+     * 2, ...).  Fills *next and returns 0; 1 when there is no frame left;
+     * -1 with err set to end the run (as a failure).  A frame with no rows
+     * to render is done at once.  NULL: the run is the first frame alone. */
+    int (*next_frame)(void *ctx, int frame, sched_frame *next, fr_error *err);
+    /** Puts frame's scene on host i before the host starts the first of
+     * that frame's slabs (once per host and frame): the worker's path of it
+     * into scene[scene_cap], and the render's lease on it (stage_scene) into
+     * lease[lease_cap] ("" for none), which the scheduler renews while the
+     * frame runs and removes (tr_remove) once it is done or the run ends.
+     * -1 with err: the host is dropped.  NULL: every frame uses the host's
+     * scene (sched_host.scene). */
+    int (*stage)(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
+                 size_t lease_cap, fr_error *err);
+    /** Every row of frame is saved in its job directory (its other slabs'
+     * copies are stopped): called at once, so frames finish in the order
+     * they complete.  -1 with err ends the run (as a failure). */
+    int (*frame_done)(void *ctx, int frame, fr_error *err);
     void *ctx;
 } sched_hooks;
 
@@ -122,6 +166,7 @@ typedef struct {
                                     never spans rows of two bases */
     int sums;                  /**< workers keep each pixel's sample sums (--sums), and a partial without
                                     them does not check out (job_sums) */
+    const char *label;         /**< what messages call this first frame (sched_frame.label); NULL = none */
     double stop_at;            /**< on the hooks' clock: stop there, as when stop is set, with
                                     sched_stats.timed_out; 0 = no limit */
     int slab_rows;             /**< rows per slab; 0 = slabs that shrink toward the end (the rows left over
@@ -137,7 +182,9 @@ typedef struct {
 
 /** Totals of a run. */
 typedef struct {
-    int slabs;                 /**< slabs in this run (not counting resumed rows) */
+    int slabs;                 /**< slabs in this run (not counting resumed rows), every frame's */
+    int frames;                /**< frames in this run (1 without next_frame), and done of them */
+    int frames_done;
     int retries;               /**< failed attempts */
     int duplicates;            /**< straggler copies started */
     double wall_s;
@@ -149,9 +196,10 @@ typedef struct {
     int timed_out;             /**< stopped at stop_at */
 } sched_stats;
 
-/** Renders every row not in p->have on hosts[0..nhosts).  Returns 0 when
- * all rows are saved in the job directory; otherwise -1 with err naming
- * the missing rows and the reason (no host left, a slab failed too often,
+/** Renders every row not in p->have on hosts[0..nhosts), and those of
+ * each frame the next_frame hook gives.  Returns 0 when all rows of every
+ * frame are saved in their job directories; otherwise -1 with err naming
+ * the missing rows (of the first frame not done) and the reason (no host left, a slab failed too often,
  * interrupted, the job directory cannot be written).  Every process it
  * started is gone when it returns. */
 int sched_run(const sched_params *p, sched_host *hosts, int nhosts, sched_stats *st, fr_error *err);

@@ -6,7 +6,8 @@
  * another host, a lost host's slabs go elsewhere without counting as
  * failures, lying partials are refused, --resume renders only what is
  * missing, and a slab that fails everywhere ends the run with the rows
- * named. */
+ * named; the frames of an animation run as one stream of slabs, frame 2
+ * starting while frame 1's last slab runs. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,7 +17,7 @@
 #include "sched.h"
 #include "support/fakehost.h"
 
-enum { W = 8, MAX_EVENTS = 4096 };
+enum { W = 8, MAX_EVENTS = 4096, MAX_FRAMES = 4 };
 
 typedef struct {
     sched_event_kind kind;
@@ -41,6 +42,14 @@ typedef struct {
     sched_stats st;
     fr_error err;
     int rc;
+    /* frames after the first (test_frames_*) */
+    int nframes;               /* frames in all, the first included */
+    char fjob[MAX_FRAMES][64]; /* their job directories (fjob[0] is jobdir) */
+    int staged[MAX_FRAMES][FAKE_MAX_HOSTS];
+    int done[MAX_FRAMES];      /* the order in which frame_done came, 1 based; 0 = not done */
+    double done_t[MAX_FRAMES];
+    int ndone;
+    char label[MAX_FRAMES][16];
 } run;
 
 static void on_event(void *ctx, const sched_event *e)
@@ -597,8 +606,173 @@ static void test_pending_without_hook(void)
     teardown(r);
 }
 
+/* The frames of an animation (the next_frame, stage and frame_done hooks):
+ * frame f's job directory is fjob[f], its scene "fF.fbin" on every host. */
+static int next_frame(void *ctx, int f, sched_frame *next, fr_error *err)
+{
+    run *r = ctx;
+    if (f >= r->nframes)
+        return 1;
+    snprintf(r->fjob[f], sizeof r->fjob[f], "/tmp/franja-sched.XXXXXX");
+    if (!mkdtemp(r->fjob[f]))
+        return fr_fail(err, "mkdtemp failed");
+    snprintf(r->label[f], sizeof r->label[f], "frame %d", f + 1);
+    *next = (sched_frame){.spec = r->p.spec, .jobdir = r->fjob[f], .label = r->label[f]};
+    return job_open(r->fjob[f], &next->spec, 0, err) ? -1 : 0;
+}
+
+static int stage(void *ctx, int f, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
+                 size_t lease_cap, fr_error *err)
+{
+    (void)h, (void)err, (void)lease_cap;
+    run *r = ctx;
+    r->staged[f][host_i]++;
+    snprintf(scene, scene_cap, "f%d.fbin", f);
+    lease[0] = 0;
+    return 0;
+}
+
+static int frame_done(void *ctx, int f, fr_error *err)
+{
+    (void)err;
+    run *r = ctx;
+    r->done[f] = ++r->ndone;
+    r->done_t[f] = r->world.now;
+    return 0;
+}
+
+static run *setup_frames(int nframes, int height, int slab_rows)
+{
+    run *r = setup(height, slab_rows);
+    r->nframes = nframes;
+    snprintf(r->fjob[0], sizeof r->fjob[0], "%s", r->jobdir);
+    snprintf(r->label[0], sizeof r->label[0], "frame 1");
+    r->p.label = r->label[0];
+    r->p.hooks.next_frame = next_frame;
+    r->p.hooks.stage = stage;
+    r->p.hooks.frame_done = frame_done;
+    return r;
+}
+
+/* Every row of frame f's job directory holds the fake pixels. */
+static int frame_ok(run *r, int f)
+{
+    char keep[64];
+    snprintf(keep, sizeof keep, "%s", r->jobdir);
+    snprintf(r->jobdir, sizeof r->jobdir, "%s", r->fjob[f]);
+    int ok = stitched_ok(r);
+    snprintf(r->jobdir, sizeof r->jobdir, "%s", keep);
+    return ok;
+}
+
+static void teardown_frames(run *r)
+{
+    for (int f = 1; f < r->nframes; f++)
+        if (r->fjob[f][0])
+            job_remove(r->fjob[f]);
+    teardown(r);
+}
+
+/* The frame a spawn rendered, from its scene's name. */
+static int spawn_frame(const fake_spawn *sp)
+{
+    return sp->scene[0] == 'f' ? atoi(sp->scene + 1) : -1;
+}
+
+/* Two frames on two slots: when frame 1's slabs are all started and one
+ * slot is free (its last slab is slow), that slot starts frame 2 at once
+ * instead of waiting for frame 1's tail; each frame is done as soon as
+ * its rows are saved (here frame 2 first), and its scene went to the host
+ * once. */
+static void test_frames_overlap(void)
+{
+    run *r = setup_frames(2, 16, 4);
+    /* 4 slabs a frame; the second process (frame 1's rows 4:8) takes 8 s. */
+    host(r, "a", 2, (fake_script){.duration = 1, .durations = {1, 8}});
+    go(r);
+    CHECK(r->rc == 0, "two-frame run failed: %s", r->err.msg);
+    CHECK(r->st.frames == 2 && r->st.frames_done == 2, "%d frames, %d done", r->st.frames, r->st.frames_done);
+    CHECK(r->st.slabs == 8, "%d slabs, expected 8", r->st.slabs);
+    double last_end_1 = 0, first_start_2 = 1e9;
+    int n1 = 0, n2 = 0;
+    for (int i = 0; i < r->world.nspawn; i++) {
+        const fake_spawn *sp = &r->world.spawn[i];
+        int f = spawn_frame(sp);
+        if (f == 0 && sp->end > last_end_1)
+            last_end_1 = sp->end;
+        if (f == 1 && sp->start < first_start_2)
+            first_start_2 = sp->start;
+        n1 += f == 0;
+        n2 += f == 1;
+    }
+    CHECK(n1 >= 4 && n2 >= 4, "%d and %d processes for the two frames, expected 4 each at least", n1, n2);
+    CHECK(first_start_2 < last_end_1 - 1.5, "frame 2's first slab started at %.1f s, frame 1's last ended at "
+          "%.1f s: no overlap", first_start_2, last_end_1);
+    /* Frame 2 ends first (frame 1 waits for its slow slab): frames are
+     * done as they complete. */
+    CHECK(r->done[1] == 1 && r->done[0] == 2, "frames done in the order %d, %d", r->done[0], r->done[1]);
+    CHECK(r->done_t[0] >= last_end_1 - 0.01 && r->done_t[0] < last_end_1 + 0.5,
+          "frame 1 done at %.1f s, its last slab ended at %.1f s", r->done_t[0], last_end_1);
+    CHECK(r->world.peak[0] == 2, "peak %d processes on 2 slots", r->world.peak[0]);
+    /* One slot ran 3 quick slabs of frame 1 then all of frame 2 while the
+     * other ran the slow one: about 8 s in all, not 8 s and then frame 2's
+     * 2 s on two slots. */
+    CHECK(r->st.wall_s < 9, "took %.1f virtual seconds; frame by frame takes 10", r->st.wall_s);
+    CHECK(r->staged[0][0] == 1 && r->staged[1][0] == 1, "scenes staged %d and %d times, expected once each",
+          r->staged[0][0], r->staged[1][0]);
+    CHECK(frame_ok(r, 0) && frame_ok(r, 1), "a frame's stitched rows are not the fake pixels");
+    teardown_frames(r);
+}
+
+/* A retry of frame 1's slab goes before frame 2's slabs, on the other
+ * host; a host lost in the middle of the range is dropped, its slabs go
+ * elsewhere, and every frame is done, each scene staged once per host
+ * that ran it. */
+static void test_frames_host_lost(void)
+{
+    run *r = setup_frames(3, 16, 2);
+    int a = host(r, "a", 2, (fake_script){.duration = 1});
+    int b = host(r, "b", 2, (fake_script){.duration = 1, .die_at = 3.5});
+    go(r);
+    CHECK(r->rc == 0, "three-frame run with a lost host failed: %s", r->err.msg);
+    CHECK(r->sh[b].dropped, "the lost host was not dropped");
+    CHECK(r->st.frames_done == 3, "%d frames done", r->st.frames_done);
+    for (int f = 0; f < 3; f++) {
+        CHECK(frame_ok(r, f), "frame %d's stitched rows are not the fake pixels", f + 1);
+        CHECK(r->staged[f][a] == 1, "frame %d staged %d times on a", f + 1, r->staged[f][a]);
+        CHECK(r->staged[f][b] <= 1, "frame %d staged %d times on b", f + 1, r->staged[f][b]);
+    }
+    CHECK(r->staged[2][b] == 0, "b got frame 3's scene after it was lost");
+    CHECK(r->done[0] == 1 && r->done[1] == 2 && r->done[2] == 3, "frames done in the order %d %d %d", r->done[0],
+          r->done[1], r->done[2]);
+    teardown_frames(r);
+}
+
+/* An interrupt in the second frame: the first is done, the error names
+ * the second frame's missing rows, and its finished slabs stay. */
+static void test_frames_interrupt(void)
+{
+    run *r = setup_frames(3, 16, 4);
+    r->stop_after_done = 6;
+    host(r, "a", 1, (fake_script){.duration = 1});
+    go(r);
+    CHECK(r->rc != 0, "an interrupted run succeeded");
+    CHECK(r->done[0] == 1 && !r->done[1] && !r->done[2], "frames done: %d %d %d", r->done[0], r->done[1],
+          r->done[2]);
+    CHECK(strstr(r->err.msg, "interrupted") && strstr(r->err.msg, "frame 2 rows 8:16 not rendered"), "message: %s",
+          r->err.msg);
+    unsigned char have[16];
+    fr_error err;
+    CHECK(job_scan(r->fjob[1], &r->p.spec, have, NULL, NULL, &err) == 8, "frame 2 does not keep its 8 rows done");
+    CHECK(r->fjob[2][0] == 0, "frame 3 was asked for before frame 2's slabs were all started");
+    teardown_frames(r);
+}
+
 int main(void)
 {
+    test_frames_overlap();
+    test_frames_host_lost();
+    test_frames_interrupt();
     test_plain();
     test_guided();
     test_straggler();

@@ -121,7 +121,8 @@ static int fake_spawn_proc(void *impl, tr_proc *p, const char *const *argv, fr_e
     fp->fails = s->fail_always || k < s->fail_first;
     fp->hangs = s->hang;
     fp->lie = s->lie;
-    w->spawn[fp->rec] = (fake_spawn){fh->i, r.slab.y0, r.slab.y1, w->now, 0, 0};
+    w->spawn[fp->rec] = (fake_spawn){fh->i, r.slab.y0, r.slab.y1, w->now, 0, 0, 0, ""};
+    snprintf(w->spawn[fp->rec].scene, sizeof w->spawn[fp->rec].scene, "%s", r.slab.scene);
     if (++w->running[fh->i] > w->peak[fh->i])
         w->peak[fh->i] = w->running[fh->i];
     p->impl = fp;
@@ -148,6 +149,7 @@ static void end(fake_host *fh, fake_proc *fp, int outcome)
     if (rec->outcome)
         return;
     rec->outcome = outcome;
+    rec->end = fh->w->now;
     fh->w->running[fh->i]--;
 }
 

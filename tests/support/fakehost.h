@@ -50,6 +50,8 @@ typedef struct {
     double start;
     int killed;                /**< killed before it ended */
     int outcome;               /**< 0 running, 1 exited 0, 2 exited 1, 3 lost */
+    double end;                /**< when it ended (exited, killed or lost); valid when outcome or killed */
+    char scene[64];            /**< the scene path it was given (cut short) */
 } fake_spawn;
 
 /** The fake hosts and what happened to them. */
