@@ -78,6 +78,27 @@ typedef struct {
     uint64_t hash;
 } open_ctx;
 
+int cl_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, char *remote, size_t cap,
+             char *lease, size_t lease_cap, int *uploaded, fr_error *err)
+{
+    if (stage_scene(tr, scene, hash, remote, cap, lease, lease_cap, uploaded, err))
+        return -1;
+    /* The cache stays bounded; a failure to trim it does not stop the render. */
+    uint64_t limit = entry->cache ? entry->cache : HOSTS_CACHE_DEFAULT, bytes;
+    int removed;
+    fr_error e;
+    if (stage_evict(tr, remote, limit, &removed, &bytes, &e))
+        tr_note(tr, "%s", e.msg);
+    else if (removed) {
+        char lim[32], gone[32];
+        hosts_format_size(limit, lim);
+        hosts_format_size(bytes, gone);
+        tr_note(tr, "scene cache over its limit (%s): removed %d least recently used scene%s (%s)", lim, removed,
+                removed == 1 ? "" : "s", gone);
+    }
+    return 0;
+}
+
 static int probe_and_stage(cl_host *h, int i, void *vctx, fr_error *err)
 {
     (void)i;
@@ -86,23 +107,8 @@ static int probe_and_stage(cl_host *h, int i, void *vctx, fr_error *err)
         return -1;
     if (!c->scene)
         return 0;
-    if (stage_scene(h->tr, c->scene, c->hash, h->scene, sizeof h->scene, h->lease, sizeof h->lease,
-                    &h->uploaded, err))
-        return -1;
-    /* The cache stays bounded; a failure to trim it does not stop the render. */
-    uint64_t limit = h->entry->cache ? h->entry->cache : HOSTS_CACHE_DEFAULT, bytes;
-    int removed;
-    fr_error e;
-    if (stage_evict(h->tr, h->scene, limit, &removed, &bytes, &e))
-        tr_note(h->tr, "%s", e.msg);
-    else if (removed) {
-        char lim[32], gone[32];
-        hosts_format_size(limit, lim);
-        hosts_format_size(bytes, gone);
-        tr_note(h->tr, "scene cache over its limit (%s): removed %d least recently used scene%s (%s)", lim, removed,
-                removed == 1 ? "" : "s", gone);
-    }
-    return 0;
+    return cl_stage(h->tr, h->entry, c->scene, c->hash, h->scene, sizeof h->scene, h->lease, sizeof h->lease,
+                    &h->uploaded, err);
 }
 
 void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash)

@@ -40,6 +40,14 @@ void cl_each(cl_host *hosts, int n, const tr_options *o, cl_step step, void *ctx
  * not NULL, stage the scene with content hash `hash` (stage_scene). */
 void cl_open(cl_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash);
 
+/** The render's step after the probe, for one more scene on a ready host
+ * (the frames of an animation): stage_scene (remote, lease, *uploaded as
+ * it says), then the host's scene cache trimmed to its limit (stage_evict;
+ * what went, or why it could not, is a remark of the host).  -1 with err
+ * when the scene cannot be staged. */
+int cl_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, char *remote, size_t cap,
+             char *lease, size_t lease_cap, int *uploaded, fr_error *err);
+
 /** Hosts being made ready in the background (cl_start). */
 typedef struct cl_group cl_group;
 

@@ -1,5 +1,5 @@
-/* cmd_frames.c -- `franja render PATTERN --frames LIST`: one render per
- * frame, outputs that exist skipped. */
+/* cmd_frames.c -- `franja render PATTERN --frames LIST`: the walk over
+ * the frames (outputs that exist skipped), and the frame-by-frame run. */
 #include "cmd_frames.h"
 
 #include <errno.h>
@@ -9,7 +9,6 @@
 #include <sys/stat.h>
 
 #include "clock.h"
-#include "frames.h"
 
 /* argv with every string that holds (points into) one of the patterns
  * rewritten for frame f; NULL when out of memory or a name is too long.
@@ -88,11 +87,11 @@ int frames_check_plain(const char *scene)
     return 0;
 }
 
-int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn)
+int frames_begin(frames_iter *it, int argc, char **argv, const frames_job *job)
 {
+    memset(it, 0, sizeof *it);
     fr_error err;
-    frame_list fl;
-    if (frames_parse(job->list, &fl, &err)) {
+    if (frames_parse(job->list, &it->fl, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return 2;
     }
@@ -106,55 +105,102 @@ int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn
     if (what) {
         fprintf(stderr, "franja render: --frames: %s '%s' has no # for the frame number (e.g. "
                 "shots/f.####.json -o out/f.####.exr: each frame its own file)\n", what, name);
-        frames_free(&fl);
+        frames_free(&it->fl);
         return 2;
     }
-    const char *pats[] = {job->scene, job->out, job->jobdir, job->preview};
-    double t0 = clk_now();
-    size_t rendered = 0, skipped = 0;
-    int rc = 0;
-    for (size_t i = 0; i < fl.n && !rc; i++) {
-        uint32_t f = fl.v[i];
-        char scene[4096], out[4096];
-        char **v = frame_args(argc, argv, pats, 4, f);
-        if (!v || frames_subst(job->scene, f, scene, sizeof scene) || frames_subst(job->out, f, out, sizeof out)) {
+    it->job = *job;
+    it->argc = argc;
+    it->argv = argv;
+    it->t0 = clk_now();
+    return 0;
+}
+
+int frames_next(frames_iter *it, frames_one *one)
+{
+    const char *pats[] = {it->job.scene, it->job.out, it->job.jobdir, it->job.preview};
+    memset(one, 0, sizeof *one);
+    for (; it->i < it->fl.n; it->i++) {
+        uint32_t f = it->fl.v[it->i];
+        size_t k = it->i + 1;
+        if (frames_subst(it->job.scene, f, one->scene, sizeof one->scene) ||
+            frames_subst(it->job.out, f, one->out, sizeof one->out) ||
+            !(one->argv = frame_args(it->argc, it->argv, pats, 4, f))) {
             fprintf(stderr, "franja render: frame %u: out of memory or a file name too long\n", f);
-            if (v)
-                free_args(argc, v);
-            rc = 1;
-            break;
+            return 2;
         }
+        one->argc = it->argc;
+        one->number = f;
+        one->index = k;
         struct stat st;
-        if (!job->overwrite && !stat(out, &st)) {
+        if (!it->job.overwrite && !stat(one->out, &st)) {
             fprintf(stderr, "franja: frame %u (%zu of %zu): %s exists, skipped (--overwrite renders it again)\n",
-                    f, i + 1, fl.n, out);
-            skipped++;
-            free_args(argc, v);
+                    f, k, it->fl.n, one->out);
+            it->skipped++;
+            frames_put(one);
             continue;
         }
-        fprintf(stderr, "franja: frame %u (%zu of %zu): %s -> %s\n", f, i + 1, fl.n, scene, out);
-        if (make_parents(out)) {
-            fprintf(stderr, "franja render: frame %u: cannot make the directory of %s: %s\n", f, out, strerror(errno));
-            free_args(argc, v);
-            rc = 1;
-            break;
+        fprintf(stderr, "franja: frame %u (%zu of %zu): %s -> %s\n", f, k, it->fl.n, one->scene, one->out);
+        if (make_parents(one->out)) {
+            fprintf(stderr, "franja render: frame %u: cannot make the directory of %s: %s\n", f, one->out,
+                    strerror(errno));
+            frames_put(one);
+            return 2;
         }
-        rc = fn(argc, v);
-        free_args(argc, v);
-        if (!rc) {
-            rendered++;
-            continue;
-        }
-        if (rc == 130)
-            fprintf(stderr, "franja: interrupted at frame %u (%s): %zu of %zu frames done; rerun with --resume "
-                    "to go on\n", f, out, rendered + skipped, fl.n);
-        else
-            fprintf(stderr, "franja render: frame %u (%s -> %s) failed; %zu of %zu frames done\n", f, scene, out,
-                    rendered + skipped, fl.n);
+        it->i++;
+        return 0;
     }
+    return 1;
+}
+
+void frames_put(frames_one *one)
+{
+    if (one->argv)
+        free_args(one->argc, one->argv);
+    one->argv = NULL;
+}
+
+void frames_wrote(frames_iter *it)
+{
+    it->rendered++;
+}
+
+void frames_failed(frames_iter *it, uint32_t number, const char *scene, const char *out, int rc)
+{
+    if (rc == 130)
+        fprintf(stderr, "franja: interrupted at frame %u (%s): %zu of %zu frames done; rerun with --resume "
+                "to go on\n", number, out, it->rendered + it->skipped, it->fl.n);
+    else
+        fprintf(stderr, "franja render: frame %u (%s -> %s) failed; %zu of %zu frames done\n", number, scene, out,
+                it->rendered + it->skipped, it->fl.n);
+}
+
+int frames_end(frames_iter *it, int rc)
+{
     if (!rc)
         fprintf(stderr, "franja: frames: %zu of %zu done (%zu rendered, %zu skipped: output exists) in %.2f s\n",
-                rendered + skipped, fl.n, rendered, skipped, clk_now() - t0);
-    frames_free(&fl);
+                it->rendered + it->skipped, it->fl.n, it->rendered, it->skipped, clk_now() - it->t0);
+    frames_free(&it->fl);
     return rc;
+}
+
+int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn)
+{
+    frames_iter it;
+    if (frames_begin(&it, argc, argv, job))
+        return 2;
+    int rc = 0, r;
+    frames_one one;
+    while (!rc && (r = frames_next(&it, &one)) != 1) {
+        if (r) {
+            rc = r - 1;
+            break;
+        }
+        rc = fn(one.argc, one.argv);
+        frames_put(&one);
+        if (!rc)
+            frames_wrote(&it);
+        else
+            frames_failed(&it, one.number, one.scene, one.out, rc);
+    }
+    return frames_end(&it, rc);
 }

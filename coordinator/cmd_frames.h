@@ -1,12 +1,22 @@
 /** @file cmd_frames.h
- * `franja render PATTERN --frames LIST`: renders an animation frame by
- * frame through the single-image render, each frame with its own output
- * and job directory (so --resume and the job lock work per frame), and
- * skips a frame whose output exists unless --overwrite.  The directories
- * of a frame's output are made when missing.
+ * `franja render PATTERN --frames LIST`: the frames of an animation, each
+ * with its own output and job directory (so --resume and the job lock work
+ * per frame); a frame whose output exists is skipped unless --overwrite,
+ * and the directories of a frame's output are made when missing.
+ *
+ * frames_begin / frames_next / frames_end walk the list for a render that
+ * runs the frames together over one set of hosts (cmd_render.c);
+ * frames_run renders them one after another through the single-image
+ * render.  Both print the same lines: each frame announced or skipped, a
+ * frame that fails or is interrupted named, and a summary.
  */
 #ifndef FRANJA_CMD_FRAMES_H
 #define FRANJA_CMD_FRAMES_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "frames.h"
 
 /** Renders one image: `franja render` with argv as given (argv[0] is the
  * command's name); returns its exit status. */
@@ -22,9 +32,51 @@ typedef struct {
     const char *scene, *out, *jobdir, *preview;
 } frames_job;
 
-/** Checks the patterns, then renders each frame of job->list with fn,
- * printing a line per frame and a summary on stderr.  Stops at the first
- * frame that fails and returns its status (1 failure, 2 usage error, 130
+/** A walk over the frames (fields private but for the counts). */
+typedef struct {
+    frames_job job;
+    int argc;
+    char **argv;
+    frame_list fl;
+    size_t i;                  /**< frames of the list looked at */
+    size_t rendered, skipped;  /**< frames written by this run, frames skipped (output exists) */
+    double t0;
+} frames_iter;
+
+/** One frame to render. */
+typedef struct {
+    uint32_t number;           /**< its frame number */
+    size_t index;              /**< its place in the list, from 1 */
+    char scene[4096], out[4096];
+    int argc;
+    char **argv;               /**< the command line with the patterns filled in (frames_put frees it) */
+} frames_one;
+
+/** Parses the list and checks the patterns; 0, or 2 (usage error,
+ * printed).  Takes nothing: argv and job's strings must outlive it. */
+int frames_begin(frames_iter *it, int argc, char **argv, const frames_job *job);
+
+/** The next frame to render: passes over (and says so) frames whose
+ * output exists, announces the frame and makes its output's directories.
+ * 0 with *one filled; 1 when no frame is left; otherwise 1 + the exit
+ * status (the failure printed). */
+int frames_next(frames_iter *it, frames_one *one);
+
+/** Frees what frames_next gave *one. */
+void frames_put(frames_one *one);
+
+/** One frame written (counts it). */
+void frames_wrote(frames_iter *it);
+
+/** A frame failed with exit status rc (130: interrupted): prints which and
+ * how many frames are done. */
+void frames_failed(frames_iter *it, uint32_t number, const char *scene, const char *out, int rc);
+
+/** Ends the walk: with rc 0 prints the summary; frees the list; returns rc. */
+int frames_end(frames_iter *it, int rc);
+
+/** The whole animation frame by frame with fn; stops at the first frame
+ * that fails and returns its status (1 failure, 2 usage error, 130
  * interrupted: the finished slabs of that frame stay for --resume); 0
  * when every frame's output exists; 2 for a bad list or pattern. */
 int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn);

@@ -465,7 +465,17 @@ typedef struct {
     int rows_before;           /* rows done before this run (resumed) */
     mon_host *mh;              /* nhosts entries for the monitor */
     char (*mstate)[320];       /* their state strings */
+    struct anim_run *fx;     /* the frames of an animation run together, or NULL */
 } reporter;
+
+/* The frames of an animation run over one set of hosts (render_frames);
+ * the scheduler's frame hooks. */
+typedef struct anim_run anim_run;
+static int rf_next(void *ctx, int frame, sched_frame *next, fr_error *err);
+static int rf_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
+                    size_t lease_cap, fr_error *err);
+static int rf_done(void *ctx, int frame, fr_error *err);
+static void rf_rendered(anim_run *fx, int frame, int host);
 
 /* A host's event to the JSON stream and the monitor. */
 static void host_event(reporter *r, const char *what, const char *host, uint32_t y0, uint32_t y1, double t,
@@ -492,6 +502,8 @@ static void on_event(void *ctx, const sched_event *ev)
     };
     if (ev->kind != SCHED_SLAB_DONE && ev->host >= 0 && ev->host < r->nhosts)
         host_event(r, what[ev->kind], r->hosts[ev->host].name, ev->y0, ev->y1, ev->t, ev->text);
+    if (ev->kind == SCHED_SLAB_DONE && r->fx)
+        rf_rendered(r->fx, ev->frame, ev->host);
     if (ev->kind == SCHED_SLAB_DONE || (r->tty && ev->kind == SCHED_COPY))
         return;
     clear_line(r);
@@ -593,7 +605,10 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
         snprintf(s->scene, sizeof s->scene, "%s", h.scene);
         snprintf(s->lease, sizeof s->lease, "%s", h.lease);
         s->lease_t = clk_now();
-        if (table || !isatty(2))
+        if ((table || !isatty(2)) && j->rep && j->rep->fx) /* each frame's scene is said as it is staged */
+            fprintf(stderr, "franja: host %s: %s %s, %d slots, %s (%.2f s)\n", s->name, h.info.os, h.info.arch,
+                    s->slots, h.info.version, h.ready_s);
+        else if (table || !isatty(2))
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", s->name, h.info.os,
                     h.info.arch, s->slots, h.info.version,
                     hosts_is_local(h.entry) ? "local" : h.uploaded ? "uploaded" : "already there", h.ready_s);
@@ -636,6 +651,7 @@ typedef struct {
     int npass;                 /* passes run */
     uint32_t stopped;          /* the samples per pixel of the pass the limit stopped; 0 = none */
     sched_stats total;         /* over the passes */
+    const char *label;         /* an animation's frame: "frame N"; NULL otherwise */
 } passes;
 
 static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_window *win, float *rgb,
@@ -724,9 +740,11 @@ static void add_stats(sched_stats *to, const sched_stats *st)
 /* Connects the hosts and runs the slabs not yet in the job directory.  The
  * render starts as soon as one host is ready; the others join when they
  * are (a host that accepts a connection and never answers costs nothing
- * unless it is the only one). */
+ * unless it is the only one).  With fx, ps is the first frame of an
+ * animation, and the next frames follow over the same hosts (fx's hooks
+ * stage each frame's scene and write each frame); fbin is then not used. */
 static int run_slabs(const render_args *a, const hosts_table *table, const char *fbin, passes *ps,
-                     pg_reporter *pg, mon_server *mon, char *used, size_t used_cap, fr_error *err)
+                     pg_reporter *pg, mon_server *mon, char *used, size_t used_cap, anim_run *fx, fr_error *err)
 {
     const job_spec *spec = &ps->spec;
     const char *jobdir = ps->jobdir;
@@ -740,7 +758,7 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
     if (cl && sh && mh && mstate) {
         for (int i = 0; i < n; i++)
             cl[i].entry = &table->v[i];
-        g = cl_start(cl, n, &a->tr, fbin, spec->hash);
+        g = cl_start(cl, n, &a->tr, fx ? NULL : fbin, spec->hash);
     }
     if (!g) {
         free(cl);
@@ -755,7 +773,8 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
         sh[i].slots = table->v[i].cores; /* a guess for the slab size until it is ready */
     }
     reporter rep = {.tty = isatty(2), .hosts = sh, .nhosts = n, .spec = spec, .pg = pg, .mon = mon,
-                    .rows_before = rows_job - rows_missing, .mh = mh, .mstate = mstate, .total = rows_missing};
+                    .rows_before = rows_job - rows_missing, .mh = mh, .mstate = mstate, .total = rows_missing,
+                    .fx = fx};
     joiner j = {a, g, cl, &rep, 0};
     rep.join = &j;
     monitor_update(&rep);
@@ -826,6 +845,12 @@ static int run_slabs(const render_args *a, const hosts_table *table, const char 
                                * where signals do not reach it (worker/lifeline.h). */
                               .lifeline = !a->slurm.on,
                               .hooks = {.event = on_event, .progress = on_progress, .admit = on_admit, .ctx = &rep}};
+            if (fx) {
+                p.label = ps->label;
+                p.hooks.next_frame = rf_next;
+                p.hooks.stage = rf_stage;
+                p.hooks.frame_done = rf_done;
+            }
             rc = sched_run(&p, sh, n, &st, err);
             add_stats(&ps->total, &st);
             if (rc && st.timed_out && !stop_flag) {
@@ -915,343 +940,654 @@ static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_wind
     return 0;
 }
 
-int cmd_render(int argc, char **argv)
-{
+/* One image of a render, from its job lock to its output: the render of
+ * one scene, or one frame of an animation. */
+typedef struct {
     render_args a;
-    /* Parsed in a copy: argv stays as typed, for the lock file's command
-     * line and the salloc hint. */
-    char **args = opt_copy(argc, argv);
-    int pr = args ? parse(argc, args, &a) : 2;
-    free(args);
-    if (pr)
-        return pr == 1 ? 0 : 2;
-    static int in_frames; /* rendering one frame of --frames */
-    if (a.frames && !in_frames) {
-        frames_job fj = {a.frames, a.overwrite, a.scene, a.out, a.jobdir, a.preview};
-        in_frames = 1;
-        int rc = frames_run(argc, argv, &fj, cmd_render);
-        in_frames = 0;
-        return rc;
-    }
-    if (!a.frames && frames_check_plain(a.scene))
-        return 2;
-    fr_error err;
-    if (out_check(a.out, &err) || (a.preview && out_check_type(a.preview, &err))) {
-        fprintf(stderr, "franja render: %s\n", err.msg);
-        return 2;
-    }
+    int argc;
+    char **argv;               /* as typed, for the lock file (not owned) */
     char jobdir[4096], fbin[4200];
-    if (a.jobdir)
-        snprintf(jobdir, sizeof jobdir, "%s", a.jobdir);
+    job_lock lk;
+    int locked;
+    job_spec spec;
+    fr_tonemap tm;
+    int crop_rows;
+    unsigned char *have;
+    uint32_t *base;
+    float *rgb;
+    passes ps;
+    int rows_job, rows_have;
+    double t0;
+    pg_reporter *pg;           /* --progress json, or NULL */
+    mon_server *mon;           /* --monitor, or NULL */
+} image;
+
+/* Takes the image's job lock and checks what its job directory holds
+ * against --resume and --fresh.  0, or the exit status (said). */
+static int image_lock(image *im)
+{
+    render_args *a = &im->a;
+    fr_error err;
+    if (a->jobdir)
+        snprintf(im->jobdir, sizeof im->jobdir, "%s", a->jobdir);
     else
-        snprintf(jobdir, sizeof jobdir, "%s.franja-job", a.out);
+        snprintf(im->jobdir, sizeof im->jobdir, "%s.franja-job", a->out);
 
     /* One writer per job directory, before anything is read or written
      * there (joblock.h). */
     char cmdline[4096];
     size_t cl = (size_t)snprintf(cmdline, sizeof cmdline, "franja");
-    for (int i = 0; i < argc && cl < sizeof cmdline; i++)
-        cl += (size_t)snprintf(cmdline + cl, sizeof cmdline - cl, " %s", argv[i]);
-    job_lock lk;
-    int lr = jlk_acquire(jobdir, a.out, cmdline, a.no_lock, &lk, &err);
+    for (int i = 0; i < im->argc && cl < sizeof cmdline; i++)
+        cl += (size_t)snprintf(cmdline + cl, sizeof cmdline - cl, " %s", im->argv[i]);
+    int lr = jlk_acquire(im->jobdir, a->out, cmdline, a->no_lock, &im->lk, &err);
     if (lr) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return lr == JLK_BUSY || lr == JLK_NOLOCKS ? 2 : 1;
     }
-    if (lk.unlocked)
+    im->locked = 1;
+    if (im->lk.unlocked)
         fprintf(stderr, "franja render: warning: %s is not locked (--no-lock): nothing keeps another render "
-                "of %s out of it\n", jobdir, a.out);
-    if (!a.resume && !a.fresh) {
-        int rows = job_rows_present(jobdir);
+                "of %s out of it\n", im->jobdir, a->out);
+    if (!a->resume && !a->fresh) {
+        int rows = job_rows_present(im->jobdir);
         if (rows > 0) {
             fprintf(stderr, "franja render: %s holds %d finished rows of an earlier render of %s; rerun with "
-                    "--resume to finish it, or with --fresh to discard them\n", jobdir, rows, a.out);
-            jlk_release(&lk, 0);
+                    "--resume to finish it, or with --fresh to discard them\n", im->jobdir, rows, a->out);
+            jlk_release(&im->lk, 0);
+            im->locked = 0;
             return 2;
         }
     }
 
-    if (a.resume && !a.frames) {
+    if (a->resume && !a->frames) {
         /* Nothing to go on from: the render finished and its job
          * directory went with it. */
         char jf[4200];
         struct stat st;
-        snprintf(jf, sizeof jf, "%s/job", jobdir);
-        if (stat(jf, &st) != 0 && stat(a.out, &st) == 0) {
+        snprintf(jf, sizeof jf, "%s/job", im->jobdir);
+        if (stat(jf, &st) != 0 && stat(a->out, &st) == 0) {
             fprintf(stderr, "franja render: --resume: nothing to resume: %s is finished and its job directory %s "
                     "is gone (a render removes it when done, unless --keep-job); render again without --resume "
-                    "(from the first sample), and with --keep-job to add samples to it later\n", a.out, jobdir);
-            return unlock_with(&lk, 2);
+                    "(from the first sample), and with --keep-job to add samples to it later\n", a->out,
+                    im->jobdir);
+            return 2;
         }
     }
+    return 0;
+}
 
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-    signal(SIGPIPE, SIG_IGN);
-
-    uint32_t probe = UINT32_MAX;
-    if (quick_spp(&probe, &err) < 0) {
-        fprintf(stderr, "franja render: %s\n", err.msg);
-        return unlock_with(&lk, 2);
-    }
-    hosts_table table;
-    slurm_alloc alloc;
-    memset(&alloc, 0, sizeof alloc);
-    if (a.slurm.on) {
-        if (cli_slurm_hosts("render", &a.slurm, argc, argv, &a.tr, &alloc, &table))
-            return unlock_with(&lk, 2);
-    } else if (a.hosts) {
-        if (cli_load_hosts("render", a.hosts, &table))
-            return unlock_with(&lk, 2);
-    } else {
-        table.n = 1;
-        table.v = calloc(1, sizeof *table.v);
-        if (!table.v)
-            return unlock_with(&lk, 1);
-        snprintf(table.path, sizeof table.path, "(this machine)");
-        strcpy(table.v[0].name, "local");
-        strcpy(table.v[0].address, "local");
-    }
-
-    double t0 = clk_now();
+/* Gets the image's scene (compiled into its job directory when needed),
+ * works out what to render and opens the job directory: the rows it
+ * holds, the passes of --time-limit.  0, or the exit status (said). */
+static int image_open(image *im)
+{
+    render_args *a = &im->a;
+    fr_error err;
+    im->t0 = clk_now();
     fr_scene sc;
-    if (scene_binary(&a, jobdir, fbin, sizeof fbin, &sc, &err)) {
+    if (scene_binary(a, im->jobdir, im->fbin, sizeof im->fbin, &sc, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
-        hosts_free(&table);
-        slurm_close(&alloc);
-        return unlock_with(&lk, stop_flag ? 130 : 1);
+        return stop_flag ? 130 : 1;
     }
-    job_spec spec = {sc.hash, a.width ? a.width : sc.settings.width, a.height ? a.height : sc.settings.height,
-                     a.spp ? a.spp : sc.settings.spp,
-                     a.integrator ? (uint32_t)(a.integrator - 1) : sc.settings.integrator,
-                     a.noise_threshold > 0.0f ? a.noise_threshold : sc.settings.noise_threshold};
-    if (a.scale > 0) {
-        spec.width = opt_scaled(sc.settings.width, a.scale);
-        spec.height = opt_scaled(sc.settings.height, a.scale);
+    job_spec spec = {sc.hash, a->width ? a->width : sc.settings.width, a->height ? a->height : sc.settings.height,
+                     a->spp ? a->spp : sc.settings.spp,
+                     a->integrator ? (uint32_t)(a->integrator - 1) : sc.settings.integrator,
+                     a->noise_threshold > 0.0f ? a->noise_threshold : sc.settings.noise_threshold};
+    if (a->scale > 0) {
+        spec.width = opt_scaled(sc.settings.width, a->scale);
+        spec.height = opt_scaled(sc.settings.height, a->scale);
     }
     char note[400];
-    if (a.width && opt_aspect_note(spec.width, spec.height, sc.settings.width, sc.settings.height, note, sizeof note))
+    if (a->width && opt_aspect_note(spec.width, spec.height, sc.settings.width, sc.settings.height, note,
+                                    sizeof note))
         fprintf(stderr, "franja render: warning: --size: %s\n", note);
+    int rc = 0;
     if (spec.width > PROTO_MAX_SIZE || spec.height > PROTO_MAX_SIZE) {
         fprintf(stderr, "franja render: --scale: %ux%u is over the largest size, %u pixels a side\n", spec.width,
                 spec.height, PROTO_MAX_SIZE);
-        scn_free(&sc);
-        hosts_free(&table);
-        slurm_close(&alloc);
-        return unlock_with(&lk, 2);
-    }
-    if (spec.integrator == FR_INTEGRATOR_BDPT && a.noise_threshold > 0.0f) {
+        rc = 2;
+    } else if (spec.integrator == FR_INTEGRATOR_BDPT && a->noise_threshold > 0.0f) {
         fprintf(stderr, "franja render: --noise-threshold: adaptive sampling is for path tracing, not bdpt\n");
-        scn_free(&sc);
-        hosts_free(&table);
-        slurm_close(&alloc);
-        return unlock_with(&lk, 2);
+        rc = 2;
     }
-    if (spec.integrator == FR_INTEGRATOR_BDPT)
+    if (!rc && spec.integrator == FR_INTEGRATOR_BDPT)
         spec.noise_threshold = 0.0f; /* bidirectional workers take every sample */
-    if (spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
-        fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a.scene, err.msg);
-        scn_free(&sc);
-        hosts_free(&table);
-        slurm_close(&alloc);
-        return unlock_with(&lk, a.integrator ? 2 : 1);
-    }
-    if (a.time_limit > 0 && !job_sums(&spec)) {
+    if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
+        fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a->scene, err.msg);
+        rc = a->integrator ? 2 : 1;
+    } else if (!rc && a->time_limit > 0 && !job_sums(&spec)) {
         fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
                 "only path tracing without adaptive sampling keeps (this render %s)\n",
                 spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"
-                : a.noise_threshold > 0.0f        ? "has --noise-threshold"
+                : a->noise_threshold > 0.0f       ? "has --noise-threshold"
                                                   : "has the scene's noise_threshold");
-        scn_free(&sc);
-        hosts_free(&table);
-        slurm_close(&alloc);
-        return unlock_with(&lk, 2);
-    }
-    if (a.crop && crop_check(&a.win, spec.width, spec.height, &err)) {
+        rc = 2;
+    } else if (!rc && a->crop && crop_check(&a->win, spec.width, spec.height, &err)) {
         fprintf(stderr, "franja render: --crop %s\n", err.msg);
+        rc = 2;
+    }
+    if (rc) {
         scn_free(&sc);
-        hosts_free(&table);
-        slurm_close(&alloc);
-        return unlock_with(&lk, 2);
+        return rc;
     }
     /* A crop renders the window's rows only, except bidirectionally: light
      * paths started from every pixel of the image reach the window. */
-    int crop_rows = a.crop && spec.integrator != FR_INTEGRATOR_BDPT;
-    if (a.crop && !crop_rows)
+    int crop_rows = im->crop_rows = a->crop && spec.integrator != FR_INTEGRATOR_BDPT;
+    if (a->crop && !crop_rows)
         fprintf(stderr, "franja: --crop with --integrator bdpt renders every row (light traced from the whole "
                 "image reaches the window)\n");
     uint32_t asked = spec.spp;
     if (quick_spp(&spec.spp, &err) > 0)
         fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
     /* Tone mapping: the scene's defaults, overridden by the command line. */
-    fr_tonemap tm = sc.tonemap;
-    if (a.exposure_set)
-        tm.exposure = a.exposure;
-    if (a.curve)
-        tm_curve_parse(a.curve, &tm.curve);
+    im->tm = sc.tonemap;
+    if (a->exposure_set)
+        im->tm.exposure = a->exposure;
+    if (a->curve)
+        tm_curve_parse(a->curve, &im->tm.curve);
     scn_free(&sc);
+    im->spec = spec;
 
-    unsigned char *have = calloc(spec.height, 1);
-    uint32_t *base = calloc(spec.height, sizeof *base);
-    float *rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *rgb);
-    int rc = 1;
-    pg_reporter *pg = NULL;
-    mon_server *mon = NULL;
-    passes ps = {.a = &a, .jobdir = jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows, .have = have,
-                 .base = base, .rgb = rgb, .scratch = NULL};
-    if (!have || !base || !rgb || !(ps.scratch = calloc(spec.height, 1))) {
+    im->have = calloc(spec.height, 1);
+    im->base = calloc(spec.height, sizeof *im->base);
+    im->rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *im->rgb);
+    passes *ps = &im->ps;
+    *ps = (passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
+                   .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL};
+    if (!im->have || !im->base || !im->rgb || !(ps->scratch = calloc(spec.height, 1))) {
         fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
-        goto done;
+        return 1;
     }
-    int jr = job_open(jobdir, &spec, a.resume, &err);
+    int jr = job_open(im->jobdir, &spec, a->resume, &err);
     if (jr) {
         fprintf(stderr, "franja render: %s\n", err.msg);
-        if (jr == JOB_REFUSED)
-            rc = 2;
-        goto done;
+        return jr == JOB_REFUSED ? 2 : 1;
     }
     /* What the job directory holds toward the samples asked for. */
-    if (plan(&ps, spec.spp, &err)) {
+    if (plan(ps, spec.spp, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
-        goto done;
+        return 1;
     }
     int rows_have = 0, rows_base = 0;
     uint32_t lo, hi, blo = UINT32_MAX, bhi = 0;
     for (uint32_t y = 0; y < spec.height; y++) {
-        rows_have += have[y] && needed(&ps, y);
-        if (base[y] > 0 && needed(&ps, y)) {
+        rows_have += im->have[y] && needed(ps, y);
+        if (im->base[y] > 0 && needed(ps, y)) {
             rows_base++;
-            blo = base[y] < blo ? base[y] : blo;
-            bhi = base[y] > bhi ? base[y] : bhi;
+            blo = im->base[y] < blo ? im->base[y] : blo;
+            bhi = im->base[y] > bhi ? im->base[y] : bhi;
         }
     }
-    kept_range(&ps, &lo, &hi);
-    if (a.resume)
-        fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", ps.rows_kept, spec.height, jobdir);
-    if (rows_base && a.time_limit <= 0)
+    kept_range(ps, &lo, &hi);
+    if (a->resume)
+        fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", ps->rows_kept, spec.height,
+                im->jobdir);
+    if (rows_base && a->time_limit <= 0)
         fprintf(stderr, "franja: adding samples: %d rows go on from the %u%s samples per pixel kept with their sums to "
                 "%u\n", rows_base, blo, blo != bhi ? " or more" : "", spec.spp);
     /* The rows this render needs (a crop's window). */
-    int rows_job = crop_rows ? (int)(a.win.y1 - a.win.y0) : (int)spec.height;
-    ps.rows_job = rows_job;
-    if (a.time_limit > 0) {
-        ps.deadline = t0 + a.time_limit;
+    int rows_job = crop_rows ? (int)(a->win.y1 - a->win.y0) : (int)spec.height;
+    ps->rows_job = im->rows_job = rows_job;
+    im->rows_have = rows_have;
+    if (a->time_limit > 0) {
+        ps->deadline = im->t0 + a->time_limit;
         /* A complete image kept at one sample count is where the passes
          * start, and what is written if the first of them does not end. */
         if (lo == hi && lo > 0 && lo < spec.spp) {
-            if (plan(&ps, lo, &err) || pass_image(&ps, &err)) {
+            if (plan(ps, lo, &err) || pass_image(ps, &err)) {
                 fprintf(stderr, "franja render: %s\n", err.msg);
-                goto done;
+                return 1;
             }
-            ps.reached = lo;
+            ps->reached = lo;
             fprintf(stderr, "franja: the job holds a whole image with %u samples per pixel; passes go on from it\n",
                     lo);
-            if (plan(&ps, spec.spp, &err)) {
+            if (plan(ps, spec.spp, &err)) {
                 fprintf(stderr, "franja render: %s\n", err.msg);
-                goto done;
+                return 1;
             }
         }
     }
-    if (a.json && !(pg = pg_start(stdout, a.out, jobdir, &spec, (uint32_t)rows_job, &err))) {
+    return 0;
+}
+
+/* Every row the image needs is in its job directory (or, with
+ * --time-limit, the last complete pass in memory): stitches, writes the
+ * output, removes the job directory (unless --keep-job) and gives up the
+ * lock.  used: the hosts that rendered rows, for the metadata.  0, or 1
+ * (said). */
+static int image_write(image *im, const char *used)
+{
+    render_args *a = &im->a;
+    passes *ps = &im->ps;
+    job_spec spec = im->spec;
+    fr_error err;
+    if (a->time_limit > 0 && ps->reached) {
+        /* The image of the last complete pass is in rgb. */
+        spec.spp = ps->reached;
+        if (ps->stopped)
+            fprintf(stderr, "franja: time limit of %g s reached: %u samples per pixel (the pass to %u was stopped)\n",
+                    a->time_limit, ps->reached, ps->stopped);
+        else
+            fprintf(stderr, "franja: every %u samples per pixel within the time limit\n", ps->reached);
+    } else if (im->crop_rows ? crop_stitch(im->jobdir, &spec, &a->win, im->rgb, im->have, &err)
+                             : job_stitch(im->jobdir, &spec, im->rgb, &a->tr.notes, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return 1;
+    }
+    job_spec out_spec = spec;
+    float *rgb = im->rgb;
+    if (a->crop) {
+        crop_black(&a->win, rgb, spec.width, spec.height);
+        if (a->crop_output) {
+            /* The window moves to the start of the buffer. */
+            float *w = malloc((size_t)(a->win.x1 - a->win.x0) * (a->win.y1 - a->win.y0) * 3 * sizeof *w);
+            if (!w) {
+                fprintf(stderr, "franja render: out of memory for the window\n");
+                return 1;
+            }
+            crop_extract(&a->win, rgb, spec.width, w);
+            free(rgb);
+            rgb = im->rgb = ps->rgb = w;
+            out_spec.width = a->win.x1 - a->win.x0;
+            out_spec.height = a->win.y1 - a->win.y0;
+        }
+    }
+    out_meta meta;
+    out_meta_make(&meta, &spec, a->reproducible ? -1 : clk_now() - im->t0, a->reproducible ? NULL : used);
+    if (a->reproducible)
+        out_meta_set_time(&meta, reproducible_epoch());
+    a->io.attrs = meta.attrs;
+    if (out_write_with(a->out, rgb, &out_spec, &im->tm, &a->io, &err)) {
+        /* Said only once checked: the rows are still there. */
+        if (job_rows_present(im->jobdir) >= im->rows_job) {
+            fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
+                    "to write %s\n", err.msg, im->jobdir, a->out);
+        } else {
+            char kept[4400];
+            job_kept_note(im->jobdir, kept, sizeof kept);
+            fprintf(stderr, "franja render: %s\nfranja render: %s\n", err.msg, kept);
+        }
+        return 1;
+    }
+    pg_stop(im->pg, "ok", spec.spp);
+    im->pg = NULL;
+    mon_status(im->mon, "done");
+    mon_stop(im->mon);
+    im->mon = NULL;
+    if (!a->keep_job)
+        job_remove(im->jobdir);
+    else if (job_sums(&spec))
+        job_prune(im->jobdir, &spec); /* rows kept with more samples make the fewer useless */
+    jlk_release(&im->lk, !a->keep_job);
+    im->locked = 0;
+    fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a->out, out_spec.width, out_spec.height, spec.spp,
+            clk_now() - im->t0);
+    return 0;
+}
+
+/* Ends the image: after a failure (rc not 0) its job directory stays for
+ * --resume if it holds rows and the lock is given up; frees it. */
+static void image_close(image *im, int rc)
+{
+    pg_stop(im->pg, stop_flag ? "interrupted" : "failed", im->spec.spp);
+    mon_stop(im->mon);
+    if (rc && im->locked)
+        unlock_with(&im->lk, rc);
+    free(im->have);
+    free(im->base);
+    free(im->ps.scratch);
+    free(im->rgb);
+    free(im);
+}
+
+/* Parses argv into a new image; NULL with *status set (0 after --help, 2
+ * on a usage error). */
+static image *image_parse(int argc, char **argv, int *status)
+{
+    image *im = calloc(1, sizeof *im);
+    /* Parsed in a copy: argv stays as typed, for the lock file's command
+     * line and the salloc hint. */
+    char **args = opt_copy(argc, argv);
+    int pr = args && im ? parse(argc, args, &im->a) : 2;
+    free(args);
+    if (pr) {
+        free(im);
+        *status = pr == 1 ? 0 : 2;
+        return NULL;
+    }
+    im->argc = argc;
+    im->argv = argv;
+    return im;
+}
+
+static void on_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+}
+
+/* The hosts of the render: the table, a Slurm allocation or this
+ * machine.  0, or 2 (said). */
+static int load_hosts(render_args *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc)
+{
+    memset(alloc, 0, sizeof *alloc);
+    if (a->slurm.on)
+        return cli_slurm_hosts("render", &a->slurm, argc, argv, &a->tr, alloc, table) ? 2 : 0;
+    if (a->hosts)
+        return cli_load_hosts("render", a->hosts, table) ? 2 : 0;
+    table->n = 1;
+    table->v = calloc(1, sizeof *table->v);
+    if (!table->v)
+        return 1;
+    snprintf(table->path, sizeof table->path, "(this machine)");
+    strcpy(table->v[0].name, "local");
+    strcpy(table->v[0].address, "local");
+    return 0;
+}
+
+static int render_frames(int argc, char **argv, render_args *a);
+
+int cmd_render(int argc, char **argv)
+{
+    int status;
+    image *im = image_parse(argc, argv, &status);
+    if (!im)
+        return status;
+    render_args *a = &im->a;
+    static int in_frames; /* rendering one frame of --frames frame by frame */
+    if (a->frames && !in_frames) {
+        in_frames = 1;
+        int rc = render_frames(argc, argv, a);
+        in_frames = 0;
+        free(im);
+        return rc;
+    }
+    if (frames_check_plain(a->scene)) {
+        free(im);
+        return 2;
+    }
+    fr_error err;
+    if (out_check(a->out, &err) || (a->preview && out_check_type(a->preview, &err))) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        free(im);
+        return 2;
+    }
+    int rc = image_lock(im);
+    if (rc) {
+        image_close(im, rc);
+        return rc;
+    }
+    on_signals();
+    uint32_t probe = UINT32_MAX;
+    if (quick_spp(&probe, &err) < 0) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        image_close(im, 2);
+        return 2;
+    }
+    hosts_table table;
+    slurm_alloc alloc;
+    if ((rc = load_hosts(a, argc, argv, &table, &alloc))) {
+        image_close(im, rc);
+        return rc;
+    }
+    rc = image_open(im);
+    if (rc)
+        goto done;
+    rc = 1;
+    if (a->json && !(im->pg = pg_start(stdout, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job, &err))) {
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         goto done;
     }
-    if (a.monitor) {
-        if (!(mon = mon_start((uint16_t)a.monitor_port, a.out, jobdir, &spec, &tm, &err))) {
+    if (a->monitor) {
+        if (!(im->mon = mon_start((uint16_t)a->monitor_port, a->out, im->jobdir, &im->spec, &im->tm, &err))) {
             fprintf(stderr, "franja render: --monitor: %s\n", err.msg);
             goto done;
         }
-        mon_status(mon, "rendering");
-        fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(mon));
+        mon_status(im->mon, "rendering");
+        fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(im->mon));
     }
     pv_writer *pv = NULL;
-    if (a.preview && !(pv = pv_start(a.preview, jobdir, &spec, &tm, a.preview_every,
-                                     (note_sink){cli_note_stderr, NULL}, &err))) {
+    if (a->preview && !(pv = pv_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,
+                                      (note_sink){cli_note_stderr, NULL}, &err))) {
         fprintf(stderr, "franja render: --preview: %s\n", err.msg);
         goto done;
     }
     char used[1024] = "";
-    int slabs_rc = rows_have < rows_job ? run_slabs(&a, &table, fbin, &ps, pg, mon, used, sizeof used, &err) : 0;
+    int slabs_rc = im->rows_have < im->rows_job
+                       ? run_slabs(a, &table, im->fbin, &im->ps, im->pg, im->mon, used, sizeof used, NULL, &err)
+                       : 0;
     pv_stop(pv);
     if (slabs_rc) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
-    if (a.time_limit > 0 && ps.reached) {
-        /* The image of the last complete pass is in rgb. */
-        spec.spp = ps.reached;
-        if (ps.stopped)
-            fprintf(stderr, "franja: time limit of %g s reached: %u samples per pixel (the pass to %u was stopped)\n",
-                    a.time_limit, ps.reached, ps.stopped);
-        else
-            fprintf(stderr, "franja: every %u samples per pixel within the time limit\n", ps.reached);
-    } else if (crop_rows ? crop_stitch(jobdir, &spec, &a.win, rgb, have, &err)
-                         : job_stitch(jobdir, &spec, rgb, &a.tr.notes, &err)) {
-        fprintf(stderr, "franja render: %s\n", err.msg);
-        goto done;
-    }
-    job_spec out_spec = spec;
-    if (a.crop) {
-        crop_black(&a.win, rgb, spec.width, spec.height);
-        if (a.crop_output) {
-            /* The window moves to the start of the buffer. */
-            float *w = malloc((size_t)(a.win.x1 - a.win.x0) * (a.win.y1 - a.win.y0) * 3 * sizeof *w);
-            if (!w) {
-                fprintf(stderr, "franja render: out of memory for the window\n");
-                goto done;
-            }
-            crop_extract(&a.win, rgb, spec.width, w);
-            free(rgb);
-            rgb = w;
-            out_spec.width = a.win.x1 - a.win.x0;
-            out_spec.height = a.win.y1 - a.win.y0;
-        }
-    }
-    out_meta meta;
-    out_meta_make(&meta, &spec, a.reproducible ? -1 : clk_now() - t0, a.reproducible ? NULL : used);
-    if (a.reproducible)
-        out_meta_set_time(&meta, reproducible_epoch());
-    a.io.attrs = meta.attrs;
-    if (out_write_with(a.out, rgb, &out_spec, &tm, &a.io, &err)) {
-        /* Said only once checked: the rows are still there. */
-        if (job_rows_present(jobdir) >= rows_job) {
-            fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
-                    "to write %s\n", err.msg, jobdir, a.out);
-        } else {
-            char kept[4400];
-            job_kept_note(jobdir, kept, sizeof kept);
-            fprintf(stderr, "franja render: %s\nfranja render: %s\n", err.msg, kept);
-        }
-        goto done;
-    }
-    pg_stop(pg, "ok", spec.spp);
-    pg = NULL;
-    mon_status(mon, "done");
-    mon_stop(mon);
-    mon = NULL;
-    if (!a.keep_job)
-        job_remove(jobdir);
-    else if (job_sums(&spec))
-        job_prune(jobdir, &spec); /* rows kept with more samples make the fewer useless */
-    jlk_release(&lk, !a.keep_job);
-    fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a.out, out_spec.width, out_spec.height, spec.spp,
-            clk_now() - t0);
-    rc = 0;
+    rc = image_write(im, used);
 done:
-    pg_stop(pg, stop_flag ? "interrupted" : "failed", spec.spp);
-    mon_stop(mon);
-    if (rc)
-        unlock_with(&lk, rc);
     if (rc && stop_flag)
         rc = 130;
-    free(have);
-    free(base);
-    free(ps.scratch);
-    free(rgb);
+    image_close(im, rc);
     hosts_free(&table);
     slurm_close(&alloc);
     return rc;
+}
+
+/* One frame of an animation run together with the others. */
+typedef struct {
+    frames_one one;            /* its number, files and command line */
+    image *im;                 /* NULL once closed */
+    int written;
+    int failed;                /* the exit status it failed with (said when the run ends); 0 = none */
+    char label[32];            /* "frame N" */
+    unsigned char *rendered_on; /* per host: it rendered rows of this frame */
+} frame_slot;
+
+struct anim_run {
+    frames_iter it;
+    const hosts_table *table;
+    frame_slot **fr;           /* by the scheduler's frame index */
+    int nfr, capfr;
+    int failed;                /* a frame failed: no frame is opened after it */
+};
+
+/* Frees what an image holds but its settings (a frame that is written). */
+static void image_shrink(image *im)
+{
+    free(im->have);
+    free(im->base);
+    free(im->ps.scratch);
+    free(im->rgb);
+    im->have = NULL;
+    im->base = NULL;
+    im->ps.scratch = NULL;
+    im->rgb = im->ps.rgb = NULL;
+    im->ps.have = NULL;
+    im->ps.base = NULL;
+}
+
+/* The next frame to render, locked, compiled and its job directory open:
+ * 0 with *next (frame index fx->nfr - 1); 1 when no frame is left; -1
+ * when a frame failed (its reason said; fx->failed set, and the frame
+ * named when the run ends). */
+static int rf_open(anim_run *fx, sched_frame *next)
+{
+    if (fx->failed)
+        return 1;
+    frame_slot *fs = calloc(1, sizeof *fs);
+    if (fs && fx->nfr == fx->capfr) {
+        int cap = fx->capfr ? 2 * fx->capfr : 8;
+        frame_slot **v = realloc(fx->fr, (size_t)cap * sizeof *v);
+        if (v) {
+            fx->fr = v;
+            fx->capfr = cap;
+        }
+    }
+    if (!fs || fx->nfr == fx->capfr) {
+        free(fs);
+        fprintf(stderr, "franja render: out of memory\n");
+        fx->failed = 1;
+        return -1;
+    }
+    int r = frames_next(&fx->it, &fs->one);
+    if (r) {
+        free(fs);
+        if (r == 1)
+            return 1;
+        fx->failed = r - 1; /* said, with the frame's number */
+        return -1;
+    }
+    fx->fr[fx->nfr++] = fs;
+    snprintf(fs->label, sizeof fs->label, "frame %u", fs->one.number);
+    fs->rendered_on = calloc((size_t)fx->table->n, 1);
+    int status = 1;
+    fs->im = fs->rendered_on ? image_parse(fs->one.argc, fs->one.argv, &status) : NULL;
+    int rc = fs->im ? 0 : status ? status : 2;
+    fr_error e;
+    if (!rc && out_check(fs->im->a.out, &e)) {
+        fprintf(stderr, "franja render: %s\n", e.msg);
+        rc = 2;
+    }
+    if (!rc)
+        rc = image_lock(fs->im);
+    if (!rc)
+        rc = image_open(fs->im);
+    if (rc) {
+        if (fs->im)
+            image_close(fs->im, rc);
+        fs->im = NULL;
+        fs->failed = fx->failed = stop_flag ? 130 : rc;
+        return -1;
+    }
+    image *im = fs->im;
+    im->ps.label = fs->label;
+    *next = (sched_frame){im->ps.spec, im->jobdir, im->have, im->base, job_sums(&im->ps.spec), fs->label};
+    return 0;
+}
+
+/* The scheduler asks for the next frame.  One that fails to open ends the
+ * list: the frames in flight are finished first, then the run ends with
+ * that frame's failure. */
+static int rf_next(void *ctx, int frame, sched_frame *next, fr_error *err)
+{
+    (void)frame, (void)err; /* frames are opened in the scheduler's order: frame == fx->nfr */
+    reporter *r = ctx;
+    if (stop_flag)
+        return 1; /* no new frame once interrupted */
+    clear_line(r);
+    return rf_open(r->fx, next) ? 1 : 0;
+}
+
+static int rf_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
+                    size_t lease_cap, fr_error *err)
+{
+    reporter *r = ctx;
+    anim_run *fx = r->fx;
+    frame_slot *fs = fx->fr[frame];
+    const hosts_entry *e = &fx->table->v[host_i];
+    double t0 = clk_now();
+    int uploaded = 0;
+    fr_error e2;
+    if (cl_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, scene, scene_cap, lease, lease_cap, &uploaded, &e2))
+        return fr_fail(err, "%s: %s", fs->label, e2.msg);
+    if (fx->table->path[0] != '(' || !isatty(2)) {
+        clear_line(r);
+        fprintf(stderr, "franja: host %s: %s: scene %s (%.2f s)\n", h->name, fs->label,
+                hosts_is_local(e) ? "local" : uploaded ? "uploaded" : "already there", clk_now() - t0);
+    }
+    return 0;
+}
+
+static void rf_rendered(anim_run *fx, int frame, int host)
+{
+    if (frame >= 0 && frame < fx->nfr && host >= 0 && host < fx->table->n && fx->fr[frame]->rendered_on)
+        fx->fr[frame]->rendered_on[host] = 1;
+}
+
+static int rf_done(void *ctx, int frame, fr_error *err)
+{
+    reporter *r = ctx;
+    anim_run *fx = r->fx;
+    frame_slot *fs = fx->fr[frame];
+    char used[1024] = "";
+    for (int i = 0, k = 0; i < fx->table->n; i++)
+        if (fs->rendered_on[i] && (size_t)k < sizeof used)
+            k += snprintf(used + k, sizeof used - (size_t)k, "%s%s", k ? "," : "", fx->table->v[i].name);
+    clear_line(r);
+    if (image_write(fs->im, used)) {
+        fs->failed = fx->failed = 1;
+        return fr_fail(err, "%s could not be written", fs->label);
+    }
+    fs->written = 1;
+    frames_wrote(&fx->it);
+    image_shrink(fs->im); /* the settings stay: the scheduler's run may still read the first frame's */
+    return 0;
+}
+
+/* `franja render PATTERN --frames LIST`: the frames run together over one
+ * set of hosts, each written as soon as its rows are in; a frame-by-frame
+ * run where an option works on one image at a time (--time-limit,
+ * --preview, --monitor, --progress json) or the hosts are a Slurm
+ * allocation. */
+static int render_frames(int argc, char **argv, render_args *a)
+{
+    frames_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview};
+    if (a->time_limit > 0 || a->preview || a->monitor || a->json || a->slurm.on)
+        return frames_run(argc, argv, &fj, cmd_render);
+    anim_run fx;
+    memset(&fx, 0, sizeof fx);
+    if (frames_begin(&fx.it, argc, argv, &fj))
+        return 2;
+    on_signals();
+    fr_error err;
+    uint32_t probe = UINT32_MAX;
+    if (quick_spp(&probe, &err) < 0) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return frames_end(&fx.it, 2);
+    }
+    hosts_table table;
+    slurm_alloc alloc;
+    int rc = load_hosts(a, argc, argv, &table, &alloc);
+    if (rc)
+        return frames_end(&fx.it, rc);
+    fx.table = &table;
+    sched_frame first;
+    if (rf_open(&fx, &first) == 0) {
+        char used[1024];
+        if (run_slabs(a, &table, NULL, &fx.fr[0]->im->ps, NULL, NULL, used, sizeof used, &fx, &err)) {
+            fprintf(stderr, "franja render: %s\n", err.msg);
+            rc = 1;
+        }
+    }
+    /* The frame to name: after an interrupt the first not written, else
+     * the one that failed, else (the hosts failed) the first not written. */
+    frame_slot *named = NULL;
+    for (int i = 0; i < fx.nfr && !named; i++)
+        if (fx.fr[i]->failed && !stop_flag)
+            named = fx.fr[i];
+    for (int i = 0; i < fx.nfr && !named; i++)
+        if (!fx.fr[i]->written)
+            named = fx.fr[i];
+    if (stop_flag && (rc || fx.failed))
+        rc = 130;
+    else if (fx.failed)
+        rc = fx.failed;
+    if (rc && named)
+        frames_failed(&fx.it, named->one.number, named->one.scene, named->one.out, rc);
+    /* The frames still open are closed; their finished slabs stay for
+     * --resume. */
+    for (int i = 0; i < fx.nfr; i++) {
+        frame_slot *fs = fx.fr[i];
+        if (fs->im)
+            image_close(fs->im, fs->written ? 0 : rc ? rc : 1);
+        frames_put(&fs->one);
+        free(fs->rendered_on);
+        free(fs);
+    }
+    free(fx.fr);
+    hosts_free(&table);
+    slurm_close(&alloc);
+    return frames_end(&fx.it, rc);
 }

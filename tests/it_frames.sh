@@ -3,8 +3,12 @@
 # animation (a sphere moving) gives, frame for frame, the bytes of three
 # single renders; outputs that exist are skipped unless --overwrite; an
 # interrupt keeps the frame's finished slabs and --resume goes on from
-# there; over SSH each frame's scene is uploaded once per host; bad
-# patterns and lists are refused before anything renders.
+# there; frames run together over one set of hosts (a slab of frame 2
+# starts while frame 1's last slab runs; an interrupt with two frames in
+# flight keeps both frames' slabs for --resume; a host that fails in the
+# middle of the range is dropped and the others finish); over SSH each
+# frame's scene is uploaded once per host; bad patterns and lists are
+# refused before anything renders.
 . "$(dirname "$0")/coord/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
@@ -65,6 +69,93 @@ for i in 1 2 3; do
 done
 check "frame 2 kept its finished slabs" grep -q "resuming: $((kept * 4)) of 16 rows" logr
 check "frame 1 is skipped on resume" grep -q "frame 1 (1 of 3): slow/f.0001.pfm exists, skipped" logr
+
+# Frames overlap: frame 1's last slab (rows 12:16) is held until a slab
+# of frame 2 has started, so the animation ends (within the gate's 30 s)
+# only if the slot that finished frame 1's other slabs went on to frame 2
+# while frame 1's tail still ran.
+cat >gate.sh <<SH
+#!/bin/sh
+case " \$* " in *" --rows "*) ;; *) exec "$WORKER" "\$@" ;; esac
+case " \$* " in
+*f.0001*" --rows 12:16 "*)
+    n=0
+    while [ ! -e "$FH/f2started" ] && [ \$n -lt 300 ]; do sleep 0.1; n=\$((n + 1)); done
+    [ -e "$FH/f2started" ] && echo overlapped >>"$FH/gatelog" || echo "no frame 2 slab in 30 s" >>"$FH/gatelog" ;;
+*f.0002*) touch "$FH/f2started" ;;
+esac
+exec "$WORKER" "\$@"
+SH
+chmod +x gate.sh
+printf 'here local - 2 worker=%s/gate.sh\n' "$FH" >t_gate
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'ov/f.####.pfm' $SIZE --hosts t_gate --slab-rows 4 2>logo
+check "the gated animation renders" test $? -eq 0
+check "frame 2 started while frame 1's last slab ran" grep -q overlapped gatelog
+check "frame 1's last slab waited for nothing else" sh -c "! grep -q 'no frame 2' gatelog"
+for i in 1 2 3; do
+    check "overlapped frame $i equals its single render" cmp -s "ov/f.000$i.pfm" "ref$i.pfm"
+done
+
+# Ctrl-C while two frames are in flight (the last slab of frames 1 and 2
+# held, one on each slot), then --resume: each frame keeps its own
+# finished slabs and ends in its bytes.
+cat >hold.sh <<SH
+#!/bin/sh
+case " \$* " in *f.000[12]*" --rows 12:16 "*) [ -e "$FH/hold" ] && exec sleep 600 ;; esac
+exec "$WORKER" "\$@"
+SH
+chmod +x hold.sh
+printf 'here local - 2 worker=%s/hold.sh\n' "$FH" >t_hold
+touch hold
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'held/f.####.pfm' $SIZE --hosts t_hold --slab-rows 4 2>logh &
+FH_BG=$!
+fh_until fh_has_slabs held/f.0002.pfm.franja-job 3
+kill -INT $FH_BG
+fr_wait
+check "the animation interrupted with two frames in flight exits 130" test $rc -eq 130
+check "the interrupt names the first unfinished frame" grep -q "interrupted at frame 1 (held/f.0001.pfm)" logh
+check "frame 1 kept its 3 finished slabs" test "$(fh_slabs held/f.0001.pfm.franja-job)" -eq 3
+check "frame 2 kept its 3 finished slabs" test "$(fh_slabs held/f.0002.pfm.franja-job)" -eq 3
+check "frame 3 was not started" test ! -e held/f.0003.pfm.franja-job
+check "neither frame was written" test ! -e held/f.0001.pfm -a ! -e held/f.0002.pfm
+rm hold
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'held/f.####.pfm' $SIZE --hosts t_hold --slab-rows 4 --resume 2>logh2
+check "the resumed animation renders" test $? -eq 0
+check "frame 1 resumes from 12 rows" grep -q "resuming: 12 of 16 rows already done in held/f.0001.pfm.franja-job" logh2
+check "frame 2 resumes from 12 rows" grep -q "resuming: 12 of 16 rows already done in held/f.0002.pfm.franja-job" logh2
+for i in 1 2 3; do
+    check "held and resumed frame $i equals its single render" cmp -s "held/f.000$i.pfm" "ref$i.pfm"
+done
+
+# A host that fails from its sixth slab on, in the middle of the range: it
+# is dropped, the other host renders the rest, every frame in its bytes.
+cat >failing.sh <<SH
+#!/bin/sh
+case " \$* " in *" --rows "*) ;; *) exec "$WORKER" "\$@" ;; esac
+echo x >>"$FH/failcount"
+[ "\$(wc -l <"$FH/failcount")" -gt 5 ] && exit 1
+exec "$WORKER" "\$@"
+SH
+chmod +x failing.sh
+printf 'good local - 1\nbad local - 1 worker=%s/failing.sh\n' "$FH" >t_fail
+"$FRANJA" render 'f.####.json' --frames 1-3 -o 'fail/f.####.pfm' $SIZE --hosts t_fail --slab-rows 2 2>logf
+check "the animation with a failing host renders" test $? -eq 0
+check "the failing host is dropped" grep -q "dropping host bad: 3 failures in a row" logf
+check "the failing host rendered 5 slabs, then failed 3 times" test "$(wc -l <failcount)" -eq 8
+for i in 1 2 3; do
+    check "frame $i with a failing host equals its single render" cmp -s "fail/f.000$i.pfm" "ref$i.pfm"
+done
+check "every frame is written" grep -q "frames: 3 of 3 done (3 rendered" logf
+
+# A frame whose scene is missing in the middle of the range: the frames
+# before it are finished and written, the animation stops there (status 1).
+cp f.0001.json g.0001.json
+cp f.0003.json g.0003.json
+"$FRANJA" render 'g.####.json' --frames 1-3 -o 'gap/g.####.pfm' $SIZE -j 2 2>logg
+check "a missing frame fails the animation (status 1)" test $? -eq 1
+check "the frame before it is written" cmp -s gap/g.0001.pfm ref1.pfm
+check "the missing frame is named" grep -q "frame 2 (g.0002.json -> gap/g.0002.pfm) failed; 1 of 3 frames done" logg
+check "the frame after it is not started" test ! -e gap/g.0003.pfm -a ! -e gap/g.0003.pfm.franja-job
 
 # Two SSH hosts: each frame's scene goes to each host once.
 fh_start a 2 1
