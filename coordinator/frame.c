@@ -1,0 +1,461 @@
+/* frame.c -- one image of a render from its job lock to its output (see
+ * frame.h). */
+#include "frame.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "bdpt.h"
+#include "clock.h"
+#include "compile.h"
+#include "compile_child.h"
+#include "fbin.h"
+#include "opt.h"
+#include "protocol.h"
+#include "quick.h"
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && !strcasecmp(s + a - b, suffix);
+}
+
+/* --reproducible's DateTime: SOURCE_DATE_EPOCH when it is a number of
+ * seconds (the convention of reproducible builds), else 0 (1970). */
+static long long reproducible_epoch(void)
+{
+    const char *v = getenv("SOURCE_DATE_EPOCH");
+    char *end;
+    long long e = v && *v ? strtoll(v, &end, 10) : 0;
+    return v && *v && !*end ? e : 0;
+}
+
+static void print_warning(void *user, const char *msg)
+{
+    fprintf(stderr, "%s: warning: %s\n", (const char *)user, msg);
+}
+
+/* Gets the binary scene: loads an .fbin, or compiles a JSON scene into the
+ * job directory.  *path receives the .fbin to ship. */
+static int scene_binary(const render_args *a, const char *jobdir, char *path, size_t cap, fr_scene *sc,
+                        volatile sig_atomic_t *stop, fr_error *err)
+{
+    if (!ends_with(a->scene, ".json") && !compile_is_gltf(a->scene)) {
+        if (a->camera)
+            return fr_fail(err, "%s: --camera applies to glTF scenes (a compiled scene has its camera)", a->scene);
+        snprintf(path, cap, "%s", a->scene);
+        return fbin_load(path, sc, err);
+    }
+    if (mkdir(jobdir, 0755) && errno != EEXIST)
+        return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
+    snprintf(path, cap, "%s/scene.fbin", jobdir);
+    /* What a compile of a render killed by SIGKILL left; the job lock
+     * keeps any other compile out of this directory. */
+    compile_child_sweep(path);
+    /* In a child process, so that Ctrl-C stops a long compile at once. */
+    compile_opts co = {a->camera, print_warning, (void *)"franja"};
+    if (compile_child(a->scene, &co, path, stop, NULL, err))
+        return -1;
+    return fbin_load(path, sc, err);
+}
+/* After a failure: a job directory with no finished slab holds nothing
+ * worth keeping (a compiled scene at most), so it goes; one with slabs
+ * stays for --resume.  Then the lock is given up.  Returns rc. */
+static int unlock_with(job_lock *lk, int rc)
+{
+    if (lk->fd >= 0 && job_rows_present(lk->dir) == 0) {
+        job_remove(lk->dir);
+        jlk_release(lk, 1);
+    }
+    jlk_release(lk, 0);
+    return rc;
+}
+
+/* The window's rows from the job directory into rgb (the other rows are
+ * left as they are); fails naming the window's rows that are missing.
+ * have (height bytes) is scratch. */
+static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_window *win, float *rgb,
+                       unsigned char *have, fr_error *err)
+{
+    if (job_gather(jobdir, spec, rgb, have, NULL, err) < 0)
+        return -1;
+    int missing = 0;
+    for (uint32_t y = 0; y < spec->height; y++) {
+        if (y < win->y0 || y >= win->y1)
+            have[y] = 1;
+        missing += !have[y];
+    }
+    if (missing) {
+        char rows[512];
+        job_missing_rows(have, spec->height, rows, sizeof rows);
+        return fr_fail(err, "%s: rows %s of the window are missing", jobdir, rows);
+    }
+    return 0;
+}
+
+
+/* Whether the render needs row y (a crop needs its window's). */
+static int needed(const passes *ps, uint32_t y)
+{
+    return !ps->crop_rows || (y >= ps->a->win.y0 && y < ps->a->win.y1);
+}
+
+/* What a pass to spp samples per pixel renders: the rows the job
+ * directory does not hold with spp samples, each from the most samples
+ * kept for it with their sums. */
+int frame_plan(passes *ps, uint32_t spp, fr_error *err)
+{
+    ps->spec.spp = spp;
+    int sums = job_sums(&ps->spec);
+    ps->rows_kept = job_scan(ps->jobdir, &ps->spec, ps->have, sums ? ps->base : NULL, &ps->a->tr.notes, err);
+    if (ps->rows_kept < 0)
+        return -1;
+    if (!sums)
+        memset(ps->base, 0, ps->spec.height * sizeof *ps->base);
+    ps->rows_missing = 0;
+    for (uint32_t y = 0; y < ps->spec.height; y++) {
+        if (!needed(ps, y))
+            ps->have[y] = 1; /* not rendered */
+        ps->rows_missing += !ps->have[y];
+    }
+    return 0;
+}
+
+/* The fewest and the most samples per pixel kept for a needed row (with
+ * their sums, or the samples asked for), from a plan to ps->cap. */
+static void kept_range(const passes *ps, uint32_t *lo, uint32_t *hi)
+{
+    *lo = UINT32_MAX;
+    *hi = 0;
+    for (uint32_t y = 0; y < ps->spec.height; y++) {
+        if (!needed(ps, y))
+            continue;
+        uint32_t k = ps->have[y] ? ps->cap : ps->base[y];
+        *lo = k < *lo ? k : *lo;
+        *hi = k > *hi ? k : *hi;
+    }
+    if (*lo == UINT32_MAX)
+        *lo = ps->cap;
+}
+
+/* The samples per pixel of the next pass of a --time-limit render, 0 when
+ * every needed row has the samples asked for. */
+int frame_next_pass(passes *ps, uint32_t *spp, fr_error *err)
+{
+    if (frame_plan(ps, ps->cap, err))
+        return -1;
+    uint32_t lo, hi;
+    kept_range(ps, &lo, &hi);
+    *spp = 0;
+    if (lo >= ps->cap)
+        return 0;
+    uint32_t twice = lo == 0 ? 1 : lo > ps->cap / 2 ? ps->cap : 2 * lo;
+    *spp = twice > hi ? twice : hi;
+    return 0;
+}
+
+/* The image of the pass just planned and complete into ps->rgb. */
+int frame_pass_image(passes *ps, fr_error *err)
+{
+    if (ps->crop_rows)
+        return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->scratch, err);
+    return job_stitch(ps->jobdir, &ps->spec, ps->rgb, &ps->a->tr.notes, err);
+}
+
+
+/* Takes the image's job lock and checks what its job directory holds
+ * against --resume and --fresh.  0, or the exit status (said). */
+int frame_lock(frame_image *im)
+{
+    render_args *a = &im->a;
+    fr_error err;
+    if (a->jobdir)
+        snprintf(im->jobdir, sizeof im->jobdir, "%s", a->jobdir);
+    else
+        snprintf(im->jobdir, sizeof im->jobdir, "%s.franja-job", a->out);
+
+    /* One writer per job directory, before anything is read or written
+     * there (joblock.h). */
+    char cmdline[4096];
+    size_t cl = (size_t)snprintf(cmdline, sizeof cmdline, "franja");
+    for (int i = 0; i < im->argc && cl < sizeof cmdline; i++)
+        cl += (size_t)snprintf(cmdline + cl, sizeof cmdline - cl, " %s", im->argv[i]);
+    int lr = jlk_acquire(im->jobdir, a->out, cmdline, a->no_lock, &im->lk, &err);
+    if (lr) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return lr == JLK_BUSY || lr == JLK_NOLOCKS ? 2 : 1;
+    }
+    im->locked = 1;
+    if (im->lk.unlocked)
+        fprintf(stderr, "franja render: warning: %s is not locked (--no-lock): nothing keeps another render "
+                "of %s out of it\n", im->jobdir, a->out);
+    if (!a->resume && !a->fresh) {
+        int rows = job_rows_present(im->jobdir);
+        if (rows > 0) {
+            fprintf(stderr, "franja render: %s holds %d finished rows of an earlier render of %s; rerun with "
+                    "--resume to finish it, or with --fresh to discard them\n", im->jobdir, rows, a->out);
+            jlk_release(&im->lk, 0);
+            im->locked = 0;
+            return 2;
+        }
+    }
+
+    if (a->resume && !a->frames) {
+        /* Nothing to go on from: the render finished and its job
+         * directory went with it. */
+        char jf[4200];
+        struct stat st;
+        snprintf(jf, sizeof jf, "%s/job", im->jobdir);
+        if (stat(jf, &st) != 0 && stat(a->out, &st) == 0) {
+            fprintf(stderr, "franja render: --resume: nothing to resume: %s is finished and its job directory %s "
+                    "is gone (a render removes it when done, unless --keep-job); render again without --resume "
+                    "(from the first sample), and with --keep-job to add samples to it later\n", a->out,
+                    im->jobdir);
+            return 2;
+        }
+    }
+    return 0;
+}
+
+/* Gets the image's scene (compiled into its job directory when needed),
+ * works out what to render and opens the job directory: the rows it
+ * holds, the passes of --time-limit.  0, or the exit status (said). */
+int frame_open(frame_image *im)
+{
+    render_args *a = &im->a;
+    fr_error err;
+    im->t0 = clk_now();
+    fr_scene sc;
+    if (scene_binary(a, im->jobdir, im->fbin, sizeof im->fbin, &sc, im->stop, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return *im->stop ? 130 : 1;
+    }
+    job_spec spec = {sc.hash, a->width ? a->width : sc.settings.width, a->height ? a->height : sc.settings.height,
+                     a->spp ? a->spp : sc.settings.spp,
+                     a->integrator ? (uint32_t)(a->integrator - 1) : sc.settings.integrator,
+                     a->noise_threshold > 0.0f ? a->noise_threshold : sc.settings.noise_threshold};
+    if (a->scale > 0) {
+        spec.width = opt_scaled(sc.settings.width, a->scale);
+        spec.height = opt_scaled(sc.settings.height, a->scale);
+    }
+    char note[400];
+    if (a->width && opt_aspect_note(spec.width, spec.height, sc.settings.width, sc.settings.height, note,
+                                    sizeof note))
+        fprintf(stderr, "franja render: warning: --size: %s\n", note);
+    int rc = 0;
+    if (spec.width > PROTO_MAX_SIZE || spec.height > PROTO_MAX_SIZE) {
+        fprintf(stderr, "franja render: --scale: %ux%u is over the largest size, %u pixels a side\n", spec.width,
+                spec.height, PROTO_MAX_SIZE);
+        rc = 2;
+    } else if (spec.integrator == FR_INTEGRATOR_BDPT && a->noise_threshold > 0.0f) {
+        fprintf(stderr, "franja render: --noise-threshold: adaptive sampling is for path tracing, not bdpt\n");
+        rc = 2;
+    }
+    if (!rc && spec.integrator == FR_INTEGRATOR_BDPT)
+        spec.noise_threshold = 0.0f; /* bidirectional workers take every sample */
+    if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
+        fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a->scene, err.msg);
+        rc = a->integrator ? 2 : 1;
+    } else if (!rc && a->time_limit > 0 && !job_sums(&spec)) {
+        fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
+                "only path tracing without adaptive sampling keeps (this render %s)\n",
+                spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"
+                : a->noise_threshold > 0.0f       ? "has --noise-threshold"
+                                                  : "has the scene's noise_threshold");
+        rc = 2;
+    } else if (!rc && a->crop && crop_check(&a->win, spec.width, spec.height, &err)) {
+        fprintf(stderr, "franja render: --crop %s\n", err.msg);
+        rc = 2;
+    }
+    if (rc) {
+        scn_free(&sc);
+        return rc;
+    }
+    /* A crop renders the window's rows only, except bidirectionally: light
+     * paths started from every pixel of the image reach the window. */
+    int crop_rows = im->crop_rows = a->crop && spec.integrator != FR_INTEGRATOR_BDPT;
+    if (a->crop && !crop_rows)
+        fprintf(stderr, "franja: --crop with --integrator bdpt renders every row (light traced from the whole "
+                "image reaches the window)\n");
+    uint32_t asked = spec.spp;
+    if (quick_spp(&spec.spp, &err) > 0)
+        fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
+    /* Tone mapping: the scene's defaults, overridden by the command line. */
+    im->tm = sc.tonemap;
+    if (a->exposure_set)
+        im->tm.exposure = a->exposure;
+    if (a->curve)
+        tm_curve_parse(a->curve, &im->tm.curve);
+    scn_free(&sc);
+    im->spec = spec;
+
+    im->have = calloc(spec.height, 1);
+    im->base = calloc(spec.height, sizeof *im->base);
+    im->rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *im->rgb);
+    passes *ps = &im->ps;
+    *ps = (passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
+                   .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL};
+    if (!im->have || !im->base || !im->rgb || !(ps->scratch = calloc(spec.height, 1))) {
+        fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
+        return 1;
+    }
+    int jr = job_open(im->jobdir, &spec, a->resume, &err);
+    if (jr) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return jr == JOB_REFUSED ? 2 : 1;
+    }
+    /* What the job directory holds toward the samples asked for. */
+    if (frame_plan(ps, spec.spp, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return 1;
+    }
+    int rows_have = 0, rows_base = 0;
+    uint32_t lo, hi, blo = UINT32_MAX, bhi = 0;
+    for (uint32_t y = 0; y < spec.height; y++) {
+        rows_have += im->have[y] && needed(ps, y);
+        if (im->base[y] > 0 && needed(ps, y)) {
+            rows_base++;
+            blo = im->base[y] < blo ? im->base[y] : blo;
+            bhi = im->base[y] > bhi ? im->base[y] : bhi;
+        }
+    }
+    kept_range(ps, &lo, &hi);
+    if (a->resume)
+        fprintf(stderr, "franja: resuming: %d of %u rows already done in %s\n", ps->rows_kept, spec.height,
+                im->jobdir);
+    if (rows_base && a->time_limit <= 0)
+        fprintf(stderr, "franja: adding samples: %d rows go on from the %u%s samples per pixel kept with their sums to "
+                "%u\n", rows_base, blo, blo != bhi ? " or more" : "", spec.spp);
+    /* The rows this render needs (a crop's window). */
+    int rows_job = crop_rows ? (int)(a->win.y1 - a->win.y0) : (int)spec.height;
+    ps->rows_job = im->rows_job = rows_job;
+    im->rows_have = rows_have;
+    if (a->time_limit > 0) {
+        ps->deadline = im->t0 + a->time_limit;
+        /* A complete image kept at one sample count is where the passes
+         * start, and what is written if the first of them does not end. */
+        if (lo == hi && lo > 0 && lo < spec.spp) {
+            if (frame_plan(ps, lo, &err) || frame_pass_image(ps, &err)) {
+                fprintf(stderr, "franja render: %s\n", err.msg);
+                return 1;
+            }
+            ps->reached = lo;
+            fprintf(stderr, "franja: the job holds a whole image with %u samples per pixel; passes go on from it\n",
+                    lo);
+            if (frame_plan(ps, spec.spp, &err)) {
+                fprintf(stderr, "franja render: %s\n", err.msg);
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Every row the image needs is in its job directory (or, with
+ * --time-limit, the last complete pass in memory): stitches, writes the
+ * output, removes the job directory (unless --keep-job) and gives up the
+ * lock.  used: the hosts that rendered rows, for the metadata.  0, or 1
+ * (said). */
+int frame_write(frame_image *im, const char *used)
+{
+    render_args *a = &im->a;
+    passes *ps = &im->ps;
+    job_spec spec = im->spec;
+    fr_error err;
+    if (a->time_limit > 0 && ps->reached) {
+        /* The image of the last complete pass is in rgb. */
+        spec.spp = ps->reached;
+        if (ps->stopped)
+            fprintf(stderr, "franja: time limit of %g s reached: %u samples per pixel (the pass to %u was stopped)\n",
+                    a->time_limit, ps->reached, ps->stopped);
+        else
+            fprintf(stderr, "franja: every %u samples per pixel within the time limit\n", ps->reached);
+    } else if (im->crop_rows ? crop_stitch(im->jobdir, &spec, &a->win, im->rgb, im->have, &err)
+                             : job_stitch(im->jobdir, &spec, im->rgb, &a->tr.notes, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        return 1;
+    }
+    job_spec out_spec = spec;
+    float *rgb = im->rgb;
+    if (a->crop) {
+        crop_black(&a->win, rgb, spec.width, spec.height);
+        if (a->crop_output) {
+            /* The window moves to the start of the buffer. */
+            float *w = malloc((size_t)(a->win.x1 - a->win.x0) * (a->win.y1 - a->win.y0) * 3 * sizeof *w);
+            if (!w) {
+                fprintf(stderr, "franja render: out of memory for the window\n");
+                return 1;
+            }
+            crop_extract(&a->win, rgb, spec.width, w);
+            free(rgb);
+            rgb = im->rgb = ps->rgb = w;
+            out_spec.width = a->win.x1 - a->win.x0;
+            out_spec.height = a->win.y1 - a->win.y0;
+        }
+    }
+    out_meta meta;
+    out_meta_make(&meta, &spec, a->reproducible ? -1 : clk_now() - im->t0, a->reproducible ? NULL : used);
+    if (a->reproducible)
+        out_meta_set_time(&meta, reproducible_epoch());
+    a->io.attrs = meta.attrs;
+    if (out_write_with(a->out, rgb, &out_spec, &im->tm, &a->io, &err)) {
+        /* Said only once checked: the rows are still there. */
+        if (job_rows_present(im->jobdir) >= im->rows_job) {
+            fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
+                    "to write %s\n", err.msg, im->jobdir, a->out);
+        } else {
+            char kept[4400];
+            job_kept_note(im->jobdir, kept, sizeof kept);
+            fprintf(stderr, "franja render: %s\nfranja render: %s\n", err.msg, kept);
+        }
+        return 1;
+    }
+    pg_stop(im->pg, "ok", spec.spp);
+    im->pg = NULL;
+    mon_status(im->mon, "done");
+    mon_stop(im->mon);
+    im->mon = NULL;
+    if (!a->keep_job)
+        job_remove(im->jobdir);
+    else if (job_sums(&spec))
+        job_prune(im->jobdir, &spec); /* rows kept with more samples make the fewer useless */
+    jlk_release(&im->lk, !a->keep_job);
+    im->locked = 0;
+    fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a->out, out_spec.width, out_spec.height, spec.spp,
+            clk_now() - im->t0);
+    return 0;
+}
+
+/* Ends the image: after a failure (rc not 0) its job directory stays for
+ * --resume if it holds rows and the lock is given up; frees it. */
+void frame_close(frame_image *im, int rc)
+{
+    pg_stop(im->pg, *im->stop ? "interrupted" : "failed", im->spec.spp);
+    mon_stop(im->mon);
+    if (rc && im->locked)
+        unlock_with(&im->lk, rc);
+    free(im->have);
+    free(im->base);
+    free(im->ps.scratch);
+    free(im->rgb);
+    free(im);
+}
+
+/* Frees what an image holds but its settings (a frame that is written). */
+void frame_shrink(frame_image *im)
+{
+    free(im->have);
+    free(im->base);
+    free(im->ps.scratch);
+    free(im->rgb);
+    im->have = NULL;
+    im->base = NULL;
+    im->ps.scratch = NULL;
+    im->rgb = im->ps.rgb = NULL;
+    im->ps.have = NULL;
+    im->ps.base = NULL;
+}

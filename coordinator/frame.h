@@ -1,0 +1,151 @@
+/** @file frame.h
+ * One image of `franja render`, from its job lock to its output, without
+ * the hosts: the render of one scene, or one frame of an animation (which
+ * opens one of these per frame while the others render).  frame_lock
+ * takes the job directory's lock and checks it against --resume and
+ * --fresh; frame_open compiles or loads the scene, works out the image's
+ * spec and opens the job directory (the rows it holds, the passes of
+ * --time-limit); the slabs are then rendered into the job directory by the
+ * caller's scheduler; frame_write stitches the rows, writes the output
+ * and removes the job directory; frame_close ends it, keeping the finished
+ * slabs of a failed image for --resume.  Each step says what went wrong on
+ * stderr and returns the exit status for it.
+ */
+#ifndef FRANJA_FRAME_H
+#define FRANJA_FRAME_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "cli.h"
+#include "crop.h"
+#include "jobdir.h"
+#include "joblock.h"
+#include "monitor.h"
+#include "output.h"
+#include "progress.h"
+#include "sched.h"
+#include "tonemap.h"
+
+/** `franja render`'s command line, parsed (cmd_render.c). */
+typedef struct {
+    const char *scene, *out, *hosts, *jobdir, *camera;
+    uint32_t jobs, spp, width, height, slab_rows, retries;
+    float exposure;
+    int exposure_set;          /* --exposure given: overrides the scene's */
+    const char *curve;         /* --tonemap, or NULL for the scene's */
+    char out_buf[4096];        /* out when -o is omitted */
+    const char *preview;       /* --preview FILE, or NULL */
+    uint32_t preview_every;    /* seconds */
+    int integrator;            /* 1 + FR_INTEGRATOR_*, 0 for the scene's */
+    float noise_threshold;     /* --noise-threshold, 0 for the scene's */
+    int json;                  /* --progress json */
+    int crop, crop_output;     /* --crop given, --crop-output */
+    iio_options io;            /* --exr-half, --exr-compression, --jpeg-quality */
+    double scale;              /* --scale, 0 when not given */
+    crop_window win;
+    int monitor;               /* --monitor given */
+    uint32_t monitor_port;
+    int resume, keep_job, fresh, no_lock;
+    const char *frames;        /* --frames LIST, or NULL */
+    int overwrite;             /* --overwrite */
+    int reproducible;          /* --reproducible: no render time or hosts in the metadata */
+    double time_limit;         /* --time-limit, seconds; 0 when not given */
+    tr_options tr;
+    cli_slurm slurm;
+} render_args;
+
+/** The passes of a render.  Without --time-limit there is one, to the
+ * samples asked for.  With it, each pass brings every row the render needs
+ * to twice the fewest samples kept for a row (1 at first; never fewer than
+ * the most kept for a row; at most the samples asked for), adding samples
+ * to the kept sums, and the image of each complete pass is kept in memory:
+ * when the limit stops a pass, that image is written. */
+typedef struct {
+    const render_args *a;
+    const char *jobdir;
+    job_spec spec;             /* the pass being planned or run (spp) */
+    uint32_t cap;              /* the samples per pixel asked for */
+    int crop_rows;             /* only the rows of a's --crop window */
+    unsigned char *have;       /* rows the pass does not render (done, or outside a crop) */
+    uint32_t *base;            /* samples with sums that each row goes on from (job_scan) */
+    int rows_job, rows_missing;
+    int rows_kept;             /* rows the job directory holds at spec.spp, needed or not */
+    double deadline;           /* clk_now() time of --time-limit; 0 = none */
+    float *rgb;                /* --time-limit: the image of the last complete pass */
+    unsigned char *scratch;    /* height bytes */
+    uint32_t reached;          /* the samples per pixel of rgb; 0 = none yet */
+    int npass;                 /* passes run */
+    uint32_t stopped;          /* the samples per pixel of the pass the limit stopped; 0 = none */
+    sched_stats total;         /* over the passes */
+    const char *label;         /* an animation's frame: "frame N"; NULL otherwise */
+} passes;
+
+/** One image of a render, from its job lock to its output: the render of
+ * one scene, or one frame of an animation.  The caller fills a (parsed),
+ * argc, argv and stop; the rest is frame_lock's and frame_open's. */
+typedef struct {
+    render_args a;
+    volatile sig_atomic_t *stop; /* set on SIGINT/SIGTERM (not owned) */
+    int argc;
+    char **argv;               /* as typed, for the lock file (not owned) */
+    char jobdir[4096], fbin[4200];
+    job_lock lk;
+    int locked;
+    job_spec spec;
+    fr_tonemap tm;
+    int crop_rows;
+    unsigned char *have;
+    uint32_t *base;
+    float *rgb;
+    passes ps;
+    int rows_job, rows_have;
+    double t0;
+    pg_reporter *pg;           /* --progress json, or NULL */
+    mon_server *mon;           /* --monitor, or NULL */
+} frame_image;
+
+/** What a pass to spp samples per pixel renders: the rows the job
+ * directory does not hold with spp samples (ps->have), each from the most
+ * samples kept for it with their sums (ps->base).  -1 with err when the
+ * job directory cannot be read. */
+int frame_plan(passes *ps, uint32_t spp, fr_error *err);
+
+/** The samples per pixel of the next pass of a --time-limit render into
+ * *spp, 0 when every needed row has the samples asked for.  -1 with err
+ * when the job directory cannot be read. */
+int frame_next_pass(passes *ps, uint32_t *spp, fr_error *err);
+
+/** The image of the pass just planned and complete into ps->rgb.  -1 with
+ * err when a row is missing or unreadable. */
+int frame_pass_image(passes *ps, fr_error *err);
+
+/** Takes im's job lock (its job directory: --job, else OUT.franja-job)
+ * and refuses a job directory with finished rows unless --resume or
+ * --fresh, and a --resume of a single render that finished.  0, or the
+ * exit status (said; frame_close gives the lock up). */
+int frame_lock(frame_image *im);
+
+/** Gets the binary scene (compiled into the job directory when needed),
+ * checks the options against it, and opens the job directory: im->spec,
+ * im->tm, the rows held (im->ps, im->rows_have of im->rows_job).  0, or
+ * the exit status (said; 130 when interrupted). */
+int frame_open(frame_image *im);
+
+/** Every row the image needs is in its job directory (or, with
+ * --time-limit, the last complete pass in memory): stitches, writes the
+ * output, removes the job directory (unless --keep-job), gives up the lock
+ * and says "franja: wrote ...".  used: the hosts that rendered rows, for
+ * the metadata.  0, or 1 (said: the rows stay for --resume). */
+int frame_write(frame_image *im, const char *used);
+
+/** Frees the pixels and row tables of a written image; its settings
+ * stay. */
+void frame_shrink(frame_image *im);
+
+/** Ends the image: after a failure (rc not 0) a job directory without
+ * finished rows goes, one with rows stays for --resume, and the lock is
+ * given up; frees im. */
+void frame_close(frame_image *im, int rc);
+
+#endif
