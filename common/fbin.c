@@ -259,6 +259,9 @@ static int validate_lights(const fr_scene *s, const void *base, const uint64_t *
             return fr_fail(err, "section lights, byte %zu: light %u: a second environment", AT(l), i);
         if (!(l->pick > 0.0f && l->pick <= 1.0f) || !(l->cdf >= 0.0f && l->cdf <= 1.0f))
             return fr_fail(err, "section lights, byte %zu: light %u: bad pick probability", AT(l), i);
+        if (i > 0 && !(l->cdf >= s->lights[i - 1].cdf))
+            return fr_fail(err, "section lights, byte %zu: light %u: cumulative pick probability below the light "
+                           "before it", AT(l), i);
         if (!finite3(l->position) || !finite3(l->intensity) || v3_min(l->intensity) < 0.0f)
             return fr_fail(err, "section lights, byte %zu: light %u: non-finite position or bad intensity", AT(l), i);
         if (l->kind == FR_LIGHT_SPOT &&

@@ -305,6 +305,9 @@ static void test_lights(void)
     poke_at("sun axis not unit", light + 64 + 32, u, "section lights", light + 64);
     poke_at("second environment", light + 64, FR_LIGHT_ENV, "section lights", light + 64);
     poke_at("light kind", light + 64, 9, "section lights", light + 64);
+    /* The second light's cumulative pick probability below the first's
+     * (lgt_pick's binary search needs them in order). */
+    poke_at("cumulative pick probability decreasing", light + 64 + 60, 0, "section lights", light + 64);
     good = keep;
     scn_free(&lit);
 }
