@@ -42,6 +42,12 @@ int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit);
  * cannot hide its own sampled point, and near its silhouette rounding would
  * make it seem to. */
 int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip);
+/** Which of the two equivalent traversals runs: on x86-64 processors with
+ * AVX2 one that tests a node's eight boxes at once (the default there),
+ * elsewhere, or with `on` 0, the portable one.  Both give the same bits;
+ * tests and benchmarks use this to compare them.  Returns 1 if the wide one
+ * is now in use.  Not thread-safe: call it before tracing starts. */
+int trace_set_wide(int on);
 /** Nearest hit on one primitive, for tests and the BVH: t or 0. */
 float trace_prim(const fr_scene *s, uint32_t prim, const fr_ray *r, float tmax, float *a, float *b);
 /** Rebuild the surface at a hit. */

@@ -7,8 +7,10 @@
  * box planes, rays with a finite tmax) are traced with trace_closest and
  * compared with a loop over every primitive: same primitive, same t, same
  * barycentrics, bit for bit.  trace_occluded must agree with the nearest
- * hit, with and without a skipped primitive. */
+ * hit, with and without a skipped primitive.  Where there are two
+ * traversals (x86-64 with AVX2), both are checked. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -252,25 +254,37 @@ int main(void)
         {"grid", 40, 4000},          {"sheets", 600, 4000},   {"degenerate", 300, 2000},
         {"copies", 200, 1000},       {"mixed", 800, 3000},    {"mixed soup", 1500, 3000},
     };
-    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+    /* Every case through both traversals where there are two (the eight-lane
+     * one on x86-64 with AVX2, the portable one everywhere). */
+    int wide = trace_set_wide(1);
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+    CHECK(wide == (__builtin_cpu_supports("avx2") != 0), "the eight-lane traversal is %s on a processor %s AVX2",
+          wide ? "used" : "not used", __builtin_cpu_supports("avx2") ? "with" : "without");
+#endif
+    for (size_t c = 0; c < (wide ? 2 : 1) * (sizeof cases / sizeof cases[0]); c++) {
+        size_t cs = c % (sizeof cases / sizeof cases[0]);
+        if (wide)
+            trace_set_wide(c == cs);
         fr_builder b[2];
         uint64_t seed = rng_state;
         for (int k = 0; k < 2; k++) {
             rng_state = seed;
             start(&b[k]);
-            switch (c) {
+            switch (cs) {
             case 0: soup(&b[k], 1, 0.5f); break;
-            case 1: soup(&b[k], cases[c].n, 0.05f); break;
-            case 2: soup(&b[k], cases[c].n, 0.8f); break;
-            case 3: grid(&b[k], cases[c].n); break;
-            case 4: sheets(&b[k], cases[c].n); break;
-            case 5: degenerate(&b[k], cases[c].n); soup(&b[k], 200, 0.1f); break;
-            case 6: copies(&b[k], cases[c].n); soup(&b[k], 20, 0.1f); break;
-            case 7: others(&b[k], cases[c].n); break;
-            default: others(&b[k], 100); soup(&b[k], cases[c].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
+            case 1: soup(&b[k], cases[cs].n, 0.05f); break;
+            case 2: soup(&b[k], cases[cs].n, 0.8f); break;
+            case 3: grid(&b[k], cases[cs].n); break;
+            case 4: sheets(&b[k], cases[cs].n); break;
+            case 5: degenerate(&b[k], cases[cs].n); soup(&b[k], 200, 0.1f); break;
+            case 6: copies(&b[k], cases[cs].n); soup(&b[k], 20, 0.1f); break;
+            case 7: others(&b[k], cases[cs].n); break;
+            default: others(&b[k], 100); soup(&b[k], cases[cs].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
             }
         }
-        compare(cases[c].name, &b[0], &b[1], cases[c].rays);
+        char name[96];
+        snprintf(name, sizeof name, "%s (%s traversal)", cases[cs].name, wide && c == cs ? "eight-lane" : "portable");
+        compare(name, &b[0], &b[1], cases[cs].rays);
         bld_free(&b[0]);
         bld_free(&b[1]);
     }
