@@ -11,6 +11,10 @@
 # - CPU ratio: CPU seconds (user + system, franja and its workers) of -j 1
 #   over -j N: below 1.0 when N processes at once each run slower (shared
 #   caches, memory, hyper-threads, straggler copies that are thrown away).
+# - machine ceiling: the same CPU ratio for N whole renders with -j 1 run
+#   side by side, which share nothing but the machine: what N processes of
+#   this work lose to each other on these cores whatever schedules them.
+#   The efficiency over this ceiling is the part the coordinator can reach.
 cd "$(dirname "$0")/../.." || exit 1
 . tests/coord/bench_common.sh
 N=$(nproc)
@@ -48,4 +52,22 @@ done
 C1=$(median $c1) CN=$(median $cn) OCC=$(median $occs)
 echo "CPU seconds, -j 1:$c1 (median $C1); -j $N:$cn (median $CN); CPU ratio $(calc "$C1 / $CN")"
 echo "occupancy of the $N slots (busy seconds / ($N x render seconds)):$occs; median $OCC"
+
+# The machine ceiling: CPU seconds of one -j 1 render alone against N of
+# them at once (per render), alternated RUNS times.
+together() {
+    sh -c "k=0; while [ \$k -lt $1 ]; do bin/franja render $SCENE -o $T/s\$k.pfm $ARGS -j 1 >/dev/null 2>&1 & k=\$((k + 1)); done; wait; cat /proc/\$\$/stat" >"$T/stat" ||
+        return 1
+    awk -v hz="$(getconf CLK_TCK)" -v n="$1" '{ sub(/.*\) /, ""); printf "%.3f", ($14 + $15) / hz / n }' "$T/stat"
+}
+s1="" sn=""
+i=0
+while [ $i -lt "$RUNS" ]; do
+    s1="$s1 $(together 1)" sn="$sn $(together "$N")"
+    i=$((i + 1))
+done
+S1=$(median $s1) SN=$(median $sn)
+CEIL=$(calc "$S1 / $SN")
+echo "machine ceiling: CPU seconds of one -j 1 render alone:$s1 (median $S1); each of $N at once:$sn (median $SN); ratio $CEIL"
+echo "parallel efficiency over the machine ceiling: $(calc "$TA / ($N * $TB) / $CEIL")"
 echo "machine after: load $(cut -d' ' -f1-3 /proc/loadavg)"
