@@ -11,7 +11,8 @@
 # mid-render leave no step and no worker running, and so does SIGKILL of
 # franja in an allocation that lives on; --resume finishes in a
 # second allocation (a batch job from hosts/franja.sbatch);
-# a node whose worker is another version is dropped, by name; outside an
+# a node whose worker is another version is dropped, by name; an
+# animation (--frames) gives each frame's own bytes; outside an
 # allocation --slurm says what to run instead.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 . "$ROOT/tests/slurm/lib.sh"
@@ -96,6 +97,19 @@ check "it lies in the nodes' cache under its content hash" \
     test "$(ls "$WD/scenes" | grep -Ec '^[0-9a-f]{16}\.fbin$')" -eq 1
 check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
 check "no step is left after the render" no_leftovers
+
+# An animation in one allocation: every frame equals its own render.
+for i in 1 2; do
+    sed "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [$((150 * i + 100)), 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+        "$ROOT/scenes/cornell.json" >"f.000$i.json"
+    "$FRANJA" render "f.000$i.json" -o "fref$i.pfm" $SIZE -j 1 2>/dev/null
+done
+render logf -N3 -n6 "$FRANJA" render 'f.####.json' --frames 1-2 -o 'anim/f.####.pfm' $SIZE --slurm --workdir "$T/animwd"
+check "frames 1-2 in one allocation: both written ($(tail -n 2 logf))" grep -q "frames: 2 of 2 done (2 rendered" logf
+check "frame 1 equals its own render" cmp -s anim/f.0001.pfm fref1.pfm
+check "frame 2 equals its own render" cmp -s anim/f.0002.pfm fref2.pfm
+check "and the frames differ" sh -c '! cmp -s fref1.pfm fref2.pfm'
+check "no step is left after the animation" no_leftovers
 
 # Bidirectional: every step's partial carries its splats over the whole
 # image, and the sum over nodes has the bytes of a one-process render.
