@@ -1005,12 +1005,11 @@ static int rf_done(void *ctx, int frame, fr_error *err)
 /* `franja render PATTERN --frames LIST`: the frames run together over one
  * set of hosts, each written as soon as its rows are in; a frame-by-frame
  * run where an option works on one image at a time (--time-limit,
- * --preview, --monitor, --progress json) or the hosts are a Slurm
- * allocation. */
+ * --preview, --monitor, --progress json). */
 static int render_frames(int argc, char **argv, render_args *a)
 {
     frames_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview};
-    if (a->time_limit > 0 || a->preview || a->monitor || a->json || a->slurm.on)
+    if (a->time_limit > 0 || a->preview || a->monitor || a->json)
         return frames_run(argc, argv, &fj, cmd_render);
     anim_run fx;
     memset(&fx, 0, sizeof fx);

@@ -12,7 +12,8 @@
 # franja in an allocation that lives on; --resume finishes in a
 # second allocation (a batch job from hosts/franja.sbatch);
 # a node whose worker is another version is dropped, by name; an
-# animation (--frames) gives each frame's own bytes; outside an
+# animation (--frames) runs its frames over one set of nodes and gives
+# each frame's own bytes; outside an
 # allocation --slurm says what to run instead.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 . "$ROOT/tests/slurm/lib.sh"
@@ -109,6 +110,10 @@ check "frames 1-2 in one allocation: both written ($(tail -n 2 logf))" grep -q "
 check "frame 1 equals its own render" cmp -s anim/f.0001.pfm fref1.pfm
 check "frame 2 equals its own render" cmp -s anim/f.0002.pfm fref2.pfm
 check "and the frames differ" sh -c '! cmp -s fref1.pfm fref2.pfm'
+check "the frames run over one set of steps: each node probed once" \
+    test "$(grep -c ': Linux .* slots, franja-worker' logf)" -eq 3
+check "each frame's scene staged on each node" \
+    test "$(grep -Ec 'host n[123]: frame [12]: scene (uploaded|already there)' logf)" -eq 6
 check "no step is left after the animation" no_leftovers
 
 # Bidirectional: every step's partial carries its splats over the whole
