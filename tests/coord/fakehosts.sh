@@ -81,11 +81,21 @@ LogLevel ERROR
 # every worker start up to seconds.  SHLVL=1 makes the login shell nested.
 SetEnv SHLVL=1
 CFG
+    rm -f "$d/sshd.pid"
     ${FH_NETNS:+ip netns exec "$FH_NETNS"} /usr/sbin/sshd -f "$d/sshd_config" -E "$d/sshd.log" || {
         echo "FAIL: sshd for $name did not start:"
         cat "$d/sshd.log"
         return 1
     }
+    # sshd returns once it has forked, before it listens; it writes its PID
+    # file after binding, so a client that starts before the file exists
+    # can find the port closed on a busy machine.
+    i=0
+    while [ ! -s "$d/sshd.pid" ]; do
+        [ $i -lt 200 ] || { echo "FAIL: sshd for $name did not listen within 20 s:"; cat "$d/sshd.log"; return 1; }
+        sleep 0.1
+        i=$((i + 1))
+    done
     echo "[$addr]:$port $(cut -d' ' -f1,2 "$d/host_key.pub")" >>"$FH/known_hosts"
     echo "$name $addr:$port $FH_USER $cores identity=$FH/client_key workdir=$d/work worker=$worker" >>"$FH/hosts"
     FH_HOSTS="$FH_HOSTS $name"
