@@ -125,11 +125,52 @@ void file_dir(const char *path, char *dir, size_t cap)
         snprintf(dir, cap, "%.*s", (int)(slash - path), path);
 }
 
+/* A target that is not a file to replace: a character device or a FIFO
+ * (itself, or through a system link such as /dev/stdout) is opened as it
+ * is; 1 when so, 0 for a plain target, -1 (err set) when refused. */
+static int out_direct(const char *path, file_out *o, fr_error *err)
+{
+    struct stat ls, st;
+    if (lstat(path, &ls))
+        return 0;
+    int flags = O_WRONLY | O_CLOEXEC;
+    if (S_ISLNK(ls.st_mode)) {
+        if (strncmp(path, "/dev/", 5) && strncmp(path, "/proc/", 6))
+            return 0; /* a link elsewhere is replaced, never followed */
+        /* /dev/stdout and its kind: what the link reaches is written,
+         * a plain file from its start, as a shell's > would. */
+        if (stat(path, &st))
+            return fr_fail(err, "%s: %s", path, strerror(errno));
+        if (S_ISREG(st.st_mode))
+            flags |= O_TRUNC;
+        else if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))
+            return fr_fail(err, "%s: cannot write over %s", path, kind(st.st_mode));
+    } else if (S_ISREG(ls.st_mode)) {
+        return 0;
+    } else if (!S_ISCHR(ls.st_mode) && !S_ISFIFO(ls.st_mode)) {
+        return fr_fail(err, "%s: cannot write over %s", path, kind(ls.st_mode));
+    }
+    if (snprintf(o->tmp, sizeof o->tmp, "%s", path) >= (int)sizeof o->tmp)
+        return fr_fail(err, "%s: path too long", path);
+    o->fd = open(path, flags);
+    if (o->fd < 0) {
+        int e = errno;
+        o->tmp[0] = 0;
+        return fr_fail(err, "%s: %s", path, strerror(e));
+    }
+    o->direct = 1;
+    return 1;
+}
+
 int file_out_open(const char *path, file_out *o, fr_error *err)
 {
     static unsigned counter;
     o->fd = -1;
+    o->direct = 0;
     o->tmp[0] = 0;
+    int d = out_direct(path, o, err);
+    if (d)
+        return d < 0 ? -1 : 0;
     const char *slash = strrchr(path, '/');
     int dirlen = slash ? (int)(slash - path + 1) : 0;
     const char *base = path + dirlen;
@@ -170,6 +211,13 @@ int file_out_write(file_out *o, const void *data, size_t n, fr_error *err)
 int file_out_commit(file_out *o, const char *path, fr_error *err)
 {
     int rc = 0;
+    if (o->direct) {
+        if (close(o->fd))
+            rc = fr_fail(err, "%s: close failed: %s", path, strerror(errno));
+        o->fd = -1;
+        o->tmp[0] = 0;
+        return rc;
+    }
     if (fsync(o->fd))
         rc = fr_fail(err, "%s: fsync failed: %s", o->tmp, strerror(errno));
     if (close(o->fd) && rc == 0)
@@ -187,7 +235,7 @@ void file_out_abort(file_out *o)
 {
     if (o->fd >= 0)
         close(o->fd);
-    if (o->tmp[0])
+    if (o->tmp[0] && !o->direct)
         unlink(o->tmp);
     o->fd = -1;
     o->tmp[0] = 0;

@@ -49,17 +49,25 @@ int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_err
 
 /** An output file being written: a private temporary file in the target's
  * directory, which file_out_commit renames over the target, so that the
- * target is always either the old file or the complete new one. */
+ * target is always either the old file or the complete new one.  A target
+ * that is a character device or a FIFO (/dev/null, /dev/stdout, a named
+ * pipe) is written in place instead, never replaced. */
 typedef struct {
     int fd;                    /**< open for writing; -1 once committed or aborted */
-    char tmp[4400];            /**< the temporary file's name */
+    int direct;                /**< 1: fd is the target itself (a device or FIFO), tmp its name */
+    char tmp[4400];            /**< the temporary file's name (the target's when direct) */
 } file_out;
 
 /** Creates the temporary file for path: DIR/.BASE.tmp-PID-N.EXT (it keeps
  * path's extension, for writers that choose a format by it and write by
  * name), with O_CREAT|O_EXCL|O_NOFOLLOW (never an existing file or a
  * link), mode 0666 less the umask.  Fails with "PATH: cannot create a
- * temporary file beside it: <system error>". */
+ * temporary file beside it: <system error>".  When path is a character
+ * device or a FIFO, or a link under /dev/ or /proc/ (/dev/stdout) to one
+ * or to a plain file (then truncated), it is opened for writing as it is
+ * (direct); a link elsewhere is replaced, never followed.  A block device,
+ * a socket or a directory is refused: "PATH: cannot write over a block
+ * device". */
 int file_out_open(const char *path, file_out *o, fr_error *err);
 
 /** Writes all n bytes to the temporary file (short writes and EINTR
@@ -67,10 +75,12 @@ int file_out_open(const char *path, file_out *o, fr_error *err);
 int file_out_write(file_out *o, const void *data, size_t n, fr_error *err);
 
 /** Puts the file in place: fsync, close and rename over path, each
- * checked.  On failure the temporary file is removed and path untouched. */
+ * checked.  On failure the temporary file is removed and path untouched.
+ * A direct target is only closed. */
 int file_out_commit(file_out *o, const char *path, fr_error *err);
 
-/** Closes and removes the temporary file; nothing once committed. */
+/** Closes and removes the temporary file (a direct target is only
+ * closed); nothing once committed. */
 void file_out_abort(file_out *o);
 
 /** Writes data[0..len) to path atomically (open, write, commit). */

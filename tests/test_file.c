@@ -5,6 +5,7 @@
  * temporary file, nor does a process of another machine with the same pid
  * on a shared file system. */
 #include <dirent.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -230,6 +231,65 @@ static void test_failures(void)
     rmdir(sub);
 }
 
+/* A device or a FIFO is written in place, never replaced by a file: the
+ * target stays what it was, and nothing is left beside it. */
+static void test_devices(void)
+{
+    fr_error err;
+    struct stat st;
+    CHECK(file_write_atomic("/dev/null", "gone", 4, &err) == 0, "/dev/null: %s", err.msg);
+    CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "/dev/null is no longer a character device");
+    file_out o;
+    CHECK(file_out_open("/dev/null", &o, &err) == 0 && o.direct, "/dev/null is not written in place");
+    file_out_abort(&o);
+    CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "an abort removed /dev/null");
+
+    char fifo[128];
+    snprintf(fifo, sizeof fifo, "%s/pipe.ppm", dir);
+    CHECK(mkfifo(fifo, 0600) == 0, "mkfifo");
+    int r = open(fifo, O_RDONLY | O_NONBLOCK);
+    CHECK(r >= 0, "open the FIFO for reading");
+    CHECK(file_write_atomic(fifo, "P6 data", 7, &err) == 0, "FIFO: %s", err.msg);
+    char got[16] = "";
+    CHECK(read(r, got, sizeof got - 1) == 7 && !strcmp(got, "P6 data"), "the FIFO's reader got '%s'", got);
+    close(r);
+    CHECK(lstat(fifo, &st) == 0 && S_ISFIFO(st.st_mode), "the FIFO was replaced");
+    CHECK(entries() == 1, "%d entries beside the FIFO, expected 1", entries());
+    unlink(fifo);
+
+    /* A link of the user's to a device is replaced, not followed. */
+    char link[128];
+    snprintf(link, sizeof link, "%s/out.pfm", dir);
+    CHECK(symlink("/dev/null", link) == 0, "symlink");
+    CHECK(file_write_atomic(link, "mine", 4, &err) == 0, "link: %s", err.msg);
+    CHECK(lstat(link, &st) == 0 && S_ISREG(st.st_mode) && has(link, "mine"), "the link was followed");
+    CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "/dev/null changed");
+    unlink(link);
+
+    /* /dev/stdout reaching a plain file: the file is written, the link kept. */
+    char out[128];
+    snprintf(out, sizeof out, "%s/stdout.ppm", dir);
+    CHECK(file_write_atomic(out, "old content", 11, &err) == 0, "out: %s", err.msg);
+    fflush(stdout);
+    int saved = dup(1), f = open(out, O_WRONLY);
+    CHECK(saved >= 0 && f >= 0 && dup2(f, 1) == 1, "stdout to a file");
+    int rc = file_write_atomic("/dev/stdout", "new", 3, &err);
+    dup2(saved, 1);
+    close(saved);
+    close(f);
+    CHECK(rc == 0, "/dev/stdout: %s", err.msg);
+    CHECK(has(out, "new"), "the file behind /dev/stdout holds the new content only");
+    CHECK(lstat("/dev/stdout", &st) == 0 && S_ISLNK(st.st_mode), "/dev/stdout is no longer a link");
+    unlink(out);
+
+    char sub[128];
+    snprintf(sub, sizeof sub, "%s/sub", dir);
+    CHECK(mkdir(sub, 0700) == 0, "mkdir");
+    CHECK(file_write_atomic(sub, "x", 1, &err) < 0 && strstr(err.msg, "cannot write over a directory"),
+          "a directory: %s", err.msg);
+    rmdir(sub);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/franja-file.XXXXXX");
@@ -243,6 +303,7 @@ int main(void)
     test_processes();
     test_same_pid_elsewhere();
     test_failures();
+    test_devices();
     rmdir(dir);
     return check_done();
 }

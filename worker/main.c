@@ -204,13 +204,24 @@ int main(int argc, char **argv)
     }
     lifeline_stop();
 
-    FILE *f = to_stdout ? stdout : fopen(out, "wb");
+    /* A file is written beside its target and renamed over it whole
+     * (file.h), so a reader never sees half a partial and a failed write
+     * leaves what was there; a device or FIFO is written in place. */
+    file_out o = {.fd = -1};
+    FILE *f = stdout;
     int rc = 0;
-    if (!f) {
-        fprintf(stderr, "franja-worker: %s: %s\n", out, strerror(errno));
-        rc = 1;
-    } else if ((sl->sums ? img_write_sums(f, &info, rgb, sums, &err) : img_write(f, sl->format, &info, rgb, splat, &err)) <
-               0) {
+    if (!to_stdout) {
+        int fd = -1;
+        if (file_out_open(out, &o, &err) || (fd = dup(o.fd)) < 0 || !(f = fdopen(fd, "wb"))) {
+            if (fd >= 0)
+                close(fd);
+            fprintf(stderr, "franja-worker: %s\n", o.fd < 0 ? err.msg : strerror(errno));
+            f = NULL;
+            rc = 1;
+        }
+    }
+    if (f && (sl->sums ? img_write_sums(f, &info, rgb, sums, &err) : img_write(f, sl->format, &info, rgb, splat, &err)) <
+                 0) {
         fprintf(stderr, "franja-worker: %s: %s\n", to_stdout ? "standard output" : out, err.msg);
         rc = 1;
     }
@@ -218,8 +229,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "franja-worker: %s: %s\n", out, strerror(errno));
         rc = 1;
     }
-    if (rc && !to_stdout)
-        remove(out);
+    if (!to_stdout && o.fd >= 0) {
+        if (rc)
+            file_out_abort(&o);
+        else if (file_out_commit(&o, out, &err)) {
+            fprintf(stderr, "franja-worker: %s\n", err.msg);
+            rc = 1;
+        }
+    }
     free(rgb);
     free(splat);
     free(sums);
