@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "simd4.h"
 
@@ -20,8 +21,9 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
         return fr_fail(err, "section nodes: the scene has primitives but no BVH");
     unsigned char *depth = calloc(s->n_nodes, 1);
     unsigned char *owner = calloc(s->n_leaves, 1);   /* 1: in a leaf, 2: in a mixed leaf */
+    unsigned char *seen = calloc(s->n_prims, 1);     /* 1: in some lane */
     int rc = 0;
-    if (!depth || !owner) {
+    if (!depth || !owner || !seen) {
         rc = fr_fail(err, "out of memory validating the BVH");
         goto done;
     }
@@ -82,29 +84,45 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
             }
         }
     }
-    /* The blocks list the primitives in order, each once: lanes hold
-     * next, next+1, ... and unused lanes (FR_NONE) only end a block. */
-    uint32_t next = 0;
+    /* Every lane names a primitive or none (unused lanes only end a block),
+     * a triangle's lane holds copies of its vertices, and every primitive
+     * is in at least one lane. */
     for (uint32_t j = 0; j < s->n_leaves && rc == 0; j++) {
         const fr_bvh_leaf *L = &s->leaves[j];
         if (!owner[j]) {
             rc = fr_fail(err, "section leaves, byte %zu: block %u belongs to no leaf", AT(L), j);
             break;
         }
-        int used = 0;
-        while (used < 4 && L->prim[used] == next && next < s->n_prims) {
-            if (s->prims[next].kind != FR_PRIM_TRIANGLE && owner[j] != 2) {
-                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u is not a triangle but "
-                             "its leaf is not marked mixed", AT(L->prim + used), j, used, next);
+        for (int lane = 0; lane < 4 && rc == 0; lane++) {
+            uint32_t p = L->prim[lane];
+            if (p == FR_NONE) {
+                if (lane == 0 || (lane < 3 && L->prim[lane + 1] != FR_NONE))
+                    rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: unused, but %s", AT(L->prim + lane),
+                                 j, lane, lane == 0 ? "the first lane of a block must be used" : "a later lane is used");
+                continue;
+            }
+            if (p >= s->n_prims) {
+                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u of %u", AT(L->prim + lane),
+                             j, lane, p, s->n_prims);
                 break;
             }
-            used++;
-            next++;
+            seen[p] = 1;
+            if (s->prims[p].kind != FR_PRIM_TRIANGLE) {
+                if (owner[j] != 2)
+                    rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u is not a triangle but "
+                                 "its leaf is not marked mixed", AT(L->prim + lane), j, lane, p);
+                continue;
+            }
+            const fr_triangle *t = &s->triangles[s->prims[p].index];
+            for (int v = 0; v < 3 && rc == 0; v++) {
+                vec3 q = s->positions[t->v[v]];
+                const float c[3] = {q.x, q.y, q.z};
+                for (int a = 0; a < 3 && rc == 0; a++)
+                    if (memcmp(&L->v[3 * v + a][lane], &c[a], sizeof c[a]))
+                        rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: vertex %d of primitive %u "
+                                     "differs from its triangle's", AT(&L->v[3 * v + a][lane]), j, lane, v, p);
+            }
         }
-        for (int lane = used; lane < 4 && rc == 0; lane++)
-            if (L->prim[lane] != FR_NONE || lane == 0)
-                rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: primitive %u, expected %s", AT(L->prim + lane),
-                             j, lane, L->prim[lane], lane == 0 ? "the next primitive in order" : "the next primitive or none");
         /* Every coordinate finite: x * 0 is 0 for finite x, NaN otherwise. */
         f4 acc = f4_set1(0.0f);
         for (int v = 0; v < 9; v++)
@@ -115,10 +133,12 @@ int bvh_validate(const fr_scene *s, const void *base, fr_error *err)
                     rc = fr_fail(err, "section leaves, byte %zu: block %u lane %d: non-finite vertex coordinate",
                                  AT(&L->v[v / 4][v % 4]), j, v % 4);
     }
-    if (rc == 0 && next != s->n_prims)
-        rc = fr_fail(err, "section prims, byte %zu: primitive %u is in no BVH leaf", AT(s->prims + next), next);
+    for (uint32_t p = 0; p < s->n_prims && rc == 0; p++)
+        if (!seen[p])
+            rc = fr_fail(err, "section prims, byte %zu: primitive %u is in no BVH leaf", AT(s->prims + p), p);
 done:
     free(depth);
     free(owner);
+    free(seen);
     return rc;
 }

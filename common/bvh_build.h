@@ -2,11 +2,15 @@
  * Building the BVH of a scene at compile time (the layout it produces is
  * described in bvh.h and scene.h).
  *
- * A binned surface-area-heuristic build (32 bins per axis on primitive
+ * A binned surface-area-heuristic build (32 bins per axis on reference
  * centroids, O(n log n)): a node takes the child range with the largest
  * surface area and splits it at the cheapest bin boundary until it has
  * eight children or the SAH prefers leaves; below the depth where the tree
- * could exceed FR_BVH_MAX_DEPTH it halves ranges instead.  It is
+ * could exceed FR_BVH_MAX_DEPTH it halves ranges instead.  Where the two
+ * sides of the best such split overlap, it also tries spatial splits (a
+ * plane across the range's longest axis, triangles crossing it cut in two,
+ * each side bounding its part only), up to one extra reference per
+ * primitive in all; a triangle then sits in several leaves.  It is
  * single-threaded and uses only exactly rounded float operations, so a
  * scene gives the same bytes on every machine.
  */

@@ -6,7 +6,9 @@
  * the boxes, axis-parallel ones with exact zero components, rays lying in
  * box planes, rays with a finite tmax) are traced with trace_closest and
  * compared with a loop over every primitive: same primitive, same t, same
- * barycentrics, bit for bit.  trace_occluded must agree with the nearest
+ * barycentrics, bit for bit.  Long crossing slivers make the build split
+ * triangles spatially (one triangle in several leaves): the walk must still
+ * return each hit once, as brute force does.  trace_occluded must agree with the nearest
  * hit, with and without a skipped primitive.  Where there are two
  * traversals (x86-64 with AVX2), both are checked. */
 #include <math.h>
@@ -141,6 +143,27 @@ static void others(fr_builder *b, int n)
     }
 }
 
+/* A sheet of long thin triangles lying diagonal to the axes (a 5 x m
+ * grid stretched along one diagonal, squeezed along the other, bumpy):
+ * their boxes are mostly empty, so the build cuts them with spatial splits
+ * and puts parts of one triangle in several leaves. */
+static void slivers(fr_builder *b, int n)
+{
+    int m = n / 8 + 2;
+    uint32_t base = b->positions.count;
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < m; j++) {
+            float u = 0.5f * (float)i - 1.0f, w = 2.0f * (float)j / (float)(m - 1) - 1.0f;
+            vert(b, v3((u - w) * 0.70710678f, 0.1f * rnd() + 0.2f * w, (u + w) * 0.70710678f));
+        }
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j + 1 < m; j++) {
+            uint32_t a = base + (uint32_t)(i * m + j), c = a + (uint32_t)m;
+            tri(b, a, c, c + 1);
+            tri(b, a, c + 1, a + 1);
+        }
+}
+
 /* ---- rays ---- */
 
 static fr_ray make_ray(const fr_scene *s, int kind)
@@ -202,7 +225,7 @@ static int brute(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip, 
 
 static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
 
-static void compare(const char *name, fr_builder *b, fr_builder *again, int rays)
+static void compare(const char *name, fr_builder *b, fr_builder *again, int rays, int want_split)
 {
     fr_scene s;
     fr_error err;
@@ -211,6 +234,16 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
         return;
     }
     CHECK(s.n_nodes > 0, "%s: has a BVH", name);
+    /* Lanes in use: one per primitive, more where spatial splits put a
+     * primitive in several leaves. */
+    uint32_t lanes = 0;
+    for (uint32_t j = 0; j < s.n_leaves; j++)
+        for (int k = 0; k < 4; k++)
+            lanes += s.leaves[j].prim[k] != FR_NONE;
+    CHECK(lanes >= s.n_prims, "%s: %u lanes for %u primitives", name, lanes, s.n_prims);
+    if (want_split)
+        CHECK(lanes > s.n_prims + s.n_prims / 4, "%s: %u lanes for %u primitives: spatial splits not used", name, lanes,
+              s.n_prims);
     int bad = 0, badany = 0, hits = 0;
     for (int i = 0; i < rays; i++) {
         fr_ray r = make_ray(&s, i % 4);
@@ -253,6 +286,7 @@ int main(void)
         {"small soup", 1, 2000},     {"soup", 3000, 4000},    {"large triangles", 400, 3000},
         {"grid", 40, 4000},          {"sheets", 600, 4000},   {"degenerate", 300, 2000},
         {"copies", 200, 1000},       {"mixed", 800, 3000},    {"mixed soup", 1500, 3000},
+        {"slivers", 2000, 4000},     {"slivers and sheets", 600, 4000},
     };
     /* Every case through both traversals where there are two (the eight-lane
      * one on x86-64 with AVX2, the portable one everywhere). */
@@ -279,12 +313,14 @@ int main(void)
             case 5: degenerate(&b[k], cases[cs].n); soup(&b[k], 200, 0.1f); break;
             case 6: copies(&b[k], cases[cs].n); soup(&b[k], 20, 0.1f); break;
             case 7: others(&b[k], cases[cs].n); break;
-            default: others(&b[k], 100); soup(&b[k], cases[cs].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
+            case 8: others(&b[k], 100); soup(&b[k], cases[cs].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
+            case 9: slivers(&b[k], cases[cs].n); break;
+            default: slivers(&b[k], cases[cs].n); sheets(&b[k], 200); copies(&b[k], 30); others(&b[k], 40); break;
             }
         }
         char name[96];
         snprintf(name, sizeof name, "%s (%s traversal)", cases[cs].name, wide && c == cs ? "eight-lane" : "portable");
-        compare(name, &b[0], &b[1], cases[cs].rays);
+        compare(name, &b[0], &b[1], cases[cs].rays, cs == 9);
         bld_free(&b[0]);
         bld_free(&b[1]);
     }

@@ -217,7 +217,31 @@ static void test_contents(void)
     }
     /* Leaf blocks. */
     poke("lane 0 unused", leaf + 144, FR_NONE, "section leaves");
-    poke("primitive out of order", leaf + 144, 3, "section leaves");
+    poke("primitive past the end", leaf + 144, good.n_prims, "section leaves");
+    /* A lane's vertex copies must be its triangle's, bit for bit; unused
+     * lanes only end a block. */
+    int tlane = -1;
+    uint32_t tb = 0;
+    for (uint32_t j = 0; j < good.n_leaves && tlane < 0; j++)
+        for (int lane = 0; lane < 4 && tlane < 0; lane++)
+            if (good.leaves[j].prim[lane] != FR_NONE &&
+                good.prims[good.leaves[j].prim[lane]].kind == FR_PRIM_TRIANGLE) {
+                tlane = lane;
+                tb = j;
+            }
+    CHECK(tlane >= 0, "no leaf block holds a triangle (test scene changed?)");
+    if (tlane >= 0) {
+        size_t at = leaf + 160 * (size_t)tb + 16 * 4 + 4 * (size_t)tlane;   /* vertex 1, y */
+        float y = good.leaves[tb].v[4][tlane], moved = y + 0.25f, nz = -0.0f;
+        memcpy(&u, &moved, 4);
+        poke_at("vertex copy differs from its triangle", at, u, "section leaves", at);
+        if (y == 0.0f) {   /* -0 for 0: equal as floats, not as copies */
+            memcpy(&u, &nz, 4);
+            poke_at("vertex copy with another zero", at, u, "section leaves", at);
+        }
+    }
+    if (good.leaves[0].prim[2] != FR_NONE)
+        poke("unused lane before a used one", leaf + 144 + 4, FR_NONE, "section leaves");
     memcpy(&u, &inf, 4);
     poke("infinite vertex", leaf + 8, u, "section leaves");
     /* Lights and materials. */
@@ -358,14 +382,31 @@ static void set_slot(fr_bvh_node *n, int k, uint32_t child, uint32_t leaf)
     n->leaf[k] = leaf;
 }
 
+/* Lane `lane` of block L holds primitive p's vertices (none if not a triangle). */
+static void copy_vertices(fr_bvh_leaf *L, uint32_t lane, uint32_t p)
+{
+    if (good.prims[p].kind != FR_PRIM_TRIANGLE)
+        return;
+    const fr_triangle *t = &good.triangles[good.prims[p].index];
+    for (int v = 0; v < 3; v++) {
+        vec3 q = good.positions[t->v[v]];
+        L->v[3 * v][lane] = q.x;
+        L->v[3 * v + 1][lane] = q.y;
+        L->v[3 * v + 2][lane] = q.z;
+    }
+}
+
 static void test_shapes(void)
 {
     /* One leaf with all of the good scene's primitives (mixed: spheres and
      * rects), hung at the bottom of a chain of `depth` nodes. */
     uint32_t np = good.n_prims, nblk = (np + 3) / 4;
-    fr_bvh_leaf *blocks = calloc(nblk, sizeof *blocks);
-    for (uint32_t i = 0; i < 4 * nblk; i++)
+    fr_bvh_leaf *blocks = calloc(nblk + 1, sizeof *blocks);
+    for (uint32_t i = 0; i < 4 * nblk; i++) {
         blocks[i / 4].prim[i % 4] = i < np ? i : FR_NONE;
+        if (i < np)
+            copy_vertices(&blocks[i / 4], i % 4, i);
+    }
     int depths[] = {1, 2, 63, 64, 65, 90};
     fr_bvh_node chain[100];
     fr_error err;
@@ -384,6 +425,31 @@ static void test_shapes(void)
         else
             CHECK(rc < 0 && strstr(err.msg, "deeper than 64") && strstr(err.msg, "section nodes"),
                   "chain of %d nodes: %s", n, rc < 0 ? err.msg : "accepted");
+    }
+    /* A primitive may be in several lanes (a spatial split puts a triangle
+     * in each leaf its parts are in): a second leaf holding a triangle
+     * again, beside the first, is accepted; with its vertex copies moved it
+     * is refused. */
+    uint32_t tri = FR_NONE;
+    for (uint32_t p = 0; p < np && tri == FR_NONE; p++)
+        if (good.prims[p].kind == FR_PRIM_TRIANGLE)
+            tri = p;
+    CHECK(tri != FR_NONE, "the test scene has no triangle");
+    if (tri != FR_NONE) {
+        fr_bvh_leaf *twice = &blocks[nblk];
+        memset(twice, 0, sizeof *twice);
+        twice->prim[0] = tri;
+        twice->prim[1] = twice->prim[2] = twice->prim[3] = FR_NONE;
+        copy_vertices(twice, 0, tri);
+        chain[0] = empty_node();
+        set_slot(&chain[0], 0, 0, nblk | FR_BVH_MIXED);
+        set_slot(&chain[0], 1, nblk, 1);
+        int rc = open_with_bvh(chain, 1, blocks, nblk + 1, &err);
+        CHECK(rc == 0, "a triangle in two leaves refused: %s", err.msg);
+        twice->v[8][0] += 1.0f;
+        rc = open_with_bvh(chain, 1, blocks, nblk + 1, &err);
+        CHECK(rc < 0 && strstr(err.msg, "differs from its triangle") && strstr(err.msg, "section leaves"),
+              "a second copy with a moved vertex: %s", rc < 0 ? err.msg : "accepted");
     }
     /* Children must come after their parent, inside the array. */
     chain[0] = empty_node();
