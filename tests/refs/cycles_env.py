@@ -18,28 +18,21 @@
 #           light only (max bounces 0), lit by the map alone.
 import math
 import os
-import struct
 import sys
 
 import bpy
-from mathutils import Vector
 
-args = sys.argv[sys.argv.index("--") + 1:]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cycles_common as cc  # noqa: E402
+
+args = cc.args()
 sky_path, out = os.path.abspath(args[0]), args[1]
-scene = bpy.context.scene
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj, do_unlink=True)
-
-
-def blender(v):
-    return Vector((v[0], -v[2], v[1]))
+scene = cc.empty_scene()
 
 
 def world(rotation_deg):
     w = bpy.data.worlds.new("sky")
-    w.use_nodes = True
-    nodes, links = w.node_tree.nodes, w.node_tree.links
-    nodes.clear()
+    nodes, links = cc.nodes_of(w)
     coord = nodes.new("ShaderNodeTexCoord")
     mapping = nodes.new("ShaderNodeMapping")
     mapping.vector_type = "POINT"
@@ -58,59 +51,23 @@ def world(rotation_deg):
     scene.world = w
 
 
-cam_data = bpy.data.cameras.new("camera")
-cam_data.sensor_fit = "VERTICAL"
-cam = bpy.data.objects.new("camera", cam_data)
-scene.collection.objects.link(cam)
-scene.camera = cam
+cam = cc.camera(scene, 20)
 
 
 def view(position, target, fov_deg, w, h):
-    p, t = blender(position), blender(target)
-    cam.location = p
-    cam.rotation_mode = "QUATERNION"
-    cam.rotation_quaternion = (t - p).to_track_quat("-Z", "Y")
-    cam_data.angle_y = math.radians(fov_deg)
+    cc.aim(cam, position, target)
+    cam.data.angle_y = math.radians(fov_deg)
     scene.render.resolution_x = w
     scene.render.resolution_y = h
 
 
-scene.render.engine = "CYCLES"
-c = scene.cycles
-c.device = "CPU"
-c.use_adaptive_sampling = False
-c.use_denoising = False
-c.sample_clamp_direct = 0.0
-c.sample_clamp_indirect = 0.0
-c.blur_glossy = 0.0
-c.seed = 1
-c.pixel_filter_type = "BOX"
-c.filter_width = 1.0
-c.max_bounces = 0
-c.diffuse_bounces = 0
-c.glossy_bounces = 0
-c.transmission_bounces = 0
-c.transparent_max_bounces = 0
-scene.render.resolution_percentage = 100
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
-scene.render.image_settings.exr_codec = "ZIP"
+cc.settings(scene, 64, 1, 0)
 
 
 def render(name, samples):
-    c.samples = samples
-    path = os.path.join(out, "cycles-env-%s.exr" % name)
-    scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
-    img = bpy.data.images.load(path)
-    w, h = img.size
-    px = list(img.pixels)  # RGBA, bottom row first
-    with open(os.path.join(out, "cycles-env-%s.pfm" % name), "wb") as f:
-        f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
-        for i in range(w * h):
-            f.write(struct.pack("<3f", *px[4 * i:4 * i + 3]))
-    bpy.data.images.remove(img)
+    scene.cycles.samples = samples
+    path = os.path.join(out, "cycles-env-" + name)
+    cc.render(scene, path + ".exr", path + ".pfm")
 
 
 el, az = math.radians(35), math.radians(60)
@@ -127,19 +84,12 @@ render("rot", 64)
 
 world(0)
 mat = bpy.data.materials.new("diffuse")
-mat.use_nodes = True
-mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1)
-nodes, links = mat.node_tree.nodes, mat.node_tree.links
-nodes.clear()
-diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-diffuse.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1)
-diffuse.inputs["Roughness"].default_value = 0.0
+nodes, links = cc.nodes_of(mat)
+diffuse = cc.diffuse(nodes, (0.5, 0.5, 0.5))
 output = nodes.new("ShaderNodeOutputMaterial")
 links.new(diffuse.outputs[0], output.inputs["Surface"])
 bpy.ops.mesh.primitive_plane_add(size=200, location=(0, 0, 0))
 bpy.context.active_object.data.materials.append(mat)
-bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=0.5, location=blender((0, 0.5, 0)))
-bpy.ops.object.shade_smooth()
-bpy.context.active_object.data.materials.append(mat)
+cc.sphere((0, 0.5, 0), 0.5, mat)
 view((3, 5, -3), (0, 0.3, 0), 40, 64, 64)
 render("ground", 1024)

@@ -21,12 +21,14 @@
 # test sees the exporter's own numbers.
 import math
 import os
-import struct
 import sys
 
 import bpy
 
-out = sys.argv[sys.argv.index("--") + 1]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cycles_common as cc  # noqa: E402
+
+out = cc.args()[0]
 scene = bpy.context.scene
 
 LIGHTS = {
@@ -38,8 +40,7 @@ LIGHTS = {
 
 
 def clear():
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj, do_unlink=True)
+    cc.empty_scene()
     for coll in (bpy.data.meshes, bpy.data.lights, bpy.data.cameras, bpy.data.materials):
         for block in list(coll):
             coll.remove(block)
@@ -51,23 +52,14 @@ def build(name, spec):
     plane = bpy.context.active_object
     plane.name = "floor"
     mat = bpy.data.materials.new("white")
-    mat.use_nodes = True
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1)
-    bsdf.inputs["Roughness"].default_value = 0.0
+    nodes, links = cc.nodes_of(mat)
+    bsdf = cc.diffuse(nodes, (0.8, 0.8, 0.8))
     output = nodes.new("ShaderNodeOutputMaterial")
     links.new(bsdf.outputs[0], output.inputs["Surface"])
     plane.data.materials.append(mat)
 
-    cam_data = bpy.data.cameras.new("camera")
-    cam_data.sensor_fit = "VERTICAL"
-    cam_data.angle_y = math.radians(60.0)
-    cam = bpy.data.objects.new("camera", cam_data)
-    scene.collection.objects.link(cam)
+    cam = cc.camera(scene, 60.0)
     cam.location = (0, 0, 3)
-    scene.camera = cam
 
     light = bpy.data.lights.new(name, spec["type"])
     light.energy = spec["energy"]
@@ -86,45 +78,14 @@ def build(name, spec):
     obj.rotation_euler = spec["rotation"]
 
 
-world = bpy.data.worlds.new("black")
-world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-scene.world = world
-
-scene.render.engine = "CYCLES"
-c = scene.cycles
-c.device = "CPU"
-c.samples = 256
-c.use_adaptive_sampling = False
-c.use_denoising = False
-c.sample_clamp_direct = 0.0
-c.sample_clamp_indirect = 0.0
-c.blur_glossy = 0.0
-c.seed = 1
-for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "volume_bounces",
-             "transparent_max_bounces"):
-    setattr(c, attr, 0)
+cc.black_world(scene)
+cc.settings(scene, 256, 1, 0)
 scene.render.resolution_x = 32
 scene.render.resolution_y = 32
-scene.render.resolution_percentage = 100
-scene.render.filter_size = 1.0
-c.pixel_filter_type = "BOX"
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
-scene.render.image_settings.exr_codec = "ZIP"
 
 for name, spec in LIGHTS.items():
     build(name, spec)
-    path = os.path.join(out, "cycles-light-%s.exr" % name)
-    scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
-    img = bpy.data.images.load(path)
-    w, h = img.size
-    px = list(img.pixels)  # RGBA, bottom row first
-    with open(os.path.join(out, "cycles-light-%s.pfm" % name), "wb") as f:
-        f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
-        for i in range(w * h):
-            f.write(struct.pack("<3f", *px[4 * i:4 * i + 3]))
+    path = os.path.join(out, "cycles-light-" + name)
+    cc.render(scene, path + ".exr", path + ".pfm")
     bpy.ops.export_scene.gltf(filepath=os.path.join(out, "blender-light-%s.gltf" % name),
                               export_format="GLTF_EMBEDDED", export_cameras=True, export_lights=True)

@@ -13,25 +13,19 @@
 # clamping, box pixel filter 1 px wide.  Writes the linear RGB pixels as a
 # little-endian float32 PFM, bottom row first (as the test tools read it).
 import json
-import math
 import os
-import struct
 import sys
 
 import bpy
-from mathutils import Vector
 
-args = sys.argv[sys.argv.index("--") + 1:]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cycles_common as cc  # noqa: E402
+
+args = cc.args()
 scene_path, out_path, spp = args[0], os.path.abspath(args[1]), int(args[2])
 seed = int(args[3]) if len(args) > 3 else 0
 desc = json.load(open(scene_path))
-scene = bpy.context.scene
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj, do_unlink=True)
-
-
-def blender(v):
-    return Vector((v[0], -v[2], v[1]))
+scene = cc.empty_scene()
 
 
 def rgb(v):
@@ -40,15 +34,11 @@ def rgb(v):
 
 def material(name, m):
     mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
+    nodes, links = cc.nodes_of(mat)
     out = nodes.new("ShaderNodeOutputMaterial")
     kind = m["type"]
     if kind == "lambert":
-        n = nodes.new("ShaderNodeBsdfDiffuse")
-        n.inputs["Color"].default_value = rgb(m["albedo"]) + (1,)
-        n.inputs["Roughness"].default_value = 0.0
+        n = cc.diffuse(nodes, rgb(m["albedo"]))
     elif kind == "mirror":
         n = nodes.new("ShaderNodeBsdfGlossy")
         n.distribution = "SHARP"
@@ -71,24 +61,17 @@ def material(name, m):
 mats = {k: material(k, v) for k, v in desc["materials"].items()}
 for i, sh in enumerate(desc["shapes"]):
     if sh["type"] == "quad":
-        me = bpy.data.meshes.new("quad%d" % i)
-        me.from_pydata([blender(v) for v in sh["vertices"]], [], [(0, 1, 2, 3)])
-        ob = bpy.data.objects.new("quad%d" % i, me)
+        cc.quad(scene, i, sh["vertices"], mats[sh["material"]])
     elif sh["type"] == "sphere":
-        bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=sh["radius"],
-                                             location=blender(sh["center"]))
-        ob = bpy.context.active_object
-        bpy.ops.object.shade_smooth()
+        # every object in the scene's own collection
+        ob = cc.sphere(sh["center"], sh["radius"], mats[sh["material"]])
         bpy.context.collection.objects.unlink(ob)
+        scene.collection.objects.link(ob)
     else:
         raise SystemExit("cycles_noise.py: shape kind %s not supported" % sh["type"])
-    ob.data.materials.append(mats[sh["material"]])
-    scene.collection.objects.link(ob)
 
 world = bpy.data.worlds.new("world")
-world.use_nodes = True
-nodes, links = world.node_tree.nodes, world.node_tree.links
-nodes.clear()
+nodes, links = cc.nodes_of(world)
 wout = nodes.new("ShaderNodeOutputWorld")
 bg = nodes.new("ShaderNodeBackground")
 bg.inputs["Color"].default_value = (0, 0, 0, 1)
@@ -114,52 +97,13 @@ if "medium" in desc:
 scene.world = world
 
 cam_desc = desc["camera"]
-cam_data = bpy.data.cameras.new("camera")
-cam_data.sensor_fit = "VERTICAL"
-cam_data.angle_y = math.radians(cam_desc["fov"])
-cam_data.clip_start = 1e-3
-cam_data.clip_end = 1e6
-cam = bpy.data.objects.new("camera", cam_data)
-scene.collection.objects.link(cam)
-scene.camera = cam
-p, t = blender(cam_desc["position"]), blender(cam_desc["target"])
-cam.location = p
-cam.rotation_mode = "QUATERNION"
-cam.rotation_quaternion = (t - p).to_track_quat("-Z", "Y")
+cam = cc.camera(scene, cam_desc["fov"], clip=(1e-3, 1e6))
+cc.aim(cam, cam_desc["position"], cam_desc["target"])
 
 img = desc["image"]
-scene.render.engine = "CYCLES"
+cc.settings(scene, spp, seed, img.get("max_depth", 8) - 1)
 scene.render.resolution_x = img["width"]
 scene.render.resolution_y = img["height"]
-scene.render.resolution_percentage = 100
-c = scene.cycles
-c.device = "CPU"
-c.samples = spp
-c.use_adaptive_sampling = False
-c.use_denoising = False
-c.sample_clamp_direct = 0.0
-c.sample_clamp_indirect = 0.0
-c.blur_glossy = 0.0
-c.caustics_reflective = True
-c.caustics_refractive = True
-c.seed = seed
-c.pixel_filter_type = "BOX"
-c.filter_width = 1.0
-n = img.get("max_depth", 8) - 1
-c.max_bounces = c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = n
-c.volume_bounces = n
-c.transparent_max_bounces = n
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
 exr = out_path + ".exr"
-scene.render.filepath = exr
-bpy.ops.render.render(write_still=True)
-im = bpy.data.images.load(exr)
-w, h = im.size
-px = list(im.pixels)  # RGBA, bottom row first
-with open(out_path, "wb") as f:
-    f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
-    for i in range(w * h):
-        f.write(struct.pack("<3f", *px[4 * i:4 * i + 3]))
+cc.render(scene, exr, out_path)
 os.remove(exr)

@@ -25,28 +25,22 @@
 # RGBA) and its RGB pixels as OUTDIR/NAME.pfm (little-endian float32,
 # bottom row first).
 import json
-import math
 import os
-import struct
 import sys
 
 import bpy
-from mathutils import Vector
 
-args = sys.argv[sys.argv.index("--") + 1:]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cycles_common as cc  # noqa: E402
+
+args = cc.args()
 scene_path, out, out_name = os.path.abspath(args[0]), args[1], args[2]
 samples = int(args[3]) if len(args) > 3 else 1024
 seed = int(args[4]) if len(args) > 4 else 1
 with open(scene_path) as f:
     js = json.load(f)
 base = os.path.dirname(scene_path)
-scene = bpy.context.scene
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj, do_unlink=True)
-
-
-def blender(v):
-    return Vector((v[0], -v[2], v[1]))
+scene = cc.empty_scene()
 
 
 def fail(msg):
@@ -55,9 +49,7 @@ def fail(msg):
 
 # ---- environment ----
 w = bpy.data.worlds.new("sky")
-w.use_nodes = True
-nodes, links = w.node_tree.nodes, w.node_tree.links
-nodes.clear()
+nodes, links = cc.nodes_of(w)
 bg = nodes.new("ShaderNodeBackground")
 output = nodes.new("ShaderNodeOutputWorld")
 links.new(bg.outputs["Background"], output.inputs["Surface"])
@@ -80,14 +72,10 @@ scene.world = w
 mats = {}
 for name, m in js["materials"].items():
     mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
+    nodes, links = cc.nodes_of(mat)
     kind = m["type"]
     if kind == "lambert":
-        bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-        bsdf.inputs["Color"].default_value = tuple(m["albedo"]) + (1,)
-        bsdf.inputs["Roughness"].default_value = 0.0
+        bsdf = cc.diffuse(nodes, m["albedo"])
     elif kind == "conductor" and m.get("fresnel") == "none" and m.get("masking") == "separable":
         bsdf = nodes.new("ShaderNodeBsdfGlossy")
         bsdf.distribution = "GGX"
@@ -130,74 +118,24 @@ for name, m in js["materials"].items():
 # ---- shapes ----
 for i, s in enumerate(js["shapes"]):
     if s["type"] == "sphere":
-        bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=s["radius"],
-                                             location=blender(s["center"]))
-        bpy.ops.object.shade_smooth()
+        cc.sphere(s["center"], s["radius"], mats[s["material"]])
     elif s["type"] == "plane" and s["normal"] == [0, 1, 0]:
-        bpy.ops.mesh.primitive_plane_add(size=4000, location=blender(s["point"]))
+        bpy.ops.mesh.primitive_plane_add(size=4000, location=cc.blender(s["point"]))
+        bpy.context.active_object.data.materials.append(mats[s["material"]])
     elif s["type"] == "quad":
-        mesh = bpy.data.meshes.new("quad%d" % i)
-        mesh.from_pydata([blender(v) for v in s["vertices"]], [], [(0, 1, 2, 3)])
-        obj = bpy.data.objects.new("quad%d" % i, mesh)
-        scene.collection.objects.link(obj)
-        bpy.context.view_layer.objects.active = obj
+        cc.quad(scene, i, s["vertices"], mats[s["material"]])
     else:
         fail("shapes[%d]: not a shape this script translates" % i)
-    bpy.context.active_object.data.materials.append(mats[s["material"]])
 
 # ---- camera and settings ----
 cj, ij = js["camera"], js["image"]
 if cj.get("up", [0, 1, 0]) != [0, 1, 0] or cj.get("aperture", 0) != 0:
     fail("camera: a pinhole with up [0, 1, 0] expected")
-cam_data = bpy.data.cameras.new("camera")
-cam_data.sensor_fit = "VERTICAL"
-cam_data.angle_y = math.radians(cj["fov"])
-cam_data.clip_start = 1e-3
-cam_data.clip_end = 1e7
-cam = bpy.data.objects.new("camera", cam_data)
-scene.collection.objects.link(cam)
-scene.camera = cam
-p, t = blender(cj["position"]), blender(cj["target"])
-cam.location = p
-cam.rotation_mode = "QUATERNION"
-cam.rotation_quaternion = (t - p).to_track_quat("-Z", "Y")
+cam = cc.camera(scene, cj["fov"], clip=(1e-3, 1e7))
+cc.aim(cam, cj["position"], cj["target"])
 
-scene.render.engine = "CYCLES"
+cc.settings(scene, samples, seed, ij["max_depth"] - 1)
 scene.render.resolution_x = ij["width"]
 scene.render.resolution_y = ij["height"]
-scene.render.resolution_percentage = 100
-c = scene.cycles
-c.device = "CPU"
-c.samples = samples
-c.use_adaptive_sampling = False
-c.use_denoising = False
-c.sample_clamp_direct = 0.0
-c.sample_clamp_indirect = 0.0
-c.blur_glossy = 0.0
-c.caustics_reflective = True
-c.caustics_refractive = True
-c.seed = seed
-c.pixel_filter_type = "BOX"
-c.filter_width = 1.0
-n = ij["max_depth"] - 1
-c.max_bounces = n
-c.diffuse_bounces = n
-c.glossy_bounces = n
-c.transmission_bounces = n
-c.transparent_max_bounces = n
-c.volume_bounces = n
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
-scene.render.image_settings.exr_codec = "ZIP"
-
-path = os.path.join(out, out_name + ".exr")
-scene.render.filepath = path
-bpy.ops.render.render(write_still=True)
-img = bpy.data.images.load(path)
-w, h = img.size
-px = list(img.pixels)  # RGBA, bottom row first
-with open(os.path.join(out, out_name + ".pfm"), "wb") as f:
-    f.write(b"PF\n%d %d\n-1.0\n" % (w, h))
-    for i in range(w * h):
-        f.write(struct.pack("<3f", *px[4 * i:4 * i + 3]))
+path = os.path.join(out, out_name)
+cc.render(scene, path + ".exr", path + ".pfm")
