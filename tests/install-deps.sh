@@ -1,6 +1,9 @@
 #!/bin/sh
-# Install the Debian 12 packages Franja needs to build, test and cross-build.
-# Idempotent; run as root (make deps).  Edit only the package list.
+# Install the Debian 12 packages Franja needs to build, test and cross-build
+# (make deps); with the argument `bench`, also what the benchmarks and the
+# references compare against: Blender's Cycles, and numpy for Blender's
+# glTF exporter (make bench-deps).  Idempotent; run as root.  Edit only the
+# package lists.
 set -e
 export DEBIAN_FRONTEND=noninteractive
 apt-get update
@@ -13,3 +16,6 @@ apt-get install -y --no-install-recommends \
     slurmctld slurmd slurm-client munge \
     docker.io debootstrap qemu-user-static \
     gcc-aarch64-linux-gnu libc6-dev-arm64-cross
+if [ "${1:-}" = bench ]; then
+    apt-get install -y --no-install-recommends blender python3-numpy
+fi
