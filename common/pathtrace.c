@@ -115,10 +115,16 @@ static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta
     return L;
 }
 
-vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index)
+/* pt_sample, with the pixel's sampler seeds kept in *shared when it is not
+ * NULL (smp_start_shared): the same bits either way. */
+static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index,
+                             smp_shared *shared)
 {
     fr_sampler smp;
-    smp_start(&smp, x, y, index, s->settings.seed);
+    if (shared)
+        smp_start_shared(&smp, shared, x, y, index, s->settings.seed);
+    else
+        smp_start(&smp, x, y, index, s->settings.seed);
     float px, py, lx = 0.0f, ly = 0.0f;
     smp_2d(&smp, &px, &py);
     if (s->camera.aperture > 0.0f)
@@ -198,6 +204,11 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
     return L;
 }
 
+vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index)
+{
+    return pt_sample_seeded(s, strategy, x, y, index, NULL);
+}
+
 /* Adaptive sampling: a pixel's error is estimated after every block of
  * this many samples (whole blocks keep the sampler's stratification
  * whole: each block of 16 indices is a well-spread point set). */
@@ -228,6 +239,7 @@ void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32
     uint32_t w = s->settings.width, spp = s->settings.spp;
     float e = s->settings.noise_threshold;
     uint32_t first_check = e > 0.0f ? adapt_min(spp) : spp;
+    smp_shared shared = {0};
     for (uint32_t y = y0; y < y1; y++) {
         for (uint32_t x = 0; x < w; x++) {
             /* The decision to stop reads this pixel's own samples only, so
@@ -235,7 +247,7 @@ void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32
             double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0;
             uint32_t n = 0;
             while (n < spp) {
-                vec3 c = pt_sample(s, strategy, x, y, n++);
+                vec3 c = pt_sample_seeded(s, strategy, x, y, n++, &shared);
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
                 if (first_check < spp) {
                     double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
@@ -259,12 +271,13 @@ void pt_render_rows_sums(const fr_scene *s, pt_strategy strategy, uint32_t y0, u
     /* The loop of pt_render_rows without adaptive stops, from sample
      * `first` on: the same additions in the same order, so the same bits. */
     uint32_t w = s->settings.width, spp = s->settings.spp;
+    smp_shared shared = {0};
     for (uint32_t y = y0; y < y1; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t k = ((size_t)(y - y0) * w + x) * 3;
             double acc[3] = {sums[k], sums[k + 1], sums[k + 2]};
             for (uint32_t n = first; n < spp; n++) {
-                vec3 c = pt_sample(s, strategy, x, y, n);
+                vec3 c = pt_sample_seeded(s, strategy, x, y, n, &shared);
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
             }
             for (int i = 0; i < 3; i++) {

@@ -1,5 +1,7 @@
 #include "sampler.h"
 
+#include <stddef.h>
+
 uint32_t smp_hash(uint32_t x)
 {
     /* Two multiply-xorshift rounds (Wellons' "lowbias32" constants). */
@@ -85,21 +87,58 @@ void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t s
     s->index = index;
     s->rindex = reverse_bits(index);
     s->dim = 0;
+    s->shared = NULL;
 }
 
-void smp_2d(fr_sampler *s, float *u, float *v)
+void smp_start_shared(fr_sampler *s, smp_shared *shared, uint32_t x, uint32_t y, uint32_t index, uint32_t seed)
+{
+    smp_start(s, x, y, index, seed);
+    if (shared->pixel != s->pixel) {
+        shared->pixel = s->pixel;
+        shared->valid = 0;
+    }
+    s->shared = shared;
+}
+
+/* The seeds of dimension pair d: the pair's mix h (returned), and when sv
+ * is not NULL the second coordinate's seed, a mix of h.  The key
+ * pixel * 2^32 + pair * GOLDEN64 differs for every pixel and pair below
+ * 2^32, and mix64 is a bijection.  Both depend on the pixel and the pair
+ * only, so the pixel's samples share them where s->shared is set. */
+static inline uint64_t pair_seeds(fr_sampler *s, uint32_t d, uint32_t *sv)
+{
+    smp_shared *c = s->shared;
+    if (c && d < SMP_SHARED_PAIRS && (c->valid >> d & 1)) {
+        if (sv)
+            *sv = c->pair[d].sv;
+        return c->pair[d].h;
+    }
+    uint64_t h = mix64(s->pixel + d * GOLDEN64);
+    if (c && d < SMP_SHARED_PAIRS) {
+        c->pair[d].h = h;
+        c->pair[d].sv = (uint32_t)mix64(h ^ GOLDEN64);
+        c->valid |= (uint64_t)1 << d;
+        if (sv)
+            *sv = c->pair[d].sv;
+    } else if (sv)
+        *sv = (uint32_t)mix64(h ^ GOLDEN64);
+    return h;
+}
+
+/* Inlined where it is called (always_inline: the link-time optimiser
+ * would keep it a call for its size): the sampler's state and the two
+ * results stay in registers. */
+__attribute__((always_inline)) inline void smp_2d(fr_sampler *s, float *u, float *v)
 {
     /* Owen-scramble the index to shuffle the order per dimension pair, take
      * the point of the 2D Sobol sequence, Owen-scramble both coordinates
      * (the first Sobol dimension is the bit reversal of the index, so its
      * scrambling needs one reversal, not three).  The three scrambling
-     * seeds come from two 64-bit mixes of (pixel, pair): the key
-     * pixel * 2^32 + pair * GOLDEN64 differs for every pixel and pair
-     * below 2^32, and mix64 is a bijection.  The index's bit reversal is
-     * made once per sample (smp_start), and the two coordinates are
-     * reversed together in one 64-bit word. */
-    uint64_t h = mix64(s->pixel + s->dim++ * GOLDEN64);
-    uint32_t sv = (uint32_t)mix64(h ^ GOLDEN64);
+     * seeds come from two 64-bit mixes of (pixel, pair) (pair_seeds).  The
+     * index's bit reversal is made once per sample (smp_start), and the
+     * two coordinates are reversed together in one 64-bit word. */
+    uint32_t sv;
+    uint64_t h = pair_seeds(s, s->dim++, &sv);
     uint32_t i = reverse_bits(lk_permute(s->rindex, (uint32_t)h));
     uint64_t r = reverse_bits2((uint64_t)lk_permute(sobol1_rev(i), sv) << 32 | lk_permute(i, (uint32_t)(h >> 32)));
     *u = to_unit((uint32_t)(r >> 32));
@@ -111,7 +150,7 @@ float smp_random(fr_sampler *s)
     /* The pair's mix, offset by the index and mixed again: not stratified,
      * and unrelated to every smp_2d number (those are mixes of keys, not of
      * mixes plus an index). */
-    uint64_t h = mix64(s->pixel + s->dim++ * GOLDEN64);
+    uint64_t h = pair_seeds(s, s->dim++, NULL);
     return to_unit((uint32_t)(mix64(h + (uint64_t)(s->index + 1) * 0xd6e8feb86659fd93ull) >> 32));
 }
 

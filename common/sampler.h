@@ -17,16 +17,38 @@
 
 #include <stdint.h>
 
+/** The scrambling seeds of one pixel's dimension pairs, which do not
+ * depend on the sample index: a pixel's samples can share them (see
+ * smp_start_shared).  Filled as the pairs are first drawn; valid bit d
+ * says that pair d holds its seeds. */
+#define SMP_SHARED_PAIRS 64
+typedef struct {
+    uint64_t pixel;            /**< the pixel hash the entries belong to (fr_sampler.pixel) */
+    uint64_t valid;            /**< bit d: pair d is filled */
+    struct {
+        uint64_t h;            /**< index shuffle (low half) and first coordinate (high half) seeds */
+        uint32_t sv;           /**< second coordinate seed */
+        uint32_t pad;
+    } pair[SMP_SHARED_PAIRS];
+} smp_shared;
+
 /** Where a pixel sample is in its sequence of random numbers. */
 typedef struct {
     uint64_t pixel;            /**< hash of pixel and seed, in the high half */
     uint32_t index;            /**< sample index within the pixel */
     uint32_t rindex;           /**< the index, bit-reversed */
     uint32_t dim;              /**< next dimension pair */
+    smp_shared *shared;        /**< seeds shared with the pixel's other samples, or NULL */
 } fr_sampler;
 
 /** Start sample `index` of pixel (x, y). */
 void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t seed);
+/** smp_start, keeping the pixel's scrambling seeds in *shared (caller-
+ * owned, alive while s is used) so that the pixel's next samples reuse
+ * them instead of hashing them again; the numbers are the same bits as
+ * smp_start's.  *shared may hold another pixel's seeds (or be zeroed):
+ * it is then started over for this pixel. */
+void smp_start_shared(fr_sampler *s, smp_shared *shared, uint32_t x, uint32_t y, uint32_t index, uint32_t seed);
 /** Next two numbers in [0, 1), from one stratified 2D pattern. */
 void smp_2d(fr_sampler *s, float *u, float *v);
 /** Next number in [0, 1), not stratified: for decisions that gain nothing

@@ -127,6 +127,38 @@ int main(void)
     double r = (sxy / M - (sx / M) * (sy / M)) * 12.0;
     CHECK(fabs(r) < 5.0 / 256.0, "smp_random against the pair before it: correlation %.4f", r);
 
+    /* Seeds shared between a pixel's samples (smp_start_shared) give the
+     * numbers smp_start gives, bit for bit: samples of one pixel in a row,
+     * another pixel in between (the shared seeds start over), a skipped
+     * pair, smp_random among the pairs, more pairs than are shared, and a
+     * shared block that held another pixel's seeds at the start. */
+    smp_shared sh;
+    memset(&sh, 0xa5, sizeof sh);
+    int same = 1;
+    uint32_t order[][2] = {{5, 7}, {5, 7}, {5, 7}, {6, 7}, {6, 7}, {5, 7}, {0, 0}, {0, 0}};
+    for (uint32_t k = 0; k < sizeof order / sizeof *order; k++)
+        for (uint32_t index = 0; index < 5; index++) {
+            fr_sampler a, b;
+            smp_start(&a, order[k][0], order[k][1], index + k, 11);
+            smp_start_shared(&b, &sh, order[k][0], order[k][1], index + k, 11);
+            for (int d = 0; d < SMP_SHARED_PAIRS + 6; d++) {
+                float ua, va, ub, vb;
+                if (d % 7 == 3) {
+                    smp_skip(&a);
+                    smp_skip(&b);
+                } else if (d % 5 == 4) {
+                    ua = smp_random(&a);
+                    ub = smp_random(&b);
+                    same &= ua == ub;
+                } else {
+                    smp_2d(&a, &ua, &va);
+                    smp_2d(&b, &ub, &vb);
+                    same &= ua == ub && va == vb;
+                }
+            }
+        }
+    CHECK(same, "shared seeds give the same numbers as smp_start");
+
     /* Pixels differ: pair 0 of sample 0 over many pixels is uniform. */
     uint32_t cells[64] = {0};
     for (uint32_t k = 0; k < 64 * 256; k++) {
