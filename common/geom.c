@@ -178,7 +178,9 @@ vec3 geo_plane_point(const fr_plane *p, const fr_ray *r, float t, vec3 *err)
     return v3_add(r->o, dt);
 }
 
-vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
+/* Inlined where it is called (always_inline), so that its four vectors
+ * are not passed through the stack. */
+__attribute__((always_inline)) inline vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
 {
     float d = fabsf(ng.x) * err.x + fabsf(ng.y) * err.y + fabsf(ng.z) * err.z;
     /* A degenerate surface's NaN normal or error: no push (and no NaN). */
@@ -197,8 +199,20 @@ vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
     f4 step = (f4){ng.x, ng.y, ng.z, 0.0f} * f4_set1(d);
     f4 o = (f4){p.x, p.y, p.z, 0.0f} + step;
     i4 i = (i4)o, zero4 = i4_set1(0);
-    i4 mag = i & i4_set1(0x7fffffff), neg = i < zero4;
+    i4 mag = i & i4_set1(0x7fffffff);
     i4 up = step > f4_set1(0.0f), down = step < f4_set1(0.0f), move = up | down;
+    /* The common case, every coordinate that moves finite and not zero:
+     * +1 where the sum and the step have the same sign (away from zero),
+     * -1 where they differ (the sign of a step that moves is its bit
+     * pattern's), nothing where the step is 0 (on a surface along an axis
+     * plane through the origin, with no error to push off: d = 0). */
+    i4 plain = ((mag > zero4) & (mag < i4_set1(0x7f800000))) | ~move;
+    if ((i4_bits(plain) & 7) == 7) {
+        i4 delta = ((i ^ (i4)step) >> 31) | i4_set1(1);
+        f4 q = (f4)(i + (delta & move));
+        return v3(q[0], q[1], q[2]);
+    }
+    i4 neg = i < zero4;
     i4 out = (neg & down) | (~neg & up);                       /* away from zero */
     i4 nan = mag > i4_set1(0x7f800000), stay = (mag == i4_set1(0x7f800000)) & out;
     i4 delta = ((out & ~nan) & i4_set1(2)) - i4_set1(1);       /* +1 or -1 */

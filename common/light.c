@@ -14,7 +14,8 @@ vec3 lgt_emitted(const fr_material *m, vec3 ng, vec3 w)
 /* Emitted radiance le of light primitive `prim` at its point p, times the
  * material's emission texture there (a, b: the rect's edge coordinates or
  * the triangle's barycentrics of p1, p2, as trace_surface takes them). */
-static vec3 textured(const fr_scene *s, const fr_material *m, uint32_t prim, vec3 p, float a, float b, vec3 le)
+static inline __attribute__((always_inline)) vec3 textured(const fr_scene *s, const fr_material *m, uint32_t prim, vec3 p,
+                                                           float a, float b, vec3 le)
 {
     if (m->tex_emission == FR_NONE || v3_is_zero(le))
         return le;
@@ -207,8 +208,8 @@ static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u
  * is not NULL a bound on the point's error per coordinate (the
  * geo_*_point functions give the bound; the point is computed here as
  * light sampling always has). */
-static void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2, vec3 *p, vec3 *n, float *ua, float *ub,
-                       vec3 *err)
+static inline __attribute__((always_inline)) void prim_point(const fr_scene *s, const fr_prim *pr, float u1, float u2,
+                                                             vec3 *p, vec3 *n, float *ua, float *ub, vec3 *err)
 {
     if (pr->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[pr->index];
@@ -262,7 +263,11 @@ int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 
     return 1;
 }
 
-int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out)
+/* Inlined where it is called, with prim_point and textured
+ * (always_inline): the light sample's vectors stay in registers instead of
+ * going through the stack at each call. */
+__attribute__((always_inline)) inline int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2,
+                                                     fr_light_sample *out)
 {
     if (s->n_lights == 0)
         return 0;

@@ -114,7 +114,9 @@ vec3 mf_sample_cosine(float u1, float u2)
 {
     float r = sqrtf(u1), s, c;
     fm_sincosf(2.0f * FM_PI * u2, &s, &c);
-    return v3(r * c, r * s, sqrtf(fmaxf(0.0f, 1.0f - u1)));
+    /* 1 - u1 clamped at 0 as fmaxf(0, .) would, without its library call. */
+    float z2 = 1.0f - u1;
+    return v3(r * c, r * s, sqrtf(z2 > 0.0f ? z2 : 0.0f));
 }
 
 static inline float pow5(float x) { float x2 = x * x; return x2 * x2 * x; }
