@@ -153,7 +153,9 @@ float fm_cosf(float x)
     return quadrant(sin_kernel(r), cos_kernel(r), k + 1);
 }
 
-void fm_sincosf(float x, float *sp, float *cp)
+/* Inlined where it is called (always_inline): a sampled direction's sine
+ * and cosine come back in registers, not through the two pointers. */
+__attribute__((always_inline)) inline void fm_sincosf(float x, float *sp, float *cp)
 {
     double r;
     int k = reduce_pio2(x, &r);

@@ -133,7 +133,9 @@ float geo_triangle(vec3 p0, vec3 p1, vec3 p2, const fr_ray *r, float tmax, float
     return t;
 }
 
-vec3 geo_triangle_point(vec3 p0, vec3 p1, vec3 p2, float b1, float b2, vec3 *err)
+/* Inlined where a hit point is made (always_inline), with no vectors
+ * passed through the stack. */
+__attribute__((always_inline)) inline vec3 geo_triangle_point(vec3 p0, vec3 p1, vec3 p2, float b1, float b2, vec3 *err)
 {
     float b0 = 1.0f - b1 - b2;
     vec3 w0 = v3_scale(p0, b0), w1 = v3_scale(p1, b1), w2 = v3_scale(p2, b2);
