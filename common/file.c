@@ -127,13 +127,14 @@ void file_dir(const char *path, char *dir, size_t cap)
 
 /* A target that is not a file to replace: a character device or a FIFO
  * (itself, or through a system link such as /dev/stdout) is opened as it
- * is; 1 when so, 0 for a plain target, -1 (err set) when refused. */
-static int out_direct(const char *path, file_out *o, fr_error *err)
+ * is, with *flags; 1 when so, 0 for a plain target, -1 (err set) when
+ * refused. */
+static int direct_kind(const char *path, int *flags, fr_error *err)
 {
     struct stat ls, st;
     if (lstat(path, &ls))
         return 0;
-    int flags = O_WRONLY | O_CLOEXEC;
+    *flags = O_WRONLY | O_CLOEXEC;
     if (S_ISLNK(ls.st_mode)) {
         if (strncmp(path, "/dev/", 5) && strncmp(path, "/proc/", 6))
             return 0; /* a link elsewhere is replaced, never followed */
@@ -142,7 +143,7 @@ static int out_direct(const char *path, file_out *o, fr_error *err)
         if (stat(path, &st))
             return fr_fail(err, "%s: %s", path, strerror(errno));
         if (S_ISREG(st.st_mode))
-            flags |= O_TRUNC;
+            *flags |= O_TRUNC;
         else if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))
             return fr_fail(err, "%s: cannot write over %s", path, kind(st.st_mode));
     } else if (S_ISREG(ls.st_mode)) {
@@ -150,6 +151,21 @@ static int out_direct(const char *path, file_out *o, fr_error *err)
     } else if (!S_ISCHR(ls.st_mode) && !S_ISFIFO(ls.st_mode)) {
         return fr_fail(err, "%s: cannot write over %s", path, kind(ls.st_mode));
     }
+    return 1;
+}
+
+int file_out_in_place(const char *path)
+{
+    int flags;
+    fr_error e;
+    return direct_kind(path, &flags, &e) == 1;
+}
+
+static int out_direct(const char *path, file_out *o, fr_error *err)
+{
+    int flags, d = direct_kind(path, &flags, err);
+    if (d <= 0)
+        return d;
     if (snprintf(o->tmp, sizeof o->tmp, "%s", path) >= (int)sizeof o->tmp)
         return fr_fail(err, "%s: path too long", path);
     o->fd = open(path, flags);

@@ -70,6 +70,11 @@ typedef struct {
  * device". */
 int file_out_open(const char *path, file_out *o, fr_error *err);
 
+/** 1 when file_out_open(path) would write path in place (a character
+ * device or FIFO, or a link under /dev/ or /proc/ to one or to a plain
+ * file), else 0 (a plain target, a missing one, or one it refuses). */
+int file_out_in_place(const char *path);
+
 /** Writes all n bytes to the temporary file (short writes and EINTR
  * retried).  On failure the caller still calls file_out_abort. */
 int file_out_write(file_out *o, const void *data, size_t n, fr_error *err);

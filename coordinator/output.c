@@ -28,6 +28,12 @@ static const char *extension(const char *path)
 
 static int is_ext(const char *path, const char *ext) { return !strcasecmp(extension(path), ext); }
 
+/* PFM is written to a path ending in .pfm, and to a stream file_out
+ * writes in place whose name has no extension (/dev/null, /dev/stdout, a
+ * named pipe): it has no name to choose a format by, and PFM is the one
+ * written without OpenImageIO. */
+static int is_pfm(const char *path) { return is_ext(path, "pfm") || (!*extension(path) && file_out_in_place(path)); }
+
 void out_meta_make(out_meta *m, const job_spec *spec, double seconds, const char *hosts)
 {
     memset(m, 0, sizeof *m);
@@ -92,7 +98,7 @@ void out_meta_set_time(out_meta *m, long long epoch)
 
 int out_check_type(const char *path, fr_error *err)
 {
-    if (is_ext(path, "pfm"))
+    if (is_pfm(path))
         return 0;
     const char *why = iio_unavailable();
     if (why)
@@ -113,6 +119,13 @@ int out_check(const char *path, fr_error *err)
     struct stat st;
     if (lstat(path, &st) == 0 && S_ISDIR(st.st_mode))
         return fr_fail(err, "%s: is a directory", path);
+    /* A device or named pipe is written in place at the end: opened now,
+     * a pipe's reader would see its end before the image. */
+    if (file_out_in_place(path)) {
+        if (access(path, W_OK))
+            return fr_fail(err, "%s: cannot write: %s", path, strerror(errno));
+        return 0;
+    }
     file_out o;
     if (file_out_open(path, &o, err))
         return -1;
@@ -157,7 +170,7 @@ int out_encode_with(const char *path, const float *rgb, const job_spec *spec, co
     size_t n = (size_t)spec->width * spec->height * 3;
     *data = NULL;
     *len = 0;
-    if (is_ext(path, "pfm"))
+    if (is_pfm(path))
         return encode_pfm(path, rgb, spec, data, len, err);
     if (is_ext(path, "exr") || is_ext(path, "hdr"))
         return iio_encode_with(path, rgb, IIO_F32, spec->width, spec->height, o, data, len, err);

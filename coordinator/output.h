@@ -1,6 +1,7 @@
 /** @file output.h
  * The final image: tone mapping (once, after stitching) and an atomic write
- * in the format the file name's extension names.
+ * in the format the file name's extension names (PFM for a character device
+ * or named pipe whose name has none, such as /dev/null or /dev/stdout).
  *
  * HDR outputs (.exr, .hdr, .pfm) keep linear radiance and ignore the tone
  * mapping; LDR outputs (.png, .jpg, .bmp, .ppm 8-bit; .tif 16-bit) are

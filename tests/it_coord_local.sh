@@ -35,6 +35,21 @@ done
 if command -v oiiotool >/dev/null; then
     check "EXR holds the linear radiance of the PFM" sh -c "oiiotool out.exr ref.pfm --diff --fail 0 | grep -q PASS"
 fi
+# A stream without an extension (a device, a named pipe) gets PFM; /dev/null stays a device.
+"$FRANJA" render scene.fbin -o /dev/stdout $SIZE 2>/dev/null >stdout.pfm
+check "-o /dev/stdout writes the PFM to standard output" cmp -s stdout.pfm ref.pfm
+"$FRANJA" render scene.fbin -o /dev/null $SIZE 2>devnull.log
+check "-o /dev/null succeeds" test $? -eq 0
+check "/dev/null is still a character device" test -c /dev/null
+mkfifo pipe
+timeout 120 cat pipe >fifo.pfm &
+"$FRANJA" render scene.fbin -o pipe $SIZE 2>/dev/null
+wait
+check "-o FIFO writes the PFM into the pipe" cmp -s fifo.pfm ref.pfm
+check "the FIFO stays a FIFO" test -p pipe
+touch plain
+"$FRANJA" render scene.fbin -o plain $SIZE 2>eplain
+check "a plain file without an extension is still refused" grep -q "unknown image type ''" eplain
 "$FRANJA" render scene.fbin -o bright.png $SIZE --exposure 1 2>/dev/null
 check "--exposure changes an LDR output" sh -c "! cmp -s bright.png out.png"
 "$FRANJA" render scene.fbin -o bright.pfm $SIZE --exposure 1 2>/dev/null

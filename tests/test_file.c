@@ -240,6 +240,7 @@ static void test_devices(void)
     CHECK(file_write_atomic("/dev/null", "gone", 4, &err) == 0, "/dev/null: %s", err.msg);
     CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "/dev/null is no longer a character device");
     file_out o;
+    CHECK(file_out_in_place("/dev/null"), "/dev/null is not said to be written in place");
     CHECK(file_out_open("/dev/null", &o, &err) == 0 && o.direct, "/dev/null is not written in place");
     file_out_abort(&o);
     CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "an abort removed /dev/null");
@@ -253,6 +254,7 @@ static void test_devices(void)
     char got[16] = "";
     CHECK(read(r, got, sizeof got - 1) == 7 && !strcmp(got, "P6 data"), "the FIFO's reader got '%s'", got);
     close(r);
+    CHECK(file_out_in_place(fifo), "a FIFO is not said to be written in place");
     CHECK(lstat(fifo, &st) == 0 && S_ISFIFO(st.st_mode), "the FIFO was replaced");
     CHECK(entries() == 1, "%d entries beside the FIFO, expected 1", entries());
     unlink(fifo);
@@ -261,7 +263,9 @@ static void test_devices(void)
     char link[128];
     snprintf(link, sizeof link, "%s/out.pfm", dir);
     CHECK(symlink("/dev/null", link) == 0, "symlink");
+    CHECK(!file_out_in_place(link), "a user's link to /dev/null is said to be written in place");
     CHECK(file_write_atomic(link, "mine", 4, &err) == 0, "link: %s", err.msg);
+    CHECK(!file_out_in_place(link), "a plain file is said to be written in place");
     CHECK(lstat(link, &st) == 0 && S_ISREG(st.st_mode) && has(link, "mine"), "the link was followed");
     CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "/dev/null changed");
     unlink(link);
@@ -273,10 +277,12 @@ static void test_devices(void)
     fflush(stdout);
     int saved = dup(1), f = open(out, O_WRONLY);
     CHECK(saved >= 0 && f >= 0 && dup2(f, 1) == 1, "stdout to a file");
+    int in_place = file_out_in_place("/dev/stdout");
     int rc = file_write_atomic("/dev/stdout", "new", 3, &err);
     dup2(saved, 1);
     close(saved);
     close(f);
+    CHECK(in_place, "/dev/stdout to a file is not said to be written in place");
     CHECK(rc == 0, "/dev/stdout: %s", err.msg);
     CHECK(has(out, "new"), "the file behind /dev/stdout holds the new content only");
     CHECK(lstat("/dev/stdout", &st) == 0 && S_ISLNK(st.st_mode), "/dev/stdout is no longer a link");
@@ -285,6 +291,7 @@ static void test_devices(void)
     char sub[128];
     snprintf(sub, sizeof sub, "%s/sub", dir);
     CHECK(mkdir(sub, 0700) == 0, "mkdir");
+    CHECK(!file_out_in_place(sub), "a directory is said to be written in place");
     CHECK(file_write_atomic(sub, "x", 1, &err) < 0 && strstr(err.msg, "cannot write over a directory"),
           "a directory: %s", err.msg);
     rmdir(sub);

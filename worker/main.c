@@ -213,9 +213,14 @@ int main(int argc, char **argv)
     if (!to_stdout) {
         int fd = -1;
         if (file_out_open(out, &o, &err) || (fd = dup(o.fd)) < 0 || !(f = fdopen(fd, "wb"))) {
+            int e = errno;
             if (fd >= 0)
                 close(fd);
-            fprintf(stderr, "franja-worker: %s\n", o.fd < 0 ? err.msg : strerror(errno));
+            errno = e;
+            if (o.fd < 0)
+                fprintf(stderr, "franja-worker: %s\n", err.msg);
+            else
+                fprintf(stderr, "franja-worker: %s: %s\n", out, strerror(errno));
             f = NULL;
             rc = 1;
         }
