@@ -6,18 +6,15 @@
 
 #include "simd4.h"
 
-/* Leaves hold up to LEAF_MAX primitives (four blocks) when the SAH finds
- * that cheaper than splitting; LEAF_MIN or fewer always make a leaf (one
- * block is tested as fast as one triangle).  Costs are in units of one
- * block test; a node test (eight boxes) costs about the same.  Splitting a
- * child into two slots of a node that still has a free slot adds no node
- * test, only a box tested together with the others and one more leaf or
- * subtree to visit: that split is charged half a node test.  (Charged
- * nothing, such splits cut the leaf blocks a ray tests on the knot and the
- * terrain of tests/bench by a quarter, but also cut sheets of long
- * overlapping slivers into many small leaves that cost more; half a node
- * keeps the first and not the second.) */
-enum { BINS = 32, LEAF_MIN = 4, LEAF_MAX = 16 };
+/* Costs are in units of one leaf block test (four triangles); a node test
+ * (eight boxes) costs about the same, TRAV_COST.  Every slot of a node a
+ * ray enters (a leaf or a child node) is also charged SLOT_COST: it adds a
+ * box tested together with the others and one more leaf or subtree to
+ * visit.  (Charged nothing, the collapse cuts sheets of long overlapping
+ * slivers into many small leaves that cost more.)  A subtree becomes a
+ * leaf of at most LEAF_MAX references (four blocks); binary leaves hold at
+ * most LEAF_MIN (one block). */
+enum { BINS = 32, LEAF_MIN = 4, LEAF_MAX = 16, SWEEP_MAX = 64 };
 #define TRAV_COST 1.0f
 #define SLOT_COST 0.5f
 /* Spatial splits: tried where an object split's two sides overlap by more
@@ -48,6 +45,8 @@ typedef struct {
     float min_overlap;         /* half area of the root times OVERLAP */
     fr_array *nodes, *leaves;
     fr_error *err;
+    struct bnode *bn;          /* the binary tree */
+    uint32_t n_bn, cap_bn;
 } build;
 
 static box4 box_empty(void) { return (box4){f4_set1(INFINITY), f4_set1(-INFINITY)}; }
@@ -329,17 +328,78 @@ static int spatial_split(build *B, const span *s, int a, float plane, span *l, s
     return 1;
 }
 
-/* Split span s into *l and *r.  Returns 0 when s should rather be a leaf
- * (allowed only if !force), 1 after partitioning.  `trav` is what the
- * split adds to the traversal (TRAV_COST for a new node, SLOT_COST for a
- * free slot).  `median` skips the SAH and halves the range (the depth
- * guard: halving always terminates). */
-static int split_span(build *B, const span *s, span *l, span *r, int force, int median, float trav)
+/* ---- exact sweeps for small spans ----
+ * Spans of at most SWEEP_MAX references are split by sorting their
+ * centroids along each axis and trying every cut between neighbours (ties
+ * broken by primitive index, which appears at most once in a span, so the
+ * order is one whatever the sort's algorithm). */
+typedef struct { float key; uint32_t id, pos; } skey;
+
+static int skey_cmp(const void *pa, const void *pb)
+{
+    const skey *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+/* The references of s in centroid order along axis a, into k. */
+static void sweep_keys(const build *B, const span *s, int a, skey *k)
+{
+    for (uint32_t i = s->begin; i < s->end; i++)
+        k[i - s->begin] = (skey){centroid(B->box[i])[a], B->id[i], i};
+    qsort(k, s->end - s->begin, sizeof *k, skey_cmp);
+}
+
+/* The cheapest cut of s in centroid order: its cost (INFINITY if every
+ * centroid is the same point), *axis, *nleft references on the left, and
+ * *overlap, the half area where the two sides' boxes overlap. */
+static float sweep_best(const build *B, const span *s, int *axis, uint32_t *nleft, float *overlap)
+{
+    uint32_t n = s->end - s->begin;
+    skey k[SWEEP_MAX];
+    box4 rbox[SWEEP_MAX];
+    float best = INFINITY;
+    for (int a = 0; a < 3; a++) {
+        if (!(s->cent.hi[a] > s->cent.lo[a]))
+            continue;
+        sweep_keys(B, s, a, k);
+        box4 acc = box_empty();
+        for (uint32_t i = n - 1; i > 0; i--) {
+            box_grow(&acc, B->box[k[i].pos]);
+            rbox[i] = acc;
+        }
+        acc = box_empty();
+        for (uint32_t i = 1; i < n; i++) {
+            box_grow(&acc, B->box[k[i - 1].pos]);
+            float cost = half_area(acc) * blocks(i) + half_area(rbox[i]) * blocks(n - i);
+            if (cost < best) {
+                best = cost;
+                *axis = a;
+                *nleft = i;
+                box4 o = box_clip(acc, rbox[i]);
+                *overlap = box_is_empty(o) ? 0.0f : half_area(o);
+            }
+        }
+    }
+    return best;
+}
+
+/* Split span s (of at least two references) into *l and *r: the cheapest
+ * object split (SAH on blocks), or a spatial split where that is cheaper.
+ * `median` skips the SAH and halves the range (the depth guard: halving
+ * always terminates). */
+static void split_span(build *B, const span *s, span *l, span *r, int median)
 {
     uint32_t n = s->end - s->begin;
     int best_axis = -1, best_bin = 0, nb = bin_count(n);
     float best_cost = INFINITY;
     f4 scale = bin_scale(s, nb);
+    uint32_t sweep_left = 0;
+    float sweep_overlap = INFINITY;
+    int sweep = !median && n <= SWEEP_MAX;
+    if (sweep)
+        best_cost = sweep_best(B, s, &best_axis, &sweep_left, &sweep_overlap);
     if (!median) {
         box4 bins[3][BINS];
         uint32_t count[3][BINS];
@@ -348,7 +408,7 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
                 bins[a][k] = box_empty();
                 count[a][k] = 0;
             }
-        for (uint32_t i = s->begin; i < s->end; i++) {
+        for (uint32_t i = s->begin; i < s->end && !sweep; i++) {
             box4 bx = B->box[i];
             i4 k = bin_of(centroid(bx), s->cent.lo, scale, nb);
             for (int a = 0; a < 3; a++) {
@@ -357,7 +417,7 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
             }
         }
         for (int a = 0; a < 3; a++) {
-            if (scale[a] == 0.0f)
+            if (sweep || scale[a] == 0.0f)
                 continue;
             float right_area[BINS];
             uint32_t right_count[BINS];
@@ -389,7 +449,9 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
         float sp_plane = 0.0f, sp_cost = INFINITY;
         if (s->cap > s->end && n > 1) {
             float overlap = INFINITY;
-            if (best_axis >= 0) {
+            if (sweep) {
+                overlap = sweep_overlap;
+            } else if (best_axis >= 0) {
                 box4 lb = box_empty(), rb = box_empty();
                 for (int k = 0; k < nb; k++)
                     box_grow(k < best_bin ? &lb : &rb, bins[best_axis][k]);
@@ -399,15 +461,8 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
             if (overlap > B->min_overlap)
                 sp_cost = spatial_best(B, s, nb, &sp_axis, &sp_plane);
         }
-        float area = half_area(s->box);
-        if (sp_cost < best_cost) {
-            if (!force && area * blocks(n) <= trav * area + sp_cost)
-                return 0;
-            if (spatial_split(B, s, sp_axis, sp_plane, l, r))
-                return 1;
-        }
-        if (!force && area * blocks(n) <= trav * area + best_cost)
-            return 0;
+        if (sp_cost < best_cost && spatial_split(B, s, sp_axis, sp_plane, l, r))
+            return;
     }
     *l = (span){s->begin, s->begin, s->begin, box_empty(), box_empty(), 0};
     *r = (span){s->end, s->end, s->cap, box_empty(), box_empty(), 0};
@@ -416,11 +471,28 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
         l->end = l->cap = r->begin = s->begin + n / 2;
         span_bounds(B, l);
         span_bounds(B, r);
-        return 1;
+        return;
+    }
+    uint32_t i = s->begin, j = s->end;
+    if (sweep) {
+        /* Sort the references along the axis and cut after sweep_left. */
+        skey k[SWEEP_MAX];
+        sweep_keys(B, s, best_axis, k);
+        for (uint32_t q = 0; q < n; q++) {
+            B->tbox[q] = B->box[k[q].pos];
+            B->tid[q] = B->id[k[q].pos];
+        }
+        memcpy(B->box + s->begin, B->tbox, n * sizeof *B->box);
+        memcpy(B->id + s->begin, B->tid, n * sizeof *B->id);
+        i = j = s->begin + sweep_left;
+        for (uint32_t q = s->begin; q < s->end; q++) {
+            span *side = q < i ? l : r;
+            box_grow(&side->box, B->box[q]);
+            box_add(&side->cent, centroid(B->box[q]));
+        }
     }
     /* Partition by bin, collecting both sides' bounds on the way. */
     float lo = s->cent.lo[best_axis], sc = scale[best_axis];
-    uint32_t i = s->begin, j = s->end;
     while (i < j) {
         box4 bx = B->box[i];
         f4 c = centroid(bx);
@@ -445,27 +517,194 @@ static int split_span(build *B, const span *s, span *l, span *r, int force, int 
     }
     l->box = L.box; l->cent = L.cent;
     r->box = R.box; r->cent = R.cent;
-    return 1;
 }
 
-/* Fill the blocks of a leaf; *first and *meta become the parent's slot. */
-static int emit_leaf(build *B, const span *s, uint32_t *first, uint32_t *meta)
+/* ---- the binary tree and its collapse ----
+ *
+ * The builder first splits references down to binary leaves of at most
+ * LEAF_MIN (always taking the split, SAH or spatial, that split_span finds
+ * best), then chooses which binary nodes become 8-wide nodes and which
+ * subtrees become leaves by dynamic programming over the binary tree
+ * (bottom-up): cost[v][j-1] is the least SAH cost of v's subtree given as
+ * at most j slots of a wide node, each slot a leaf (area times its blocks)
+ * or a wide node (area times TRAV_COST plus the cost of its own up to eight
+ * slots), each slot also charged its area times SLOT_COST.  A subtree
+ * becomes a leaf only with at most LEAF_MAX references; its references are
+ * packed into blocks together, so small binary leaves fill blocks. */
+
+typedef struct bnode {
+    box4 box;
+    uint32_t kid[2];           /* children, or a leaf's references [kid[0], kid[1]) */
+    uint32_t refs;             /* references in the subtree */
+    uint8_t is_leaf;
+    uint8_t as_leaf;           /* as one slot: 1 a leaf, 0 a wide node */
+    uint8_t wide;              /* as a wide node: slots from kid[0] (the rest from kid[1]) */
+    uint8_t pick[FR_BVH_WIDTH]; /* pick[j-1], j >= 2: 0 = as j-1 slots, else slots from kid[0] */
+    float cost[FR_BVH_WIDTH];  /* cost[j-1]: as at most j slots */
+} bnode;
+
+/* Levels of halving below a binary node of n references. */
+static int halving_levels(uint32_t n)
+{
+    int l = 0;
+    while (n > LEAF_MIN) {
+        n = n - n / 2;
+        l++;
+    }
+    return l;
+}
+
+static uint32_t bnode_push(build *B)
+{
+    if (B->n_bn == B->cap_bn) {
+        size_t cap = B->cap_bn ? 2 * (size_t)B->cap_bn : 1024;
+        if (cap > 0xffffffffu)
+            return FR_NONE;
+        bnode *m = realloc(B->bn, cap * sizeof *m);
+        if (!m)
+            return FR_NONE;
+        B->bn = m;
+        B->cap_bn = (uint32_t)cap;
+    }
+    memset(&B->bn[B->n_bn], 0, sizeof *B->bn);
+    return B->n_bn++;
+}
+
+/* The costs of binary node v from those of its children. */
+static void bnode_costs(bnode *bn, uint32_t v)
+{
+    bnode *n = &bn[v];
+    float area = half_area(n->box), slot = area * SLOT_COST;
+    if (n->is_leaf) {
+        for (int j = 0; j < FR_BVH_WIDTH; j++) {
+            n->cost[j] = slot + area * blocks(n->refs);
+            n->pick[j] = 0;
+        }
+        n->as_leaf = 1;
+        return;
+    }
+    const float *ca = bn[n->kid[0]].cost, *cb = bn[n->kid[1]].cost;
+    float split[FR_BVH_WIDTH + 1];
+    uint8_t at[FR_BVH_WIDTH + 1];
+    for (int j = 2; j <= FR_BVH_WIDTH; j++) {
+        split[j] = INFINITY;
+        at[j] = 1;
+        for (int k = 1; k < j; k++) {
+            float c = ca[k - 1] + cb[j - k - 1];
+            if (c < split[j]) {
+                split[j] = c;
+                at[j] = (uint8_t)k;
+            }
+        }
+    }
+    float as_node = area * TRAV_COST + split[FR_BVH_WIDTH];
+    float as_leaf = n->refs <= LEAF_MAX ? area * blocks(n->refs) : INFINITY;
+    n->wide = at[FR_BVH_WIDTH];
+    n->as_leaf = as_leaf <= as_node;
+    n->cost[0] = slot + (n->as_leaf ? as_leaf : as_node);
+    n->pick[0] = 0;
+    for (int j = 2; j <= FR_BVH_WIDTH; j++) {
+        if (split[j] < n->cost[j - 2]) {
+            n->cost[j - 1] = split[j];
+            n->pick[j - 1] = at[j];
+        } else {
+            n->cost[j - 1] = n->cost[j - 2];
+            n->pick[j - 1] = 0;
+        }
+    }
+}
+
+/* Split s into the binary subtree rooted at a new node, *index. */
+static int bin_build(build *B, const span *s, int depth, int median, uint32_t *index)
+{
+    uint32_t me = bnode_push(B);
+    if (me == FR_NONE)
+        return fr_fail(B->err, "out of memory for the BVH build");
+    uint32_t n = s->end - s->begin;
+    if (!median)
+        median = depth + 2 + halving_levels(n) >= FR_BVH_MAX_DEPTH;
+    span pair[2];
+    if (n <= LEAF_MIN) {
+        bnode *v = &B->bn[me];
+        v->box = s->box;
+        v->kid[0] = s->begin;
+        v->kid[1] = s->end;
+        v->refs = n;
+        v->is_leaf = 1;
+        bnode_costs(B->bn, me);
+        *index = me;
+        return 0;
+    }
+    split_span(B, s, &pair[0], &pair[1], median);
+    uint32_t kid[2];
+    for (int c = 0; c < 2; c++)
+        if (bin_build(B, &pair[c], depth + 1, median, &kid[c]) < 0)
+            return -1;
+    bnode *v = &B->bn[me];   /* the array may have moved */
+    v->box = s->box;
+    v->kid[0] = kid[0];
+    v->kid[1] = kid[1];
+    v->refs = B->bn[kid[0]].refs + B->bn[kid[1]].refs;
+    bnode_costs(B->bn, me);
+    *index = me;
+    return 0;
+}
+
+/* The slots of binary node v given as at most j slots, appended to
+ * slot[*ns]. */
+static void gather_slots(const bnode *bn, uint32_t v, int j, uint32_t *slot, int *ns)
+{
+    while (j > 1 && !bn[v].is_leaf && bn[v].pick[j - 1] == 0)
+        j--;
+    if (j == 1 || bn[v].is_leaf) {
+        slot[(*ns)++] = v;
+        return;
+    }
+    int k = bn[v].pick[j - 1];
+    gather_slots(bn, bn[v].kid[0], k, slot, ns);
+    gather_slots(bn, bn[v].kid[1], j - k, slot, ns);
+}
+
+/* The references of v's subtree, each primitive once, appended to
+ * B->tid[*n]. */
+static void gather_refs(build *B, uint32_t v, uint32_t *n)
+{
+    const bnode *x = &B->bn[v];
+    if (!x->is_leaf) {
+        gather_refs(B, x->kid[0], n);
+        gather_refs(B, x->kid[1], n);
+        return;
+    }
+    for (uint32_t i = x->kid[0]; i < x->kid[1]; i++) {
+        uint32_t id = B->id[i], k = 0;
+        while (k < *n && B->tid[k] != id)
+            k++;
+        if (k == *n)
+            B->tid[(*n)++] = id;
+    }
+}
+
+/* Fill the blocks of a leaf holding v's subtree; *first and *meta become
+ * the parent's slot. */
+static int emit_leaf(build *B, uint32_t v, uint32_t *first, uint32_t *meta)
 {
     const fr_prim *prims = B->b->prims.data;
     const fr_triangle *tris = B->b->triangles.data;
     const vec3 *pos = B->b->positions.data;
-    uint32_t n = s->end - s->begin, nblk = (n + 3) / 4, mixed = 0;
+    uint32_t n = 0;
+    gather_refs(B, v, &n);
+    uint32_t nblk = (n + 3) / 4, mixed = 0;
     *first = B->leaves->count;
     for (uint32_t k = 0; k < nblk; k++) {
         fr_bvh_leaf L;
         memset(&L, 0, sizeof L);
         for (uint32_t lane = 0; lane < 4; lane++) {
-            uint32_t i = s->begin + 4 * k + lane;
-            if (i >= s->end) {
+            uint32_t i = 4 * k + lane;
+            if (i >= n) {
                 L.prim[lane] = FR_NONE;
                 continue;
             }
-            uint32_t id = B->id[i];
+            uint32_t id = B->tid[i];
             const fr_prim *p = &prims[id];
             if (B->out_of[id] == FR_NONE) {
                 B->out_of[id] = B->n_out;
@@ -477,11 +716,11 @@ static int emit_leaf(build *B, const span *s, uint32_t *first, uint32_t *meta)
                 continue;
             }
             const fr_triangle *t = &tris[p->index];
-            for (int v = 0; v < 3; v++) {
-                vec3 q = pos[t->v[v]];
-                L.v[3 * v + 0][lane] = q.x;
-                L.v[3 * v + 1][lane] = q.y;
-                L.v[3 * v + 2][lane] = q.z;
+            for (int c = 0; c < 3; c++) {
+                vec3 q = pos[t->v[c]];
+                L.v[3 * c + 0][lane] = q.x;
+                L.v[3 * c + 1][lane] = q.y;
+                L.v[3 * c + 2][lane] = q.z;
             }
         }
         if (bld_push(B->leaves, &L) == FR_NONE)
@@ -491,75 +730,40 @@ static int emit_leaf(build *B, const span *s, uint32_t *first, uint32_t *meta)
     return 0;
 }
 
-/* Levels a tree of halving splits needs below a node of n references. */
-static int median_levels(uint32_t n)
-{
-    int l = 0;
-    while (n > LEAF_MIN) {
-        n = (n + 3) / 4;
-        l++;
-    }
-    return l;
-}
-
-/* Make a node at `depth` whose children start as init[0..nc); split the
- * widest child until there are FR_BVH_WIDTH.  *index receives the node's
- * index. */
-static int build_node(build *B, const span *init, int nc, int depth, int median, uint32_t *index)
+/* Emit binary node v as a wide node (children after it, depth first);
+ * *index receives the node's index. */
+static int emit_node(build *B, uint32_t v, uint32_t *index)
 {
     fr_bvh_node node;
     memset(&node, 0, sizeof node);
     uint32_t me = bld_push(B->nodes, &node);
     if (me == FR_NONE)
         return fr_fail(B->err, "out of memory for the BVH nodes");
-    span ch[FR_BVH_WIDTH];
-    memcpy(ch, init, (size_t)nc * sizeof *ch);
-    if (!median) {
-        uint32_t refs = 0;
-        for (int i = 0; i < nc; i++)
-            refs += init[i].end - init[i].begin;
-        median = depth + 2 + median_levels(refs) >= FR_BVH_MAX_DEPTH;
-    }
-    while (nc < FR_BVH_WIDTH) {
-        /* The child with the largest area (or most references, when only
-         * halving) gains most from being split. */
-        int pick = -1;
-        float best = -1.0f;
-        for (int i = 0; i < nc; i++) {
-            float key = median ? (float)(ch[i].end - ch[i].begin) : half_area(ch[i].box);
-            if (!ch[i].leaf && key > best) {
-                best = key;
-                pick = i;
-            }
-        }
-        if (pick < 0)
-            break;
-        uint32_t n = ch[pick].end - ch[pick].begin;
-        span l, r;
-        if (n <= LEAF_MIN || !split_span(B, &ch[pick], &l, &r, n > LEAF_MAX, median, SLOT_COST)) {
-            ch[pick].leaf = 1;
-            continue;
-        }
-        ch[pick] = l;
-        ch[nc++] = r;
+    uint32_t slot[FR_BVH_WIDTH];
+    int ns = 0;
+    const bnode *x = &B->bn[v];
+    if (x->is_leaf) {
+        slot[ns++] = v;
+    } else {
+        gather_slots(B->bn, x->kid[0], x->wide, slot, &ns);
+        gather_slots(B->bn, x->kid[1], FR_BVH_WIDTH - x->wide, slot, &ns);
     }
     for (int i = 0; i < FR_BVH_WIDTH; i++) {
         fr_bvh_node *nd = (fr_bvh_node *)B->nodes->data + me;
-        box4 bx = i < nc ? ch[i].box : box_empty();
+        box4 bx = i < ns ? B->bn[slot[i]].box : box_empty();
         for (int a = 0; a < 3; a++) {
             nd->box[a][i] = bx.lo[a];
             nd->box[3 + a][i] = bx.hi[a];
         }
         nd->child[i] = FR_NONE;
         nd->leaf[i] = 0;
-        if (i >= nc)
+        if (i >= ns)
             continue;
-        uint32_t n = ch[i].end - ch[i].begin, child, meta = 0;
-        span pair[2];
-        if (!ch[i].leaf && n > LEAF_MIN && split_span(B, &ch[i], &pair[0], &pair[1], n > LEAF_MAX, median, TRAV_COST)) {
-            if (build_node(B, pair, 2, depth + 1, median, &child) < 0)
+        uint32_t child, meta = 0;
+        if (B->bn[slot[i]].as_leaf) {
+            if (emit_leaf(B, slot[i], &child, &meta) < 0)
                 return -1;
-        } else if (emit_leaf(B, &ch[i], &child, &meta) < 0) {
+        } else if (emit_node(B, slot[i], &child) < 0) {
             return -1;
         }
         nd = (fr_bvh_node *)B->nodes->data + me;   /* the array may have moved */
@@ -607,8 +811,10 @@ int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err)
         span all = {0, n, cap, box_empty(), box_empty(), 0};
         span_bounds(&B, &all);
         B.min_overlap = half_area(all.box) * OVERLAP;
-        uint32_t root;
-        rc = build_node(&B, &all, 1, 1, 0, &root);
+        uint32_t broot, root;
+        rc = bin_build(&B, &all, 1, 0, &broot);
+        if (rc == 0)
+            rc = emit_node(&B, broot, &root);
     }
     if (rc == 0 && B.n_out != n)
         rc = fr_fail(err, "BVH build lost primitives (%u of %u in leaves)", B.n_out, n);
@@ -617,6 +823,7 @@ int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err)
     free(B.tbox);
     free(B.tid);
     free(B.out_of);
+    free(B.bn);
     if (rc < 0) {
         free(B.out);
         return -1;

@@ -2,17 +2,21 @@
  * Building the BVH of a scene at compile time (the layout it produces is
  * described in bvh.h and scene.h).
  *
- * A binned surface-area-heuristic build (32 bins per axis on reference
- * centroids, O(n log n)): a node takes the child range with the largest
- * surface area and splits it at the cheapest bin boundary until it has
- * eight children or the SAH prefers leaves; below the depth where the tree
- * could exceed FR_BVH_MAX_DEPTH it halves ranges instead.  Where the two
- * sides of the best such split overlap, it also tries spatial splits (a
- * plane across the range's longest axis, triangles crossing it cut in two,
- * each side bounding its part only), up to one extra reference per
- * primitive in all; a triangle then sits in several leaves.  It is
- * single-threaded and uses only exactly rounded float operations, so a
- * scene gives the same bytes on every machine.
+ * A binary tree first: binned surface-area-heuristic splits (32 bins per
+ * axis on reference centroids, O(n log n); spans of at most 64 references
+ * sorted and cut at the best of every place) down to leaves of at most
+ * four references; below the depth where the tree could exceed
+ * FR_BVH_MAX_DEPTH it halves ranges instead.  Where the two sides of the
+ * best such split overlap, it also tries spatial splits (a plane across
+ * the range's longest axis, triangles crossing it cut in two, each side
+ * bounding its part only), up to one extra reference per primitive in all;
+ * a triangle then sits in several leaves.  The binary tree is then
+ * collapsed to the 8-wide one at the least SAH cost (dynamic programming
+ * over each subtree: which descendants become a node's up to eight
+ * children, which subtrees become leaves of up to four blocks, their
+ * references packed into full blocks).  It is single-threaded and uses
+ * only exactly rounded float operations, so a scene gives the same bytes
+ * on every machine.
  */
 #ifndef FRANJA_BVH_BUILD_H
 #define FRANJA_BVH_BUILD_H

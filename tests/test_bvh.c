@@ -9,7 +9,9 @@
  * barycentrics, bit for bit.  Long crossing slivers make the build split
  * triangles spatially (one triangle in several leaves): the walk must still
  * return each hit once, as brute force does.  trace_occluded must agree with the nearest
- * hit, with and without a skipped primitive.  Where there are two
+ * hit, with and without a skipped primitive.  Every tree must pass
+ * bvh_validate, name a primitive at most once per leaf and leave lanes
+ * empty only in a leaf's last block.  Where there are two
  * traversals (x86-64 with AVX2), both are checked. */
 #include <math.h>
 #include <stdio.h>
@@ -17,6 +19,7 @@
 #include <string.h>
 
 #include "bsdf.h"
+#include "bvh.h"
 #include "bvh_build.h"
 #include "check.h"
 #include "fbin.h"
@@ -234,6 +237,29 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
         return;
     }
     CHECK(s.n_nodes > 0, "%s: has a BVH", name);
+    CHECK(bvh_validate(&s, s.blob, &err) == 0, "%s: the tree is refused: %s", name, err.msg);
+    /* A leaf names a primitive once (a subtree packed into one leaf may
+     * hold two parts of a triangle cut by a spatial split: the builder
+     * keeps one), and only its last block may have empty lanes. */
+    int twice = 0, holes = 0;
+    for (uint32_t j = 0; j < s.n_nodes; j++)
+        for (int c = 0; c < FR_BVH_WIDTH; c++) {
+            uint32_t meta = s.nodes[j].leaf[c], nb = meta & FR_BVH_LEAF_MAX;
+            if (!meta || s.nodes[j].child[c] == FR_NONE)
+                continue;
+            const fr_bvh_leaf *L = s.leaves + s.nodes[j].child[c];
+            for (uint32_t x = 0; x < 4 * nb; x++) {
+                uint32_t px = L[x / 4].prim[x % 4];
+                if (px == FR_NONE) {
+                    holes += x / 4 + 1 < nb;
+                    continue;
+                }
+                for (uint32_t y = 0; y < x; y++)
+                    twice += L[y / 4].prim[y % 4] == px;
+            }
+        }
+    CHECK(twice == 0, "%s: %d primitives twice in one leaf", name, twice);
+    CHECK(holes == 0, "%s: %d empty lanes before a leaf's last block", name, holes);
     /* Lanes in use: one per primitive, more where spatial splits put a
      * primitive in several leaves. */
     uint32_t lanes = 0;
