@@ -49,6 +49,10 @@ float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, flo
  * result would depend on the visiting order. */
 #define FAR_SCALE 1.0000153f
 
+/* Bytes of nodes and leaf blocks above which traversal prefetches the
+ * children it enters (a smaller tree stays in the first-level cache). */
+#define WALK_PREFETCH_MIN 16384
+
 /* The axes of the watertight triangle test's frame for a ray direction:
  * kz is the axis of the largest |d| (the first of x, y, z on ties), kx
  * and ky follow it cyclically, swapped when d along kz is negative to keep
