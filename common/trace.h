@@ -52,5 +52,15 @@ int trace_set_wide(int on);
 float trace_prim(const fr_scene *s, uint32_t prim, const fr_ray *r, float tmax, float *a, float *b);
 /** Rebuild the surface at a hit. */
 void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out);
+/** trace_surface, except that with `uv` 0 the fields uv, dpdu and dpdv
+ * are left 0 instead of computed (the others are the same bits): for a
+ * caller whose shading of the hit's material (trace_hit_material) reads
+ * none of them. */
+void trace_surface_uv(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out, int uv);
+/** Index into materials of what a hit found (a primitive's or a plane's). */
+static inline uint32_t trace_hit_material(const fr_scene *s, const fr_hit *hit)
+{
+    return hit->prim == FR_NONE ? s->planes[hit->plane].material : s->prims[hit->prim].material;
+}
 
 #endif

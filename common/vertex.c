@@ -2,10 +2,21 @@
 
 #include "fmath.h"
 #include "medium.h"
+#include "texture.h"
 
 /* Interfaces a path may cross between two vertices before it is given up
  * (a ray caught between coincident boundaries). */
 #define MAX_CROSSINGS 64
+
+/* The surface at a path's vertex: uv, dpdu and dpdv only where shading
+ * the material reads them, which its textures, bump and normal maps do
+ * (tex_material) and an anisotropic roughness does (the BSDF's frame
+ * follows dpdu); else 0. */
+static inline __attribute__((always_inline)) void shading_surface(const fr_scene *s, const fr_ray *ray, const fr_hit *hit, fr_surface *sf)
+{
+    const fr_material *m = &s->materials[trace_hit_material(s, hit)];
+    trace_surface_uv(s, ray, hit, sf, tex_material_textured(m) || m->anisotropy != 0.0f);
+}
 
 float vtx_power_heuristic(float a, float b)
 {
@@ -81,7 +92,7 @@ int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, 
     if (!s->n_media) {
         if (!found)
             return VTX_ESCAPED;
-        trace_surface(s, ray, &hit, &v->sf);
+        shading_surface(s, ray, &hit, &v->sf);
         return v->kind = VTX_SURFACE;
     }
     /* Sample each medium segment up to the next surface, crossing
@@ -113,7 +124,7 @@ int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, 
         }
         if (!found)
             return VTX_ESCAPED;
-        trace_surface(s, ray, &hit, &v->sf);
+        shading_surface(s, ray, &hit, &v->sf);
         const fr_material *mb = &s->materials[v->sf.material];
         if (!mb->interface)
             return v->kind = VTX_SURFACE;

@@ -27,7 +27,8 @@ enum { VTX_ESCAPED = 0, VTX_SURFACE = 1, VTX_MEDIUM = 2, VTX_LOST = 3 };
 typedef struct {
     int kind;                  /**< VTX_ESCAPED (the ray left the scene along its direction: distant lights),
                                     VTX_SURFACE, VTX_MEDIUM, or VTX_LOST (caught between interfaces: no light) */
-    fr_surface sf;             /**< VTX_SURFACE: the surface (never a media interface) */
+    fr_surface sf;             /**< VTX_SURFACE: the surface (never a media interface); uv, dpdu and dpdv
+                                    only where its material reads them (textures, anisotropy), else 0 */
     vec3 p;                    /**< VTX_MEDIUM: the scattering point */
     fr_ray seg;                /**< VTX_MEDIUM: the segment scattered on (origin, unit direction) */
     float seg_tmax;            /**< VTX_MEDIUM: the segment's length (INFINITY: no surface behind) */
