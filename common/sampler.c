@@ -81,9 +81,14 @@ static inline float to_unit(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777
  * pairs land far apart before mixing. */
 #define GOLDEN64 0x9e3779b97f4a7c15ull
 
+static inline uint64_t pixel_hash(uint32_t x, uint32_t y, uint32_t seed)
+{
+    return (uint64_t)smp_hash(x ^ smp_hash(y ^ smp_hash(seed + 0x9e3779b9u))) << 32;
+}
+
 void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t seed)
 {
-    s->pixel = (uint64_t)smp_hash(x ^ smp_hash(y ^ smp_hash(seed + 0x9e3779b9u))) << 32;
+    s->pixel = pixel_hash(x, y, seed);
     s->index = index;
     s->rindex = reverse_bits(index);
     s->dim = 0;
@@ -92,11 +97,21 @@ void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t s
 
 void smp_start_shared(fr_sampler *s, smp_shared *shared, uint32_t x, uint32_t y, uint32_t index, uint32_t seed)
 {
-    smp_start(s, x, y, index, seed);
-    if (shared->pixel != s->pixel) {
-        shared->pixel = s->pixel;
-        shared->valid = 0;
+    /* The pixel's hash too is the one its previous sample made. */
+    if (!(shared->keyed == 1 && shared->x == x && shared->y == y && shared->seed == seed)) {
+        uint64_t pixel = pixel_hash(x, y, seed);
+        if (!(shared->keyed == 1 && shared->pixel == pixel))
+            shared->valid = 0;
+        shared->pixel = pixel;
+        shared->x = x;
+        shared->y = y;
+        shared->seed = seed;
+        shared->keyed = 1;
     }
+    s->pixel = shared->pixel;
+    s->index = index;
+    s->rindex = reverse_bits(index);
+    s->dim = 0;
     s->shared = shared;
 }
 

@@ -24,6 +24,8 @@
 #define SMP_SHARED_PAIRS 64
 typedef struct {
     uint64_t pixel;            /**< the pixel hash the entries belong to (fr_sampler.pixel) */
+    uint32_t x, y, seed;       /**< the pixel and scene seed that `pixel` hashes */
+    uint32_t keyed;            /**< 1: x, y, seed and pixel are set (a zeroed block holds no pixel) */
     uint64_t valid;            /**< bit d: pair d is filled */
     struct {
         uint64_t h;            /**< index shuffle (low half) and first coordinate (high half) seeds */
@@ -43,10 +45,10 @@ typedef struct {
 
 /** Start sample `index` of pixel (x, y). */
 void smp_start(fr_sampler *s, uint32_t x, uint32_t y, uint32_t index, uint32_t seed);
-/** smp_start, keeping the pixel's scrambling seeds in *shared (caller-
- * owned, alive while s is used) so that the pixel's next samples reuse
- * them instead of hashing them again; the numbers are the same bits as
- * smp_start's.  *shared may hold another pixel's seeds (or be zeroed):
+/** smp_start, keeping the pixel's hash and scrambling seeds in *shared
+ * (caller-owned, alive while s is used) so that the pixel's next samples
+ * reuse them instead of hashing them again; the numbers are the same bits
+ * as smp_start's.  *shared may hold another pixel's seeds (or be zeroed):
  * it is then started over for this pixel. */
 void smp_start_shared(fr_sampler *s, smp_shared *shared, uint32_t x, uint32_t y, uint32_t index, uint32_t seed);
 /** Next two numbers in [0, 1), from one stratified 2D pattern. */

@@ -158,6 +158,23 @@ int main(void)
             }
         }
     CHECK(same, "shared seeds give the same numbers as smp_start");
+    /* The same pixel under another scene seed, then a zeroed block and
+     * pixel (0, 0) with seed 0, whose coordinates a zeroed block holds. */
+    uint32_t seeds[] = {11, 12, 12, 0};
+    for (uint32_t k = 0; k < 4; k++) {
+        if (k == 3)
+            memset(&sh, 0, sizeof sh);
+        uint32_t x = k == 3 ? 0 : 5, y = k == 3 ? 0 : 7;
+        fr_sampler a, b;
+        smp_start(&a, x, y, 3, seeds[k]);
+        smp_start_shared(&b, &sh, x, y, 3, seeds[k]);
+        for (int d = 0; d < 8; d++) {
+            float ua, va, ub, vb;
+            smp_2d(&a, &ua, &va);
+            smp_2d(&b, &ub, &vb);
+            CHECK(ua == ub && va == vb, "seed %u, pixel (%u, %u): shared pair %d differs", seeds[k], x, y, d);
+        }
+    }
 
     /* Pixels differ: pair 0 of sample 0 over many pixels is uniform. */
     uint32_t cells[64] = {0};
