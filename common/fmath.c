@@ -124,6 +124,22 @@ static inline double cos_kernel(double r)
     return 1.0 + z * p;
 }
 
+/* sin_kernel(r) in lane 0 and cos_kernel(r) in lane 1, their operations
+ * two at a time in the same order (lane-wise arithmetic rounds as the
+ * scalar does): for the functions that need both. */
+typedef double d2 __attribute__((vector_size(16)));
+static inline d2 sincos_kernels(double r)
+{
+    double z = r * r, z2 = z * z;
+    d2 zv = {z, z}, z2v = {z2, z2};
+    d2 p = ((d2){-0x1.5555555552239p-3, -0x1.ffffffffe98afp-2} + zv * (d2){0x1.1111110c87333p-7, 0x1.55555545c514dp-5})
+         + z2v * (((d2){-0x1.a019f93968bb1p-13, -0x1.6c16b348bc348p-10}
+                   + zv * (d2){0x1.71d76d1671617p-19, 0x1.a00eb9af45605p-16})
+                  + z2v * (d2){-0x1.a961a17d2d4cdp-26, -0x1.23c97e63f6f01p-22});
+    d2 q = (d2){1.0, 1.0} + zv * p;
+    return (d2){r * q[0], q[1]};
+}
+
 /* c ? a : b without a branch: quadrants and octants of random directions
  * are unpredictable, and a mispredicted branch costs more than both sides. */
 static inline double pick(int c, double a, double b)
@@ -159,9 +175,9 @@ __attribute__((always_inline)) inline void fm_sincosf(float x, float *sp, float 
 {
     double r;
     int k = reduce_pio2(x, &r);
-    double s = sin_kernel(r), c = cos_kernel(r);
-    *sp = quadrant(s, c, k);
-    *cp = quadrant(s, c, k + 1);
+    d2 sc = sincos_kernels(r);
+    *sp = quadrant(sc[0], sc[1], k);
+    *cp = quadrant(sc[0], sc[1], k + 1);
 }
 
 float fm_tanf(float x)
