@@ -180,15 +180,20 @@ vec3 geo_plane_point(const fr_plane *p, const fr_ray *r, float t, vec3 *err)
     return v3_add(r->o, dt);
 }
 
-/* Inlined where it is called (always_inline), so that its four vectors
+/* Inlined where they are called (always_inline), so that their vectors
  * are not passed through the stack. */
 __attribute__((always_inline)) inline vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir)
+{
+    return geo_offset_side(p, err, ng, v3_dot(ng, dir) < 0.0f);
+}
+
+__attribute__((always_inline)) inline vec3 geo_offset_side(vec3 p, vec3 err, vec3 ng, int below)
 {
     float d = fabsf(ng.x) * err.x + fabsf(ng.y) * err.y + fabsf(ng.z) * err.z;
     /* A degenerate surface's NaN normal or error: no push (and no NaN). */
     if (!(d < INFINITY))
         return p;
-    if (v3_dot(ng, dir) < 0.0f)
+    if (below)
         d = -d;
     /* Each coordinate: p + step, then one float further along the sign of
      * step (next_up or next_down of the sum; the sum itself when step is

@@ -74,5 +74,9 @@ vec3 geo_plane_point(const fr_plane *p, const fr_ray *r, float t, vec3 *err);
  * fixed epsilon, whatever the scene's scale or distance from the origin.
  * A non-finite err or normal gives p unchanged. */
 vec3 geo_offset(vec3 p, vec3 err, vec3 ng, vec3 dir);
+/** geo_offset for every direction on one side of the surface: below = 1
+ * for a dir with v3_dot(ng, dir) < 0, 0 otherwise (geo_offset depends on
+ * dir through that side only, and gives these bits). */
+vec3 geo_offset_side(vec3 p, vec3 err, vec3 ng, int below);
 
 #endif

@@ -183,10 +183,11 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             }
             light_numbers(s, &smp, &upick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
-            if (light_sampling && vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, upick, u1, u2, &d))
+            vtx_origin org = vtx_origin_at(&v.sf, wo);
+            if (light_sampling && vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, upick, u1, u2, &org, &d))
                 L = v3_add(L, d.L);
             fr_bsdf_sample bs;
-            if (!vtx_scatter_surface(s, m, &v.sf, wo, ulobe, v1, v2, &bs, &ray, &medium))
+            if (!vtx_scatter_surface(s, m, &v.sf, wo, ulobe, v1, v2, &org, &bs, &ray, &medium))
                 break;
             beta = v3_mul(beta, bs.weight);
             prev_pdf = bs.pdf;

@@ -12,7 +12,8 @@
  * the material reads them, which its textures, bump and normal maps do
  * (tex_material) and an anisotropic roughness does (the BSDF's frame
  * follows dpdu); else 0. */
-static inline __attribute__((always_inline)) void shading_surface(const fr_scene *s, const fr_ray *ray, const fr_hit *hit, fr_surface *sf)
+static inline __attribute__((always_inline)) void shading_surface(const fr_scene *s, const fr_ray *ray,
+                                                                 const fr_hit *hit, fr_surface *sf)
 {
     const fr_material *m = &s->materials[trace_hit_material(s, hit)];
     trace_surface_uv(s, ray, hit, sf, tex_material_textured(m) || m->anisotropy != 0.0f);
@@ -136,8 +137,22 @@ int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, 
     }
 }
 
+vtx_origin vtx_origin_at(const fr_surface *sf, vec3 wo)
+{
+    int below = v3_dot(sf->ng, wo) < 0.0f;
+    return (vtx_origin){geo_offset_side(sf->p, sf->perr, sf->ng, below), below};
+}
+
+/* The origin of a ray leaving surface vertex sf along dir: *org's when on
+ * its side (geo_offset's bits either way). */
+static inline vec3 origin(const vtx_origin *org, const fr_surface *sf, vec3 dir)
+{
+    int below = v3_dot(sf->ng, dir) < 0.0f;
+    return below == org->below ? org->o : geo_offset_side(sf->p, sf->perr, sf->ng, below);
+}
+
 int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, uint32_t medium,
-                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, vtx_direct *out)
+                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, const vtx_origin *org, vtx_direct *out)
 {
     fr_light_sample *ls = &out->ls;
     if (!bsdf_has_smooth(m) || !lgt_sample(s, sf->p, upick, u1, u2, ls))
@@ -145,7 +160,7 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
     vec3 f = bsdf_eval(m, sf, wo, ls->wi, &out->scatter_pdf);
     if (v3_is_zero(f))
         return 0;
-    fr_ray shadow = {geo_offset(sf->p, sf->perr, sf->ng, ls->wi), ls->wi};
+    fr_ray shadow = {origin(org, sf, ls->wi), ls->wi};
     float tmax = ls->distant ? INFINITY : v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
     vec3 tr = v3s(1.0f);
     if (s->n_media && tmax > 0.0f)
@@ -194,12 +209,12 @@ void vtx_scatter_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium,
 }
 
 int vtx_scatter_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe,
-                        float u1, float u2, fr_bsdf_sample *bs, fr_ray *next, uint32_t *medium)
+                        float u1, float u2, const vtx_origin *org, fr_bsdf_sample *bs, fr_ray *next, uint32_t *medium)
 {
     if (!bsdf_sample(m, sf, wo, ulobe, u1, u2, bs))
         return 0;
     *medium = med_after(s, *medium, m, sf->ng, bs->wi);
-    next->o = geo_offset(sf->p, sf->perr, sf->ng, bs->wi);
+    next->o = origin(org, sf, bs->wi);
     next->d = bs->wi;
     return 1;
 }

@@ -77,6 +77,18 @@ float vtx_power_heuristic3(float a, float b, float c);
 int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vtx_mis mis,
              vec3 *equi_L, vtx_vertex *v);
 
+/** The origin of the rays that leave a surface vertex on one side of its
+ * surface (geo_offset depends on a ray's direction only through the side
+ * it leaves to), made once for a vertex's shadow ray and scattered ray. */
+typedef struct {
+    vec3 o;                    /**< geo_offset_side(sf->p, sf->perr, sf->ng, below) */
+    int below;                 /**< the side: 1 below ng, 0 above */
+} vtx_origin;
+
+/** The origin at surface vertex sf for rays leaving on the side of wo
+ * (unit, away from the surface), which the vertex's rays most often take. */
+vtx_origin vtx_origin_at(const fr_surface *sf, vec3 wo);
+
 /** Next-event estimation at a vertex: one light sample and what it adds. */
 typedef struct {
     fr_light_sample ls;        /**< the light point: direction, distance, radiance, light pdf, delta */
@@ -89,11 +101,12 @@ typedef struct {
 /** Next-event estimation at surface vertex sf, of material m (as textured
  * there), seen along wo, reached through `medium`: samples a light with
  * (upick, u1, u2), evaluates the BSDF and traces the shadow ray (through
- * media and their interfaces when the scene has media).  Returns 1 with
- * *out filled when the sample brings light, 0 when it brings none (no
- * smooth lobe, no light sample, a zero BSDF, a blocked shadow ray). */
+ * media and their interfaces when the scene has media), leaving from *org
+ * (vtx_origin_at) when it is on that side.  Returns 1 with *out filled when the sample brings light,
+ * 0 when it brings none (no smooth lobe, no light sample, a zero BSDF, a
+ * blocked shadow ray). */
 int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, uint32_t medium,
-                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, vtx_direct *out);
+                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, const vtx_origin *org, vtx_direct *out);
 
 /** Next-event estimation at medium vertex v (in `medium`), as
  * vtx_direct_surface with the phase function for the BSDF.  When
@@ -122,10 +135,11 @@ void vtx_scatter_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium,
 
 /** Scatter onward from surface vertex sf (material m, seen along wo): the
  * BSDF sampled with (ulobe, u1, u2) into *bs, *next leaving the surface on
- * the side bs->wi goes to, *medium updated if the path enters or leaves
- * the shape's medium.  Returns 0 when the path ends here (absorbed or a
- * void sample; *next and *medium untouched). */
+ * the side bs->wi goes to (from *org, vtx_origin_at, when it is on that
+ * side), *medium updated if the path enters or leaves the shape's medium.  Returns 0 when
+ * the path ends here (absorbed or a void sample; *next and *medium
+ * untouched). */
 int vtx_scatter_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, float ulobe,
-                        float u1, float u2, fr_bsdf_sample *bs, fr_ray *next, uint32_t *medium);
+                        float u1, float u2, const vtx_origin *org, fr_bsdf_sample *bs, fr_ray *next, uint32_t *medium);
 
 #endif

@@ -85,7 +85,8 @@ static void point_light(void)
     vtx_mis mis = {1, 1};
     vec3 beta = v3(1.0f, 0.5f, 0.25f);
     const fr_material *m = &s.materials[v.sf.material];
-    int got = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &d);
+    vtx_origin org = vtx_origin_at(&v.sf, v3(0, 1, 0));
+    int got = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &org, &d);
     float d2 = 0.25f + 4.0f, cosv = 2.0f / sqrtf(d2), want = 0.5f / FM_PI * 4.0f / d2 * cosv;
     CHECK(got == 1, "point light sampled");
     CHECK(d.ls.delta && d.weight == 1.0f, "a point light sample is not weighted (%g)", (double)d.weight);
@@ -94,7 +95,8 @@ static void point_light(void)
     CHECK(close_rel(d.scatter_pdf, cosv / FM_PI, 1e-5f), "Lambert pdf toward the light %g, want %g",
           (double)d.scatter_pdf, (double)(cosv / FM_PI));
     /* Seen from below the floor the Lambert lobe faces away: no light. */
-    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, -1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &d) == 0,
+    org = vtx_origin_at(&v.sf, v3(0, -1, 0));
+    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, -1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &org, &d) == 0,
           "no light through the back of the floor");
     scn_free(&s);
 
@@ -102,7 +104,8 @@ static void point_light(void)
     kind = floor_vertex(&s, &smp, &v);
     CHECK(kind == VTX_SURFACE, "blocked scene: floor below");
     m = &s.materials[v.sf.material];
-    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &d) == 0,
+    org = vtx_origin_at(&v.sf, v3(0, 1, 0));
+    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &org, &d) == 0,
           "a ball between the floor and the light blocks it");
     fr_ray up = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, 1.0f, 0.0f)};
     uint32_t medium = 0;
@@ -121,8 +124,9 @@ static void area_light(void)
     vtx_direct a, b;
     vtx_mis mis = {1, 1}, off = {0, 1};
     vec3 beta = v3s(1.0f);
-    int ga = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.5f, 0.3f, 0.7f, &a);
-    int gb = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, off, 0.5f, 0.3f, 0.7f, &b);
+    vtx_origin org = vtx_origin_at(&v.sf, v3(0, 1, 0));
+    int ga = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.5f, 0.3f, 0.7f, &org, &a);
+    int gb = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, off, 0.5f, 0.3f, 0.7f, &org, &b);
     CHECK(ga && gb && !a.ls.delta, "panel sampled");
     CHECK(b.weight == 1.0f, "not weighed: weight %g", (double)b.weight);
     CHECK(a.weight == vtx_power_heuristic(a.ls.pdf, a.scatter_pdf) && a.weight > 0.0f && a.weight < 1.0f,
@@ -140,11 +144,27 @@ static void area_light(void)
     fr_bsdf_sample bs;
     fr_ray next;
     uint32_t medium = 0;
-    CHECK(vtx_scatter_surface(&s, m, &v.sf, v3(0, 1, 0), 0.5f, 0.3f, 0.6f, &bs, &next, &medium) == 1,
+    CHECK(vtx_scatter_surface(&s, m, &v.sf, v3(0, 1, 0), 0.5f, 0.3f, 0.6f, &org, &bs, &next, &medium) == 1,
           "Lambert scatters");
     CHECK(next.d.x == bs.wi.x && next.d.y == bs.wi.y && next.d.z == bs.wi.z && next.d.y > 0.0f && next.o.y > 0.0f &&
               medium == 0,
           "next ray leaves above the floor along wi");
+    vec3 o = geo_offset(v.sf.p, v.sf.perr, v.sf.ng, bs.wi), ob = geo_offset(v.sf.p, v.sf.perr, v.sf.ng, v3(0, -1, 0));
+    CHECK(org.below == 0 && memcmp(&next.o, &o, sizeof o) == 0 && memcmp(&org.o, &o, sizeof o) == 0,
+          "the origin is geo_offset's, made for the upper side");
+    CHECK(ob.y < 0.0f && ob.y < o.y, "geo_offset pushes a downward ray's origin below the floor (%g)", (double)ob.y);
+    vtx_origin below = vtx_origin_at(&v.sf, v3(0, -1, 0));
+    CHECK(below.below == 1 && memcmp(&below.o, &ob, sizeof ob) == 0, "the origin below the floor is geo_offset's");
+    /* The vertex's origin is taken as it is for rays on its side, and not
+     * for rays on the other side. */
+    vtx_origin planted = {v3(1, 2, 3), 0};
+    CHECK(vtx_scatter_surface(&s, m, &v.sf, v3(0, 1, 0), 0.5f, 0.3f, 0.6f, &planted, &bs, &next, &medium) == 1 &&
+              next.o.x == 1.0f && next.o.y == 2.0f && next.o.z == 3.0f,
+          "the origin made for the upper side is reused");
+    planted.below = 1;
+    CHECK(vtx_scatter_surface(&s, m, &v.sf, v3(0, 1, 0), 0.5f, 0.3f, 0.6f, &planted, &bs, &next, &medium) == 1 &&
+              memcmp(&next.o, &o, sizeof o) == 0,
+          "the lower side's origin is not taken for the upper side");
     scn_free(&s);
 }
 
