@@ -774,9 +774,11 @@ static int emit_node(build *B, uint32_t v, uint32_t *index)
     return 0;
 }
 
-int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err)
+int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, uint32_t **placed, fr_error *err)
 {
     uint32_t n = b->prims.count;
+    if (placed && n == 0)
+        *placed = NULL;
     if (n == 0)
         return 0;
     if (n >= 0x80000000u)
@@ -822,12 +824,16 @@ int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err)
     free(B.id);
     free(B.tbox);
     free(B.tid);
-    free(B.out_of);
     free(B.bn);
     if (rc < 0) {
         free(B.out);
+        free(B.out_of);
         return -1;
     }
+    if (placed)
+        *placed = B.out_of;
+    else
+        free(B.out_of);
     free(b->prims.data);
     b->prims.data = B.out;
     b->prims.cap = n;

@@ -26,9 +26,12 @@
 /** Build the BVH over b->prims, reordering b->prims into leaf order, and
  * append its nodes to `nodes` (fr_array of fr_bvh_node) and its leaf blocks
  * to `leaves` (fr_array of fr_bvh_leaf), both owned by the caller.  An empty
- * scene gives neither.  Returns 0, or -1 with *err set on memory exhaustion
- * or a primitive with non-finite bounds. */
-int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, fr_error *err);
+ * scene gives neither.  With `placed` not NULL, *placed gets (malloc'd, the
+ * caller frees it; NULL for an empty scene) where each primitive went:
+ * (*placed)[i] is the new index of the primitive that was b->prims[i].
+ * Returns 0, or -1 with *err set on memory exhaustion or a primitive with
+ * non-finite bounds (*placed untouched). */
+int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, uint32_t **placed, fr_error *err);
 
 /** Bounding box of prim `i` of the builder, into *lo and *hi. */
 void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi);

@@ -14,12 +14,14 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
         return -1;
     fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
     /* The BVH reorders prims, so lights (which point at prims) come after. */
-    if (bvh_build(b, &nodes, &leaves, err) < 0) {
+    uint32_t *placed = NULL;
+    if (bvh_build(b, &nodes, &leaves, &placed, err) < 0) {
         free(nodes.data);
         free(leaves.data);
         return -1;
     }
-    int rc = frz_lights(b, err);
+    int rc = frz_lights(b, placed, err);
+    free(placed);
 
     fr_scene view;
     memset(&view, 0, sizeof view);

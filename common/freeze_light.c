@@ -235,7 +235,7 @@ double frz_light_power(const fr_builder *b, const fr_light *l)
 /* Rank of a light kind in the table: distant lights first. */
 static int rank(uint32_t kind) { return kind == FR_LIGHT_ENV ? 0 : kind == FR_LIGHT_SUN ? 1 : 2; }
 
-int frz_lights(fr_builder *b, fr_error *err)
+int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
 {
     bounds(b);
     /* Order what the readers added (stable), then append the area lights. */
@@ -263,8 +263,10 @@ int frz_lights(fr_builder *b, fr_error *err)
         return -1;
     const fr_material *mats = b->materials.data;
     fr_prim *prims = b->prims.data;
-    for (uint32_t i = 0; i < b->prims.count; i++) {
+    for (uint32_t i = 0; i < b->prims.count; i++)
         prims[i].light = FR_NONE;
+    for (uint32_t k = 0; k < b->prims.count; k++) {
+        uint32_t i = placed ? placed[k] : k;
         if (v3_is_zero(mats[prims[i].material].emission))
             continue;
         fr_light l;
@@ -273,7 +275,7 @@ int frz_lights(fr_builder *b, fr_error *err)
         l.prim = i;
         double area = prim_area(b, &prims[i]);
         if (!(area <= FLT_MAX))
-            return fr_fail(err, "primitive %u: an emitter of area %g, too large for single precision", i, area);
+            return fr_fail(err, "primitive %u: an emitter of area %g, too large for single precision", k, area);
         l.area = (float)area;
         uint32_t li = bld_push(&b->lights, &l);
         if (li == FR_NONE)

@@ -200,8 +200,9 @@ static void emission(void)
 }
 
 /* Two thousand emissive triangles of different brightness and size: each
- * is an area light picked in proportion to its power, and lgt_pick
- * returns light i for numbers in [cdf[i-1], cdf[i]). */
+ * is an area light picked in proportion to its power, lgt_pick returns
+ * light i for numbers in [cdf[i-1], cdf[i]), and the lights are listed in
+ * the order the triangles were added, whatever order the BVH put them in. */
 static void many_area_lights(void)
 {
     fr_builder b;
@@ -218,7 +219,8 @@ static void many_area_lights(void)
         bld_material_init(&m);
         m.emission = v3s(1.0f + (float)(i % 7));
         bld_push(&b.materials, &m);
-        float x = (float)(i % 50) * 0.1f, y = (float)(i / 50) * 0.1f, sz = 0.02f + 0.001f * (float)(i % 13);
+        int g = i * 37 % N; /* spread over the grid, so the BVH has to reorder them */
+        float x = (float)(g % 50) * 0.1f, y = (float)(g / 50) * 0.1f, sz = 0.02f + 0.001f * (float)(i % 13);
         bld_triangle(&b, v3(x, y, 0), v3(x + sz, y, 0), v3(x, y + sz, 0), (uint32_t)i);
     }
     fr_scene s;
@@ -228,9 +230,11 @@ static void many_area_lights(void)
     if (rc == 0) {
         CHECK(s.n_lights == N, "%u lights, expected %d", s.n_lights, N);
         double ratio0 = 0, worst = 0, prev = 0;
-        int order = 1, picks = 1;
+        int order = 1, picks = 1, added = 1, moved = 0;
         for (uint32_t i = 0; i < s.n_lights; i++) {
             const fr_light *l = &s.lights[i];
+            added &= s.prims[l->prim].material == i;
+            moved |= l->prim != i;
             const fr_material *m = &s.materials[s.prims[l->prim].material];
             double power = M_PI * v3_luma(m->emission) * l->area, ratio = l->pick / power;
             if (i == 0)
@@ -245,6 +249,8 @@ static void many_area_lights(void)
         CHECK(worst < 1e-5, "pick / power varies by %.2e", worst);
         CHECK(order && s.lights[N - 1].cdf == 1.0f, "running sums not increasing to 1");
         CHECK(picks, "lgt_pick does not return the light whose interval holds u");
+        CHECK(added, "area lights are not in the order their triangles were added");
+        CHECK(moved, "the BVH kept every triangle in place: the order check above proves nothing");
         scn_free(&s);
     }
     bld_free(&b);

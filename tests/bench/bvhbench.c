@@ -306,7 +306,7 @@ int main(int argc, char **argv)
         fill_builder(&b, &s);
         fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
         double t0 = now();
-        if (bvh_build(&b, &nodes, &leaves, &err) < 0) {
+        if (bvh_build(&b, &nodes, &leaves, NULL, &err) < 0) {
             fprintf(stderr, "bvhbench: %s\n", err.msg);
             return 1;
         }
