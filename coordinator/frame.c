@@ -175,6 +175,10 @@ int frame_lock(frame_image *im)
     fr_error err;
     if (a->jobdir)
         snprintf(im->jobdir, sizeof im->jobdir, "%s", a->jobdir);
+    else if (!strncmp(a->out, "/dev/", 5) || !strncmp(a->out, "/proc/", 6))
+        /* /dev/null, /dev/stdout: no job directory beside them, but one
+         * in the current directory, named after them. */
+        snprintf(im->jobdir, sizeof im->jobdir, "%s.franja-job", strrchr(a->out, '/') + 1);
     else
         snprintf(im->jobdir, sizeof im->jobdir, "%s.franja-job", a->out);
 

@@ -41,6 +41,9 @@ check "-o /dev/stdout writes the PFM to standard output" cmp -s stdout.pfm ref.p
 "$FRANJA" render scene.fbin -o /dev/null $SIZE 2>devnull.log
 check "-o /dev/null succeeds" test $? -eq 0
 check "/dev/null is still a character device" test -c /dev/null
+"$FRANJA" render scene.fbin -o /dev/null $SIZE --keep-job 2>/dev/null
+check "-o /dev/null keeps its job directory here, not in /dev" sh -c "test -d null.franja-job && ! test -e /dev/null.franja-job"
+rm -rf null.franja-job
 mkfifo pipe
 timeout 120 cat pipe >fifo.pfm &
 "$FRANJA" render scene.fbin -o pipe $SIZE 2>/dev/null
