@@ -24,6 +24,7 @@ page() {
     README.md) echo index.html ;;
     */man/*) basename "$1" | sed 's/$/.html/' ;;
     common/FORMAT.md) echo format.html ;;
+    tests/bench/README.md) echo bench.html ;;
     *) echo "$(dirname "$1").html" ;;
     esac
 }
@@ -44,7 +45,7 @@ for man in coordinator/man/*.[1-9]; do
         text "$p" | grep -qF -- "$o" && ok || bad "$p lacks the option $o"
     done
 done
-for md in README.md coordinator/README.md scenes/README.md docker/README.md common/FORMAT.md; do
+for md in README.md coordinator/README.md scenes/README.md docker/README.md common/FORMAT.md tests/bench/README.md; do
     p="$G/$(page "$md")"
     [ -s "$p" ] || { bad "no guide page $p for $md"; continue; }
     ok

@@ -20,6 +20,7 @@ coordinator/README.md coordinator.html The coordinator
 scenes/README.md scenes.html Scenes
 common/FORMAT.md format.html The binary scene format
 docker/README.md docker.html Builds for other systems
+tests/bench/README.md bench.html Benchmarks
 coordinator/man/franja.1 franja.1.html franja(1)
 coordinator/man/franja-worker.1 franja-worker.1.html franja-worker(1)
 coordinator/man/franja-hosts.5 franja-hosts.5.html franja-hosts(5)
