@@ -5,7 +5,7 @@
  * and the directories of a frame's output are made when missing.
  *
  * frames_begin / frames_next / frames_end walk the list for a render that
- * runs the frames together over one set of hosts (cmd_render.c);
+ * runs the frames together over one set of hosts (render_anim.h);
  * frames_run renders them one after another through the single-image
  * render.  Both print the same lines: each frame announced or skipped, a
  * frame that fails or is interrupted named, and a summary.

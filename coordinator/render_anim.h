@@ -1,0 +1,29 @@
+/** @file render_anim.h
+ * `franja render PATTERN --frames LIST`: the frames of an animation (see
+ * cmd_frames.h for the list, the file names and what is said) rendered
+ * together over one set of hosts, connected once.  Frames are opened
+ * (locked, compiled) in the order of the list; once every slab of a frame
+ * has started, a slot that comes free starts the next frame's slabs, and
+ * each frame is written as soon as its rows are in.  With --time-limit,
+ * --preview, --monitor or --progress json, which follow one image at a
+ * time, the frames are rendered one after another instead, each a render
+ * of its own.
+ */
+#ifndef FRANJA_RENDER_ANIM_H
+#define FRANJA_RENDER_ANIM_H
+
+#include "frame.h"
+
+/** Parses one frame's command line (argv[0] is the command's name) into a
+ * new image whose stop flag is set; NULL with *status set (0 after --help,
+ * 2 on a usage error). */
+typedef frame_image *(*ra_parse_fn)(int argc, char **argv, int *status);
+
+/** Renders the frames of a->frames; argv is the command line as typed,
+ * each frame's own made from it by cmd_frames.h's rules and parsed with
+ * parse.  Returns the exit status of `franja render` (130 when
+ * interrupted: the frames in flight keep their finished slabs for
+ * --resume). */
+int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse);
+
+#endif

@@ -1,0 +1,70 @@
+/** @file render_run.h
+ * One run of `franja render` over its hosts: the hosts of the render (a
+ * host table, a Slurm allocation or this machine), made ready while the
+ * render starts on the first of them, the scheduler's run over them (every
+ * pass of --time-limit), and what the run says: the status line on
+ * stderr (live on a terminal, a line every ten seconds in a log), the
+ * hosts' events to --progress json and --monitor, and the summary at the
+ * end.  An animation (render_anim.h) adds its frames to the same run.
+ */
+#ifndef FRANJA_RENDER_RUN_H
+#define FRANJA_RENDER_RUN_H
+
+#include <signal.h>
+#include <stddef.h>
+
+#include "error.h"
+#include "frame.h"
+#include "hosts.h"
+#include "monitor.h"
+#include "progress.h"
+#include "sched.h"
+#include "slurm.h"
+
+/** Set by SIGINT and SIGTERM once rr_signals has run: stop and keep the
+ * finished slabs. */
+extern volatile sig_atomic_t rr_stop;
+
+/** Catches SIGINT and SIGTERM (they set rr_stop) and ignores SIGPIPE. */
+void rr_signals(void);
+
+/** The hosts of a render into *table (hosts_free frees it): a's host
+ * table, the nodes of a Slurm allocation (*alloc, which slurm_close ends;
+ * zeroed when a is not under Slurm), or this machine as "local".  argv is
+ * the command line as typed (for the salloc hint).  0, or the exit status
+ * with the reason said on stderr. */
+int rr_hosts(render_args *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc);
+
+/** An animation's part of a run: the scheduler's frame hooks (sched.h,
+ * called here with ctx) and `rendered`, told of each accepted slab which
+ * host rendered rows of which frame.  The hooks print after
+ * rr_clear_line. */
+typedef struct {
+    int (*next_frame)(void *ctx, int frame, sched_frame *next, fr_error *err);
+    int (*stage)(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
+                 size_t lease_cap, fr_error *err);
+    int (*frame_done)(void *ctx, int frame, fr_error *err);
+    void (*rendered)(void *ctx, int frame, int host);
+    void *ctx;
+} rr_frames;
+
+/** Connects the hosts of table and renders the rows of ps (its passes,
+ * with --time-limit) that its job directory lacks; fbin is the scene the
+ * hosts get.  The render starts as soon as one host is ready and the
+ * others join when they are (a host that accepts a connection and never
+ * answers costs nothing unless it is the only one).  pg and mon (NULL:
+ * none) get the hosts' events.  With fx, ps is the first frame of an
+ * animation and the next ones follow over the same hosts (fx stages each
+ * frame's scene and writes each frame); fbin is then not used.  used
+ * (used_cap bytes) gets the names of the hosts that rendered rows,
+ * comma-separated, for the image's metadata.  Prints the summary.  0, or
+ * -1 with *err set (the slabs finished stay in the job directory; rr_stop
+ * says whether it was interrupted). */
+int rr_run(const render_args *a, const hosts_table *table, const char *fbin, passes *ps, pg_reporter *pg,
+           mon_server *mon, char *used, size_t used_cap, const rr_frames *fx, fr_error *err);
+
+/** Ends the live status line on a terminal, if one is drawn, so that a
+ * log line can follow. */
+void rr_clear_line(void);
+
+#endif
