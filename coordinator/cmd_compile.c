@@ -8,6 +8,7 @@
 #include "opt.h"
 #include "compile.h"
 #include "compile_child.h"
+#include "file.h"
 
 static const char usage[] =
     "usage: franja compile SCENE(.json|.gltf|.glb) [-o SCENE.fbin] [--camera NAME]\n"
@@ -96,8 +97,11 @@ int cmd_compile(int argc, char **argv)
         fprintf(stderr, "franja compile: %s\n", err.msg);
         return stop_flag ? 130 : 1;
     }
-    printf("%s: scene %s, %llu bytes: %u primitives (%u triangles), %u materials, %u lights, "
-           "%u BVH nodes, %u leaf blocks; compiled in %.3f s\n",
-           out, st.hash, st.bytes, st.prims, st.triangles, st.materials, st.lights, st.nodes, st.leaves, st.seconds);
+    /* A scene written to a device or a pipe (/dev/stdout) is not mixed
+     * with the summary. */
+    fprintf(file_out_in_place(out) ? stderr : stdout,
+            "%s: scene %s, %llu bytes: %u primitives (%u triangles), %u materials, %u lights, "
+            "%u BVH nodes, %u leaf blocks; compiled in %.3f s\n",
+            out, st.hash, st.bytes, st.prims, st.triangles, st.materials, st.lights, st.nodes, st.leaves, st.seconds);
     return 0;
 }

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "fbin.h"
+#include "file.h"
 
 /* What the child sends back, in one write. */
 typedef struct {
@@ -136,16 +137,57 @@ int compile_child_sweep(const char *out)
     return n;
 }
 
+/* Puts the compiled file into out, a target written in place (a device
+ * or a FIFO): its bytes are copied there, the target itself never
+ * replaced. */
+static int copy_into(const char *file, const char *out, fr_error *err)
+{
+    int in = open(file, O_RDONLY | O_CLOEXEC);
+    if (in < 0)
+        return fr_fail(err, "%s: %s", file, strerror(errno));
+    file_out o;
+    if (file_out_open(out, &o, err)) {
+        close(in);
+        return -1;
+    }
+    static char buf[1 << 16];
+    for (;;) {
+        ssize_t k = read(in, buf, sizeof buf);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k < 0) {
+            int e = errno;
+            close(in);
+            file_out_abort(&o);
+            return fr_fail(err, "%s: read error: %s", file, strerror(e));
+        }
+        if (k == 0)
+            break;
+        if (file_out_write(&o, buf, (size_t)k, err)) {
+            close(in);
+            file_out_abort(&o);
+            return -1;
+        }
+    }
+    close(in);
+    return file_out_commit(&o, out, err);
+}
+
 int compile_child(const char *scene, const compile_opts *o, const char *out, volatile sig_atomic_t *stop,
                   compile_child_stats *st, fr_error *err)
 {
     char dir[4200], file[4300];
     const char *slash = strrchr(out, '/');
     int dirlen = slash ? (int)(slash - out + 1) : 0;
-    if (snprintf(dir, sizeof dir, "%.*s.%s.compile-XXXXXX", dirlen, out, out + dirlen) >= (int)sizeof dir)
+    /* A device or a FIFO (/dev/null, /dev/stdout) is written in place: the
+     * compile goes to the current directory, not into /dev. */
+    int in_place = file_out_in_place(out);
+    if (snprintf(dir, sizeof dir, "%.*s.%s.compile-XXXXXX", in_place ? 0 : dirlen, out, out + dirlen) >=
+        (int)sizeof dir)
         return fr_fail(err, "%s: name too long", out);
     if (!mkdtemp(dir))
-        return fr_fail(err, "%s: cannot create a directory beside it to compile into: %s", out, strerror(errno));
+        return fr_fail(err, "%s: cannot create a directory %s to compile into: %s", out,
+                       in_place ? "in the current directory" : "beside it", strerror(errno));
     snprintf(file, sizeof file, "%s/scene.fbin", dir);
     int p[2];
     if (pipe2(p, O_CLOEXEC) < 0) {
@@ -199,14 +241,16 @@ int compile_child(const char *scene, const compile_opts *o, const char *out, vol
         rc = -1;
     } else if (stop && *stop) {
         rc = fr_fail(err, "%s: compile interrupted", scene);
+    } else if (in_place) {
+        rc = copy_into(file, out, err);
     } else if (rename(file, out)) {
         rc = fr_fail(err, "%s: %s", out, strerror(errno));
     } else {
         rc = 0;
-        if (st) {
-            *st = a.st;
-            st->hash[sizeof st->hash - 1] = 0;
-        }
+    }
+    if (rc == 0 && st) {
+        *st = a.st;
+        st->hash[sizeof st->hash - 1] = 0;
     }
     remove_dir(dir);
     return rc;

@@ -6,9 +6,12 @@
  * building the BVH, writing the file), with no point where it could look
  * at a stop request.  compile_child forks; the child compiles (compile.h)
  * and writes the binary scene into a private directory (mkdtemp, beside
- * the output); the parent waits, looking at the caller's stop flag ten
+ * the output, or in the current directory when the output is a device or
+ * a FIFO); the parent waits, looking at the caller's stop flag ten
  * times a second.  When the flag is set (SIGINT, SIGTERM) the child is
- * killed at once.  The output appears, by a rename, only when complete;
+ * killed at once.  The output appears, by a rename, only when complete
+ * (a device or a FIFO, such as /dev/null or /dev/stdout, is written in
+ * place then, never replaced);
  * the private directory is removed in every case but one: a caller killed
  * by SIGKILL.  The child then gets SIGKILL too (PR_SET_PDEATHSIG), so it
  * neither keeps what it inherited (a job lock) nor goes on compiling; its

@@ -25,6 +25,26 @@ mkdir "$T/here"
 (R=$(pwd) && cd "$T/here" && "$R/$F" compile "$T/box.json" >/dev/null) && [ -s "$T/here/box.fbin" ] && [ ! -e "$T/box.fbin" ] && ok ||
     bad "default output name (.json -> .fbin in the current directory)"
 
+# A device or a named pipe is written in place, never replaced (as root a
+# rename would turn /dev/null into a plain file), the compile runs in the
+# current directory instead of beside it, and the summary goes to stderr.
+$F compile "$T/box.json" -o "$T/ref.fbin" >/dev/null
+mkfifo "$T/pipe"
+timeout 30 cat "$T/pipe" >"$T/piped.fbin" &
+(R=$(pwd) && cd "$T/here" && "$R/$F" compile "$T/box.json" -o "$T/pipe" >"$T/pipe.out" 2>"$T/pipe.err")
+wait
+[ -p "$T/pipe" ] && cmp -s "$T/piped.fbin" "$T/ref.fbin" && ok || bad "-o FIFO: the scene written into the pipe, which stays one"
+[ ! -s "$T/pipe.out" ] && grep -q "pipe: scene " "$T/pipe.err" && ok || bad "-o FIFO: the summary on stderr, not with the scene"
+[ -z "$(ls -A "$T" | grep compile-)" ] && [ -z "$(ls -A "$T/here" | grep compile-)" ] && ok ||
+    bad "-o FIFO: the compile's private directory left behind"
+$F compile "$T/box.json" -o /dev/stdout 2>/dev/null | cmp -s - "$T/ref.fbin" && ok || bad "-o /dev/stdout: the scene alone"
+if $F compile "$T/box.json" -o /dev/null 2>/dev/null && [ -c /dev/null ]; then
+    ok
+else
+    bad "-o /dev/null: /dev/null is still a device"
+    [ -c /dev/null ] || { rm -f /dev/null && mknod -m 666 /dev/null c 1 3; } # for the tests after this one
+fi
+
 # --- compiled scenes render the bytes their JSON renders ---
 for s in scenes/*.json; do
     # (meshes and image textures need the compiler: the worker refuses that JSON)
