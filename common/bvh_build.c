@@ -650,6 +650,366 @@ static int bin_build(build *B, const span *s, int depth, int median, uint32_t *i
     return 0;
 }
 
+/* ---- reinsertion ----
+ *
+ * Before the collapse the binary tree is improved by moving subtrees (the
+ * insertion-based optimisation of Bittner, Hapala and Havran, 2013), each
+ * move kept only where it lowers the collapse's cost of the whole tree.
+ * Leaves keep their references, so a primitive cut by spatial splits stays
+ * in the same leaves.
+ *   - A leaf N is taken out (its parent goes, its sibling takes the
+ *     parent's place, the nodes above are refitted) and put as the sibling
+ *     of another node under a new parent.
+ *   - An inner node N is taken out with its parent, and its two children
+ *     are put back one after the other (the larger first).
+ * Where a subtree goes is chosen by the summed area of the inner nodes,
+ * the usual stand-in for the SAH: beside the node where it grows least,
+ * found by branch and bound from the root (nodes in the order of how much
+ * their ancestors would grow, a heap with ties to the lower index, a
+ * subtree skipped where that growth plus the moved subtree's own area
+ * reaches the best place found; no place where the tree would get deeper
+ * than FR_BVH_MAX_DEPTH).  A move that does not lower the inner area is
+ * not tried; one that does is kept only if the collapse's cost of the
+ * root (bnode_costs, recomputed up both paths) falls, else undone exactly.
+ * A pass tries, worst first, the twentieth of the nodes whose parent is
+ * largest against its two children (area(P) / (area(N) + area(S)) *
+ * area(P)); passes stop when one gains less than REINS_STOP of the cost,
+ * or after REINS_PASSES. */
+
+enum { REINS_PASSES = 3, REINS_SHARE = 20 };
+#define REINS_STOP 0.01f
+
+typedef struct {
+    float c;                   /* growth of the ancestors' areas */
+    uint32_t node, depth;      /* depth: the root is 1 */
+} reins_item;
+
+typedef struct {
+    bnode *bn;                 /* the tree, changed in place */
+    float *area;               /* per node: half_area(box) */
+    uint32_t *up;              /* parent, FR_NONE at the root and out of the tree */
+    uint8_t *height;           /* levels of the subtree: 1 for a leaf */
+    uint32_t root, n;
+    reins_item *heap;          /* the search's (a node enters it once) */
+    uint32_t nh;
+} reins;
+
+static int reins_before(reins_item a, reins_item b) { return a.c < b.c || (a.c == b.c && a.node < b.node); }
+
+static void reins_push(reins *R, reins_item it)
+{
+    uint32_t i = R->nh++;
+    while (i > 0) {
+        uint32_t p = (i - 1) / 2;
+        if (!reins_before(it, R->heap[p]))
+            break;
+        R->heap[i] = R->heap[p];
+        i = p;
+    }
+    R->heap[i] = it;
+}
+
+static reins_item reins_pop(reins *R)
+{
+    reins_item top = R->heap[0], last = R->heap[--R->nh];
+    uint32_t i = 0, n = R->nh;
+    for (;;) {
+        uint32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && reins_before(R->heap[c + 1], R->heap[c]))
+            c++;
+        if (!reins_before(R->heap[c], last))
+            break;
+        R->heap[i] = R->heap[c];
+        i = c;
+    }
+    if (n > 0)
+        R->heap[i] = last;
+    return top;
+}
+
+static uint8_t max_u8(uint8_t a, uint8_t b) { return a > b ? a : b; }
+
+/* Box, area, height, references and costs of inner node x and its
+ * ancestors from their children. */
+static void reins_update(reins *R, uint32_t x)
+{
+    bnode *bn = R->bn;
+    for (; x != FR_NONE; x = R->up[x]) {
+        uint32_t a = bn[x].kid[0], b = bn[x].kid[1];
+        bn[x].box = bn[a].box;
+        box_grow(&bn[x].box, bn[b].box);
+        bn[x].refs = bn[a].refs + bn[b].refs;
+        R->area[x] = half_area(bn[x].box);
+        R->height[x] = (uint8_t)(1 + max_u8(R->height[a], R->height[b]));
+        bnode_costs(bn, x);
+    }
+}
+
+/* Put x where child `from` of p was (p FR_NONE: as the root). */
+static void reins_replace(reins *R, uint32_t p, uint32_t from, uint32_t x)
+{
+    R->up[x] = p;
+    if (p == FR_NONE)
+        R->root = x;
+    else
+        R->bn[p].kid[R->bn[p].kid[0] == from ? 0 : 1] = x;
+}
+
+/* Take subtree x (not the root's child) out of the tree: its parent goes,
+ * the sibling takes the parent's place. */
+static void reins_detach(reins *R, uint32_t x)
+{
+    uint32_t p = R->up[x], g = R->up[p];
+    reins_replace(R, g, p, R->bn[p].kid[R->bn[p].kid[0] == x ? 1 : 0]);
+    reins_update(R, g);
+    R->up[x] = R->up[p] = FR_NONE;
+}
+
+/* Put subtree n beside x under the free node p (n its first child if
+ * n_first). */
+static void reins_attach(reins *R, uint32_t n, uint32_t x, uint32_t p, int n_first)
+{
+    reins_replace(R, R->up[x], x, p);
+    R->bn[p].kid[0] = n_first ? n : x;
+    R->bn[p].kid[1] = n_first ? x : n;
+    R->up[x] = R->up[n] = p;
+    reins_update(R, p);
+}
+
+/* The cheapest place for subtree n (out of the tree) as above: the node to
+ * put it beside, FR_NONE if there is none within the depth; *cost gets the
+ * growth of the inner area there. */
+static uint32_t reins_search(reins *R, uint32_t n, float *cost)
+{
+    const bnode *bn = R->bn;
+    box4 nb = bn[n].box;
+    float an = R->area[n], best = INFINITY;
+    uint32_t best_x = FR_NONE, hn = R->height[n];
+    R->nh = 0;
+    reins_push(R, (reins_item){0.0f, R->root, 1});
+    while (R->nh > 0) {
+        reins_item it = reins_pop(R);
+        if (!(it.c + an < best))
+            break;
+        uint32_t x = it.node, h = R->height[x] > hn ? R->height[x] : hn;
+        box4 u = bn[x].box;
+        box_grow(&u, nb);
+        float au = half_area(u), total = it.c + au;
+        if (total < best && it.depth + h <= FR_BVH_MAX_DEPTH) {
+            best = total;
+            best_x = x;
+        }
+        if (bn[x].is_leaf)
+            continue;
+        float c = it.c + (au - R->area[x]);
+        if (c + an < best)
+            for (int k = 0; k < 2; k++)
+                reins_push(R, (reins_item){c, bn[x].kid[k], it.depth + 1});
+    }
+    *cost = best;
+    return best_x;
+}
+
+/* The growth of the inner area from putting subtree n beside x, added up
+ * as reins_search adds it. */
+static float reins_cost_at(const reins *R, uint32_t n, uint32_t x)
+{
+    uint32_t path[256];
+    int np = 0;
+    for (uint32_t y = R->up[x]; y != FR_NONE && np < 256; y = R->up[y])
+        path[np++] = y;
+    box4 nb = R->bn[n].box;
+    float c = 0.0f;
+    while (np > 0) {
+        uint32_t y = path[--np];
+        box4 u = R->bn[y].box;
+        box_grow(&u, nb);
+        c = c + (half_area(u) - R->area[y]);
+    }
+    box4 u = R->bn[x].box;
+    box_grow(&u, nb);
+    return c + half_area(u);
+}
+
+/* The cost of binary node v emitted as the root (a wide node, as
+ * emit_node makes it). */
+static float bnode_root_cost(const bnode *bn, uint32_t v)
+{
+    const bnode *n = &bn[v];
+    if (n->is_leaf)
+        return n->cost[0];
+    float best = INFINITY;
+    for (int k = 1; k < FR_BVH_WIDTH; k++) {
+        float c = bn[n->kid[0]].cost[k - 1] + bn[n->kid[1]].cost[FR_BVH_WIDTH - k - 1];
+        best = c < best ? c : best;
+    }
+    return half_area(n->box) * TRAV_COST + best;
+}
+
+/* Whether a move from cost `before` is kept: the root's cost falls by more
+ * than rounding. */
+static int reins_better(const reins *R, float before)
+{
+    return bnode_root_cost(R->bn, R->root) < before * 0.999999f;
+}
+
+/* Move leaf n; returns whether it moved. */
+static int reins_move(reins *R, uint32_t n)
+{
+    uint32_t p = R->up[n];
+    int n_first = R->bn[p].kid[0] == n;
+    uint32_t s = R->bn[p].kid[n_first ? 1 : 0];
+    float before = bnode_root_cost(R->bn, R->root), cost;
+    reins_detach(R, n);
+    float stay = reins_cost_at(R, n, s);
+    uint32_t x = reins_search(R, n, &cost);
+    if (x != FR_NONE && x != s && cost < stay) {
+        reins_attach(R, n, x, p, 0);
+        if (reins_better(R, before))
+            return 1;
+        reins_detach(R, n);
+    }
+    reins_attach(R, n, s, p, n_first);
+    return 0;
+}
+
+/* Summed area of y and its ancestors. */
+static float reins_path_area(const reins *R, uint32_t y)
+{
+    float sum = 0.0f;
+    for (; y != FR_NONE; y = R->up[y])
+        sum += R->area[y];
+    return sum;
+}
+
+/* Take inner node n out with its parent and put its children back;
+ * returns whether that was kept. */
+static int reins_split(reins *R, uint32_t n)
+{
+    bnode *bn = R->bn;
+    uint32_t p = R->up[n], g = R->up[p], a = bn[n].kid[0], b = bn[n].kid[1];
+    int n_first = bn[p].kid[0] == n;
+    uint32_t s = bn[p].kid[n_first ? 1 : 0];
+    float before = bnode_root_cost(bn, R->root), area_before = reins_path_area(R, n);
+    reins_detach(R, n);
+    float area_after = reins_path_area(R, g);
+    R->up[a] = R->up[b] = FR_NONE;
+    uint32_t first = R->area[a] >= R->area[b] ? a : b, second = first == a ? b : a;
+    /* Beside s is where first was, within the depth; where second finds
+     * no place within it, all is undone. */
+    float c1, c2;
+    uint32_t x1 = reins_search(R, first, &c1);
+    if (x1 == FR_NONE)
+        c1 = reins_cost_at(R, first, x1 = s);
+    reins_attach(R, first, x1, n, 0);
+    uint32_t x2 = reins_search(R, second, &c2);
+    int undo = x2 == FR_NONE;
+    reins_attach(R, second, undo ? first : x2, p, 0);
+    if (!undo && area_before - area_after > c1 + c2 && reins_better(R, before))
+        return 1;
+    reins_detach(R, second);
+    reins_detach(R, first);
+    bn[n].kid[0] = a;
+    bn[n].kid[1] = b;
+    R->up[a] = R->up[b] = n;
+    R->up[n] = FR_NONE;
+    reins_update(R, n);
+    reins_attach(R, n, s, p, n_first);
+    return 0;
+}
+
+typedef struct {
+    float score;
+    uint32_t node;
+} reins_cand;
+
+/* Worst first, ties to the lower index (a total order: qsort's algorithm
+ * does not matter). */
+static int reins_cand_cmp(const void *a, const void *b)
+{
+    const reins_cand *x = a, *y = b;
+    if (x->score != y->score)
+        return x->score > y->score ? -1 : 1;
+    return x->node < y->node ? -1 : x->node > y->node;
+}
+
+/* One pass (cand: scratch for every node). */
+static void reins_pass(reins *R, reins_cand *cand)
+{
+    const bnode *bn = R->bn;
+    uint32_t nc = 0;
+    for (uint32_t i = 0; i < R->n; i++) {
+        uint32_t p = R->up[i];
+        if (p == FR_NONE || R->up[p] == FR_NONE)
+            continue;
+        uint32_t s = bn[p].kid[bn[p].kid[0] == i ? 1 : 0];
+        float score = R->area[p] / (R->area[s] + R->area[i]) * R->area[p];
+        cand[nc++] = (reins_cand){score == score ? score : 0.0f, i};   /* 0/0: flat boxes */
+    }
+    qsort(cand, nc, sizeof *cand, reins_cand_cmp);
+    for (uint32_t k = 0; k < nc / REINS_SHARE; k++) {
+        uint32_t n = cand[k].node, p = R->up[n];
+        if (p == FR_NONE || R->up[p] == FR_NONE)   /* now a child of the root */
+            continue;
+        if (bn[n].is_leaf)
+            reins_move(R, n);
+        else
+            reins_split(R, n);
+    }
+}
+
+/* Reinsertion over the binary tree at *root (its costs as bin_build left
+ * them); *root may change.  Returns 0, or -1 with B->err set on memory
+ * exhaustion. */
+static int bvh_reinsert(build *B, uint32_t *root)
+{
+    uint32_t n = B->n_bn;
+    if (n < 7)
+        return 0;
+    reins R = {0};
+    R.bn = B->bn;
+    R.n = n;
+    R.root = *root;
+    R.area = malloc((size_t)n * sizeof *R.area);
+    R.up = malloc((size_t)n * sizeof *R.up);
+    R.height = malloc(n);
+    R.heap = malloc((size_t)n * sizeof *R.heap);
+    reins_cand *cand = malloc((size_t)n * sizeof *cand);
+    int rc = 0;
+    if (!R.area || !R.up || !R.height || !R.heap || !cand) {
+        rc = fr_fail(B->err, "out of memory for the BVH reinsertion (%u nodes)", n);
+        goto done;
+    }
+    /* bin_build numbers a node before its children: from the back, children
+     * come first. */
+    for (uint32_t i = n; i-- > 0;) {
+        const bnode *v = &R.bn[i];
+        R.up[i] = FR_NONE;
+        R.height[i] = 1;
+        if (!v->is_leaf) {
+            R.height[i] = (uint8_t)(1 + max_u8(R.height[v->kid[0]], R.height[v->kid[1]]));
+            R.up[v->kid[0]] = R.up[v->kid[1]] = i;
+        }
+        R.area[i] = half_area(v->box);
+    }
+    for (int pass = 0; pass < REINS_PASSES; pass++) {
+        float before = bnode_root_cost(R.bn, R.root);
+        reins_pass(&R, cand);
+        if (!(bnode_root_cost(R.bn, R.root) < before * (1.0f - REINS_STOP)))
+            break;
+    }
+    *root = R.root;
+done:
+    free(R.area);
+    free(R.up);
+    free(R.height);
+    free(R.heap);
+    free(cand);
+    return rc;
+}
+
 /* The slots of binary node v given as at most j slots, appended to
  * slot[*ns]. */
 static void gather_slots(const bnode *bn, uint32_t v, int j, uint32_t *slot, int *ns)
@@ -776,6 +1136,49 @@ static int emit_node(build *B, uint32_t v, uint32_t *index)
 
 int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, uint32_t **placed, fr_error *err)
 {
+    return bvh_build_with(b, NULL, nodes, leaves, placed, err);
+}
+
+/* Cost of the node whose slot box has half area `area`, and its slots. */
+static double sah_node(const fr_bvh_node *nodes, uint32_t n_nodes, uint32_t v, double area, int depth)
+{
+    const fr_bvh_node *x = &nodes[v];
+    double c = area * TRAV_COST;
+    for (int i = 0; i < FR_BVH_WIDTH && depth < FR_BVH_MAX_DEPTH; i++) {
+        if (x->child[i] == FR_NONE)
+            continue;
+        f4 d = {x->box[3][i] - x->box[0][i], x->box[4][i] - x->box[1][i], x->box[5][i] - x->box[2][i], 0.0f};
+        double a = (double)d[0] * d[1] + (double)d[1] * d[2] + (double)d[2] * d[0];
+        c += a * SLOT_COST;
+        if (x->leaf[i])
+            c += a * (double)(x->leaf[i] & FR_BVH_LEAF_MAX);
+        else if (x->child[i] > v && x->child[i] < n_nodes)
+            c += sah_node(nodes, n_nodes, x->child[i], a, depth + 1);
+    }
+    return c;
+}
+
+double bvh_sah_cost(const fr_bvh_node *nodes, uint32_t n_nodes)
+{
+    if (n_nodes == 0)
+        return 0.0;
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < FR_BVH_WIDTH; i++)
+        for (int a = 0; a < 3 && nodes[0].child[i] != FR_NONE; a++) {
+            lo[a] = nodes[0].box[a][i] < lo[a] ? nodes[0].box[a][i] : lo[a];
+            hi[a] = nodes[0].box[3 + a][i] > hi[a] ? nodes[0].box[3 + a][i] : hi[a];
+        }
+    double d0 = (double)hi[0] - lo[0], d1 = (double)hi[1] - lo[1], d2 = (double)hi[2] - lo[2];
+    double area = d0 * d1 + d1 * d2 + d2 * d0;
+    if (!(area > 0.0))
+        return 0.0;
+    return sah_node(nodes, n_nodes, 0, area, 1) / area;
+}
+
+int bvh_build_with(fr_builder *b, const bvh_options *opt, fr_array *nodes, fr_array *leaves, uint32_t **placed,
+                   fr_error *err)
+{
+    int reinsert = opt ? opt->reinsert : 1;
     uint32_t n = b->prims.count;
     if (placed && n == 0)
         *placed = NULL;
@@ -815,6 +1218,8 @@ int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, uint32_t **place
         B.min_overlap = half_area(all.box) * OVERLAP;
         uint32_t broot, root;
         rc = bin_build(&B, &all, 1, 0, &broot);
+        if (rc == 0 && reinsert)
+            rc = bvh_reinsert(&B, &broot);
         if (rc == 0)
             rc = emit_node(&B, broot, &root);
     }

@@ -12,7 +12,8 @@
  * hit, with and without a skipped primitive.  Every tree must pass
  * bvh_validate, name a primitive at most once per leaf and leave lanes
  * empty only in a leaf's last block.  Where there are two
- * traversals (x86-64 with AVX2), both are checked. */
+ * traversals (x86-64 with AVX2), both are checked.  Trees built with and
+ * without reinsertion are compared by their SAH cost. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -167,6 +168,30 @@ static void slivers(fr_builder *b, int n)
         }
 }
 
+/* Triangles halving in size toward one point (and one far off): boxes
+ * nested in one another, centroids bins cannot tell apart. */
+static void nested(fr_builder *b, int n)
+{
+    float s = 1.0f;
+    for (int i = 0; i < n; i++, s *= 0.5f) {
+        vec3 c = v3(0.3f + s, 0.1f, 0.2f + 0.5f * s);
+        tri(b, vert(b, c), vert(b, v3_add(c, v3(s, 0, 0))), vert(b, v3_add(c, v3(0, s, 0.1f * s))));
+    }
+    tri(b, vert(b, v3(-1, -1, 0)), vert(b, v3(-0.9f, -1, 0)), vert(b, v3(-1, -0.9f, 0)));
+}
+
+/* Long thin triangles at random places, all along one diagonal and
+ * crossing one another: the inner nodes' area, the usual stand-in for the
+ * SAH, is a poor guide to the collapsed tree's cost here. */
+static void crossing(fr_builder *b, int n)
+{
+    for (int i = 0; i < n; i++) {
+        float u = rnd_in(-1, 1), w = rnd_in(-1, 1);
+        tri(b, vert(b, v3(u, w, 0.0f)), vert(b, v3(u + 0.5f, w + 0.5f, 0.01f * rnd())),
+            vert(b, v3(u + 0.501f, w + 0.5f, 0.0f)));
+    }
+}
+
 /* ---- rays ---- */
 
 static fr_ray make_ray(const fr_scene *s, int kind)
@@ -306,13 +331,94 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
     scn_free(&s);
 }
 
+/* Depth of the wide tree under node v (1 for v alone). */
+static int wide_depth(const fr_bvh_node *nodes, uint32_t v)
+{
+    int d = 0;
+    for (int i = 0; i < FR_BVH_WIDTH; i++)
+        if (nodes[v].child[i] != FR_NONE && !nodes[v].leaf[i]) {
+            int e = wide_depth(nodes, nodes[v].child[i]);
+            d = e > d ? e : d;
+        }
+    return d + 1;
+}
+
+/* Reinsertion against the plain top-down tree on the same scene: never a
+ * higher SAH cost (the builder keeps a move only where its own cost of the
+ * tree falls; 1e-5 allows for the rounding of its float sums against
+ * bvh_sah_cost's), every primitive still in a leaf, within the depth; where
+ * the top-down split leaves much overlap (`gain`: the least relative drop
+ * expected) it must help.  And bvh_build's tree is the reinsertion's. */
+static void reinsertion(const char *name, int which, int n, double gain)
+{
+    fr_builder b[3];
+    uint64_t seed = rng_state;
+    fr_array nodes[3], leaves[3];
+    double cost[3];
+    for (int k = 0; k < 3; k++) {
+        rng_state = seed;
+        start(&b[k]);
+        switch (which) {
+        case 0: soup(&b[k], n, 0.05f); break;
+        case 1: grid(&b[k], n); break;
+        case 2: slivers(&b[k], n); break;
+        case 3: nested(&b[k], n); break;
+        case 4: crossing(&b[k], n); break;
+        default: slivers(&b[k], n); sheets(&b[k], 200); soup(&b[k], 300, 0.2f); break;
+        }
+        nodes[k] = (fr_array){NULL, 0, 0, sizeof(fr_bvh_node)};
+        leaves[k] = (fr_array){NULL, 0, 0, sizeof(fr_bvh_leaf)};
+        bvh_options opt = {k == 1};
+        fr_error err;
+        uint32_t *placed = NULL;
+        if (bvh_build_with(&b[k], k < 2 ? &opt : NULL, &nodes[k], &leaves[k], &placed, &err) < 0) {
+            CHECK(0, "%s: build %d failed: %s", name, k, err.msg);
+            return;
+        }
+        free(placed);
+        cost[k] = bvh_sah_cost(nodes[k].data, nodes[k].count);
+        uint32_t np = b[k].prims.count, seen = 0;
+        uint8_t *in = calloc(np, 1);
+        const fr_bvh_leaf *L = leaves[k].data;
+        for (uint32_t j = 0; j < leaves[k].count; j++)
+            for (int l = 0; l < 4; l++)
+                if (L[j].prim[l] != FR_NONE && L[j].prim[l] < np && !in[L[j].prim[l]]++)
+                    seen++;
+        free(in);
+        CHECK(seen == np, "%s (build %d): %u of %u primitives in leaves", name, k, seen, np);
+        int depth = wide_depth(nodes[k].data, 0);
+        CHECK(depth <= FR_BVH_MAX_DEPTH, "%s (build %d): depth %d", name, k, depth);
+    }
+    CHECK(cost[0] > 0.0 && cost[1] <= cost[0] * (1.0 + 1e-5), "%s: SAH cost %.6f with reinsertion, %.6f without", name, cost[1],
+          cost[0]);
+    if (gain > 0.0)
+        CHECK(cost[1] < cost[0] * (1.0 - gain), "%s: SAH cost %.6f with reinsertion, %.6f without: less than %.1f %% gained",
+              name, cost[1], cost[0], 100.0 * gain);
+    CHECK(nodes[1].count == nodes[2].count && leaves[1].count == leaves[2].count &&
+              !memcmp(nodes[1].data, nodes[2].data, nodes[1].count * sizeof(fr_bvh_node)) &&
+              !memcmp(leaves[1].data, leaves[2].data, leaves[1].count * sizeof(fr_bvh_leaf)),
+          "%s: bvh_build's tree is not the one with reinsertion", name);
+    for (int k = 0; k < 3; k++) {
+        free(nodes[k].data);
+        free(leaves[k].data);
+        bld_free(&b[k]);
+    }
+}
+
 int main(void)
 {
+    reinsertion("reinsertion, soup", 0, 3000, 0.0);
+    reinsertion("reinsertion, grid", 1, 60, 0.0);
+    reinsertion("reinsertion, slivers", 2, 4000, 0.03);
+    reinsertion("reinsertion, nested", 3, 120, 0.0);
+    reinsertion("reinsertion, crossing slivers", 4, 8000, 0.015);
+    reinsertion("reinsertion, slivers, sheets and soup", 5, 2000, 0.005);
+
     struct { const char *name; int n; int rays; } cases[] = {
         {"small soup", 1, 2000},     {"soup", 3000, 4000},    {"large triangles", 400, 3000},
         {"grid", 40, 4000},          {"sheets", 600, 4000},   {"degenerate", 300, 2000},
         {"copies", 200, 1000},       {"mixed", 800, 3000},    {"mixed soup", 1500, 3000},
-        {"slivers", 2000, 4000},     {"slivers and sheets", 600, 4000},
+        {"slivers", 2000, 4000},     {"slivers and sheets", 600, 4000}, {"nested", 120, 2000},
     };
     /* Every case through both traversals where there are two (the eight-lane
      * one on x86-64 with AVX2, the portable one everywhere). */
@@ -341,6 +447,7 @@ int main(void)
             case 7: others(&b[k], cases[cs].n); break;
             case 8: others(&b[k], 100); soup(&b[k], cases[cs].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
             case 9: slivers(&b[k], cases[cs].n); break;
+            case 11: nested(&b[k], cases[cs].n); soup(&b[k], 100, 0.1f); break;
             default: slivers(&b[k], cases[cs].n); sheets(&b[k], 200); copies(&b[k], 30); others(&b[k], 40); break;
             }
         }

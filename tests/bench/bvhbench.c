@@ -293,6 +293,8 @@ int main(int argc, char **argv)
     }
     printf("scene %s: %u triangles, %zu bytes (%.1f bytes/triangle), %u nodes, %u leaf blocks\n", path, m.n_tri,
            s.blob_size, (double)s.blob_size / m.n_tri, s.n_nodes, s.n_leaves);
+    printf("tree       SAH cost %.4f (node tests + slots / 2 + leaf blocks per ray through the root box)\n",
+           bvh_sah_cost(s.nodes, s.n_nodes));
 
     /* Build times. */
     double bf[64], be[64], bh[64];
