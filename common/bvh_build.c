@@ -1111,9 +1111,12 @@ static int emit_node(build *B, uint32_t v, uint32_t *index)
     for (int i = 0; i < FR_BVH_WIDTH; i++) {
         fr_bvh_node *nd = (fr_bvh_node *)B->nodes->data + me;
         box4 bx = i < ns ? B->bn[slot[i]].box : box_empty();
+        /* + 0 makes a zero bound +0: where -0 meets +0, SSE's and NEON's
+         * min and max return different zeros, and the bytes must not
+         * depend on the machine. */
         for (int a = 0; a < 3; a++) {
-            nd->box[a][i] = bx.lo[a];
-            nd->box[3 + a][i] = bx.hi[a];
+            nd->box[a][i] = bx.lo[a] + 0.0f;
+            nd->box[3 + a][i] = bx.hi[a] + 0.0f;
         }
         nd->child[i] = FR_NONE;
         nd->leaf[i] = 0;
