@@ -224,6 +224,23 @@ int file_out_write(file_out *o, const void *data, size_t n, fr_error *err)
     return 0;
 }
 
+int file_out_copy(file_out *o, const char *src, fr_error *err)
+{
+    int in = open(src, O_RDONLY | O_CLOEXEC);
+    if (in < 0)
+        return fr_fail(err, "%s: %s", src, strerror(errno));
+    char buf[1 << 16];
+    ssize_t n;
+    int rc = 0;
+    while (!rc && (n = read(in, buf, sizeof buf)) != 0)
+        if (n < 0)
+            rc = errno == EINTR ? 0 : fr_fail(err, "%s: %s", src, strerror(errno));
+        else
+            rc = file_out_write(o, buf, (size_t)n, err);
+    close(in);
+    return rc;
+}
+
 int file_out_commit(file_out *o, const char *path, fr_error *err)
 {
     int rc = 0;

@@ -79,6 +79,11 @@ int file_out_in_place(const char *path);
  * retried).  On failure the caller still calls file_out_abort. */
 int file_out_write(file_out *o, const void *data, size_t n, fr_error *err);
 
+/** Appends every byte of the file src to the output (read errors: "SRC:
+ * <system error>"; write errors as file_out_write's).  On failure the
+ * caller still calls file_out_abort. */
+int file_out_copy(file_out *o, const char *src, fr_error *err);
+
 /** Puts the file in place: fsync, close and rename over path, each
  * checked.  On failure the temporary file is removed and path untouched.
  * A direct target is only closed. */

@@ -142,34 +142,13 @@ int compile_child_sweep(const char *out)
  * replaced. */
 static int copy_into(const char *file, const char *out, fr_error *err)
 {
-    int in = open(file, O_RDONLY | O_CLOEXEC);
-    if (in < 0)
-        return fr_fail(err, "%s: %s", file, strerror(errno));
     file_out o;
-    if (file_out_open(out, &o, err)) {
-        close(in);
+    if (file_out_open(out, &o, err))
+        return -1;
+    if (file_out_copy(&o, file, err)) {
+        file_out_abort(&o);
         return -1;
     }
-    static char buf[1 << 16];
-    for (;;) {
-        ssize_t k = read(in, buf, sizeof buf);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k < 0) {
-            int e = errno;
-            close(in);
-            file_out_abort(&o);
-            return fr_fail(err, "%s: read error: %s", file, strerror(e));
-        }
-        if (k == 0)
-            break;
-        if (file_out_write(&o, buf, (size_t)k, err)) {
-            close(in);
-            file_out_abort(&o);
-            return -1;
-        }
-    }
-    close(in);
     return file_out_commit(&o, out, err);
 }
 

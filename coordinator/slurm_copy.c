@@ -67,25 +67,12 @@ static int copy_local(const char *src, const char *dst, int mode, fr_error *err)
         }
     if (mkdir(dir, 0755) && errno != EEXIST)
         return fr_fail(err, "%s: %s", dir, strerror(errno));
-    int in = open(src, O_RDONLY | O_CLOEXEC);
-    if (in < 0)
-        return fr_fail(err, "%s: %s", src, strerror(errno));
     file_out out;
-    if (file_out_open(dst, &out, err)) {
-        close(in);
+    if (file_out_open(dst, &out, err))
         return -1;
-    }
-    char buf[1 << 16];
-    ssize_t n;
-    int rc = 0;
-    while (!rc && (n = read(in, buf, sizeof buf)) != 0)
-        if (n < 0)
-            rc = errno == EINTR ? 0 : fr_fail(err, "%s: %s", src, strerror(errno));
-        else
-            rc = file_out_write(&out, buf, (size_t)n, err);
+    int rc = file_out_copy(&out, src, err);
     if (!rc && fchmod(out.fd, (mode_t)mode))
         rc = fr_fail(err, "%s: %s", out.tmp, strerror(errno));
-    close(in);
     if (rc) {
         file_out_abort(&out);
         return -1;
