@@ -1,5 +1,5 @@
 /* cmd_frames.c -- `franja render PATTERN --frames LIST`: the walk over
- * the frames (outputs that exist skipped), and the frame-by-frame run. */
+ * the frames (outputs that exist skipped). */
 #include "cmd_frames.h"
 
 #include <errno.h>
@@ -136,6 +136,8 @@ int frames_next(frames_iter *it, frames_one *one)
             fprintf(stderr, "franja: frame %u (%zu of %zu): %s exists, skipped (--overwrite renders it again)\n",
                     f, k, it->fl.n, one->out);
             it->skipped++;
+            if (it->on_skip)
+                it->on_skip(it->skip_ctx, it->i, f, one->out);
             frames_put(one);
             continue;
         }
@@ -169,6 +171,9 @@ void frames_failed(frames_iter *it, uint32_t number, const char *scene, const ch
     if (rc == 130)
         fprintf(stderr, "franja: interrupted at frame %u (%s): %zu of %zu frames done; rerun with --resume "
                 "to go on\n", number, out, it->rendered + it->skipped, it->fl.n);
+    else if (rc == FRAMES_TIME_LIMIT)
+        fprintf(stderr, "franja: the time limit stopped the animation at frame %u (%s): %zu of %zu frames done; "
+                "rerun with --resume to go on\n", number, out, it->rendered + it->skipped, it->fl.n);
     else
         fprintf(stderr, "franja render: frame %u (%s -> %s) failed; %zu of %zu frames done\n", number, scene, out,
                 it->rendered + it->skipped, it->fl.n);
@@ -183,24 +188,3 @@ int frames_end(frames_iter *it, int rc)
     return rc;
 }
 
-int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn)
-{
-    frames_iter it;
-    if (frames_begin(&it, argc, argv, job))
-        return 2;
-    int rc = 0, r;
-    frames_one one;
-    while (!rc && (r = frames_next(&it, &one)) != 1) {
-        if (r) {
-            rc = r - 1;
-            break;
-        }
-        rc = fn(one.argc, one.argv);
-        frames_put(&one);
-        if (!rc)
-            frames_wrote(&it);
-        else
-            frames_failed(&it, one.number, one.scene, one.out, rc);
-    }
-    return frames_end(&it, rc);
-}

@@ -5,10 +5,9 @@
  * and the directories of a frame's output are made when missing.
  *
  * frames_begin / frames_next / frames_end walk the list for a render that
- * runs the frames together over one set of hosts (render_anim.h);
- * frames_run renders them one after another through the single-image
- * render.  Both print the same lines: each frame announced or skipped, a
- * frame that fails or is interrupted named, and a summary.
+ * runs the frames together over one set of hosts (render_anim.h), saying
+ * each frame announced or skipped, a frame that fails, is interrupted or
+ * is stopped by the time limit named, and a summary.
  */
 #ifndef FRANJA_CMD_FRAMES_H
 #define FRANJA_CMD_FRAMES_H
@@ -17,10 +16,6 @@
 #include <stdint.h>
 
 #include "frames.h"
-
-/** Renders one image: `franja render` with argv as given (argv[0] is the
- * command's name); returns its exit status. */
-typedef int (*frames_render_fn)(int argc, char **argv);
 
 /** What render's command line said about frames.  scene, out, jobdir and
  * preview point into argv's strings (jobdir and preview may be NULL):
@@ -32,6 +27,11 @@ typedef struct {
     const char *scene, *out, *jobdir, *preview;
 } frames_job;
 
+/** The exit status of an animation that --time-limit stopped before
+ * every frame was written (the frames in flight keep their finished slabs
+ * for --resume); the status timeout(1) uses. */
+#define FRAMES_TIME_LIMIT 124
+
 /** A walk over the frames (fields private but for the counts). */
 typedef struct {
     frames_job job;
@@ -41,6 +41,10 @@ typedef struct {
     size_t i;                  /**< frames of the list looked at */
     size_t rendered, skipped;  /**< frames written by this run, frames skipped (output exists) */
     double t0;
+    /** Told of each frame skipped (index: its place in the list, from 0);
+     * NULL: nobody.  Set after frames_begin. */
+    void (*on_skip)(void *ctx, size_t index, uint32_t number, const char *out);
+    void *skip_ctx;
 } frames_iter;
 
 /** One frame to render. */
@@ -68,18 +72,13 @@ void frames_put(frames_one *one);
 /** One frame written (counts it). */
 void frames_wrote(frames_iter *it);
 
-/** A frame failed with exit status rc (130: interrupted): prints which and
- * how many frames are done. */
+/** A frame failed with exit status rc (130: interrupted; FRAMES_TIME_LIMIT:
+ * stopped by the time limit): prints which and how many frames are
+ * done. */
 void frames_failed(frames_iter *it, uint32_t number, const char *scene, const char *out, int rc);
 
 /** Ends the walk: with rc 0 prints the summary; frees the list; returns rc. */
 int frames_end(frames_iter *it, int rc);
-
-/** The whole animation frame by frame with fn; stops at the first frame
- * that fails and returns its status (1 failure, 2 usage error, 130
- * interrupted: the finished slabs of that frame stay for --resume); 0
- * when every frame's output exists; 2 for a bad list or pattern. */
-int frames_run(int argc, char **argv, const frames_job *job, frames_render_fn fn);
 
 /** For a render without --frames: 0, or, when scene is a '#' pattern that
  * names no file, prints that --frames is needed and returns 2. */

@@ -68,7 +68,9 @@ static const char usage[] =
     "  --time-limit T       render in passes over the whole image, each doubling\n"
     "                       the samples per pixel (1, 2, 4 ... up to --spp), and\n"
     "                       stop at T (90s, 10m, 1.5h; from the start of the\n"
-    "                       command), writing the last complete pass\n"
+    "                       command), writing the last complete pass; for an\n"
+    "                       animation, the run stops at T, the frames in flight\n"
+    "                       left for --resume (exit status 124)\n"
     "  --resume             keep the finished slabs of an interrupted render; with\n"
     "                       a larger --spp, add samples to a job kept by --keep-job\n"
     "  --fresh              discard the finished slabs of an earlier render\n"
@@ -81,10 +83,13 @@ static const char usage[] =
     "  --retries N          attempts per slab before giving up (default 5)\n"
     "  --preview FILE       write the image so far to FILE (any output type) while\n"
     "                       rendering, rows not yet done as a grey checkerboard\n"
+    "                       (an animation: each frame's FILE, or the newest\n"
+    "                       frame's when FILE has no #)\n"
     "  --preview-every S    seconds between preview images (default 5)\n"
     "  --progress MODE      auto (a live line on a terminal, else plain lines) or\n"
     "                       json (also one JSON object a line on stdout, for\n"
-    "                       wrapper tools) (default auto)\n"
+    "                       wrapper tools; a frame's events carry \"frame\")\n"
+    "                       (default auto)\n"
     "  --monitor PORT       serve a live page of the render (image so far, hosts,\n"
     "                       ETA) on http://127.0.0.1:PORT/ (0: a free port, said\n"
     "                       on stderr); from another machine: ssh -L\n"
@@ -340,11 +345,8 @@ int cmd_render(int argc, char **argv)
     if (!im)
         return status;
     render_args *a = &im->a;
-    static int in_frames; /* rendering one frame of --frames frame by frame */
-    if (a->frames && !in_frames) {
-        in_frames = 1;
+    if (a->frames) {
         int rc = ra_render(argc, argv, a, image_parse);
-        in_frames = 0;
         free(im);
         return rc;
     }
@@ -380,7 +382,7 @@ int cmd_render(int argc, char **argv)
     if (rc)
         goto done;
     rc = 1;
-    if (a->json && !(im->pg = pg_start(stdout, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job, &err))) {
+    if (a->json && !(im->pg = pg_start(stdout, PG_NO_FRAME, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job, &err))) {
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         goto done;
     }

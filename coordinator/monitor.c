@@ -18,7 +18,7 @@
 #include "output.h"
 #include "preview.h"
 
-enum { MON_EVENTS = 50, MON_CONNECTIONS = 16, MON_IDLE_S = 10 };
+enum { MON_EVENTS = 50, MON_CONNECTIONS = 16, MON_IDLE_S = 10, MON_CURRENT = 64 };
 
 typedef struct {
     char name[64];
@@ -34,13 +34,30 @@ typedef struct {
     char text[300];
 } event_copy;
 
+/* A frame of an animation rendering now. */
+typedef struct {
+    size_t index;
+    uint32_t number;
+    char output[256];
+    int rows_done, rows;
+} frame_copy;
+
 struct mon_server {
     struct MHD_Daemon *daemon;
     uint16_t port;
-    char *output, *dir;
+    char *output;
+    pthread_mutex_t lock;      /* everything below */
+    char *dir;                 /* the image's job directory; NULL: no image yet */
     job_spec spec;
     fr_tonemap tm;
-    pthread_mutex_t lock;      /* everything below */
+    /* An animation: NULL states for a single image. */
+    char *list;
+    char *states;              /* one letter a frame, count of them, terminated */
+    size_t count;
+    frame_copy cur[MON_CURRENT];
+    int ncur;
+    long shown;                /* the frame whose image is served; -1: none */
+    int last_rows;             /* rows of the frame opened last */
     double t;
     int done, total, before;
     host_copy *hosts;
@@ -117,6 +134,111 @@ void mon_status(mon_server *m, const char *status)
 
 uint16_t mon_port(const mon_server *m) { return m->port; }
 
+void mon_frame(mon_server *m, size_t index, uint32_t number, char state, const char *output, int rows_done,
+               int rows)
+{
+    if (!m || !m->states || index >= m->count)
+        return;
+    pthread_mutex_lock(&m->lock);
+    m->states[index] = state;
+    int k = 0;
+    while (k < m->ncur && m->cur[k].index != index)
+        k++;
+    if (state == 'r') {
+        if (k == m->ncur && m->ncur < MON_CURRENT)
+            m->ncur++;
+        if (k < m->ncur) {
+            frame_copy *c = &m->cur[k];
+            c->index = index;
+            c->number = number;
+            copy_str(c->output, sizeof c->output, output);
+            c->rows_done = rows_done;
+            c->rows = rows;
+            m->last_rows = rows;
+        }
+    } else if (k < m->ncur) {
+        memmove(&m->cur[k], &m->cur[k + 1], (size_t)(m->ncur - k - 1) * sizeof *m->cur);
+        m->ncur--;
+    }
+    pthread_mutex_unlock(&m->lock);
+}
+
+int mon_show(mon_server *m, uint32_t number, const char *dir, const job_spec *spec, const fr_tonemap *tm,
+             fr_error *err)
+{
+    if (!m)
+        return 0;
+    char *d = strdup(dir);
+    float *rgb = malloc((size_t)spec->width * spec->height * 3 * sizeof *rgb);
+    unsigned char *have = malloc(spec->height);
+    if (!d || !rgb || !have) {
+        free(d);
+        free(rgb);
+        free(have);
+        return fr_fail(err, "out of memory for a %ux%u monitor image", spec->width, spec->height);
+    }
+    pthread_mutex_lock(&m->lock);
+    free(m->dir);
+    free(m->rgb);
+    free(m->have);
+    m->dir = d;
+    m->rgb = rgb;
+    m->have = have;
+    m->spec = *spec;
+    m->tm = *tm;
+    m->shown = number;
+    m->png_rows = -1; /* the next request reads the new frame's rows */
+    m->png_at = 0;
+    pthread_mutex_unlock(&m->lock);
+    return 0;
+}
+
+/* An animation's part of state.json, and its ETA, under lock. */
+static void frames_json(const mon_server *m, cJSON *o, double rate)
+{
+    cJSON *f = cJSON_AddObjectToObject(o, "frames");
+    if (!f)
+        return;
+    cJSON_AddStringToObject(f, "list", m->list);
+    cJSON_AddNumberToObject(f, "count", (double)m->count);
+    cJSON_AddStringToObject(f, "states", m->states);
+    static const char letters[] = "wrdsfx";
+    static const char *const names[] = {"waiting", "rendering", "done", "skipped", "failed", "stopped"};
+    size_t n[6] = {0};
+    for (size_t i = 0; i < m->count; i++) {
+        const char *at = strchr(letters, m->states[i]);
+        if (at)
+            n[at - letters]++;
+    }
+    for (int k = 0; k < 6; k++)
+        cJSON_AddNumberToObject(f, names[k], (double)n[k]);
+    cJSON *cur = cJSON_AddArrayToObject(f, "current");
+    double left = (double)n[0] * m->last_rows;
+    for (int i = 0; cur && i < m->ncur; i++) {
+        const frame_copy *c = &m->cur[i];
+        cJSON *j = cJSON_CreateObject();
+        if (!j)
+            break;
+        cJSON_AddNumberToObject(j, "frame", c->number);
+        cJSON_AddStringToObject(j, "output", c->output);
+        cJSON_AddNumberToObject(j, "rows_done", c->rows_done);
+        cJSON_AddNumberToObject(j, "rows", c->rows);
+        cJSON_AddItemToArray(cur, j);
+        left += c->rows > c->rows_done ? c->rows - c->rows_done : 0;
+    }
+    if (m->shown >= 0)
+        cJSON_AddNumberToObject(f, "shown", (double)m->shown);
+    else
+        cJSON_AddNullToObject(f, "shown");
+    cJSON_DeleteItemFromObject(o, "eta_s");
+    if (left <= 0 && n[0] == 0 && n[1] == 0)
+        cJSON_AddNumberToObject(o, "eta_s", 0);
+    else if (rate > 0)
+        cJSON_AddNumberToObject(o, "eta_s", left / rate);
+    else
+        cJSON_AddNullToObject(o, "eta_s");
+}
+
 /* /state.json, under lock.  NULL when out of memory. */
 static char *state_json(mon_server *m)
 {
@@ -168,6 +290,8 @@ static char *state_json(mon_server *m)
         cJSON_AddStringToObject(j, "text", e->text);
         cJSON_AddItemToArray(es, j);
     }
+    if (m->states)
+        frames_json(m, o, rate);
     char *s = cJSON_PrintUnformatted(o);
     cJSON_Delete(o);
     return s;
@@ -177,6 +301,8 @@ static char *state_json(mon_server *m)
  * when the job directory's rows changed), under lock. */
 static void refresh_image(mon_server *m)
 {
+    if (!m->dir)
+        return;
     int rows = job_rows_present(m->dir);
     double now = clk_now();
     if (m->png && (rows == m->png_rows || now - m->png_at < 1.0))
@@ -270,6 +396,8 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *u
 static void release(mon_server *m)
 {
     free(m->output);
+    free(m->list);
+    free(m->states);
     free(m->dir);
     free(m->hosts);
     free(m->png);
@@ -278,26 +406,16 @@ static void release(mon_server *m)
     free(m);
 }
 
-mon_server *mon_start(uint16_t port, const char *output, const char *dir, const job_spec *spec, const fr_tonemap *tm,
-                      fr_error *err)
+/* A server for output, no image yet (mon_show gives it one). */
+static mon_server *start(uint16_t port, const char *output, fr_error *err)
 {
     mon_server *m = calloc(1, sizeof *m);
-    if (!m) {
+    if (!m || !(m->output = strdup(output))) {
+        free(m);
         fr_fail(err, "out of memory");
         return NULL;
     }
-    m->output = strdup(output);
-    m->dir = strdup(dir);
-    m->rgb = malloc((size_t)spec->width * spec->height * 3 * sizeof *m->rgb);
-    m->have = malloc(spec->height);
-    if (!m->output || !m->dir || !m->rgb || !m->have) {
-        release(m);
-        fr_fail(err, "out of memory for a %ux%u monitor image", spec->width, spec->height);
-        return NULL;
-    }
-    m->spec = *spec;
-    m->tm = *tm;
-    m->total = (int)spec->height;
+    m->shown = -1;
     copy_str(m->status, sizeof m->status, "starting");
     /* The listening socket is made here, so that a port in use is said as such. */
     int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -329,6 +447,48 @@ mon_server *mon_start(uint16_t port, const char *output, const char *dir, const 
         fr_fail(err, "cannot start the web server on 127.0.0.1:%u", port);
         return NULL;
     }
+    return m;
+}
+
+mon_server *mon_start(uint16_t port, const char *output, const char *dir, const job_spec *spec, const fr_tonemap *tm,
+                      fr_error *err)
+{
+    mon_server *m = start(port, output, err);
+    if (m && mon_show(m, 0, dir, spec, tm, err)) {
+        mon_stop(m);
+        return NULL;
+    }
+    if (m) {
+        pthread_mutex_lock(&m->lock);
+        m->shown = -1; /* a single image: no frame */
+        m->total = (int)spec->height;
+        pthread_mutex_unlock(&m->lock);
+    }
+    return m;
+}
+
+mon_server *mon_start_frames(uint16_t port, const char *output, const char *list, size_t n, fr_error *err)
+{
+    char *states = malloc(n + 1), *l = strdup(list);
+    if (!states || !l) {
+        free(states);
+        free(l);
+        fr_fail(err, "out of memory");
+        return NULL;
+    }
+    memset(states, 'w', n);
+    states[n] = '\0';
+    mon_server *m = start(port, output, err);
+    if (!m) {
+        free(states);
+        free(l);
+        return NULL;
+    }
+    pthread_mutex_lock(&m->lock);
+    m->states = states;
+    m->list = l;
+    m->count = n;
+    pthread_mutex_unlock(&m->lock);
     return m;
 }
 

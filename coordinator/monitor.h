@@ -4,9 +4,23 @@
  *
  *     /              the page (HTML, its script polls the two below)
  *     /state.json    the render now: rows, elapsed time, ETA, each host's
- *                    state, slots, rows, rows/s and failures, the last events
+ *                    state, slots, rows, rows/s and failures, the last events;
+ *                    for an animation its frames too (below)
  *     /image.png     the image so far (preview.h: rows not rendered yet as a
- *                    checkerboard), tone-mapped like an LDR output
+ *                    checkerboard), tone-mapped like an LDR output; for an
+ *                    animation, that of the frame shown (mon_show)
+ *
+ * An animation's monitor (mon_start_frames) knows each frame of the list
+ * by its place in it: waiting, rendering (with its rows), written, skipped
+ * (its output existed), failed or stopped (interrupted or stopped by the
+ * time limit, its finished slabs kept).  state.json then has "frames":
+ * {"list", "count", "states" (a letter a frame in list order: w r d s f x),
+ * "waiting", "rendering", "done", "skipped", "failed", "stopped" (counts),
+ * "current" (the frames rendering: frame, output, rows_done, rows),
+ * "shown" (the frame whose image is served, null before one)}, and its
+ * eta_s is the animation's: the rows left of the frames rendering, and of
+ * each frame waiting as many as the last frame opened has, at the rate of
+ * the rows done so far.
  *
  * Only GET and HEAD are answered, only for a Host header naming this
  * machine (localhost, 127.0.0.1, [::1], any port: a page of another site
@@ -42,6 +56,24 @@ typedef struct {
  * privileged) or the server cannot start. */
 mon_server *mon_start(uint16_t port, const char *output, const char *dir, const job_spec *spec, const fr_tonemap *tm,
                       fr_error *err);
+
+/** Starts serving an animation on 127.0.0.1:port: output is the output
+ * pattern, list the --frames value, n the frames in it (each waiting);
+ * there is no image until mon_show.  As mon_start otherwise. */
+mon_server *mon_start_frames(uint16_t port, const char *output, const char *list, size_t n, fr_error *err);
+
+/** A frame's state: index is its place in the list (from 0; others are
+ * ignored), state one of 'w' waiting, 'r' rendering, 'd' written, 's'
+ * skipped, 'f' failed, 'x' stopped; for 'r', rows_done of rows are done
+ * and output is its file.  Copies everything; any thread. */
+void mon_frame(mon_server *m, size_t index, uint32_t number, char state, const char *output, int rows_done,
+               int rows);
+
+/** Serves the image of frame number (a frame rendering) from its job
+ * directory dir from now on.  Strings are copied.  -1 with err when out
+ * of memory (the image before stays). */
+int mon_show(mon_server *m, uint32_t number, const char *dir, const job_spec *spec, const fr_tonemap *tm,
+             fr_error *err);
 
 /** The port the monitor listens on. */
 uint16_t mon_port(const mon_server *m);

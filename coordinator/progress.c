@@ -11,7 +11,8 @@
 
 struct pg_reporter {
     FILE *out;
-    char *dir;
+    long frame;                /* the frame every event carries; PG_NO_FRAME: none */
+    char *dir;                 /* NULL: an animation's own reporter (no thread) */
     job_spec spec;
     uint32_t total;            /* rows the render needs */
     double t0;
@@ -39,6 +40,14 @@ void pg_json_string(FILE *out, const char *s)
     fputc('"', out);
 }
 
+/* Starts an event's object: its name, then the frame when it has one. */
+static void begin(FILE *out, const char *event, long frame)
+{
+    fprintf(out, "{\"event\":\"%s\"", event);
+    if (frame != PG_NO_FRAME)
+        fprintf(out, ",\"frame\":%ld", frame);
+}
+
 /* Prints a progress event if the count of finished rows changed. */
 static void poll_once(pg_reporter *r)
 {
@@ -55,9 +64,9 @@ static void poll_once(pg_reporter *r)
     double t = clk_now() - r->t0;
     double tp = clk_now() - r->tp;
     double rate = tp > 0 ? (rows - r->rows0) / tp : 0;
-    fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
-                    "\"eta_s\":",
-            rows, r->total, t, rate);
+    begin(r->out, "progress", r->frame);
+    fprintf(r->out, ",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,\"eta_s\":", rows,
+            r->total, t, rate);
     if (rate > 0)
         fprintf(r->out, "%.1f}\n", rows < (int)r->total ? (r->total - (uint32_t)rows) / rate : 0.0);
     else
@@ -66,12 +75,14 @@ static void poll_once(pg_reporter *r)
     funlockfile(r->out);
 }
 
-void pg_event(pg_reporter *r, const char *what, const char *host, uint32_t y0, uint32_t y1, const char *text)
+void pg_event(pg_reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
+              const char *text)
 {
     if (!r)
         return;
     flockfile(r->out);
-    fputs("{\"event\":\"host\",\"what\":", r->out);
+    begin(r->out, "host", frame);
+    fputs(",\"what\":", r->out);
     pg_json_string(r->out, what);
     fputs(",\"host\":", r->out);
     pg_json_string(r->out, host);
@@ -107,8 +118,8 @@ static void *run(void *arg)
     return NULL;
 }
 
-pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_spec *spec, uint32_t rows,
-                      fr_error *err)
+pg_reporter *pg_start(FILE *out, long frame, const char *output, const char *dir, const job_spec *spec,
+                      uint32_t rows, fr_error *err)
 {
     pg_reporter *r = calloc(1, sizeof *r);
     if (!r || !(r->dir = strdup(dir))) {
@@ -117,16 +128,20 @@ pg_reporter *pg_start(FILE *out, const char *output, const char *dir, const job_
         return NULL;
     }
     r->out = out;
+    r->frame = frame;
     r->spec = *spec;
     r->total = rows;
     r->t0 = r->tp = clk_now();
     r->spp = spec->spp;
     r->rows0 = r->rows = job_rows_at(dir, spec->spp);
-    fputs("{\"event\":\"start\",\"output\":", out);
+    flockfile(out);
+    begin(out, "start", frame);
+    fputs(",\"output\":", out);
     pg_json_string(out, output);
     fprintf(out, ",\"width\":%u,\"height\":%u,\"spp\":%u,\"rows\":%u,\"rows_done\":%d,\"time\":%lld}\n",
             spec->width, spec->height, spec->spp, rows, r->rows0, (long long)time(NULL));
     fflush(out);
+    funlockfile(out);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
@@ -156,8 +171,8 @@ void pg_pass(pg_reporter *r, int k, uint32_t spp)
     pthread_mutex_unlock(&r->lock);
     r->tp = clk_now();
     r->rows0 = r->rows = rows;
-    fprintf(r->out, "{\"event\":\"pass\",\"pass\":%d,\"spp\":%u,\"rows_done\":%d,\"elapsed_s\":%.3f}\n", k, spp, rows,
-            clk_now() - r->t0);
+    begin(r->out, "pass", r->frame);
+    fprintf(r->out, ",\"pass\":%d,\"spp\":%u,\"rows_done\":%d,\"elapsed_s\":%.3f}\n", k, spp, rows, clk_now() - r->t0);
     fflush(r->out);
     funlockfile(r->out);
 }
@@ -171,21 +186,69 @@ void pg_stop(pg_reporter *r, const char *status, uint32_t spp)
     pthread_cond_signal(&r->wake);
     pthread_mutex_unlock(&r->lock);
     pthread_join(r->thread, NULL);
+    flockfile(r->out);
     if (!strcmp(status, "ok") && r->rows != (int)r->total) {
         /* Every row is in the image now, whatever the directory shows. */
         double t = clk_now() - r->t0;
-        fprintf(r->out, "{\"event\":\"progress\",\"rows_done\":%u,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,"
-                        "\"eta_s\":0}\n",
-                r->total, r->total, t, clk_now() > r->tp ? (r->total - (uint32_t)r->rows0) / (clk_now() - r->tp) : 0.0);
+        begin(r->out, "progress", r->frame);
+        fprintf(r->out, ",\"rows_done\":%u,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,\"eta_s\":0}\n", r->total,
+                r->total, t, clk_now() > r->tp ? (r->total - (uint32_t)r->rows0) / (clk_now() - r->tp) : 0.0);
         r->rows = (int)r->total;
     } else if (strcmp(status, "ok")) {
         poll_once(r);
     }
-    fprintf(r->out, "{\"event\":\"done\",\"status\":\"%s\",\"spp\":%u,\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n",
-            status, spp, r->rows, r->total, clk_now() - r->t0);
+    begin(r->out, "done", r->frame);
+    fprintf(r->out, ",\"status\":\"%s\",\"spp\":%u,\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n", status, spp,
+            r->rows, r->total, clk_now() - r->t0);
     fflush(r->out);
+    funlockfile(r->out);
     pthread_cond_destroy(&r->wake);
     pthread_mutex_destroy(&r->lock);
     free(r->dir);
+    free(r);
+}
+
+pg_reporter *pg_run_start(FILE *out, const char *list, size_t n, fr_error *err)
+{
+    pg_reporter *r = calloc(1, sizeof *r);
+    if (!r) {
+        fr_fail(err, "out of memory");
+        return NULL;
+    }
+    r->out = out;
+    r->frame = PG_NO_FRAME;
+    r->t0 = r->tp = clk_now();
+    flockfile(out);
+    fputs("{\"event\":\"frames\",\"list\":", out);
+    pg_json_string(out, list);
+    fprintf(out, ",\"frames\":%zu,\"time\":%lld}\n", n, (long long)time(NULL));
+    fflush(out);
+    funlockfile(out);
+    return r;
+}
+
+void pg_skipped(pg_reporter *r, long frame, const char *output)
+{
+    if (!r)
+        return;
+    flockfile(r->out);
+    begin(r->out, "skipped", frame);
+    fputs(",\"output\":", r->out);
+    pg_json_string(r->out, output);
+    fputs("}\n", r->out);
+    fflush(r->out);
+    funlockfile(r->out);
+}
+
+void pg_run_end(pg_reporter *r, const char *status, size_t n, size_t rendered, size_t skipped)
+{
+    if (!r)
+        return;
+    flockfile(r->out);
+    fprintf(r->out, "{\"event\":\"frames_done\",\"status\":\"%s\",\"frames\":%zu,\"rendered\":%zu,\"skipped\":%zu,"
+                    "\"elapsed_s\":%.3f}\n",
+            status, n, rendered, skipped, clk_now() - r->t0);
+    fflush(r->out);
+    funlockfile(r->out);
     free(r);
 }

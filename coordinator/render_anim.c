@@ -11,6 +11,7 @@
 #include "cluster.h"
 #include "cmd.h"
 #include "cmd_frames.h"
+#include "preview.h"
 #include "quick.h"
 #include "render_run.h"
 
@@ -22,16 +23,79 @@ typedef struct {
     int failed;                /* the exit status it failed with (said when the run ends); 0 = none */
     char label[32];            /* "frame N" */
     unsigned char *rendered_on; /* per host: it rendered rows of this frame */
+    pv_writer *pv;             /* its --preview writer, or NULL */
+    int rows_done;             /* rows in its job directory (for the monitor) */
 } frame_slot;
 
 typedef struct {
     frames_iter it;
     ra_parse_fn parse;         /* a frame's command line */
+    const render_args *a;      /* the command's own */
     const hosts_table *table;
     frame_slot **fr;           /* by the scheduler's frame index */
     int nfr, capfr;
     int failed;                /* a frame failed: no frame is opened after it */
+    double deadline;           /* --time-limit: clk_now() time the run stops at; 0 = none */
+    pg_reporter *pg;           /* the run's --progress json, or NULL */
+    mon_server *mon;           /* the run's --monitor, or NULL */
 } anim_run;
+
+/* The monitor's view of frame fs in state st. */
+static void show_state(anim_run *fx, const frame_slot *fs, char st)
+{
+    int rows = fs->im ? fs->im->rows_job : 0;
+    mon_frame(fx->mon, fs->one.index - 1, fs->one.number, st, fs->one.out, fs->rows_done, rows);
+}
+
+/* A frame whose output exists is passed over: said to the reporters. */
+static void on_skip(void *ctx, size_t index, uint32_t number, const char *out)
+{
+    anim_run *fx = ctx;
+    pg_skipped(fx->pg, number, out);
+    mon_frame(fx->mon, index, number, 's', out, 0, 0);
+}
+
+/* Stops the preview writers of frames before fs that write fs's file (a
+ * --preview without #: the file follows the newest frame). */
+static void preview_take_over(anim_run *fx, const frame_slot *fs)
+{
+    for (int i = 0; i < fx->nfr; i++) {
+        frame_slot *o = fx->fr[i];
+        if (o != fs && o->pv && o->im && !strcmp(o->im->a.preview, fs->im->a.preview)) {
+            pv_stop(o->pv);
+            o->pv = NULL;
+        }
+    }
+}
+
+/* A frame's reporters, once it is open: its --progress json events, the
+ * monitor's image and its --preview.  0, or the exit status (said). */
+static int frame_reporters(anim_run *fx, frame_slot *fs)
+{
+    frame_image *im = fs->im;
+    render_args *a = &im->a;
+    fr_error err;
+    fs->rows_done = im->rows_have;
+    if (fx->pg && !(im->pg = pg_start(stdout, fs->one.number, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job,
+                                      &err))) {
+        fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
+        return 1;
+    }
+    if (fx->mon) {
+        show_state(fx, fs, 'r');
+        if (mon_show(fx->mon, fs->one.number, im->jobdir, &im->spec, &im->tm, &err))
+            fprintf(stderr, "franja render: --monitor: %s: %s\n", fs->label, err.msg);
+    }
+    if (a->preview) {
+        preview_take_over(fx, fs);
+        if (!(fs->pv = pv_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,
+                                (note_sink){cli_note_stderr, NULL}, &err))) {
+            fprintf(stderr, "franja render: --preview: %s\n", err.msg);
+            return 1;
+        }
+    }
+    return 0;
+}
 
 /* The next frame to render, locked, compiled and its job directory open:
  * 0 with *next (frame index fx->nfr - 1); 1 when no frame is left; -1
@@ -71,19 +135,28 @@ static int rf_open(anim_run *fx, sched_frame *next)
     fs->im = fs->rendered_on ? fx->parse(fs->one.argc, fs->one.argv, &status) : NULL;
     int rc = fs->im ? 0 : status ? status : 2;
     fr_error e;
-    if (!rc && out_check(fs->im->a.out, &e)) {
+    if (!rc && (out_check(fs->im->a.out, &e) || (fs->im->a.preview && out_check_type(fs->im->a.preview, &e)))) {
         fprintf(stderr, "franja render: %s\n", e.msg);
         rc = 2;
     }
-    if (!rc)
+    if (!rc) {
+        /* The run's limit (fx->deadline), not passes of each frame. */
+        fs->im->a.time_limit = 0;
         rc = frame_lock(fs->im);
+    }
     if (!rc)
         rc = frame_open(fs->im);
+    if (!rc)
+        rc = frame_reporters(fx, fs);
     if (rc) {
-        if (fs->im)
+        if (fs->im) {
+            pv_stop(fs->pv);
+            fs->pv = NULL;
             frame_close(fs->im, rc);
+        }
         fs->im = NULL;
         fs->failed = fx->failed = rr_stop ? 130 : rc;
+        show_state(fx, fs, rr_stop ? 'x' : 'f');
         return -1;
     }
     frame_image *im = fs->im;
@@ -97,9 +170,10 @@ static int rf_open(anim_run *fx, sched_frame *next)
  * that frame's failure. */
 static int rf_next(void *ctx, int frame, sched_frame *next, fr_error *err)
 {
+    anim_run *fx = ctx;
     (void)frame, (void)err; /* frames are opened in the scheduler's order: frame == fx->nfr */
-    if (rr_stop)
-        return 1; /* no new frame once interrupted */
+    if (rr_stop || (fx->deadline > 0 && clk_now() >= fx->deadline))
+        return 1; /* no new frame once interrupted or at the time limit */
     rr_clear_line();
     return rf_open(ctx, next) ? 1 : 0;
 }
@@ -123,11 +197,23 @@ static int rf_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene
     return 0;
 }
 
-static void rf_rendered(void *ctx, int frame, int host)
+static void rf_rendered(void *ctx, int frame, int host, uint32_t y0, uint32_t y1)
 {
     anim_run *fx = ctx;
-    if (frame >= 0 && frame < fx->nfr && host >= 0 && host < fx->table->n && fx->fr[frame]->rendered_on)
-        fx->fr[frame]->rendered_on[host] = 1;
+    if (frame < 0 || frame >= fx->nfr)
+        return;
+    frame_slot *fs = fx->fr[frame];
+    if (host >= 0 && host < fx->table->n && fs->rendered_on)
+        fs->rendered_on[host] = 1;
+    fs->rows_done += (int)(y1 - y0);
+    if (fs->im && !fs->written)
+        show_state(fx, fs, 'r');
+}
+
+static long rf_number(void *ctx, int frame)
+{
+    anim_run *fx = ctx;
+    return frame >= 0 && frame < fx->nfr ? (long)fx->fr[frame]->one.number : PG_NO_FRAME;
 }
 
 static int rf_done(void *ctx, int frame, fr_error *err)
@@ -139,30 +225,56 @@ static int rf_done(void *ctx, int frame, fr_error *err)
         if (fs->rendered_on[i] && (size_t)k < sizeof used)
             k += snprintf(used + k, sizeof used - (size_t)k, "%s%s", k ? "," : "", fx->table->v[i].name);
     rr_clear_line();
+    pv_stop(fs->pv); /* its last image: the whole frame */
+    fs->pv = NULL;
     if (frame_write(fs->im, used)) {
         fs->failed = fx->failed = 1;
+        show_state(fx, fs, 'f');
         return fr_fail(err, "%s could not be written", fs->label);
     }
     fs->written = 1;
+    show_state(fx, fs, 'd');
     frames_wrote(&fx->it);
     frame_shrink(fs->im); /* the settings stay: the scheduler's run may still read the first frame's */
     return 0;
 }
 
+/* The run's reporters: --progress json's frames event and the monitor.
+ * 0, or the exit status (said). */
+static int run_reporters(anim_run *fx, const render_args *a)
+{
+    fr_error err;
+    if (a->json && !(fx->pg = pg_run_start(stdout, a->frames, fx->it.fl.n, &err))) {
+        fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
+        return 1;
+    }
+    if (a->monitor) {
+        if (!(fx->mon = mon_start_frames((uint16_t)a->monitor_port, a->out, a->frames, fx->it.fl.n, &err))) {
+            fprintf(stderr, "franja render: --monitor: %s\n", err.msg);
+            return 1;
+        }
+        mon_status(fx->mon, "rendering");
+        fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(fx->mon));
+    }
+    return 0;
+}
+
 /* `franja render PATTERN --frames LIST`: the frames run together over one
- * set of hosts, each written as soon as its rows are in; a frame-by-frame
- * run where an option works on one image at a time (--time-limit,
- * --preview, --monitor, --progress json). */
+ * set of hosts, each written as soon as its rows are in. */
 int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
 {
+    double t_start = clk_now();
     frames_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview};
-    if (a->time_limit > 0 || a->preview || a->monitor || a->json)
-        return frames_run(argc, argv, &fj, cmd_render);
     anim_run fx;
     memset(&fx, 0, sizeof fx);
     fx.parse = parse;
+    fx.a = a;
     if (frames_begin(&fx.it, argc, argv, &fj))
         return 2;
+    fx.it.on_skip = on_skip;
+    fx.it.skip_ctx = &fx;
+    if (a->time_limit > 0)
+        fx.deadline = t_start + a->time_limit;
     rr_signals();
     fr_error err;
     uint32_t probe = UINT32_MAX;
@@ -170,23 +282,26 @@ int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
         fprintf(stderr, "franja render: %s\n", err.msg);
         return frames_end(&fx.it, 2);
     }
-    hosts_table table;
-    slurm_alloc alloc;
-    int rc = rr_hosts(a, argc, argv, &table, &alloc);
-    if (rc)
-        return frames_end(&fx.it, rc);
+    int rc = run_reporters(&fx, a);
+    hosts_table table = {0};
+    slurm_alloc alloc = {0};
+    if (!rc)
+        rc = rr_hosts(a, argc, argv, &table, &alloc);
+    int timed_out = 0, hosts_ok = !rc;
     fx.table = &table;
     sched_frame first;
-    if (rf_open(&fx, &first) == 0) {
+    if (!rc && rf_open(&fx, &first) == 0) {
         char used[1024];
-        rr_frames hooks = {rf_next, rf_stage, rf_done, rf_rendered, &fx};
-        if (rr_run(a, &table, NULL, &fx.fr[0]->im->ps, NULL, NULL, used, sizeof used, &hooks, &err)) {
-            fprintf(stderr, "franja render: %s\n", err.msg);
+        rr_frames hooks = {rf_next, rf_stage, rf_done, rf_rendered, rf_number, &fx, fx.deadline, &timed_out};
+        if (rr_run(a, &table, NULL, &fx.fr[0]->im->ps, fx.pg, fx.mon, used, sizeof used, &hooks, &err)) {
+            if (!timed_out)
+                fprintf(stderr, "franja render: %s\n", err.msg);
             rc = 1;
         }
     }
     /* The frame to name: after an interrupt the first not written, else
-     * the one that failed, else (the hosts failed) the first not written. */
+     * the one that failed, else (the hosts failed, the time limit) the
+     * first not written. */
     frame_slot *named = NULL;
     for (int i = 0; i < fx.nfr && !named; i++)
         if (fx.fr[i]->failed && !rr_stop)
@@ -198,12 +313,23 @@ int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
         rc = 130;
     else if (fx.failed)
         rc = fx.failed;
+    else if (timed_out)
+        rc = FRAMES_TIME_LIMIT;
+    if (timed_out && rc == FRAMES_TIME_LIMIT)
+        fprintf(stderr, "franja: time limit of %g s reached\n", a->time_limit);
     if (rc && named)
         frames_failed(&fx.it, named->one.number, named->one.scene, named->one.out, rc);
     /* The frames still open are closed; their finished slabs stay for
      * --resume. */
+    const char *how = rc == 130 ? "interrupted" : rc == FRAMES_TIME_LIMIT ? "time_limit" : "failed";
     for (int i = 0; i < fx.nfr; i++) {
         frame_slot *fs = fx.fr[i];
+        pv_stop(fs->pv);
+        if (fs->im && !fs->written) {
+            pg_stop(fs->im->pg, how, fs->im->spec.spp);
+            fs->im->pg = NULL;
+            show_state(&fx, fs, fs->failed && rc != 130 ? 'f' : 'x');
+        }
         if (fs->im)
             frame_close(fs->im, fs->written ? 0 : rc ? rc : 1);
         frames_put(&fs->one);
@@ -211,7 +337,12 @@ int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
         free(fs);
     }
     free(fx.fr);
-    hosts_free(&table);
-    slurm_close(&alloc);
+    pg_run_end(fx.pg, rc == 0 ? "ok" : how, fx.it.fl.n, fx.it.rendered, fx.it.skipped);
+    mon_status(fx.mon, rc == 0 ? "done" : rc == 130 ? "interrupted" : rc == FRAMES_TIME_LIMIT ? "stopped" : "failed");
+    mon_stop(fx.mon);
+    if (hosts_ok) {
+        hosts_free(&table);
+        slurm_close(&alloc);
+    }
     return frames_end(&fx.it, rc);
 }

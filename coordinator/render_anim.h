@@ -4,10 +4,13 @@
  * together over one set of hosts, connected once.  Frames are opened
  * (locked, compiled) in the order of the list; once every slab of a frame
  * has started, a slot that comes free starts the next frame's slabs, and
- * each frame is written as soon as its rows are in.  With --time-limit,
- * --preview, --monitor or --progress json, which follow one image at a
- * time, the frames are rendered one after another instead, each a render
- * of its own.
+ * each frame is written as soon as its rows are in.  The reporters follow
+ * the frames in flight: --progress json is one stream whose frame events
+ * carry the frame's number (progress.h), the monitor shows every frame's
+ * state and the newest frame's image (monitor.h), and --preview writes each
+ * frame's file while it renders (one without '#' follows the newest frame).
+ * --time-limit is the run's: at the limit the frames in flight stop with
+ * their finished slabs kept, as after an interrupt.
  */
 #ifndef FRANJA_RENDER_ANIM_H
 #define FRANJA_RENDER_ANIM_H
@@ -22,8 +25,8 @@ typedef frame_image *(*ra_parse_fn)(int argc, char **argv, int *status);
 /** Renders the frames of a->frames; argv is the command line as typed,
  * each frame's own made from it by cmd_frames.h's rules and parsed with
  * parse.  Returns the exit status of `franja render` (130 when
- * interrupted: the frames in flight keep their finished slabs for
- * --resume). */
+ * interrupted, FRAMES_TIME_LIMIT when stopped by --time-limit: the frames
+ * in flight keep their finished slabs for --resume). */
 int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse);
 
 #endif

@@ -118,11 +118,12 @@ typedef struct {
     const rr_frames *fx;       /* the frames of an animation run together, or NULL */
 } reporter;
 
-/* A host's event to the JSON stream and the monitor. */
-static void host_event(reporter *r, const char *what, const char *host, uint32_t y0, uint32_t y1, double t,
-                       const char *text)
+/* A host's event to the JSON stream and the monitor; frame: the frame
+ * number of an animation's rows y0:y1, else PG_NO_FRAME. */
+static void host_event(reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
+                       double t, const char *text)
 {
-    pg_event(r->pg, what, host, y0, y1, text);
+    pg_event(r->pg, frame, what, host, y0, y1, text);
     mon_event(r->mon, t, host, what, text);
 }
 
@@ -143,10 +144,12 @@ static void on_event(void *ctx, const sched_event *ev)
         [SCHED_SLAB_DONE] = "done", [SCHED_SLAB_FAILED] = "failed", [SCHED_COPY] = "copy",
         [SCHED_HOST_DROPPED] = "dropped", [SCHED_HOST_SHRUNK] = "shrunk", [SCHED_HOST_RETRY] = "retry",
     };
+    /* A slab's event is about a frame of an animation: its number goes with it. */
+    long frame = r->fx && ev->y1 > ev->y0 ? r->fx->number(r->fx->ctx, ev->frame) : PG_NO_FRAME;
     if (ev->kind != SCHED_SLAB_DONE && ev->host >= 0 && ev->host < r->nhosts)
-        host_event(r, what[ev->kind], r->hosts[ev->host].name, ev->y0, ev->y1, ev->t, ev->text);
+        host_event(r, frame, what[ev->kind], r->hosts[ev->host].name, ev->y0, ev->y1, ev->t, ev->text);
     if (ev->kind == SCHED_SLAB_DONE && r->fx)
-        r->fx->rendered(r->fx->ctx, ev->frame, ev->host);
+        r->fx->rendered(r->fx->ctx, ev->frame, ev->host, ev->y0, ev->y1);
     if (ev->kind == SCHED_SLAB_DONE || (r->tty && ev->kind == SCHED_COPY))
         return;
     rr_clear_line();
@@ -228,7 +231,7 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
             if (j->rep) {
                 char line[1200];
                 snprintf(line, sizeof line, "host %s is not used: %s", h.entry->name, j->cl[i].err.msg);
-                host_event(j->rep, "unused", h.entry->name, 0, 0, j->rep->t, line);
+                host_event(j->rep, PG_NO_FRAME, "unused", h.entry->name, 0, 0, j->rep->t, line);
             }
             s->dropped = 1;
             snprintf(s->drop_reason, sizeof s->drop_reason, "%s", j->cl[i].err.msg);
@@ -259,7 +262,7 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
             char line[600];
             snprintf(line, sizeof line, "host %s ready: %s %s, %d slots (%.2f s)", s->name, h.info.os, h.info.arch,
                      s->slots, h.ready_s);
-            host_event(j->rep, "ready", s->name, 0, 0, j->rep->t, line);
+            host_event(j->rep, PG_NO_FRAME, "ready", s->name, 0, 0, j->rep->t, line);
         }
     }
 }
@@ -395,8 +398,9 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
                               .base = ps->base,
                               .sums = job_sums(spec),
                               /* The first pass of a --time-limit render
-                               * always ends: it is the least image there is. */
-                              .stop_at = ps->deadline > 0 && ps->reached ? ps->deadline : 0,
+                               * always ends: it is the least image there is.
+                               * An animation's limit is the whole run's. */
+                              .stop_at = ps->deadline > 0 && ps->reached ? ps->deadline : fx ? fx->deadline : 0,
                               .slab_rows = (int)a->slab_rows,
                               .max_attempts = (int)a->retries,
                               .max_host_failures = 3,
@@ -414,6 +418,12 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
             }
             rc = sched_run(&p, sh, n, &st, err);
             add_stats(&ps->total, &st);
+            if (rc && st.timed_out && !rr_stop && fx) {
+                /* An animation's limit: the frames in flight stop, their
+                 * finished slabs stay. */
+                *fx->timed_out = 1;
+                break;
+            }
             if (rc && st.timed_out && !rr_stop) {
                 /* The pass in flight is given up; its finished slabs stay. */
                 ps->stopped = spp;
@@ -440,8 +450,10 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
         job_spec shown = *spec;
         if (ps->deadline > 0 && ps->reached)
             shown.spp = ps->reached;
-        summary(sh, n, &shown, &ps->total, rep.done, rows_missing, clk_now() - t0,
-                rc == 0 ? NULL : rr_stop ? "interrupted" : "failed");
+        const char *ended = rc == 0 ? NULL : rr_stop ? "interrupted" : "failed";
+        if (rc && !rr_stop && fx && ps->total.timed_out)
+            ended = "stopped by the time limit";
+        summary(sh, n, &shown, &ps->total, rep.done, rows_missing, clk_now() - t0, ended);
         /* The hosts that rendered rows, for the image's metadata. */
         for (int i = 0, k = 0; i < n && used_cap; i++)
             if (sh[i].rows > 0 && k >= 0 && (size_t)k < used_cap)

@@ -12,6 +12,7 @@
 
 #include <signal.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "error.h"
 #include "frame.h"
@@ -36,16 +37,20 @@ void rr_signals(void);
 int rr_hosts(render_args *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc);
 
 /** An animation's part of a run: the scheduler's frame hooks (sched.h,
- * called here with ctx) and `rendered`, told of each accepted slab which
- * host rendered rows of which frame.  The hooks print after
- * rr_clear_line. */
+ * called here with ctx); `number`, the frame number of the scheduler's
+ * frame index (for the reporters' events); `rendered`, told of each
+ * accepted slab which host rendered rows y0:y1 of which frame; and the
+ * run's --time-limit.  The hooks print after rr_clear_line. */
 typedef struct {
     int (*next_frame)(void *ctx, int frame, sched_frame *next, fr_error *err);
     int (*stage)(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
                  size_t lease_cap, fr_error *err);
     int (*frame_done)(void *ctx, int frame, fr_error *err);
-    void (*rendered)(void *ctx, int frame, int host);
+    void (*rendered)(void *ctx, int frame, int host, uint32_t y0, uint32_t y1);
+    long (*number)(void *ctx, int frame);
     void *ctx;
+    double deadline;           /**< clk_now() time at which the run stops (--time-limit); 0 = none */
+    int *timed_out;            /**< set to 1 when the run stopped at deadline */
 } rr_frames;
 
 /** Connects the hosts of table and renders the rows of ps (its passes,
@@ -55,7 +60,8 @@ typedef struct {
  * answers costs nothing unless it is the only one).  pg and mon (NULL:
  * none) get the hosts' events.  With fx, ps is the first frame of an
  * animation and the next ones follow over the same hosts (fx stages each
- * frame's scene and writes each frame); fbin is then not used.  used
+ * frame's scene and writes each frame; its deadline stops the run, with
+ * -1 and *fx->timed_out set); fbin is then not used.  used
  * (used_cap bytes) gets the names of the hosts that rendered rows,
  * comma-separated, for the image's metadata.  Prints the summary.  0, or
  * -1 with *err set (the slabs finished stay in the job directory; rr_stop

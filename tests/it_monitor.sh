@@ -3,7 +3,9 @@
 # loaded in a real browser (headless chromium) during a render on two
 # hosts, one of which fails every slab; the page shows the image so far,
 # each host's state, slots, rows and failures, the ETA and the events, and
-# --progress json carries the same host events.
+# --progress json carries the same host events; for an animation rendered
+# with its frames together, the page shows which frames are written and
+# which are rendering, with their rows, and the newest frame's image.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 need chromium curl jq ss
@@ -115,6 +117,71 @@ jq -se 'any(.[]; .event == "host" and .what == "ready" and .host == "good")' "$T
 jq -se 'any(.[]; .event == "done" and .status == "interrupted")' "$T/events" >/dev/null && ok ||
     bad "--progress json: no interrupted done event"
 curl -sf "$URL/state.json" >/dev/null && bad "the monitor still answers after the render" || ok
+
+# An animation: frames 1-3 of a sphere moving; the last slab of frames 2
+# and 3 never ends while "hold" exists, so the page is caught with frame 1
+# written and frames 2 and 3 rendering, 12 of 16 rows each.  The other
+# slabs take 2 s each, so that the held ones are given up as stuck (8
+# times a slab's time, plus 5 s) only long after the checks.
+for i in 1 2 3; do
+    sed "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [$((100 * i + 150)), 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+        scenes/cornell.json >"$T/f.000$i.json"
+done
+cat >"$T/hold.sh" <<SH
+#!/bin/sh
+case " \$* " in
+*f.000[23]*" --rows 12:16 "*) [ -e "$T/hold" ] && exec sleep 600 ;;
+*" --rows "*) sleep 2 ;;
+esac
+exec "$W" "\$@"
+SH
+chmod +x "$T/hold.sh"
+printf 'here local - 2 worker=%s\n' "$T/hold.sh" >"$T/thold"
+touch "$T/hold"
+"$F" render "$T/f.####.json" --frames 1-3 -o "$T/anim/f.####.pfm" --size 24x16 --spp 2 --slab-rows 4 \
+    --hosts "$T/thold" --monitor 0 --progress json >"$T/aevents" 2>"$T/alog" &
+pid=$!
+port=""
+i=0
+while [ -z "$port" ] && [ $i -lt 300 ] && kill -0 $pid 2>/dev/null; do
+    port=$(sed -n 's|^franja: monitor on http://127.0.0.1:\([0-9]*\)/$|\1|p' "$T/alog")
+    sleep 0.1
+    i=$((i + 1))
+done
+[ -n "$port" ] && ok || bad "an animation: no monitor address on stderr: $(cat "$T/alog")"
+URL="http://127.0.0.1:$port"
+i=0
+until state | jq -e '.frames.states == "drr" and ([.frames.current[].rows_done] == [12, 12])' >/dev/null 2>&1 ||
+    [ $i -ge 600 ]; do
+    sleep 0.1
+    i=$((i + 1))
+done
+s=$(state)
+echo "$s" | jq -e '.status == "rendering" and .frames.list == "1-3" and .frames.count == 3 and .frames.done == 1 and
+    .frames.rendering == 2 and .frames.waiting == 0 and .frames.shown == 3 and
+    ([.frames.current[] | [.frame, .rows_done, .rows]] == [[2, 12, 16], [3, 12, 16]]) and
+    .width == 24 and .height == 16 and (.eta_s | type) == "number"' >/dev/null && ok ||
+    bad "an animation's state.json: $s"
+curl -sf "$URL/image.png" -o "$T/anim.png" && [ "$(head -c 8 "$T/anim.png" | od -An -c | tr -d ' ')" = '211PNG\r\n032\n' ] &&
+    ok || bad "an animation's image.png is not a PNG"
+browse --dump-dom "$URL/" >"$T/adom.html"
+grep -q 'id="fsum">1 written, 2 rendering, 0 skipped, 0 waiting of 3<' "$T/adom.html" && ok ||
+    bad "the page does not count the frames: $(grep -o 'id="fsum">[^<]*' "$T/adom.html")"
+grep -q '<div id="strip"><span class="d" title="frame 1: written"></span><span class="r" title="frame 2: rendering"></span><span class="r" title="frame 3: rendering"></span></div>' \
+    "$T/adom.html" && ok || bad "the page's strip of frames: $(grep -o '<div id="strip">.*</div>' "$T/adom.html" | head -c 400)"
+grep -q "<tr><td>2</td><td class=\"state\">$T/anim/f.0002.pfm</td><td>12/16</td><td>75</td></tr>" "$T/adom.html" && ok ||
+    bad "the page does not show frame 2 rendering: $(grep -o '<table id="current">.*</table>' "$T/adom.html" | head -c 600)"
+grep -q 'id="imgrows">image: frame 3, 24x16, 12 rows rendered<' "$T/adom.html" && ok ||
+    bad "the page does not show frame 3's image: $(grep -o 'id="imgrows">[^<]*' "$T/adom.html")"
+kill -INT $pid
+wait $pid
+rc=$?
+pid=""
+rm "$T/hold"
+[ $rc = 130 ] && ok || bad "the interrupted animation exited $rc: $(tail -n 3 "$T/alog")"
+[ "$(jq -c 'select(.event == "done") | [.frame, .status]' "$T/aevents" | tr '\n' ' ')" = \
+    '[1,"ok"] [2,"interrupted"] [3,"interrupted"] ' ] && ok || bad "an animation's done events: $(cat "$T/aevents")"
+curl -sf "$URL/state.json" >/dev/null && bad "the animation's monitor still answers after the render" || ok
 
 # Bad values and a port in use.
 expect_error "--monitor x" "--monitor: 'x' is not an integer in 0..65535" "$F" render scenes/spheres.json --monitor x

@@ -1,7 +1,7 @@
 #!/bin/sh
 # An animation rendered with --frames: five frames of the Cornell box with
 # a sphere moving, 128x128 at 16 spp, -j 2 (FRAMES, SIZE, SPP, JOBS change
-# them).  B is this build's --frames, which runs the frames together over
+# them; OPTS adds options to both, e.g. OPTS='--progress json').  B is this build's --frames, which runs the frames together over
 # one set of workers; A is the reference: REF=path/to/an/older/franja (its
 # own --frames, e.g. a build of the frame-by-frame version), else the
 # frames as separate renders one after another.  Every frame of B must be
@@ -9,7 +9,7 @@
 cd "$(dirname "$0")/../.." || exit 1
 . tests/coord/bench_common.sh
 FRAMES=${FRAMES:-5}
-ARGS="--size ${SIZE:-128x128} --spp ${SPP:-16} -j ${JOBS:-2}"
+ARGS="--size ${SIZE:-128x128} --spp ${SPP:-16} -j ${JOBS:-2} ${OPTS:-}"
 T=$(mktemp -d /tmp/franja-bench.XXXXXX)
 trap 'rm -rf "$T"' EXIT
 i=1
