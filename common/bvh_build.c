@@ -4,39 +4,32 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh2.h"
+#include "bvh_reinsert.h"
 #include "simd4.h"
 
-/* Costs are in units of one leaf block test (four triangles); a node test
- * (eight boxes) costs about the same, TRAV_COST.  Every slot of a node a
- * ray enters (a leaf or a child node) is also charged SLOT_COST: it adds a
- * box tested together with the others and one more leaf or subtree to
- * visit.  (Charged nothing, the collapse cuts sheets of long overlapping
- * slivers into many small leaves that cost more.)  A subtree becomes a
- * leaf of at most LEAF_MAX references (four blocks); binary leaves hold at
- * most LEAF_MIN (one block). */
-enum { BINS = 32, LEAF_MIN = 4, LEAF_MAX = 16, SWEEP_MAX = 64 };
-#define TRAV_COST 1.0f
-#define SLOT_COST 0.5f
+enum { BINS = 32, SWEEP_MAX = 64 };
 /* Spatial splits: tried where an object split's two sides overlap by more
  * than OVERLAP times the root's area, with room for as many extra
  * references as there are primitives. */
 #define OVERLAP 1e-5f
 
-typedef struct { f4 lo, hi; } box4;   /* lane 3 unused (kept 0) */
+/* Box midpoints (halves added: no overflow for coordinates near FLT_MAX). */
+static f4 centroid(bvh2_box b) { return b.lo * f4_set1(0.5f) + b.hi * f4_set1(0.5f); }
 
 /* A contiguous range of references with its bounds and the bounds of its
  * centroids. */
 typedef struct {
     uint32_t begin, end;       /* its references */
     uint32_t cap;              /* [end, cap): room for references a spatial split adds */
-    box4 box, cent;
+    bvh2_box box, cent;
     int leaf;                  /* decided: becomes a leaf */
 } span;
 
 typedef struct {
-    box4 *box;                 /* per reference: bounds of its part of its primitive */
+    bvh2_box *box;             /* per reference: bounds of its part of its primitive */
     uint32_t *id;              /* per reference: index into the builder's prims */
-    box4 *tbox;                /* scratch for a spatial split's references */
+    bvh2_box *tbox;            /* scratch for a spatial split's references */
     uint32_t *tid;
     const fr_builder *b;
     fr_prim *out;              /* prims in the order leaves first name them */
@@ -45,24 +38,9 @@ typedef struct {
     float min_overlap;         /* half area of the root times OVERLAP */
     fr_array *nodes, *leaves;
     fr_error *err;
-    struct bnode *bn;          /* the binary tree */
+    bvh2_node *bn;             /* the binary tree */
     uint32_t n_bn, cap_bn;
 } build;
-
-static box4 box_empty(void) { return (box4){f4_set1(INFINITY), f4_set1(-INFINITY)}; }
-static void box_grow(box4 *a, box4 b) { a->lo = f4_min_num(b.lo, a->lo); a->hi = f4_max_num(b.hi, a->hi); }
-static void box_add(box4 *a, f4 p) { a->lo = f4_min_num(p, a->lo); a->hi = f4_max_num(p, a->hi); }
-/* Box midpoints (halves added: no overflow for coordinates near FLT_MAX). */
-static f4 centroid(box4 b) { return b.lo * f4_set1(0.5f) + b.hi * f4_set1(0.5f); }
-
-/* Half the surface area: the SAH only compares areas. */
-static float half_area(box4 b)
-{
-    f4 d = b.hi - b.lo;
-    return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
-}
-
-static float blocks(uint32_t n) { return (float)((n + 3) / 4); }
 
 void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi)
 {
@@ -88,17 +66,17 @@ void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi)
 /* Bounds of references [begin, end). */
 static void span_bounds(const build *B, span *s)
 {
-    s->box = box_empty();
-    s->cent = box_empty();
+    s->box = bvh2_box_empty();
+    s->cent = bvh2_box_empty();
     for (uint32_t i = s->begin; i < s->end; i++) {
-        box_grow(&s->box, B->box[i]);
-        box_add(&s->cent, centroid(B->box[i]));
+        bvh2_box_grow(&s->box, B->box[i]);
+        bvh2_box_add(&s->cent, centroid(B->box[i]));
     }
 }
 
 static void swap_refs(build *B, uint32_t i, uint32_t j)
 {
-    box4 tb = B->box[i]; B->box[i] = B->box[j]; B->box[j] = tb;
+    bvh2_box tb = B->box[i]; B->box[i] = B->box[j]; B->box[j] = tb;
     uint32_t ti = B->id[i]; B->id[i] = B->id[j]; B->id[j] = ti;
 }
 
@@ -146,9 +124,12 @@ static int bin_at(float c, float lo, float scale, int nb)
  * for the extra references (the reference budget is shared out with the
  * references as spans are split). */
 
-static int box_is_empty(box4 b) { return !(b.lo[0] <= b.hi[0] && b.lo[1] <= b.hi[1] && b.lo[2] <= b.hi[2]); }
+static int box_is_empty(bvh2_box b) { return !(b.lo[0] <= b.hi[0] && b.lo[1] <= b.hi[1] && b.lo[2] <= b.hi[2]); }
 
-static box4 box_clip(box4 a, box4 b) { return (box4){f4_max_num(b.lo, a.lo), f4_min_num(b.hi, a.hi)}; }
+static bvh2_box box_clip(bvh2_box a, bvh2_box b)
+{
+    return (bvh2_box){f4_max_num(b.lo, a.lo), f4_min_num(b.hi, a.hi)};
+}
 
 static f4 vload(vec3 p) { return (f4){p.x, p.y, p.z, 0.0f}; }
 
@@ -157,7 +138,7 @@ static f4 vload(vec3 p) { return (f4){p.x, p.y, p.z, 0.0f}; }
  * the exact point: the rounded coordinates are widened by far more than
  * their rounding error (a few units in the last place of |p| + |q|) and
  * kept within the edge's own bounds; on axis a the point is c exactly. */
-static void add_crossing(box4 *r, f4 p, f4 q, i4 on_a, float pa, float qa, float c)
+static void add_crossing(bvh2_box *r, f4 p, f4 q, i4 on_a, float pa, float qa, float c)
 {
     f4 t = f4_set1((c - pa) / (qa - pa));
     f4 x = p + (q - p) * t;
@@ -175,9 +156,9 @@ static void add_crossing(box4 *r, f4 p, f4 q, i4 on_a, float pa, float qa, float
  * slab and the points where its edges cross the planes, within the
  * reference's box; for other primitives the reference's box cut to the
  * slab.  May be empty. */
-static box4 ref_slab(const build *B, uint32_t i, int a, float lo, float hi)
+static bvh2_box ref_slab(const build *B, uint32_t i, int a, float lo, float hi)
 {
-    box4 rb = B->box[i];
+    bvh2_box rb = B->box[i];
     const fr_prim *p = (const fr_prim *)B->b->prims.data + B->id[i];
     if (p->kind != FR_PRIM_TRIANGLE) {
         rb.lo[a] = rb.lo[a] > lo ? rb.lo[a] : lo;
@@ -189,12 +170,12 @@ static box4 ref_slab(const build *B, uint32_t i, int a, float lo, float hi)
     f4 v[3] = {vload(pos[t->v[0]]), vload(pos[t->v[1]]), vload(pos[t->v[2]])};
     i4 on_a = i4_set1(0);
     on_a[a] = -1;
-    box4 r = box_empty();
+    bvh2_box r = bvh2_box_empty();
     for (int k = 0; k < 3; k++) {
         f4 P = v[k], Q = v[k == 2 ? 0 : k + 1];
         float pa = P[a], qa = Q[a];
         if (pa >= lo && pa <= hi)
-            box_add(&r, P);
+            bvh2_box_add(&r, P);
         if ((pa < lo && qa > lo) || (pa > lo && qa < lo))
             add_crossing(&r, P, Q, on_a, pa, qa, lo);
         if ((pa < hi && qa > hi) || (pa > hi && qa < hi))
@@ -217,46 +198,46 @@ static float spatial_best(const build *B, const span *s, int nb, int *axis, floa
     if (!(ext > 0.0f))
         return best;
     float scale = (float)nb / ext, w = ext / (float)nb;
-    box4 bins[BINS];
+    bvh2_box bins[BINS];
     uint32_t enter[BINS], leave[BINS];
     for (int k = 0; k < nb; k++) {
-        bins[k] = box_empty();
+        bins[k] = bvh2_box_empty();
         enter[k] = leave[k] = 0;
     }
     for (uint32_t i = s->begin; i < s->end; i++) {
-        box4 bx = B->box[i];
+        bvh2_box bx = B->box[i];
         int k0 = bin_at(bx.lo[a], lo, scale, nb), k1 = bin_at(bx.hi[a], lo, scale, nb);
         enter[k0]++;
         leave[k1]++;
         if (k0 == k1) {
-            box_grow(&bins[k0], bx);
+            bvh2_box_grow(&bins[k0], bx);
             continue;
         }
         for (int k = k0; k <= k1; k++) {
-            box4 part = ref_slab(B, i, a, k == k0 ? -INFINITY : lo + w * (float)k,
+            bvh2_box part = ref_slab(B, i, a, k == k0 ? -INFINITY : lo + w * (float)k,
                                  k == k1 ? INFINITY : lo + w * (float)(k + 1));
             if (!box_is_empty(part))
-                box_grow(&bins[k], part);
+                bvh2_box_grow(&bins[k], part);
         }
     }
     float right_area[BINS];
     uint32_t right_count[BINS];
-    box4 acc = box_empty();
+    bvh2_box acc = bvh2_box_empty();
     uint32_t c = 0;
     for (int k = nb - 1; k > 0; k--) {
-        box_grow(&acc, bins[k]);
+        bvh2_box_grow(&acc, bins[k]);
         c += leave[k];
         right_count[k] = c;
-        right_area[k] = c ? half_area(acc) : 0.0f;
+        right_area[k] = c ? bvh2_area(acc) : 0.0f;
     }
-    acc = box_empty();
+    acc = bvh2_box_empty();
     c = 0;
     for (int k = 1; k < nb; k++) {
-        box_grow(&acc, bins[k - 1]);
+        bvh2_box_grow(&acc, bins[k - 1]);
         c += enter[k - 1];
         if (c == 0 || right_count[k] == 0)
             continue;
-        float cost = half_area(acc) * blocks(c) + right_area[k] * blocks(right_count[k]);
+        float cost = bvh2_area(acc) * bvh2_blocks(c) + right_area[k] * bvh2_blocks(right_count[k]);
         if (cost < best) {
             best = cost;
             *axis = a;
@@ -288,7 +269,7 @@ static int spatial_split(build *B, const span *s, int a, float plane, span *l, s
     uint32_t room = s->cap - s->begin, nl = 0, nr = 0;
     /* Left references from the front of the scratch, right ones from its back. */
     for (uint32_t i = s->begin; i < s->end; i++) {
-        box4 bx = B->box[i], lb = bx, rb = bx;
+        bvh2_box bx = B->box[i], lb = bx, rb = bx;
         int left = bx.lo[a] < plane || (bx.lo[a] == plane && bx.hi[a] == plane);
         int right = bx.hi[a] > plane;
         if (left && right) {
@@ -358,27 +339,27 @@ static float sweep_best(const build *B, const span *s, int *axis, uint32_t *nlef
 {
     uint32_t n = s->end - s->begin;
     skey k[SWEEP_MAX];
-    box4 rbox[SWEEP_MAX];
+    bvh2_box rbox[SWEEP_MAX];
     float best = INFINITY;
     for (int a = 0; a < 3; a++) {
         if (!(s->cent.hi[a] > s->cent.lo[a]))
             continue;
         sweep_keys(B, s, a, k);
-        box4 acc = box_empty();
+        bvh2_box acc = bvh2_box_empty();
         for (uint32_t i = n - 1; i > 0; i--) {
-            box_grow(&acc, B->box[k[i].pos]);
+            bvh2_box_grow(&acc, B->box[k[i].pos]);
             rbox[i] = acc;
         }
-        acc = box_empty();
+        acc = bvh2_box_empty();
         for (uint32_t i = 1; i < n; i++) {
-            box_grow(&acc, B->box[k[i - 1].pos]);
-            float cost = half_area(acc) * blocks(i) + half_area(rbox[i]) * blocks(n - i);
+            bvh2_box_grow(&acc, B->box[k[i - 1].pos]);
+            float cost = bvh2_area(acc) * bvh2_blocks(i) + bvh2_area(rbox[i]) * bvh2_blocks(n - i);
             if (cost < best) {
                 best = cost;
                 *axis = a;
                 *nleft = i;
-                box4 o = box_clip(acc, rbox[i]);
-                *overlap = box_is_empty(o) ? 0.0f : half_area(o);
+                bvh2_box o = box_clip(acc, rbox[i]);
+                *overlap = box_is_empty(o) ? 0.0f : bvh2_area(o);
             }
         }
     }
@@ -401,18 +382,18 @@ static void split_span(build *B, const span *s, span *l, span *r, int median)
     if (sweep)
         best_cost = sweep_best(B, s, &best_axis, &sweep_left, &sweep_overlap);
     if (!median) {
-        box4 bins[3][BINS];
+        bvh2_box bins[3][BINS];
         uint32_t count[3][BINS];
         for (int a = 0; a < 3; a++)
             for (int k = 0; k < nb; k++) {
-                bins[a][k] = box_empty();
+                bins[a][k] = bvh2_box_empty();
                 count[a][k] = 0;
             }
         for (uint32_t i = s->begin; i < s->end && !sweep; i++) {
-            box4 bx = B->box[i];
+            bvh2_box bx = B->box[i];
             i4 k = bin_of(centroid(bx), s->cent.lo, scale, nb);
             for (int a = 0; a < 3; a++) {
-                box_grow(&bins[a][k[a]], bx);
+                bvh2_box_grow(&bins[a][k[a]], bx);
                 count[a][k[a]]++;
             }
         }
@@ -421,22 +402,22 @@ static void split_span(build *B, const span *s, span *l, span *r, int median)
                 continue;
             float right_area[BINS];
             uint32_t right_count[BINS];
-            box4 acc = box_empty();
+            bvh2_box acc = bvh2_box_empty();
             uint32_t c = 0;
             for (int k = nb - 1; k > 0; k--) {
-                box_grow(&acc, bins[a][k]);
+                bvh2_box_grow(&acc, bins[a][k]);
                 c += count[a][k];
                 right_count[k] = c;
-                right_area[k] = c ? half_area(acc) : 0.0f;
+                right_area[k] = c ? bvh2_area(acc) : 0.0f;
             }
-            acc = box_empty();
+            acc = bvh2_box_empty();
             c = 0;
             for (int k = 1; k < nb; k++) {
-                box_grow(&acc, bins[a][k - 1]);
+                bvh2_box_grow(&acc, bins[a][k - 1]);
                 c += count[a][k - 1];
                 if (c == 0 || right_count[k] == 0)
                     continue;
-                float cost = half_area(acc) * blocks(c) + right_area[k] * blocks(right_count[k]);
+                float cost = bvh2_area(acc) * bvh2_blocks(c) + right_area[k] * bvh2_blocks(right_count[k]);
                 if (cost < best_cost) {
                     best_cost = cost;
                     best_axis = a;
@@ -452,11 +433,11 @@ static void split_span(build *B, const span *s, span *l, span *r, int median)
             if (sweep) {
                 overlap = sweep_overlap;
             } else if (best_axis >= 0) {
-                box4 lb = box_empty(), rb = box_empty();
+                bvh2_box lb = bvh2_box_empty(), rb = bvh2_box_empty();
                 for (int k = 0; k < nb; k++)
-                    box_grow(k < best_bin ? &lb : &rb, bins[best_axis][k]);
-                box4 o = box_clip(lb, rb);
-                overlap = box_is_empty(o) ? 0.0f : half_area(o);
+                    bvh2_box_grow(k < best_bin ? &lb : &rb, bins[best_axis][k]);
+                bvh2_box o = box_clip(lb, rb);
+                overlap = box_is_empty(o) ? 0.0f : bvh2_area(o);
             }
             if (overlap > B->min_overlap)
                 sp_cost = spatial_best(B, s, nb, &sp_axis, &sp_plane);
@@ -464,8 +445,8 @@ static void split_span(build *B, const span *s, span *l, span *r, int median)
         if (sp_cost < best_cost && spatial_split(B, s, sp_axis, sp_plane, l, r))
             return;
     }
-    *l = (span){s->begin, s->begin, s->begin, box_empty(), box_empty(), 0};
-    *r = (span){s->end, s->end, s->cap, box_empty(), box_empty(), 0};
+    *l = (span){s->begin, s->begin, s->begin, bvh2_box_empty(), bvh2_box_empty(), 0};
+    *r = (span){s->end, s->end, s->cap, bvh2_box_empty(), bvh2_box_empty(), 0};
     if (best_axis < 0) {
         /* Every centroid in one bin (or the depth guard): halve the range. */
         l->end = l->cap = r->begin = s->begin + n / 2;
@@ -487,22 +468,22 @@ static void split_span(build *B, const span *s, span *l, span *r, int median)
         i = j = s->begin + sweep_left;
         for (uint32_t q = s->begin; q < s->end; q++) {
             span *side = q < i ? l : r;
-            box_grow(&side->box, B->box[q]);
-            box_add(&side->cent, centroid(B->box[q]));
+            bvh2_box_grow(&side->box, B->box[q]);
+            bvh2_box_add(&side->cent, centroid(B->box[q]));
         }
     }
     /* Partition by bin, collecting both sides' bounds on the way. */
     float lo = s->cent.lo[best_axis], sc = scale[best_axis];
     while (i < j) {
-        box4 bx = B->box[i];
+        bvh2_box bx = B->box[i];
         f4 c = centroid(bx);
         if (bin_at(c[best_axis], lo, sc, nb) < best_bin) {
-            box_grow(&l->box, bx);
-            box_add(&l->cent, c);
+            bvh2_box_grow(&l->box, bx);
+            bvh2_box_add(&l->cent, c);
             i++;
         } else {
-            box_grow(&r->box, bx);
-            box_add(&r->cent, c);
+            bvh2_box_grow(&r->box, bx);
+            bvh2_box_add(&r->cent, c);
             j--;
             swap_refs(B, i, j);
         }
@@ -522,32 +503,22 @@ static void split_span(build *B, const span *s, span *l, span *r, int median)
 /* ---- the binary tree and its collapse ----
  *
  * The builder first splits references down to binary leaves of at most
- * LEAF_MIN (always taking the split, SAH or spatial, that split_span finds
+ * BVH2_LEAF_MIN (always taking the split, SAH or spatial, that split_span finds
  * best), then chooses which binary nodes become 8-wide nodes and which
  * subtrees become leaves by dynamic programming over the binary tree
  * (bottom-up): cost[v][j-1] is the least SAH cost of v's subtree given as
  * at most j slots of a wide node, each slot a leaf (area times its blocks)
- * or a wide node (area times TRAV_COST plus the cost of its own up to eight
- * slots), each slot also charged its area times SLOT_COST.  A subtree
- * becomes a leaf only with at most LEAF_MAX references; its references are
+ * or a wide node (area times BVH2_TRAV_COST plus the cost of its own up to eight
+ * slots), each slot also charged its area times BVH2_SLOT_COST.  A subtree
+ * becomes a leaf only with at most BVH2_LEAF_MAX references; its references are
  * packed into blocks together, so small binary leaves fill blocks. */
 
-typedef struct bnode {
-    box4 box;
-    uint32_t kid[2];           /* children, or a leaf's references [kid[0], kid[1]) */
-    uint32_t refs;             /* references in the subtree */
-    uint8_t is_leaf;
-    uint8_t as_leaf;           /* as one slot: 1 a leaf, 0 a wide node */
-    uint8_t wide;              /* as a wide node: slots from kid[0] (the rest from kid[1]) */
-    uint8_t pick[FR_BVH_WIDTH]; /* pick[j-1], j >= 2: 0 = as j-1 slots, else slots from kid[0] */
-    float cost[FR_BVH_WIDTH];  /* cost[j-1]: as at most j slots */
-} bnode;
 
 /* Levels of halving below a binary node of n references. */
 static int halving_levels(uint32_t n)
 {
     int l = 0;
-    while (n > LEAF_MIN) {
+    while (n > BVH2_LEAF_MIN) {
         n = n - n / 2;
         l++;
     }
@@ -560,7 +531,7 @@ static uint32_t bnode_push(build *B)
         size_t cap = B->cap_bn ? 2 * (size_t)B->cap_bn : 1024;
         if (cap > 0xffffffffu)
             return FR_NONE;
-        bnode *m = realloc(B->bn, cap * sizeof *m);
+        bvh2_node *m = realloc(B->bn, cap * sizeof *m);
         if (!m)
             return FR_NONE;
         B->bn = m;
@@ -568,50 +539,6 @@ static uint32_t bnode_push(build *B)
     }
     memset(&B->bn[B->n_bn], 0, sizeof *B->bn);
     return B->n_bn++;
-}
-
-/* The costs of binary node v from those of its children. */
-static void bnode_costs(bnode *bn, uint32_t v)
-{
-    bnode *n = &bn[v];
-    float area = half_area(n->box), slot = area * SLOT_COST;
-    if (n->is_leaf) {
-        for (int j = 0; j < FR_BVH_WIDTH; j++) {
-            n->cost[j] = slot + area * blocks(n->refs);
-            n->pick[j] = 0;
-        }
-        n->as_leaf = 1;
-        return;
-    }
-    const float *ca = bn[n->kid[0]].cost, *cb = bn[n->kid[1]].cost;
-    float split[FR_BVH_WIDTH + 1];
-    uint8_t at[FR_BVH_WIDTH + 1];
-    for (int j = 2; j <= FR_BVH_WIDTH; j++) {
-        split[j] = INFINITY;
-        at[j] = 1;
-        for (int k = 1; k < j; k++) {
-            float c = ca[k - 1] + cb[j - k - 1];
-            if (c < split[j]) {
-                split[j] = c;
-                at[j] = (uint8_t)k;
-            }
-        }
-    }
-    float as_node = area * TRAV_COST + split[FR_BVH_WIDTH];
-    float as_leaf = n->refs <= LEAF_MAX ? area * blocks(n->refs) : INFINITY;
-    n->wide = at[FR_BVH_WIDTH];
-    n->as_leaf = as_leaf <= as_node;
-    n->cost[0] = slot + (n->as_leaf ? as_leaf : as_node);
-    n->pick[0] = 0;
-    for (int j = 2; j <= FR_BVH_WIDTH; j++) {
-        if (split[j] < n->cost[j - 2]) {
-            n->cost[j - 1] = split[j];
-            n->pick[j - 1] = at[j];
-        } else {
-            n->cost[j - 1] = n->cost[j - 2];
-            n->pick[j - 1] = 0;
-        }
-    }
 }
 
 /* Split s into the binary subtree rooted at a new node, *index. */
@@ -624,14 +551,14 @@ static int bin_build(build *B, const span *s, int depth, int median, uint32_t *i
     if (!median)
         median = depth + 2 + halving_levels(n) >= FR_BVH_MAX_DEPTH;
     span pair[2];
-    if (n <= LEAF_MIN) {
-        bnode *v = &B->bn[me];
+    if (n <= BVH2_LEAF_MIN) {
+        bvh2_node *v = &B->bn[me];
         v->box = s->box;
         v->kid[0] = s->begin;
         v->kid[1] = s->end;
         v->refs = n;
         v->is_leaf = 1;
-        bnode_costs(B->bn, me);
+        bvh2_costs(B->bn, me);
         *index = me;
         return 0;
     }
@@ -640,379 +567,19 @@ static int bin_build(build *B, const span *s, int depth, int median, uint32_t *i
     for (int c = 0; c < 2; c++)
         if (bin_build(B, &pair[c], depth + 1, median, &kid[c]) < 0)
             return -1;
-    bnode *v = &B->bn[me];   /* the array may have moved */
+    bvh2_node *v = &B->bn[me];   /* the array may have moved */
     v->box = s->box;
     v->kid[0] = kid[0];
     v->kid[1] = kid[1];
     v->refs = B->bn[kid[0]].refs + B->bn[kid[1]].refs;
-    bnode_costs(B->bn, me);
+    bvh2_costs(B->bn, me);
     *index = me;
     return 0;
 }
 
-/* ---- reinsertion ----
- *
- * Before the collapse the binary tree is improved by moving subtrees (the
- * insertion-based optimisation of Bittner, Hapala and Havran, 2013), each
- * move kept only where it lowers the collapse's cost of the whole tree.
- * Leaves keep their references, so a primitive cut by spatial splits stays
- * in the same leaves.
- *   - A leaf N is taken out (its parent goes, its sibling takes the
- *     parent's place, the nodes above are refitted) and put as the sibling
- *     of another node under a new parent.
- *   - An inner node N is taken out with its parent, and its two children
- *     are put back one after the other (the larger first).
- * Where a subtree goes is chosen by the summed area of the inner nodes,
- * the usual stand-in for the SAH: beside the node where it grows least,
- * found by branch and bound from the root (nodes in the order of how much
- * their ancestors would grow, a heap with ties to the lower index, a
- * subtree skipped where that growth plus the moved subtree's own area
- * reaches the best place found; no place where the tree would get deeper
- * than FR_BVH_MAX_DEPTH).  A move that does not lower the inner area is
- * not tried; one that does is kept only if the collapse's cost of the
- * root (bnode_costs, recomputed up both paths) falls, else undone exactly.
- * A pass tries, worst first, the twentieth of the nodes whose parent is
- * largest against its two children (area(P) / (area(N) + area(S)) *
- * area(P)); passes stop when one gains less than REINS_STOP of the cost,
- * or after REINS_PASSES. */
-
-enum { REINS_PASSES = 3, REINS_SHARE = 20 };
-#define REINS_STOP 0.01f
-
-typedef struct {
-    float c;                   /* growth of the ancestors' areas */
-    uint32_t node, depth;      /* depth: the root is 1 */
-} reins_item;
-
-typedef struct {
-    bnode *bn;                 /* the tree, changed in place */
-    float *area;               /* per node: half_area(box) */
-    uint32_t *up;              /* parent, FR_NONE at the root and out of the tree */
-    uint8_t *height;           /* levels of the subtree: 1 for a leaf */
-    uint32_t root, n;
-    reins_item *heap;          /* the search's (a node enters it once) */
-    uint32_t nh;
-} reins;
-
-static int reins_before(reins_item a, reins_item b) { return a.c < b.c || (a.c == b.c && a.node < b.node); }
-
-static void reins_push(reins *R, reins_item it)
-{
-    uint32_t i = R->nh++;
-    while (i > 0) {
-        uint32_t p = (i - 1) / 2;
-        if (!reins_before(it, R->heap[p]))
-            break;
-        R->heap[i] = R->heap[p];
-        i = p;
-    }
-    R->heap[i] = it;
-}
-
-static reins_item reins_pop(reins *R)
-{
-    reins_item top = R->heap[0], last = R->heap[--R->nh];
-    uint32_t i = 0, n = R->nh;
-    for (;;) {
-        uint32_t c = 2 * i + 1;
-        if (c >= n)
-            break;
-        if (c + 1 < n && reins_before(R->heap[c + 1], R->heap[c]))
-            c++;
-        if (!reins_before(R->heap[c], last))
-            break;
-        R->heap[i] = R->heap[c];
-        i = c;
-    }
-    if (n > 0)
-        R->heap[i] = last;
-    return top;
-}
-
-static uint8_t max_u8(uint8_t a, uint8_t b) { return a > b ? a : b; }
-
-/* Box, area, height, references and costs of inner node x and its
- * ancestors from their children. */
-static void reins_update(reins *R, uint32_t x)
-{
-    bnode *bn = R->bn;
-    for (; x != FR_NONE; x = R->up[x]) {
-        uint32_t a = bn[x].kid[0], b = bn[x].kid[1];
-        bn[x].box = bn[a].box;
-        box_grow(&bn[x].box, bn[b].box);
-        bn[x].refs = bn[a].refs + bn[b].refs;
-        R->area[x] = half_area(bn[x].box);
-        R->height[x] = (uint8_t)(1 + max_u8(R->height[a], R->height[b]));
-        bnode_costs(bn, x);
-    }
-}
-
-/* Put x where child `from` of p was (p FR_NONE: as the root). */
-static void reins_replace(reins *R, uint32_t p, uint32_t from, uint32_t x)
-{
-    R->up[x] = p;
-    if (p == FR_NONE)
-        R->root = x;
-    else
-        R->bn[p].kid[R->bn[p].kid[0] == from ? 0 : 1] = x;
-}
-
-/* Take subtree x (not the root's child) out of the tree: its parent goes,
- * the sibling takes the parent's place. */
-static void reins_detach(reins *R, uint32_t x)
-{
-    uint32_t p = R->up[x], g = R->up[p];
-    reins_replace(R, g, p, R->bn[p].kid[R->bn[p].kid[0] == x ? 1 : 0]);
-    reins_update(R, g);
-    R->up[x] = R->up[p] = FR_NONE;
-}
-
-/* Put subtree n beside x under the free node p (n its first child if
- * n_first). */
-static void reins_attach(reins *R, uint32_t n, uint32_t x, uint32_t p, int n_first)
-{
-    reins_replace(R, R->up[x], x, p);
-    R->bn[p].kid[0] = n_first ? n : x;
-    R->bn[p].kid[1] = n_first ? x : n;
-    R->up[x] = R->up[n] = p;
-    reins_update(R, p);
-}
-
-/* The cheapest place for subtree n (out of the tree) as above: the node to
- * put it beside, FR_NONE if there is none within the depth; *cost gets the
- * growth of the inner area there. */
-static uint32_t reins_search(reins *R, uint32_t n, float *cost)
-{
-    const bnode *bn = R->bn;
-    box4 nb = bn[n].box;
-    float an = R->area[n], best = INFINITY;
-    uint32_t best_x = FR_NONE, hn = R->height[n];
-    R->nh = 0;
-    reins_push(R, (reins_item){0.0f, R->root, 1});
-    while (R->nh > 0) {
-        reins_item it = reins_pop(R);
-        if (!(it.c + an < best))
-            break;
-        uint32_t x = it.node, h = R->height[x] > hn ? R->height[x] : hn;
-        box4 u = bn[x].box;
-        box_grow(&u, nb);
-        float au = half_area(u), total = it.c + au;
-        if (total < best && it.depth + h <= FR_BVH_MAX_DEPTH) {
-            best = total;
-            best_x = x;
-        }
-        if (bn[x].is_leaf)
-            continue;
-        float c = it.c + (au - R->area[x]);
-        if (c + an < best)
-            for (int k = 0; k < 2; k++)
-                reins_push(R, (reins_item){c, bn[x].kid[k], it.depth + 1});
-    }
-    *cost = best;
-    return best_x;
-}
-
-/* The growth of the inner area from putting subtree n beside x, added up
- * as reins_search adds it. */
-static float reins_cost_at(const reins *R, uint32_t n, uint32_t x)
-{
-    uint32_t path[256];
-    int np = 0;
-    for (uint32_t y = R->up[x]; y != FR_NONE && np < 256; y = R->up[y])
-        path[np++] = y;
-    box4 nb = R->bn[n].box;
-    float c = 0.0f;
-    while (np > 0) {
-        uint32_t y = path[--np];
-        box4 u = R->bn[y].box;
-        box_grow(&u, nb);
-        c = c + (half_area(u) - R->area[y]);
-    }
-    box4 u = R->bn[x].box;
-    box_grow(&u, nb);
-    return c + half_area(u);
-}
-
-/* The cost of binary node v emitted as the root (a wide node, as
- * emit_node makes it). */
-static float bnode_root_cost(const bnode *bn, uint32_t v)
-{
-    const bnode *n = &bn[v];
-    if (n->is_leaf)
-        return n->cost[0];
-    float best = INFINITY;
-    for (int k = 1; k < FR_BVH_WIDTH; k++) {
-        float c = bn[n->kid[0]].cost[k - 1] + bn[n->kid[1]].cost[FR_BVH_WIDTH - k - 1];
-        best = c < best ? c : best;
-    }
-    return half_area(n->box) * TRAV_COST + best;
-}
-
-/* Whether a move from cost `before` is kept: the root's cost falls by more
- * than rounding. */
-static int reins_better(const reins *R, float before)
-{
-    return bnode_root_cost(R->bn, R->root) < before * 0.999999f;
-}
-
-/* Move leaf n; returns whether it moved. */
-static int reins_move(reins *R, uint32_t n)
-{
-    uint32_t p = R->up[n];
-    int n_first = R->bn[p].kid[0] == n;
-    uint32_t s = R->bn[p].kid[n_first ? 1 : 0];
-    float before = bnode_root_cost(R->bn, R->root), cost;
-    reins_detach(R, n);
-    float stay = reins_cost_at(R, n, s);
-    uint32_t x = reins_search(R, n, &cost);
-    if (x != FR_NONE && x != s && cost < stay) {
-        reins_attach(R, n, x, p, 0);
-        if (reins_better(R, before))
-            return 1;
-        reins_detach(R, n);
-    }
-    reins_attach(R, n, s, p, n_first);
-    return 0;
-}
-
-/* Summed area of y and its ancestors. */
-static float reins_path_area(const reins *R, uint32_t y)
-{
-    float sum = 0.0f;
-    for (; y != FR_NONE; y = R->up[y])
-        sum += R->area[y];
-    return sum;
-}
-
-/* Take inner node n out with its parent and put its children back;
- * returns whether that was kept. */
-static int reins_split(reins *R, uint32_t n)
-{
-    bnode *bn = R->bn;
-    uint32_t p = R->up[n], g = R->up[p], a = bn[n].kid[0], b = bn[n].kid[1];
-    int n_first = bn[p].kid[0] == n;
-    uint32_t s = bn[p].kid[n_first ? 1 : 0];
-    float before = bnode_root_cost(bn, R->root), area_before = reins_path_area(R, n);
-    reins_detach(R, n);
-    float area_after = reins_path_area(R, g);
-    R->up[a] = R->up[b] = FR_NONE;
-    uint32_t first = R->area[a] >= R->area[b] ? a : b, second = first == a ? b : a;
-    /* Beside s is where first was, within the depth; where second finds
-     * no place within it, all is undone. */
-    float c1, c2;
-    uint32_t x1 = reins_search(R, first, &c1);
-    if (x1 == FR_NONE)
-        c1 = reins_cost_at(R, first, x1 = s);
-    reins_attach(R, first, x1, n, 0);
-    uint32_t x2 = reins_search(R, second, &c2);
-    int undo = x2 == FR_NONE;
-    reins_attach(R, second, undo ? first : x2, p, 0);
-    if (!undo && area_before - area_after > c1 + c2 && reins_better(R, before))
-        return 1;
-    reins_detach(R, second);
-    reins_detach(R, first);
-    bn[n].kid[0] = a;
-    bn[n].kid[1] = b;
-    R->up[a] = R->up[b] = n;
-    R->up[n] = FR_NONE;
-    reins_update(R, n);
-    reins_attach(R, n, s, p, n_first);
-    return 0;
-}
-
-typedef struct {
-    float score;
-    uint32_t node;
-} reins_cand;
-
-/* Worst first, ties to the lower index (a total order: qsort's algorithm
- * does not matter). */
-static int reins_cand_cmp(const void *a, const void *b)
-{
-    const reins_cand *x = a, *y = b;
-    if (x->score != y->score)
-        return x->score > y->score ? -1 : 1;
-    return x->node < y->node ? -1 : x->node > y->node;
-}
-
-/* One pass (cand: scratch for every node). */
-static void reins_pass(reins *R, reins_cand *cand)
-{
-    const bnode *bn = R->bn;
-    uint32_t nc = 0;
-    for (uint32_t i = 0; i < R->n; i++) {
-        uint32_t p = R->up[i];
-        if (p == FR_NONE || R->up[p] == FR_NONE)
-            continue;
-        uint32_t s = bn[p].kid[bn[p].kid[0] == i ? 1 : 0];
-        float score = R->area[p] / (R->area[s] + R->area[i]) * R->area[p];
-        cand[nc++] = (reins_cand){score == score ? score : 0.0f, i};   /* 0/0: flat boxes */
-    }
-    qsort(cand, nc, sizeof *cand, reins_cand_cmp);
-    for (uint32_t k = 0; k < nc / REINS_SHARE; k++) {
-        uint32_t n = cand[k].node, p = R->up[n];
-        if (p == FR_NONE || R->up[p] == FR_NONE)   /* now a child of the root */
-            continue;
-        if (bn[n].is_leaf)
-            reins_move(R, n);
-        else
-            reins_split(R, n);
-    }
-}
-
-/* Reinsertion over the binary tree at *root (its costs as bin_build left
- * them); *root may change.  Returns 0, or -1 with B->err set on memory
- * exhaustion. */
-static int bvh_reinsert(build *B, uint32_t *root)
-{
-    uint32_t n = B->n_bn;
-    if (n < 7)
-        return 0;
-    reins R = {0};
-    R.bn = B->bn;
-    R.n = n;
-    R.root = *root;
-    R.area = malloc((size_t)n * sizeof *R.area);
-    R.up = malloc((size_t)n * sizeof *R.up);
-    R.height = malloc(n);
-    R.heap = malloc((size_t)n * sizeof *R.heap);
-    reins_cand *cand = malloc((size_t)n * sizeof *cand);
-    int rc = 0;
-    if (!R.area || !R.up || !R.height || !R.heap || !cand) {
-        rc = fr_fail(B->err, "out of memory for the BVH reinsertion (%u nodes)", n);
-        goto done;
-    }
-    /* bin_build numbers a node before its children: from the back, children
-     * come first. */
-    for (uint32_t i = n; i-- > 0;) {
-        const bnode *v = &R.bn[i];
-        R.up[i] = FR_NONE;
-        R.height[i] = 1;
-        if (!v->is_leaf) {
-            R.height[i] = (uint8_t)(1 + max_u8(R.height[v->kid[0]], R.height[v->kid[1]]));
-            R.up[v->kid[0]] = R.up[v->kid[1]] = i;
-        }
-        R.area[i] = half_area(v->box);
-    }
-    for (int pass = 0; pass < REINS_PASSES; pass++) {
-        float before = bnode_root_cost(R.bn, R.root);
-        reins_pass(&R, cand);
-        if (!(bnode_root_cost(R.bn, R.root) < before * (1.0f - REINS_STOP)))
-            break;
-    }
-    *root = R.root;
-done:
-    free(R.area);
-    free(R.up);
-    free(R.height);
-    free(R.heap);
-    free(cand);
-    return rc;
-}
-
 /* The slots of binary node v given as at most j slots, appended to
  * slot[*ns]. */
-static void gather_slots(const bnode *bn, uint32_t v, int j, uint32_t *slot, int *ns)
+static void gather_slots(const bvh2_node *bn, uint32_t v, int j, uint32_t *slot, int *ns)
 {
     while (j > 1 && !bn[v].is_leaf && bn[v].pick[j - 1] == 0)
         j--;
@@ -1029,7 +596,7 @@ static void gather_slots(const bnode *bn, uint32_t v, int j, uint32_t *slot, int
  * B->tid[*n]. */
 static void gather_refs(build *B, uint32_t v, uint32_t *n)
 {
-    const bnode *x = &B->bn[v];
+    const bvh2_node *x = &B->bn[v];
     if (!x->is_leaf) {
         gather_refs(B, x->kid[0], n);
         gather_refs(B, x->kid[1], n);
@@ -1101,7 +668,7 @@ static int emit_node(build *B, uint32_t v, uint32_t *index)
         return fr_fail(B->err, "out of memory for the BVH nodes");
     uint32_t slot[FR_BVH_WIDTH];
     int ns = 0;
-    const bnode *x = &B->bn[v];
+    const bvh2_node *x = &B->bn[v];
     if (x->is_leaf) {
         slot[ns++] = v;
     } else {
@@ -1110,7 +677,7 @@ static int emit_node(build *B, uint32_t v, uint32_t *index)
     }
     for (int i = 0; i < FR_BVH_WIDTH; i++) {
         fr_bvh_node *nd = (fr_bvh_node *)B->nodes->data + me;
-        box4 bx = i < ns ? B->bn[slot[i]].box : box_empty();
+        bvh2_box bx = i < ns ? B->bn[slot[i]].box : bvh2_box_empty();
         /* + 0 makes a zero bound +0: where -0 meets +0, SSE's and NEON's
          * min and max return different zeros, and the bytes must not
          * depend on the machine. */
@@ -1146,13 +713,13 @@ int bvh_build(fr_builder *b, fr_array *nodes, fr_array *leaves, uint32_t **place
 static double sah_node(const fr_bvh_node *nodes, uint32_t n_nodes, uint32_t v, double area, int depth)
 {
     const fr_bvh_node *x = &nodes[v];
-    double c = area * TRAV_COST;
+    double c = area * BVH2_TRAV_COST;
     for (int i = 0; i < FR_BVH_WIDTH && depth < FR_BVH_MAX_DEPTH; i++) {
         if (x->child[i] == FR_NONE)
             continue;
         f4 d = {x->box[3][i] - x->box[0][i], x->box[4][i] - x->box[1][i], x->box[5][i] - x->box[2][i], 0.0f};
         double a = (double)d[0] * d[1] + (double)d[1] * d[2] + (double)d[2] * d[0];
-        c += a * SLOT_COST;
+        c += a * BVH2_SLOT_COST;
         if (x->leaf[i])
             c += a * (double)(x->leaf[i] & FR_BVH_LEAF_MAX);
         else if (x->child[i] > v && x->child[i] < n_nodes)
@@ -1211,18 +778,18 @@ int bvh_build_with(fr_builder *b, const bvh_options *opt, fr_array *nodes, fr_ar
         if (!isfinite(lo.x) || !isfinite(lo.y) || !isfinite(lo.z) || !isfinite(hi.x) || !isfinite(hi.y) ||
             !isfinite(hi.z))
             rc = fr_fail(err, "primitive %u has non-finite bounds", i);
-        B.box[i] = (box4){{lo.x, lo.y, lo.z, 0.0f}, {hi.x, hi.y, hi.z, 0.0f}};
+        B.box[i] = (bvh2_box){{lo.x, lo.y, lo.z, 0.0f}, {hi.x, hi.y, hi.z, 0.0f}};
         B.id[i] = i;
         B.out_of[i] = FR_NONE;
     }
     if (rc == 0) {
-        span all = {0, n, cap, box_empty(), box_empty(), 0};
+        span all = {0, n, cap, bvh2_box_empty(), bvh2_box_empty(), 0};
         span_bounds(&B, &all);
-        B.min_overlap = half_area(all.box) * OVERLAP;
+        B.min_overlap = bvh2_area(all.box) * OVERLAP;
         uint32_t broot, root;
         rc = bin_build(&B, &all, 1, 0, &broot);
         if (rc == 0 && reinsert)
-            rc = bvh_reinsert(&B, &broot);
+            rc = bvh_reinsert(B.bn, B.n_bn, &broot, err);
         if (rc == 0)
             rc = emit_node(&B, broot, &root);
     }

@@ -16,11 +16,12 @@
  * branch and bound from the root, keeping a move only where the collapse's
  * cost of the whole tree falls: a pass over the twentieth of the nodes
  * that enlarge their parent most, up to three passes while one gains
- * 1 % of the cost.  The binary tree is then
+ * 1 % of the cost (bvh_reinsert.h).  The binary tree is then
  * collapsed to the 8-wide one at the least SAH cost (dynamic programming
  * over each subtree: which descendants become a node's up to eight
  * children, which subtrees become leaves of up to four blocks, their
- * references packed into full blocks).  It is single-threaded and uses
+ * references packed into full blocks; the tree and its cost model are in
+ * bvh2.h).  It is single-threaded and uses
  * only exactly rounded float operations, so a scene gives the same bytes
  * on every machine.
  */

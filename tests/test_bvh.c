@@ -13,7 +13,9 @@
  * bvh_validate, name a primitive at most once per leaf and leave lanes
  * empty only in a leaf's last block.  Where there are two
  * traversals (x86-64 with AVX2), both are checked.  Trees built with and
- * without reinsertion are compared by their SAH cost. */
+ * without reinsertion are compared by their SAH cost, and reinsertion is
+ * run alone (bvh_reinsert.h) on a poor binary tree, whose every node,
+ * leaf, box and cost it must keep consistent. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +24,7 @@
 #include "bsdf.h"
 #include "bvh.h"
 #include "bvh_build.h"
+#include "bvh_reinsert.h"
 #include "check.h"
 #include "fbin.h"
 #include "freeze.h"
@@ -405,6 +408,109 @@ static void reinsertion(const char *name, int which, int n, double gain)
     }
 }
 
+/* A binary tree over `leaves` small random boxes, paired in their random
+ * order (so spatially poor: reinsertion has much to gain), numbered as the
+ * build numbers it (a node before its children), costs set.  Leaf i holds
+ * references [4 i, 4 i + 4).  Returns the root. */
+static uint32_t poor_tree(bvh2_node *bn, uint32_t *n, uint32_t first, uint32_t count)
+{
+    uint32_t me = (*n)++;
+    memset(&bn[me], 0, sizeof bn[me]);
+    if (count == 1) {
+        vec3 c = rnd_vec(-1.0f, 1.0f), e = rnd_vec(0.01f, 0.05f);
+        bn[me].box = (bvh2_box){{c.x - e.x, c.y - e.y, c.z - e.z, 0.0f}, {c.x + e.x, c.y + e.y, c.z + e.z, 0.0f}};
+        bn[me].kid[0] = 4 * first;
+        bn[me].kid[1] = 4 * first + 4;
+        bn[me].refs = 4;
+        bn[me].is_leaf = 1;
+    } else {
+        uint32_t a = poor_tree(bn, n, first, count / 2), b = poor_tree(bn, n, first + count / 2, count - count / 2);
+        bn[me].kid[0] = a;
+        bn[me].kid[1] = b;
+        bn[me].box = bn[a].box;
+        bvh2_box_grow(&bn[me].box, bn[b].box);
+        bn[me].refs = bn[a].refs + bn[b].refs;
+    }
+    bvh2_costs(bn, me);
+    return me;
+}
+
+/* Walk the binary tree from v: every node reached once, each inner node's
+ * box, references and costs as its children give them (bvh2_costs again,
+ * bit for bit), leaves' reference ranges marked in *ranges.  Returns the
+ * depth under v (1 for a leaf), or -1 on a fault. */
+static int check_tree(const bvh2_node *bn, uint32_t n, uint32_t v, uint8_t *seen, uint8_t *ranges, uint32_t n_ranges)
+{
+    if (v >= n || seen[v]++)
+        return -1;
+    const bvh2_node *x = &bn[v];
+    bvh2_node again[3];
+    if (x->is_leaf) {
+        uint32_t r = x->kid[0] / 4;
+        if (x->kid[1] != x->kid[0] + 4 || r >= n_ranges || ranges[r]++)
+            return -1;
+        again[0] = *x;
+        bvh2_costs(again, 0);
+        return memcmp(again[0].cost, x->cost, sizeof x->cost) ? -1 : 1;
+    }
+    int da = check_tree(bn, n, x->kid[0], seen, ranges, n_ranges), db = check_tree(bn, n, x->kid[1], seen, ranges, n_ranges);
+    if (da < 0 || db < 0)
+        return -1;
+    again[0] = *x;
+    again[0].kid[0] = 1;
+    again[0].kid[1] = 2;
+    again[1] = bn[x->kid[0]];
+    again[2] = bn[x->kid[1]];
+    bvh2_box box = again[1].box;
+    bvh2_box_grow(&box, again[2].box);
+    if (memcmp(&box, &x->box, sizeof box) || x->refs != again[1].refs + again[2].refs)
+        return -1;
+    bvh2_costs(again, 0);
+    if (memcmp(again[0].cost, x->cost, sizeof x->cost) || again[0].as_leaf != x->as_leaf)
+        return -1;
+    return 1 + (da > db ? da : db);
+}
+
+/* bvh_reinsert through its own header, on a tree it can improve much: the
+ * same nodes relinked into one tree that reaches each once, every leaf
+ * with its references, boxes and costs consistent with the children,
+ * within the depth, the root's cost lower; the same result twice; a tree
+ * of fewer than seven nodes left alone. */
+static void reinsert_contract(void)
+{
+    enum { LEAVES = 500, NODES = 2 * LEAVES - 1 };
+    bvh2_node *bn = malloc(NODES * sizeof *bn), *copy = malloc(NODES * sizeof *copy);
+    uint8_t *seen = malloc(NODES), *ranges = malloc(LEAVES);
+    uint32_t n = 0, root = poor_tree(bn, &n, 0, LEAVES), root2 = root;
+    memcpy(copy, bn, NODES * sizeof *bn);
+    float before = bvh2_root_cost(bn, root);
+    fr_error err;
+    int rc = bvh_reinsert(bn, n, &root, &err), rc2 = bvh_reinsert(copy, n, &root2, &err);
+    CHECK(rc == 0 && rc2 == 0 && n == NODES, "reinsert: failed (%d, %d) or %u nodes", rc, rc2, n);
+    memset(seen, 0, NODES);
+    memset(ranges, 0, LEAVES);
+    int depth = check_tree(bn, n, root, seen, ranges, LEAVES), all = 1;
+    for (uint32_t i = 0; i < NODES; i++)
+        all &= seen[i] == 1;
+    for (uint32_t i = 0; i < LEAVES; i++)
+        all &= ranges[i] == 1;
+    CHECK(depth > 0 && all, "reinsert: not one consistent tree over every node and leaf (depth %d)", depth);
+    CHECK(depth <= FR_BVH_MAX_DEPTH, "reinsert: depth %d", depth);
+    float after = bvh2_root_cost(bn, root);
+    CHECK(after < before * 0.9f, "reinsert: root cost %.4f from %.4f, less than 10 %% gained", after, before);
+    CHECK(root == root2 && !memcmp(bn, copy, NODES * sizeof *bn), "reinsert: two runs differ");
+    n = 0;
+    root = poor_tree(bn, &n, 0, 3);
+    memcpy(copy, bn, n * sizeof *bn);
+    root2 = root;
+    CHECK(bvh_reinsert(bn, n, &root, &err) == 0 && root == root2 && !memcmp(bn, copy, n * sizeof *bn),
+          "reinsert: a tree of %u nodes changed", n);
+    free(bn);
+    free(copy);
+    free(seen);
+    free(ranges);
+}
+
 /* Zero bounds are stored as +0: where -0 meets +0, SSE and NEON min and
  * max return different zeros, so without that a mesh with -0 coordinates
  * would give other bytes on arm64 than on amd64. */
@@ -443,6 +549,7 @@ static void signed_zeros(void)
 int main(void)
 {
     signed_zeros();
+    reinsert_contract();
     reinsertion("reinsertion, soup", 0, 3000, 0.0);
     reinsertion("reinsertion, grid", 1, 60, 0.0);
     reinsertion("reinsertion, slivers", 2, 4000, 0.03);
