@@ -16,9 +16,16 @@
 static inline f4 ln_from(vec3 v) { return (f4){v.x, v.y, v.z, 0.0f}; }
 /** Lanes 0-2 of v as a vector. */
 static inline vec3 ln_vec(f4 v) { return v3(v[0], v[1], v[2]); }
-/** The lanes turned: (y, z, x) and (z, x, y), lane 3 kept. */
+/** The lanes turned: (y, z, x) and (z, x, y), lane 3 kept.  Clang (the
+ * fuzz build) spells GCC's lane shuffle otherwise; both move the same
+ * lanes. */
+#ifdef __clang__
+static inline f4 ln_yzx(f4 v) { return __builtin_shufflevector(v, v, 1, 2, 0, 3); }
+static inline f4 ln_zxy(f4 v) { return __builtin_shufflevector(v, v, 2, 0, 1, 3); }
+#else
 static inline f4 ln_yzx(f4 v) { return __builtin_shuffle(v, (i4){1, 2, 0, 3}); }
 static inline f4 ln_zxy(f4 v) { return __builtin_shuffle(v, (i4){2, 0, 1, 3}); }
+#endif
 /** v3_cross of lanes 0-2. */
 static inline f4 ln_cross(f4 a, f4 b) { return ln_yzx(a) * ln_zxy(b) - ln_zxy(a) * ln_yzx(b); }
 /** v3_norm of lanes 0-2: scaled by 1 / sqrt(x x + y y + z z). */
