@@ -227,20 +227,59 @@ static int parse_line(hosts_entry *h, char **w, int nw, const char *path, int li
     return 0;
 }
 
+/* A host's name and where it is, for finding repeated names. */
+typedef struct {
+    const char *name;
+    int line, i;
+} name_at;
+
+static int by_name(const void *a, const void *b)
+{
+    const name_at *x = a, *y = b;
+    int c = strcmp(x->name, y->name);
+    return c ? c : (x->line > y->line) - (x->line < y->line);
+}
+
+/* The entry of t that repeats an earlier name on the lowest line, or -1
+ * (-2 out of memory); *first is the earlier one.  Sorting keeps this
+ * O(n log n): a table of many hosts must not take minutes to read. */
+static int first_duplicate(const hosts_table *t, int *first)
+{
+    name_at *v = malloc((size_t)(t->n ? t->n : 1) * sizeof *v);
+    if (!v)
+        return -2;
+    for (int i = 0; i < t->n; i++)
+        v[i] = (name_at){t->v[i].name, t->v[i].line, i};
+    qsort(v, (size_t)t->n, sizeof *v, by_name);
+    int dup = -1;
+    /* The second of each run of one name, the first of the run before it. */
+    for (int i = 1; i < t->n; i++)
+        if (!strcmp(v[i].name, v[i - 1].name) && (i < 2 || strcmp(v[i - 2].name, v[i].name)) &&
+            (dup < 0 || v[i].line < t->v[dup].line)) {
+            dup = v[i].i;
+            *first = v[i - 1].i;
+        }
+    free(v);
+    return dup;
+}
+
 int hosts_parse(const char *text, const char *path, hosts_table *t, fr_error *err)
 {
     memset(t, 0, sizeof *t);
     snprintf(t->path, sizeof t->path, "%s", path);
-    int cap = 0, line = 0;
+    int cap = 0, line = 0, bad = 0;
     const char *p = text;
     char buf[HOSTS_MAX_LINE];
+    fr_error why;
+    /* Every line is read up to the first bad one; a name repeated before
+     * it is the first error, else that line's. */
     while (*p) {
         line++;
         const char *nl = strchr(p, '\n');
         size_t len = nl ? (size_t)(nl - p) : strlen(p);
         if (len >= sizeof buf) {
-            hosts_free(t);
-            return fr_fail(err, "%s:%d: line longer than %d characters", path, line, HOSTS_MAX_LINE - 1);
+            bad = fr_fail(&why, "%s:%d: line longer than %d characters", path, line, HOSTS_MAX_LINE - 1);
+            break;
         }
         memcpy(buf, p, len);
         buf[len] = 0;
@@ -250,31 +289,44 @@ int hosts_parse(const char *text, const char *path, hosts_table *t, fr_error *er
         if (nw == 0)
             continue;
         if (nw > 32) {
-            hosts_free(t);
-            return fr_fail(err, "%s:%d: too many fields", path, line);
+            bad = fr_fail(&why, "%s:%d: too many fields", path, line);
+            break;
+        }
+        if (t->n == HOSTS_MAX_HOSTS) {
+            bad = fr_fail(&why, "%s:%d: more than %d hosts", path, line, HOSTS_MAX_HOSTS);
+            break;
         }
         if (t->n == cap) {
             cap = cap ? cap * 2 : 8;
             hosts_entry *v = realloc(t->v, (size_t)cap * sizeof *v);
             if (!v) {
-                hosts_free(t);
-                return fr_fail(err, "%s:%d: out of memory", path, line);
+                bad = fr_fail(&why, "%s:%d: out of memory", path, line);
+                break;
             }
             t->v = v;
         }
-        hosts_entry *h = &t->v[t->n];
-        if (parse_line(h, w, nw, path, line, err)) {
-            hosts_free(t);
-            return -1;
+        if (parse_line(&t->v[t->n], w, nw, path, line, &why)) {
+            bad = -1;
+            break;
         }
-        for (int i = 0; i < t->n; i++)
-            if (!strcmp(t->v[i].name, h->name)) {
-                int first = t->v[i].line;
-                hosts_free(t);
-                return fr_fail(err, "%s:%d: duplicate host name '%s' (first defined on line %d)", path,
-                               line, w[0], first);
-            }
         t->n++;
+    }
+    int first = -1, dup = first_duplicate(t, &first);
+    if (dup == -2) {
+        hosts_free(t);
+        return fr_fail(err, "%s: out of memory", path);
+    }
+    if (dup >= 0) {
+        int at = t->v[dup].line, was = t->v[first].line;
+        char name[sizeof t->v[dup].name];
+        memcpy(name, t->v[dup].name, sizeof name);
+        hosts_free(t);
+        return fr_fail(err, "%s:%d: duplicate host name '%s' (first defined on line %d)", path, at, name, was);
+    }
+    if (bad) {
+        hosts_free(t);
+        *err = why;
+        return -1;
     }
     if (t->n == 0) {
         hosts_free(t);

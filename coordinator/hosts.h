@@ -21,6 +21,9 @@
 /** Most worker processes one host may run (cores, and franja render -j). */
 #define HOSTS_MAX_CORES 4096
 
+/** Most hosts one table may name. */
+#define HOSTS_MAX_HOSTS 65536
+
 /** The scene cache limit of a host whose line gives no cache= (10 GiB). */
 #define HOSTS_CACHE_DEFAULT (10ull << 30)
 
@@ -57,8 +60,10 @@ typedef struct {
 } hosts_table;
 
 /** Parses `text` (NUL-terminated) as a host table named `path` in messages.
- * Fails with "path:line: what was expected" on the first bad line, on a
- * duplicate name and on a table without hosts.  On failure *t is empty. */
+ * Fails with "path:line: what was expected" on the first bad line (a
+ * name given on an earlier line is one, as is a host past
+ * HOSTS_MAX_HOSTS) and on a table without hosts.  On failure *t is
+ * empty. */
 int hosts_parse(const char *text, const char *path, hosts_table *t, fr_error *err);
 
 /** Reads and parses the file at `path` (see hosts_parse). */

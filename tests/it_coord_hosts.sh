@@ -63,6 +63,22 @@ table_error "empty table" "t: no hosts" "# nothing\n\n"
 table_error "binary junk" "t: binary data" "a h - 2\n\000\001\n"
 table_error "overlong line" "t:1: line longer than" "$(head -c 5000 /dev/zero | tr '\0' a)\n"
 table_error "overlong field" "t:1: worker is longer than" "a h - 2 worker=/$(head -c 600 /dev/zero | tr '\0' a)\n"
+table_error "the first repeated name" "t:4: duplicate host name 'b' (first defined on line 2)" \
+    "a h - 1\nb h - 1\nc h - 1\nb h - 1\na h - 1\nc h - 1\n"
+table_error "a repeated name before a bad line" "t:3: duplicate host name 'a'" "a h - 1\n\na h - 1\nb h\n"
+table_error "a bad line before a repeated name" "t:2: missing user" "a h - 1\nb h\na h - 1\n"
+
+# A table of at most 65536 hosts is read at once (repeated names are
+# found by sorting them, not by comparing every pair); one more host is
+# refused, so that no table takes unbounded memory or minutes to read.
+awk 'BEGIN { for (i = 65535; i >= 0; i--) printf "h%07d local - 1\n", i }' >"$T/many"
+expect_status "65536 hosts" 0 -E "^h0065535 +local" "$FRANJA" hosts list --hosts "$T/many"
+{ sed '$d' "$T/many"; echo "h0000007 local - 2"; } >"$T/dup-last"
+expect_status "a repeated name on line 65536" 2 -F \
+    "dup-last:65536: duplicate host name 'h0000007' (first defined on line 65529)" \
+    "$FRANJA" hosts list --hosts "$T/dup-last"
+echo "x local - 1" >>"$T/many"
+expect_status "65537 hosts" 2 -F "many:65537: more than 65536 hosts" "$FRANJA" hosts list --hosts "$T/many"
 
 expect_status "missing file" 2 -F "missing: cannot open host table" "$FRANJA" hosts list --hosts "$T/missing"
 # The render command reports the same errors before doing anything.
