@@ -229,6 +229,70 @@ int stage_try_upload(tr_host *h, fr_error *err)
     return rc;
 }
 
+/* The bytes of a line of out[0..len) from *i, without its newline, into
+ * *line and *n; *i moves past the newline. */
+static void next_line(const char *out, size_t len, size_t *i, const char **line, size_t *n)
+{
+    const char *s = out + *i, *nl = memchr(s, '\n', len - *i);
+    *line = s;
+    *n = nl ? (size_t)(nl - s) : len - *i;
+    *i += *n + (nl != NULL);
+}
+
+/* Adds the decimal number s[0..n) to *sum, saturating; -1 unless s[0..n)
+ * is one or more digits. */
+static int add_number(const char *s, size_t n, uint64_t *sum)
+{
+    uint64_t v = 0;
+    if (n == 0)
+        return -1;
+    for (size_t k = 0; k < n; k++) {
+        if (s[k] < '0' || s[k] > '9')
+            return -1;
+        v = v > UINT64_MAX / 10 ? UINT64_MAX : v * 10 + (uint64_t)(s[k] - '0');
+    }
+    *sum = *sum > UINT64_MAX - v ? UINT64_MAX : *sum + v;
+    return 0;
+}
+
+int stage_parse_evicted(const char *out, size_t len, int *removed, uint64_t *bytes, fr_error *err)
+{
+    *removed = 0;
+    *bytes = 0;
+    for (size_t i = 0, line = 1; i < len; line++) {
+        const char *s;
+        size_t n;
+        next_line(out, len, &i, &s, &n);
+        const char *sp = n ? memchr(s, ' ', n) : NULL;
+        if (!sp || sp == s || add_number(sp + 1, n - (size_t)(sp + 1 - s), bytes))
+            return fr_fail(err, "line %zu: expected 'NAME BYTES', got '%.*s'", line, (int)(n < 80 ? n : 80), s);
+        if (*removed < INT_MAX)
+            (*removed)++;
+    }
+    return 0;
+}
+
+int stage_parse_cache(const char *out, size_t len, int *files, uint64_t *bytes, fr_error *err)
+{
+    *files = 0;
+    *bytes = 0;
+    for (size_t i = 0, line = 1; i < len; line++) {
+        const char *s;
+        size_t n;
+        next_line(out, len, &i, &s, &n);
+        /* wc -c pads its count with blanks on some systems. */
+        while (n && (*s == ' ' || *s == '\t'))
+            s++, n--;
+        while (n && (s[n - 1] == ' ' || s[n - 1] == '\t'))
+            n--;
+        if (add_number(s, n, bytes))
+            return fr_fail(err, "line %zu: expected a size in bytes", line);
+        if (*files < INT_MAX)
+            (*files)++;
+    }
+    return 0;
+}
+
 int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint64_t *bytes, fr_error *err)
 {
     *removed = 0;
@@ -251,11 +315,9 @@ int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint
     } else {
         size_t len;
         const char *out = (const char *)tr_proc_output(p, &len);
-        for (size_t i = 0; i < len; i++)
-            if (out[i] == ' ') {
-                (*removed)++;
-                *bytes += strtoull(out + i + 1, NULL, 10);
-            }
+        fr_error e;
+        if (stage_parse_evicted(out, len, removed, bytes, &e))
+            rc = fr_fail(err, "%s: keeping the scene cache within its limit: %s", tr_host_label(h), e.msg);
     }
     tr_proc_free(p);
     return rc;
@@ -307,27 +369,9 @@ int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err)
     } else {
         size_t len;
         const char *out = (const char *)tr_proc_output(p, &len);
-        for (size_t i = 0; i < len;) {
-            size_t j = i;
-            uint64_t v = 0;
-            int digits = 0;
-            while (j < len && out[j] != '\n') {
-                if (out[j] >= '0' && out[j] <= '9' && v < UINT64_MAX / 16) {
-                    v = v * 10 + (uint64_t)(out[j] - '0');
-                    digits++;
-                } else if (out[j] != ' ' && out[j] != '\t') {
-                    digits = -1000;
-                }
-                j++;
-            }
-            if (digits <= 0) {
-                rc = fr_fail(err, "%s: unexpected answer listing the scene cache", tr_host_label(h));
-                break;
-            }
-            (*files)++;
-            *bytes += v;
-            i = j + 1;
-        }
+        fr_error e;
+        if (stage_parse_cache(out, len, files, bytes, &e))
+            rc = fr_fail(err, "%s: unexpected answer listing the scene cache: %s", tr_host_label(h), e.msg);
     }
     tr_proc_free(p);
     return rc;
@@ -350,6 +394,7 @@ void stage_os_codename(const char *text, char *os)
                 n -= 2;
             }
             snprintf(os, 64, "%.*s", (int)(n < 63 ? n : 63), v);
+            proto_printable(os);
             return;
         }
         if (!end)
@@ -379,6 +424,7 @@ int stage_sysinfo(tr_host *h, char *arch, char *os, fr_error *err)
             rc = fr_fail(err, "%s: unexpected answer to uname -m", tr_host_label(h));
         else {
             snprintf(arch, 32, "%.*s", (int)n, text);
+            proto_printable(arch);
             stage_os_codename(text + n, os);
         }
         free(text);

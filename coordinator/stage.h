@@ -63,6 +63,12 @@ int stage_try_upload(tr_host *h, fr_error *err);
  * what went.  Nothing to do for a host without a work directory. */
 int stage_evict(tr_host *h, const char *keep, uint64_t limit, int *removed, uint64_t *bytes, fr_error *err);
 
+/** Reads what the host printed while trimming its cache (out[0..len), not
+ * NUL-terminated, NULL when len is 0): a line "NAME BYTES" for each scene
+ * removed.  Counts them into *removed and adds their sizes into *bytes
+ * (saturating).  Fails, naming the line, on a line of any other shape. */
+int stage_parse_evicted(const char *out, size_t len, int *removed, uint64_t *bytes, fr_error *err);
+
 /** What stage_clean did on one host. */
 typedef struct {
     int removed;       /**< scenes removed */
@@ -82,9 +88,16 @@ int stage_clean(tr_host *h, stage_cleaned *out, fr_error *err);
  * host without a work directory). */
 int stage_cache(tr_host *h, int *files, uint64_t *bytes, fr_error *err);
 
+/** Reads the host's cache listing (out[0..len), not NUL-terminated, NULL
+ * when len is 0): the size in bytes of each scene, a line each, blanks
+ * around it allowed.  Counts them into *files and adds them into *bytes
+ * (saturating).  Fails, naming the line, on a line of any other shape. */
+int stage_parse_cache(const char *out, size_t len, int *files, uint64_t *bytes, fr_error *err);
+
 /** What the host's system is, found without running its worker (so it works
  * before the first `franja deploy`): arch[32] from `uname -m`, os[64] the
- * VERSION_CODENAME of its /etc/os-release ("" when there is none). */
+ * VERSION_CODENAME of its /etc/os-release ("" when there is none); control
+ * characters in either are made '?' (proto_printable). */
 int stage_sysinfo(tr_host *h, char *arch, char *os, fr_error *err);
 
 /** Installs the local file at local_path on the host as WORKDIR/name,
@@ -94,7 +107,8 @@ int stage_install(tr_host *h, const char *local_path, const char *name, char *re
                   fr_error *err);
 
 /** Copies the VERSION_CODENAME of an os-release text (NUL-terminated) into
- * os[64], without quotes; "" if it has none. */
+ * os[64], without quotes, control characters made '?' (proto_printable);
+ * "" if it has none. */
 void stage_os_codename(const char *os_release, char *os);
 
 #endif

@@ -197,6 +197,8 @@ int tr_proc_add_out(tr_proc *p, const void *data, size_t n)
 {
     if (p->state != TR_RUNNING)
         return -1;
+    if (n == 0)
+        return 0;
     if (n > p->out_max - p->out_len) {
         tr_proc_fail(p, "sent more than the %zu bytes expected", p->out_max);
         p->kill_pending = 1;
