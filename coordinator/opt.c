@@ -156,7 +156,8 @@ int opt_fraction(const char *cmd, const char *opt, const char *v, float *out)
     char *end;
     errno = 0;
     double d = strtod(v, &end);
-    if (!errno && end != v && !*end && d > 0.0 && d <= 1.0) {
+    /* Above 0 as the float it becomes: 1e-50 would be 0, "not given". */
+    if (!errno && end != v && !*end && d > 0.0 && d <= 1.0 && (float)d > 0.0f) {
         *out = (float)d;
         return 0;
     }

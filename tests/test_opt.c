@@ -121,6 +121,8 @@ static void values(void)
     CHECK(opt_fraction("t", "--noise-threshold", "0", &x) == -1, "0 in (0, 1]");
     CHECK(opt_fraction("t", "--noise-threshold", "1.5", &x) == -1, "1.5 in (0, 1]");
     CHECK(opt_fraction("t", "--noise-threshold", "nan", &x) == -1, "nan in (0, 1]");
+    CHECK(opt_fraction("t", "--noise-threshold", "2E-144", &x) == -1, "2E-144 (0 as a float: not given) in (0, 1]");
+    CHECK(opt_fraction("t", "--noise-threshold", "1e-45", &x) == 0 && x > 0.0f, "1e-45 (the least float) in (0, 1]");
     double sc;
     CHECK(opt_scale("t", "--scale", "50%", &sc) == 0 && sc == 0.5, "50%%");
     CHECK(opt_scale("t", "--scale", "0.25", &sc) == 0 && sc == 0.25, "0.25");
