@@ -144,7 +144,9 @@ bin/bench/%: tests/bench/%.c $(LIB)
 	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
 
 # Fuzzing: libFuzzer targets tests/fuzz/fuzz_*.c, built with clang, ASan
-# and UBSan over the common sources, each run for FUZZ_SECONDS (tests/fuzz/run.sh).
+# and UBSan over the common sources, each run for FUZZ_SECONDS
+# (tests/fuzz/run.sh; it makes seeds with bin/franja and bin/franja-worker).
+# make test builds them too and runs each for a few seconds (tests/run.sh).
 FUZZ_SECONDS ?= 60
 FUZZ_CC      ?= clang
 FUZZ_CFLAGS   = -std=c17 -D_GNU_SOURCE -g -O1 $(FPFLAGS) -Icommon $(CJSON_CFLAGS) -fno-sanitize-recover=all
@@ -159,17 +161,18 @@ FUZZ_COORD_OBJ = $(filter-out $(B)/fuzz/coordinator/main.o,$(COORD_SRC:%.c=$(B)/
 
 $(B)/fuzz/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -c $< -o $@
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -MMD -MP -c $< -o $@
 
 $(FUZZ_COORD_LIB): $(FUZZ_COORD_OBJ)
 	rm -f $@ && $(AR) rcs $@ $^
 
 bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	@mkdir -p bin/fuzz
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -Icoordinator -fsanitize=fuzzer,address,undefined -o $@ $< $(FUZZ_COORD_LIB) \
-	    $(FUZZ_OBJ) $(CJSON_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -iquote coordinator -fsanitize=fuzzer,address,undefined -MMD -MP -MT $@ -MF $(B)/fuzz/$(@F).d \
+	    -o $@ $< $(FUZZ_COORD_LIB) \
+	    $(FUZZ_OBJ) $(CJSON_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) $(SSH_LIBS) $(MHD_LIBS) -ldl -lm -pthread
 
-fuzz: bin/franja $(FUZZ_BIN)
+fuzz: all $(FUZZ_BIN)
 	sh tests/fuzz/run.sh $(FUZZ_SECONDS)
 
 deps:
@@ -183,7 +186,7 @@ bench-deps:
 # make test runs the first part alone.
 check: test check-cross
 
-test: all $(TEST_BIN) $(TOOL_BIN)
+test: all $(TEST_BIN) $(TOOL_BIN) $(FUZZ_BIN)
 	sh tests/run.sh
 
 bench: all $(TOOL_BIN) $(BENCH_BIN)
@@ -278,4 +281,5 @@ check-cross: all static
 clean:
 	rm -rf $(B) bin
 
--include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d) $(TESTSUP_OBJ:.o=.d) $(IIO_OBJ:.o=.d)
+-include $(COMMON_OBJ:.o=.d) $(WORKER_OBJ:.o=.d) $(COORD_OBJ:.o=.d) $(TESTSUP_OBJ:.o=.d) $(IIO_OBJ:.o=.d) \
+    $(FUZZ_OBJ:.o=.d) $(FUZZ_COORD_OBJ:.o=.d) $(FUZZ_BIN:bin/fuzz/%=$(B)/fuzz/%.d)
