@@ -147,7 +147,9 @@ bin/bench/%: tests/bench/%.c $(LIB)
 # and UBSan over the common sources, each run for FUZZ_SECONDS
 # (tests/fuzz/run.sh; it makes seeds with bin/franja and bin/franja-worker).
 # make test builds them too and runs each for a few seconds (tests/run.sh).
+# FUZZ_TARGETS names some (hosts partial ...); default: all.
 FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?=
 FUZZ_CC      ?= clang
 FUZZ_CFLAGS   = -std=c17 -D_GNU_SOURCE -g -O1 $(FPFLAGS) -Icommon $(CJSON_CFLAGS) -fno-sanitize-recover=all
 FUZZ_SRC      = $(wildcard tests/fuzz/fuzz_*.c)
@@ -173,7 +175,7 @@ bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	    $(FUZZ_OBJ) $(CJSON_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) $(SSH_LIBS) $(MHD_LIBS) -ldl -lm -pthread
 
 fuzz: all $(FUZZ_BIN)
-	sh tests/fuzz/run.sh $(FUZZ_SECONDS)
+	sh tests/fuzz/run.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 deps:
 	sh tests/install-deps.sh

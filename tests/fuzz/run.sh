@@ -37,7 +37,8 @@
 # have fewer samples than its job file asks for, to be continued).  The
 # fuzzer reads at most MAX_LEN bytes of an input: example scenes that
 # compile to more (their textures) are left out, and a corpus scene that
-# does is an error.
+# does is an error.  What the last long campaign ran and found: README.md,
+# "Fuzzing".
 cd "$(dirname "$0")/../.." || exit 1
 SECS=${1:-60}
 [ $# -gt 0 ] && shift
