@@ -62,11 +62,24 @@ float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, flo
  * the winding.  Indexed by kz and that sign. */
 static const uint8_t frame_axes[3][2][2] = {{{1, 2}, {2, 1}}, {{2, 0}, {0, 2}}, {{0, 1}, {1, 0}}};
 
+/* The byte offsets in a node's box[][] of the rows a ray enters and
+ * leaves a child's box by, along x, y and z, indexed by the signs of its
+ * direction (bit a set where axis a is negative): entry rows first (the
+ * lower bound where the direction is positive), then exit rows. */
+#define ROW(a) ((size_t)(a) * sizeof(float[FR_BVH_WIDTH]))
+#define ROWS(nx, ny, nz) \
+    {ROW(0 + 3 * nx), ROW(1 + 3 * ny), ROW(2 + 3 * nz), ROW(3 - 3 * nx), ROW(4 - 3 * ny), ROW(5 - 3 * nz)}
+static const size_t box_rows[8][6] = {ROWS(0, 0, 0), ROWS(1, 0, 0), ROWS(0, 1, 0), ROWS(1, 1, 0),
+                                      ROWS(0, 0, 1), ROWS(1, 0, 1), ROWS(0, 1, 1), ROWS(1, 1, 1)};
+#undef ROWS
+#undef ROW
+
 /* Where the best hit so far is; `key` is the primitive that wins a tie at
  * t == best (lower indices win; 0 while nothing or only a plane was hit,
  * so nothing wins a tie with the ray's own tmax). */
 typedef struct {
     float best;
+    float far;                 /* best * FAR_SCALE, for the box tests */
     uint32_t key;
     fr_hit *hit;
     int found;
@@ -92,6 +105,7 @@ static inline int better(const hit_state *H, float t, uint32_t prim)
 static inline void record(hit_state *H, float t, uint32_t prim, float a, float b)
 {
     H->best = t;
+    H->far = t * FAR_SCALE;
     H->key = prim;
     H->found = 1;
     H->hit->t = t; H->hit->prim = prim; H->hit->plane = FR_NONE; H->hit->a = a; H->hit->b = b;
@@ -106,6 +120,21 @@ typedef struct { uint32_t child, leaf; float t; } stack_entry;
 #undef W
 #undef WALK_WIDE
 
+/* Each walk is a function of its own, so that trace_closest and
+ * trace_occluded stay a test and a jump: with a walk inlined into them,
+ * every call paid that walk's entry and exit (its saved registers, its
+ * aligned frame) before reaching the other copy. */
+static __attribute__((noinline)) int closest_base(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
+{
+    return walk_base(s, r, tmax, hit, 0, FR_NONE);
+}
+
+static __attribute__((noinline)) int occluded_base(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
+{
+    fr_hit h = {0};
+    return walk_base(s, r, tmax, &h, 1, skip);
+}
+
 #if TRACE_WIDE
 /* The same traversal with eight-lane box tests, for x86-64 processors with
  * AVX2, chosen at run time. */
@@ -117,14 +146,15 @@ typedef struct { uint32_t child, leaf; float t; } stack_entry;
 #undef W
 #undef WALK_WIDE
 
-static int closest_wide(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
+static __attribute__((noinline)) int closest_wide(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 {
     return walk_wide(s, r, tmax, hit, 0, FR_NONE);
 }
 
-static int occluded_wide(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *h, uint32_t skip)
+static __attribute__((noinline)) int occluded_wide(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
-    return walk_wide(s, r, tmax, h, 1, skip);
+    fr_hit h = {0};
+    return walk_wide(s, r, tmax, &h, 1, skip);
 }
 #pragma GCC pop_options
 
@@ -155,17 +185,16 @@ int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
     if (wide_on)
         return closest_wide(s, r, tmax, hit);
 #endif
-    return walk_base(s, r, tmax, hit, 0, FR_NONE);
+    return closest_base(s, r, tmax, hit);
 }
 
 int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
-    fr_hit h = {0};
 #if TRACE_WIDE
     if (wide_on)
-        return occluded_wide(s, r, tmax, &h, skip);
+        return occluded_wide(s, r, tmax, skip);
 #endif
-    return walk_base(s, r, tmax, &h, 1, skip);
+    return occluded_base(s, r, tmax, skip);
 }
 
 static inline void no_uv(fr_surface *out)
