@@ -216,6 +216,17 @@ static long rf_number(void *ctx, int frame)
     return frame >= 0 && frame < fx->nfr ? (long)fx->fr[frame]->one.number : PG_NO_FRAME;
 }
 
+static void rf_counts(void *ctx, int *done, int *frames, double *rows_ahead)
+{
+    anim_run *fx = ctx;
+    const frame_slot *last = fx->nfr ? fx->fr[fx->nfr - 1] : NULL;
+    *done = (int)(fx->it.rendered + fx->it.skipped);
+    *frames = (int)fx->it.fl.n;
+    /* The frames not looked at yet, each with the rows of the last one
+     * opened (some may be skipped: an estimate from above). */
+    *rows_ahead = last && last->im ? (double)(fx->it.fl.n - fx->it.i) * last->im->rows_job : 0;
+}
+
 static int rf_done(void *ctx, int frame, fr_error *err)
 {
     anim_run *fx = ctx;
@@ -292,7 +303,8 @@ int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
     sched_frame first;
     if (!rc && rf_open(&fx, &first) == 0) {
         char used[1024];
-        rr_frames hooks = {rf_next, rf_stage, rf_done, rf_rendered, rf_number, &fx, fx.deadline, &timed_out};
+        rr_frames hooks = {rf_next,   rf_stage, rf_done,     rf_rendered, rf_number,
+                           rf_counts, &fx,      fx.deadline, &timed_out};
         if (rr_run(a, &table, NULL, &fx.fr[0]->im->ps, fx.pg, fx.mon, used, sizeof used, &hooks, &err)) {
             if (!timed_out)
                 fprintf(stderr, "franja render: %s\n", err.msg);

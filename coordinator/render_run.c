@@ -162,7 +162,9 @@ static void draw(reporter *r, int force)
         return;
     r->last_draw = r->t;
     char line[1024];
-    sl_figures f = {r->t, r->done, r->total, (double)r->spec->width * r->spec->spp};
+    sl_figures f = {r->t, r->done, r->total, (double)r->spec->width * r->spec->spp, 0, 0, 0};
+    if (r->fx)
+        r->fx->counts(r->fx->ctx, &f.frames_done, &f.frames, &f.rows_ahead);
     sl_format(line, sizeof line, r->tty ? sl_columns(2) : 0, &f, r->hosts, r->nhosts);
     if (r->tty) {
         fprintf(stderr, "\r\033[K%s", line);

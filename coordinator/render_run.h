@@ -39,8 +39,8 @@ int rr_hosts(render_args *a, int argc, char **argv, hosts_table *table, slurm_al
 /** An animation's part of a run: the scheduler's frame hooks (sched.h,
  * called here with ctx); `number`, the frame number of the scheduler's
  * frame index (for the reporters' events); `rendered`, told of each
- * accepted slab which host rendered rows y0:y1 of which frame; and the
- * run's --time-limit.  The hooks print after rr_clear_line. */
+ * accepted slab which host rendered rows y0:y1 of which frame; `counts`,
+ * the frames for the status line; and the run's --time-limit.  The hooks print after rr_clear_line. */
 typedef struct {
     int (*next_frame)(void *ctx, int frame, sched_frame *next, fr_error *err);
     int (*stage)(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
@@ -48,6 +48,9 @@ typedef struct {
     int (*frame_done)(void *ctx, int frame, fr_error *err);
     void (*rendered)(void *ctx, int frame, int host, uint32_t y0, uint32_t y1);
     long (*number)(void *ctx, int frame);
+    /** For the status line: frames written or skipped, frames in the list,
+     * and the rows of those not started yet (estimated). */
+    void (*counts)(void *ctx, int *done, int *frames, double *rows_ahead);
     void *ctx;
     double deadline;           /**< clk_now() time at which the run stops (--time-limit); 0 = none */
     int *timed_out;            /**< set to 1 when the run stopped at deadline */

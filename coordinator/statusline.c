@@ -51,7 +51,8 @@ size_t sl_format(char *out, size_t cap, int cols, const sl_figures *f, const sch
     char part[400], d[32];
     size_t len = 0;
     out[0] = '\0';
-    snprintf(part, sizeof part, "rows %d/%d (%3.0f%%)", f->done, f->total,
+    int k = f->frames > 0 ? snprintf(part, sizeof part, "frames %d/%d ", f->frames_done, f->frames) : 0;
+    snprintf(part + k, sizeof part - (size_t)k, "rows %d/%d (%3.0f%%)", f->done, f->total,
              f->total ? 100.0 * f->done / f->total : 100.0);
     if (!append(out, cap, &len, limit, part)) {
         /* Not even that: cut it. */
@@ -66,8 +67,9 @@ size_t sl_format(char *out, size_t cap, int cols, const sl_figures *f, const sch
     snprintf(part, sizeof part, "  elapsed %s", d);
     if (!append(out, cap, &len, limit, part))
         return len;
-    if (rate > 0 && f->done < f->total) {
-        sl_duration((f->total - f->done) / rate, d, sizeof d);
+    double left = f->total - f->done + (f->frames > 0 && f->rows_ahead > 0 ? f->rows_ahead : 0);
+    if (rate > 0 && left > 0) {
+        sl_duration(left / rate, d, sizeof d);
         snprintf(part, sizeof part, "  ETA %s", d);
         if (!append(out, cap, &len, limit, part))
             return len;

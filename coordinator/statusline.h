@@ -14,12 +14,18 @@
 /** The figures of one progress line. */
 typedef struct {
     double elapsed_s;          /**< since the render began */
-    int done, total;           /**< rows done in this run, of the rows it renders */
+    int done, total;           /**< rows done in this run, of the rows it renders (an animation: of the
+                                    frames started so far) */
     double samples_per_row;    /**< width * spp */
+    int frames_done, frames;   /**< an animation: frames written or skipped, of those in the list; 0
+                                    frames: a single image */
+    double rows_ahead;         /**< an animation: rows of the frames not started yet, estimated (for the
+                                    ETA) */
 } sl_figures;
 
 /** Writes the line into out[cap] (always terminated): "rows D/T (P%)
- * elapsed M:SS  ETA M:SS  R Msamples/s" and then the hosts ("name:running/
+ * elapsed M:SS  ETA M:SS  R Msamples/s" (an animation: "frames F/N rows
+ * D/T (P%) ...", its ETA over the rows ahead too) and then the hosts ("name:running/
  * slots rate r/s", ":starting", ":down"; hosts never ready and dropped are
  * left out).  With cols > 0 it has at most cols - 1 characters: the parts
  * that do not fit are left out from the end, hosts left out are counted as

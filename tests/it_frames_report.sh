@@ -72,6 +72,7 @@ s2=$(grep -n '"event":"start","frame":2' ev | cut -d: -f1)
 d1=$(grep -n '"event":"done","frame":1' ev | cut -d: -f1)
 check "frame 2's start event ($s2) comes before frame 1's done event ($d1)" test -n "$s2" -a -n "$d1" -a "${s2:-0}" -lt "${d1:-0}"
 grep -q '^{' logj && bad "JSON events on stderr" || ok
+check "the log's last progress line counts the frames" grep -q '^franja: \[ *[0-9.]*s\] frames 3/3 rows 48/48 (100%)' logj
 
 # A skipped frame has its event; a failing host's slab failures name the
 # frame (one-row slabs: the failing host gets at least three, and is dropped).

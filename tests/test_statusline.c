@@ -1,6 +1,7 @@
 /* test_statusline.c -- the live progress line: it fits every terminal
  * width (never more than cols - 1 characters), keeps its parts in order of
- * importance, counts the hosts it leaves out, and formats durations. */
+ * importance, counts the hosts it leaves out, and formats durations; an
+ * animation's line starts with its frames and its ETA covers them. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,7 +35,7 @@ int main(void)
     hs[3].pending = 1;
     hs[3].tr = NULL;
     hs[4].dropped = 1;
-    sl_figures f = {125.0, 150, 512, 640.0 * 256};
+    sl_figures f = {125.0, 150, 512, 640.0 * 256, 0, 0, 0};
 
     /* No limit: every part and every host. */
     char full[1024];
@@ -72,12 +73,27 @@ int main(void)
     CHECK(k < sizeof small && strlen(small) == k, "cap 8: '%s'", small);
 
     /* No ETA before a row is done, nor once every row is. */
-    sl_figures start = {0.5, 0, 512, 1000};
+    sl_figures start = {0.5, 0, 512, 1000, 0, 0, 0};
     char line[256];
     sl_format(line, sizeof line, 0, &start, hs, 1);
     CHECK(!strstr(line, "ETA") && strstr(line, "elapsed 1s"), "start: '%s'", line);
-    sl_figures end = {10, 512, 512, 1000};
+    sl_figures end = {10, 512, 512, 1000, 0, 0, 0};
     sl_format(line, sizeof line, 0, &end, hs, 1);
     CHECK(!strstr(line, "ETA") && strstr(line, "(100%)"), "end: '%s'", line);
+
+    /* An animation: the frames first, and an ETA over the rows of the
+     * frames not started yet too (362 + 1024 rows at 1.2 rows/s: 1155 s). */
+    sl_figures anim = {125.0, 150, 512, 1000, 3, 8, 1024};
+    sl_format(line, sizeof line, 0, &anim, hs, 1);
+    CHECK(!strncmp(line, "frames 3/8 rows 150/512 ( 29%)  elapsed 2:05  ETA 19:15  ", 57), "animation: '%s'", line);
+    /* Its rows all done, frames ahead: still an ETA. */
+    sl_figures between = {10, 512, 512, 1000, 4, 8, 512};
+    sl_format(line, sizeof line, 0, &between, hs, 1);
+    CHECK(strstr(line, "frames 4/8 rows 512/512 (100%)") && strstr(line, "ETA 10s"), "between frames: '%s'", line);
+    for (int cols = 1; cols <= 80; cols++) {
+        size_t w = sl_format(line, sizeof line, cols, &anim, hs, 5);
+        CHECK(w <= (size_t)cols - 1 && !strncmp(line, "frames 3/8 rows 150/512", w < 23 ? w : 23),
+              "animation, cols %d: '%s'", cols, line);
+    }
     return check_done();
 }
