@@ -272,6 +272,45 @@ int stage_parse_evicted(const char *out, size_t len, int *removed, uint64_t *byt
     return 0;
 }
 
+/* A count at *s, saturating at INT_MAX, and the separator after it
+ * (sep, or the end when sep is 0); *s moves past both. */
+static int count_at(const char **s, const char *end, char sep, int *v)
+{
+    uint64_t n = 0;
+    const char *p = *s;
+    while (p < end && *p >= '0' && *p <= '9')
+        p++;
+    if (p == *s || add_number(*s, (size_t)(p - *s), &n))
+        return -1;
+    if (sep ? p == end || *p != sep : p != end)
+        return -1;
+    *v = n > INT_MAX ? INT_MAX : (int)n;
+    *s = sep ? p + 1 : p;
+    return 0;
+}
+
+int stage_parse_cleaned(const char *out, size_t len, stage_cleaned *c, fr_error *err)
+{
+    memset(c, 0, sizeof *c);
+    static const char what[] = "expected one line 'REMOVED BYTES IN_USE TEMP' (decimal numbers)";
+    if (len && out[len - 1] == '\n')
+        len--;
+    if (len == 0)
+        return fr_fail(err, "%s", what);
+    const char *s = out, *end = out + len, *b;
+    stage_cleaned got = {0, 0, 0, 0};
+    int ok = count_at(&s, end, ' ', &got.removed) == 0;
+    for (b = s; ok && s < end && *s >= '0' && *s <= '9';)
+        s++;
+    ok = ok && s > b && s < end && *s == ' ' && add_number(b, (size_t)(s - b), &got.bytes) == 0;
+    s += ok;
+    ok = ok && count_at(&s, end, ' ', &got.in_use) == 0 && count_at(&s, end, 0, &got.temp) == 0;
+    if (!ok)
+        return fr_fail(err, "%s", what);
+    *c = got;
+    return 0;
+}
+
 int stage_parse_cache(const char *out, size_t len, int *files, uint64_t *bytes, fr_error *err)
 {
     *files = 0;
@@ -338,14 +377,11 @@ int stage_clean(tr_host *h, stage_cleaned *out, fr_error *err)
     int rc = 0;
     size_t len;
     const char *text = (const char *)tr_proc_output(p, &len);
-    char buf[128];
-    unsigned long long b = 0;
-    snprintf(buf, sizeof buf, "%.*s", (int)(len < sizeof buf ? len : sizeof buf - 1), text ? text : "");
+    fr_error e;
     if (tr_proc_state(p) != TR_EXITED || tr_proc_status(p) != 0)
         rc = failed(h, p, "cleaning the scene cache", err);
-    else if (sscanf(buf, "%d %llu %d %d", &out->removed, &b, &out->in_use, &out->temp) != 4)
-        rc = fr_fail(err, "%s: unexpected answer cleaning the scene cache", tr_host_label(h));
-    out->bytes = b;
+    else if (stage_parse_cleaned(text, len, out, &e))
+        rc = fr_fail(err, "%s: unexpected answer cleaning the scene cache: %s", tr_host_label(h), e.msg);
     tr_proc_free(p);
     return rc;
 }

@@ -77,6 +77,12 @@ typedef struct {
     int temp;          /**< stale temporary files removed */
 } stage_cleaned;
 
+/** Reads what the cache cleaning printed (out[0..len), not NUL-terminated,
+ * NULL when len is 0): one line "REMOVED BYTES IN_USE TEMP" of decimal
+ * numbers, counts saturating at INT_MAX and bytes at UINT64_MAX.  Fails,
+ * saying what was expected, on anything else. */
+int stage_parse_cleaned(const char *out, size_t len, stage_cleaned *c, fr_error *err);
+
 /** Empties the host's scene cache: removes every scene but those a
  * process on the host has mapped (a running worker) or a live render holds
  * a lease on, and the temporary files of uploads that were cut off and the

@@ -1,6 +1,7 @@
 /* What the coordinator reads from a host's answers to its cache commands
  * (stage.h): the scenes the cache trimming removed ("NAME BYTES" lines),
- * the cache listing (a size a line) and the codename of os-release.  Each
+ * the cache listing (a size a line), what the cleaning did ("REMOVED
+ * BYTES IN_USE TEMP") and the codename of os-release.  Each
  * reads only the bytes the host sent (an answer is not NUL-terminated:
  * what lies after it in memory must change nothing), refuses a line of
  * another shape naming it, saturates sums instead of wrapping, and
@@ -51,6 +52,24 @@ static void cache(void)
     CHECK(stage_parse_cache(two, strlen(two), &n, &bytes, &err) == -1, "two numbers on a line were taken");
 }
 
+static void cleaned(void)
+{
+    stage_cleaned c;
+    fr_error err;
+    const char ok[] = "3 4096 1 2\n";
+    CHECK(stage_parse_cleaned(ok, strlen(ok), &c, &err) == 0 && c.removed == 3 && c.bytes == 4096 && c.in_use == 1 &&
+              c.temp == 2, "3 4096 1 2: %d %llu %d %d", c.removed, (unsigned long long)c.bytes, c.in_use, c.temp);
+    /* A count past int, which sscanf's %d could not hold. */
+    const char big[] = "99999999999 1 0 0";
+    CHECK(stage_parse_cleaned(big, strlen(big), &c, &err) == 0 && c.removed == 2147483647,
+          "a count past int: %d", c.removed);
+    CHECK(stage_parse_cleaned(ok, 7, &c, &err) == -1, "an answer cut after '3 4096 ' was taken");
+    const char *bad[] = {"", "\n", "3 4096 1", "3 4096 1 2 5", "3 -1 1 2", "3  4096 1 2", "3 4096 1 2x", "a b c d"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++)
+        CHECK(stage_parse_cleaned(bad[i], strlen(bad[i]), &c, &err) == -1 && strstr(err.msg, "REMOVED BYTES"),
+              "'%s' was taken", bad[i]);
+}
+
 static void codename(void)
 {
     char os[64];
@@ -66,6 +85,7 @@ int main(void)
 {
     evicted();
     cache();
+    cleaned();
     codename();
     return check_done();
 }

@@ -8,7 +8,8 @@
  *   3  the cache trimming's "NAME BYTES" lines (stage_parse_evicted)
  *   4  the cache listing (stage_parse_cache)
  *   5  an os-release text (stage_os_codename)
- *   6  a process's stdout and stderr as the transports collect them
+ *   6  the cache cleaning's "REMOVED BYTES IN_USE TEMP" (stage_parse_cleaned)
+ *   7  a process's stdout and stderr as the transports collect them
  *      (tr_proc_add_out, tr_proc_add_err), in chunks whose sizes the
  *      output's bytes give, and what a message shows of them
  *      (tr_proc_reason)
@@ -70,7 +71,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memcpy(text, out, len);
     text[len] = 0;
     fr_error err;
-    switch (data[0] % 7) {
+    switch (data[0] % 8) {
     case 0: {
         proto_host h;
         if (proto_parse_probe(out, len, &h, &err) == 0) {
@@ -113,6 +114,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         char os[64];
         stage_os_codename(text, os);
         printable(os, sizeof os);
+        break;
+    }
+    case 6: {
+        stage_cleaned c;
+        if (stage_parse_cleaned(len ? out : NULL, len, &c, &err) == 0 &&
+            (c.removed < 0 || c.in_use < 0 || c.temp < 0))
+            abort();
         break;
     }
     default:
