@@ -111,7 +111,7 @@ $(COORD_LIB): $(COORD_LIB_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && $(AR) rcs $@ $^
 
-$(TESTSUP_OBJ): CSTD += -Icoordinator -Itests
+$(TESTSUP_OBJ): CSTD += -iquote coordinator -Itests
 
 $(TESTSUP_LIB): $(TESTSUP_OBJ)
 	@mkdir -p $(dir $@)
@@ -126,7 +126,7 @@ bin/franja: $(B)/coordinator/main.o $(COORD_LIB) $(LIB)
 # dropped (--as-needed).
 bin/tests/%: tests/%.c $(TESTSUP_LIB) $(COORD_LIB) $(LIB)
 	@mkdir -p bin/tests
-	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -Icoordinator -Itests -o $@ $< $(TESTSUP_LIB) $(COORD_LIB) $(LIB) \
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -iquote coordinator -Itests -o $@ $< $(TESTSUP_LIB) $(COORD_LIB) $(LIB) \
 	    -Wl,--as-needed $(COORD_LIBS)
 
 bin/tools/%: tests/tools/%.c tests/tools/pfmread.h $(LIB)

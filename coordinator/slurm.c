@@ -70,9 +70,10 @@ static int nodes_from(const char *list, int timeout_s, slurm_alloc *a, fr_error 
     fr_error e;
     if (tr_pipe_run(argv, timeout_s, &text, &e))
         return fr_fail(err, "cannot expand SLURM_JOB_NODELIST='%s': %s", list, e.msg);
+    /* One name a line; the last line may lack its newline. */
     int n = 0;
     for (const char *c = text; *c; c++)
-        n += *c == '\n';
+        n += *c == '\n' || c[1] == '\0';
     if (n == 0 || n > 1000000) {
         free(text);
         return fr_fail(err, "SLURM_JOB_NODELIST='%s' names no node", list);
