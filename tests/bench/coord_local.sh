@@ -15,6 +15,7 @@
 #   side by side, which share nothing but the machine: what N processes of
 #   this work lose to each other on these cores whatever schedules them.
 #   The efficiency over this ceiling is the part the coordinator can reach.
+# - paired efficiency: each -j 1 run against the -j N run that follows it.
 cd "$(dirname "$0")/../.." || exit 1
 . tests/coord/bench_common.sh
 N=$(nproc)
@@ -27,6 +28,12 @@ bin/franja render "$SCENE" -o "$T/warm.pfm" $ARGS -j "$N" >/dev/null 2>&1
 compare "bin/franja render $SCENE -o $T/a.pfm $ARGS -j 1" "bin/franja render $SCENE -o $T/b.pfm $ARGS -j $N" || exit 1
 cmp -s "$T/a.pfm" "$T/b.pfm" || { echo "-j 1 and -j $N images differ"; exit 1; }
 echo "local -j 1: $TA s, -j $N: $TB s; speed-up $(calc "$TA / $TB"), parallel efficiency $(calc "$TA / ($N * $TB)")"
+# Each -j 1 run and the -j N run right after it form a pair; a load that
+# comes and goes over minutes moves both of a pair alike, so the median of
+# the pairs' efficiencies is steadier than the ratio of the two medians.
+pairs=$(awk -v a="$la" -v b="$lb" -v n="$N" 'BEGIN { k = split(a, A, " "); split(b, B, " ")
+    for (i = 1; i <= k; i++) printf " %.3f", A[i] / (n * B[i]) }')
+echo "parallel efficiency of each pair (-j 1, then -j $N):$pairs; median $(median $pairs)"
 
 # One render: prints "CPU-s occupancy" (see above).  The shell's children
 # times (fields 16 and 17 of its /proc stat, in clock ticks) hold franja's
