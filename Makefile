@@ -139,7 +139,7 @@ bin/tools/nolockfs: tests/tools/nolockfs.c
 	$(CC) $(CSTD) $(CFLAGS) $(shell $(PKG) --cflags fuse3) -o $@ $< $(shell $(PKG) --libs fuse3 2>/dev/null || echo -lfuse3)
 
 # Benchmark programs; only these link Embree (the reference they measure against).
-bin/bench/%: tests/bench/%.c $(LIB)
+bin/bench/%: tests/bench/%.c $(wildcard tests/bench/*.h) $(LIB)
 	@mkdir -p bin/bench
 	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
 

@@ -1,6 +1,6 @@
 /* bvhbench -- Franja's BVH against Embree 3 on the same triangles and rays.
  *
- *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH]
+ *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages 2m|4k]
  *
  * Loads a compiled scene, takes its triangles, and measures single-threaded:
  *   - BVH build time: bvh_build versus rtcCommitScene (Embree device with
@@ -14,6 +14,11 @@
  *   - with --worker: worker start-up, from process start to its first pixel
  *     written (a 1x1-pixel, 1-sample render of the scene);
  *   - the binary scene's bytes per triangle.
+ * The tree is walked where the scene is mapped from its file, as a worker
+ * walks it, and the program says how much of that mapping has 2 MiB pages
+ * (the walk's speed depends on it: bench_pages.h); --pages copies the
+ * tree's nodes and leaf blocks into anonymous memory of 2 MiB or 4 KiB
+ * pages instead, to measure either alike on every run.
  * Every figure is the median of N runs, timed in process CPU seconds (both
  * sides run on one thread; CPU time keeps a busy machine's scheduling out
  * of the figures; start-up is wall time).  Embree's hits are checked
@@ -28,6 +33,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_pages.h"
+#include "bench_rays.h"
 #include "bvh_build.h"
 #include "fbin.h"
 #include "geom.h"
@@ -117,46 +124,6 @@ static RTCScene embree_scene(RTCDevice dev, const tri_mesh *m, enum RTCBuildQual
     rtcAttachGeometry(sc, g);
     rtcReleaseGeometry(g);
     return sc;
-}
-
-/* A small counter-based generator for the bounce directions. */
-static float rnd(uint32_t *state)
-{
-    uint32_t h = (*state += 0x9E3779B9u);
-    h ^= h >> 16; h *= 0x7feb352du; h ^= h >> 15; h *= 0x846ca68bu; h ^= h >> 16;
-    return (float)(h >> 8) * (1.0f / 16777216.0f);
-}
-
-/* Primary rays, one per pixel; then for each primary hit a cosine-weighted
- * bounce from the surface (rays[n_primary..)). */
-static fr_ray *make_rays(const fr_scene *s, uint32_t w, uint32_t h, uint32_t *n_primary, uint32_t *n_bounce)
-{
-    fr_ray *r = malloc((size_t)w * h * 2 * sizeof *r);
-    fr_scene cam = *s;
-    cam.settings.width = w;
-    cam.settings.height = h;
-    uint32_t n = 0;
-    for (uint32_t y = 0; y < h; y++)
-        for (uint32_t x = 0; x < w; x++)
-            r[n++] = pt_camera_ray(&cam, x, y, 0.5f, 0.5f, 0.5f, 0.5f);
-    *n_primary = n;
-    uint32_t state = 12345;
-    for (uint32_t i = 0; i < *n_primary; i++) {
-        fr_hit hit;
-        if (!trace_closest(s, &r[i], INFINITY, &hit))
-            continue;
-        fr_surface sf;
-        trace_surface(s, &r[i], &hit, &sf);
-        vec3 ng = v3_dot(sf.ng, r[i].d) < 0.0f ? sf.ng : v3_neg(sf.ng), t, b;
-        v3_basis(ng, &t, &b);
-        float u1 = rnd(&state), u2 = rnd(&state), rr = sqrtf(u1), phi = 2.0f * 3.14159265f * u2;
-        vec3 d = v3_from_local(v3(rr * cosf(phi), rr * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u1))), t, b, ng);
-        r[n].o = geo_offset(sf.p, sf.perr, ng, d);
-        r[n].d = v3_norm(d);
-        n++;
-    }
-    *n_bounce = n - *n_primary;
-    return r;
 }
 
 static void to_embree(const fr_ray *r, struct RTCRayHit *rh)
@@ -266,18 +233,21 @@ static double startup_ms(const char *worker, const char *scene, int reps)
 
 int main(int argc, char **argv)
 {
-    const char *path = NULL, *worker = NULL;
+    const char *path = NULL, *worker = NULL, *pages = NULL;
     int reps = 5;
     uint32_t w = 512, h = 512;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) sscanf(argv[++i], "%ux%u", &w, &h);
         else if (!strcmp(argv[i], "--worker") && i + 1 < argc) worker = argv[++i];
+        else if (!strcmp(argv[i], "--pages") && i + 1 < argc) pages = argv[++i];
         else if (argv[i][0] != '-') path = argv[i];
         else { fprintf(stderr, "bvhbench: unknown argument %s\n", argv[i]); return 2; }
     }
+    if (pages && strcmp(pages, "2m") && strcmp(pages, "4k"))
+        path = NULL;
     if (!path || reps < 1 || reps > 64 || w == 0 || h == 0) {
-        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH]\n");
+        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages 2m|4k]\n");
         return 2;
     }
     fr_scene s;
@@ -293,6 +263,19 @@ int main(int argc, char **argv)
     }
     printf("scene %s: %u triangles, %zu bytes (%.1f bytes/triangle), %u nodes, %u leaf blocks\n", path, m.n_tri,
            s.blob_size, (double)s.blob_size / m.n_tri, s.n_nodes, s.n_leaves);
+    if (pages) {
+        s.nodes = page_copy(s.nodes, (size_t)s.n_nodes * sizeof *s.nodes, !strcmp(pages, "2m"));
+        s.leaves = page_copy(s.leaves, (size_t)s.n_leaves * sizeof *s.leaves, !strcmp(pages, "2m"));
+        if (!s.nodes || !s.leaves) {
+            fprintf(stderr, "bvhbench: out of memory for the tree's copy\n");
+            return 1;
+        }
+    }
+    unsigned long nkb, nhuge, lkb, lhuge;
+    if (page_state(s.nodes, &nkb, &nhuge) == 0 && page_state(s.leaves, &lkb, &lhuge) == 0)
+        printf("pages      tree %s: %lu of %lu KiB in 2 MiB pages where the nodes lie, %lu of %lu where the leaves "
+               "do (at the start)\n", pages ? (strcmp(pages, "2m") ? "copied to 4 KiB pages" : "copied to 2 MiB pages")
+               : "as mapped from the file", nhuge, nkb, lhuge, lkb);
     printf("tree       SAH cost %.4f (node tests + slots / 2 + leaf blocks per ray through the root box)\n",
            bvh_sah_cost(s.nodes, s.n_nodes));
 
@@ -336,8 +319,12 @@ int main(int argc, char **argv)
     rtcCommitScene(es);
     RTCScene eh = embree_scene(dev, &m, RTC_BUILD_QUALITY_HIGH);
     rtcCommitScene(eh);
-    uint32_t np, nb;
+    uint32_t np = 0, nb = 0;
     fr_ray *rays = make_rays(&s, w, h, &np, &nb);
+    if (!rays) {
+        fprintf(stderr, "bvhbench: out of memory for the rays\n");
+        return 1;
+    }
     uint32_t bad = disagreements(&s, es, &m, rays, np + nb), badh = disagreements(&s, eh, &m, rays, np + nb);
     printf("rays       %u primary (%ux%u), %u diffuse bounces; Embree disagrees on %u (%.3f %%), high quality on %u\n",
            np, w, h, nb, bad, 100.0 * bad / (np + nb), badh);
