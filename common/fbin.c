@@ -3,6 +3,7 @@
 #include "bvh.h"
 #include "file.h"
 #include "proto_limits.h"
+#include "scene_pages.h"
 
 #include <errno.h>
 #include <stdint.h>
@@ -450,6 +451,7 @@ int fbin_write(const fr_scene *s, const char *path, fr_error *err)
 
 void scn_free(fr_scene *s)
 {
+    scn_bvh_pages_free(s);
     if (s->blob) {
         if (s->mapped)
             munmap(s->blob, s->blob_size);

@@ -11,7 +11,9 @@
  * linear RGB; angles in the scene file are degrees, radians here.
  *
  * Ownership: an fr_scene owns `blob` (malloc'd or mmap'd, per `mapped`);
- * every array points into it.  scn_free() releases it.
+ * every array points into it, except nodes and leaves once copied to
+ * `bvh_copy` (scene_pages.h), which it also owns.  scn_free() releases
+ * both.
  */
 #ifndef FRANJA_SCENE_H
 #define FRANJA_SCENE_H
@@ -329,6 +331,7 @@ typedef struct {
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;
+    void *bvh_copy; size_t bvh_copy_size; /**< nodes and leaves in large pages, or NULL (scene_pages.h) */
 } fr_scene;
 
 /** Releases the scene's blob (free or munmap) and zeroes *s. */

@@ -37,6 +37,7 @@
 #include "bench_rays.h"
 #include "bvh_build.h"
 #include "fbin.h"
+#include "scene_pages.h"
 #include "geom.h"
 #include "pathtrace.h"
 #include "trace.h"
@@ -256,6 +257,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "bvhbench: %s\n", err.msg);
         return 1;
     }
+    scn_bvh_large_pages(&s);   /* as the worker does */
     tri_mesh m;
     if (take_triangles(&s, &m) < 0 || m.n_tri == 0) {
         fprintf(stderr, "bvhbench: %s: no triangles (or out of memory)\n", path);
