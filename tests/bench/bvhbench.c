@@ -1,6 +1,6 @@
 /* bvhbench -- Franja's BVH against Embree 3 on the same triangles and rays.
  *
- *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages 2m|4k]
+ *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages map|2m|4k]
  *
  * Loads a compiled scene, takes its triangles, and measures single-threaded:
  *   - BVH build time: bvh_build versus rtcCommitScene (Embree device with
@@ -14,11 +14,12 @@
  *   - with --worker: worker start-up, from process start to its first pixel
  *     written (a 1x1-pixel, 1-sample render of the scene);
  *   - the binary scene's bytes per triangle.
- * The tree is walked where the scene is mapped from its file, as a worker
- * walks it, and the program says how much of that mapping has 2 MiB pages
- * (the walk's speed depends on it: bench_pages.h); --pages copies the
- * tree's nodes and leaf blocks into anonymous memory of 2 MiB or 4 KiB
- * pages instead, to measure either alike on every run.
+ * The tree is walked where a worker walks it: copied to memory of 2 MiB
+ * pages where it is large enough (scn_bvh_large_pages), mapped from the
+ * file otherwise; the program says how much of the memory holding it has
+ * 2 MiB pages (the walk's speed depends on it: bench_pages.h).  --pages
+ * map walks it where the file is mapped, --pages 2m or 4k copies the
+ * nodes and leaf blocks into anonymous memory of pages of that size.
  * Every figure is the median of N runs, timed in process CPU seconds (both
  * sides run on one thread; CPU time keeps a busy machine's scheduling out
  * of the figures; start-up is wall time).  Embree's hits are checked
@@ -245,10 +246,10 @@ int main(int argc, char **argv)
         else if (argv[i][0] != '-') path = argv[i];
         else { fprintf(stderr, "bvhbench: unknown argument %s\n", argv[i]); return 2; }
     }
-    if (pages && strcmp(pages, "2m") && strcmp(pages, "4k"))
+    if (pages && strcmp(pages, "map") && strcmp(pages, "2m") && strcmp(pages, "4k"))
         path = NULL;
     if (!path || reps < 1 || reps > 64 || w == 0 || h == 0) {
-        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages 2m|4k]\n");
+        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages map|2m|4k]\n");
         return 2;
     }
     fr_scene s;
@@ -257,7 +258,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "bvhbench: %s\n", err.msg);
         return 1;
     }
-    scn_bvh_large_pages(&s);   /* as the worker does */
     tri_mesh m;
     if (take_triangles(&s, &m) < 0 || m.n_tri == 0) {
         fprintf(stderr, "bvhbench: %s: no triangles (or out of memory)\n", path);
@@ -265,7 +265,9 @@ int main(int argc, char **argv)
     }
     printf("scene %s: %u triangles, %zu bytes (%.1f bytes/triangle), %u nodes, %u leaf blocks\n", path, m.n_tri,
            s.blob_size, (double)s.blob_size / m.n_tri, s.n_nodes, s.n_leaves);
-    if (pages) {
+    if (!pages)
+        scn_bvh_large_pages(&s);   /* as the worker does */
+    else if (strcmp(pages, "map")) {
         s.nodes = page_copy(s.nodes, (size_t)s.n_nodes * sizeof *s.nodes, !strcmp(pages, "2m"));
         s.leaves = page_copy(s.leaves, (size_t)s.n_leaves * sizeof *s.leaves, !strcmp(pages, "2m"));
         if (!s.nodes || !s.leaves) {
@@ -276,8 +278,9 @@ int main(int argc, char **argv)
     unsigned long nkb, nhuge, lkb, lhuge;
     if (page_state(s.nodes, &nkb, &nhuge) == 0 && page_state(s.leaves, &lkb, &lhuge) == 0)
         printf("pages      tree %s: %lu of %lu KiB in 2 MiB pages where the nodes lie, %lu of %lu where the leaves "
-               "do (at the start)\n", pages ? (strcmp(pages, "2m") ? "copied to 4 KiB pages" : "copied to 2 MiB pages")
-               : "as mapped from the file", nhuge, nkb, lhuge, lkb);
+               "do (at the start)\n", !pages ? (s.bvh_copy ? "copied as the worker does" : "as mapped from the file (too small to copy)")
+               : !strcmp(pages, "map") ? "as mapped from the file"
+               : !strcmp(pages, "2m") ? "copied to 2 MiB pages" : "copied to 4 KiB pages", nhuge, nkb, lhuge, lkb);
     printf("tree       SAH cost %.4f (node tests + slots / 2 + leaf blocks per ray through the root box)\n",
            bvh_sah_cost(s.nodes, s.n_nodes));
 
