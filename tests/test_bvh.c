@@ -15,7 +15,9 @@
  * traversals (x86-64 with AVX2), both are checked.  Trees built with and
  * without reinsertion are compared by their SAH cost, and reinsertion is
  * run alone (bvh_reinsert.h) on a poor binary tree, whose every node,
- * leaf, box and cost it must keep consistent. */
+ * leaf, box and cost it must keep consistent.  Rays leaving from points on
+ * a height grid's triangles, as bounce rays do, meet their own triangle at
+ * t near 0 on either side. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -546,6 +548,76 @@ static void signed_zeros(void)
     bld_free(&b);
 }
 
+/* Rays leaving from points on the triangles of a height grid, as bounce
+ * rays do, a third of them grazing the surface: the triangle a ray leaves
+ * from lies at t near 0, just behind the origin, just in front of it or
+ * through it, where only the rounding-error bound of the triangle test
+ * turns it away, and its neighbours' hits are close.  The walk must
+ * return brute force's nearest hit, bit for bit, and any-hit queries must
+ * agree with it, with and without the ray's own triangle skipped, through
+ * both traversals where there are two. */
+static void from_surfaces(void)
+{
+    int wide = trace_set_wide(1);
+    for (int pass = 0; pass < (wide ? 2 : 1); pass++) {
+        trace_set_wide(wide && pass == 0);
+        const char *name = wide && pass == 0 ? "eight-lane" : "portable";
+        fr_builder b;
+        start(&b);
+        grid(&b, 40);
+        fr_scene s;
+        fr_error err;
+        if (frz_scene(&b, &s, &err) < 0) {
+            CHECK(0, "from surfaces: build failed: %s", err.msg);
+            bld_free(&b);
+            continue;
+        }
+        int rays = 6000, bad = 0, badany = 0, hits = 0, own = 0;
+        for (int i = 0; i < rays; i++) {
+            uint32_t p = rnd_u32() % s.n_prims;
+            const fr_triangle *t = &s.triangles[s.prims[p].index];
+            vec3 p0 = s.positions[t->v[0]], e1 = v3_sub(s.positions[t->v[1]], p0), e2 = v3_sub(s.positions[t->v[2]], p0);
+            float u = rnd(), v = rnd();
+            if (u + v > 1.0f) {
+                u = 1.0f - u;
+                v = 1.0f - v;
+            }
+            fr_ray r;
+            r.o = v3_add(p0, v3_add(v3_scale(e1, u), v3_scale(e2, v)));
+            /* A third of the rays graze the surface (a tenth of a radian
+             * or less from its plane), on either side. */
+            vec3 n = v3_norm(v3_cross(e1, e2)), d = rnd_dir();
+            if (i % 3 == 0)
+                d = v3_norm(v3_add(v3_sub(d, v3_scale(n, v3_dot(d, n))), v3_scale(n, rnd_in(-0.1f, 0.1f))));
+            r.d = d;
+            fr_hit hb = {0}, ht = {0};
+            int fb = brute(&s, &r, INFINITY, FR_NONE, &hb), ft = trace_closest(&s, &r, INFINITY, &ht);
+            hits += fb;
+            own += fb && hb.prim == p;
+            if (fb != ft || (fb && (ht.prim != hb.prim || !same_bits(ht.t, hb.t) || !same_bits(ht.a, hb.a) ||
+                                    !same_bits(ht.b, hb.b)))) {
+                if (bad++ < 5)
+                    CHECK(0, "from surfaces (%s) ray %d from prim %u: bvh %d prim %u t %.9g, brute %d prim %u t %.9g",
+                          name, i, p, ft, ft ? ht.prim : 0, ft ? (double)ht.t : 0.0, fb, fb ? hb.prim : 0,
+                          fb ? (double)hb.t : 0.0);
+            }
+            if (trace_occluded(&s, &r, INFINITY, FR_NONE) != fb && badany++ < 5)
+                CHECK(0, "from surfaces (%s) ray %d: any-hit %d, nearest hit %d", name, i, !fb, fb);
+            if (trace_occluded(&s, &r, INFINITY, p) != brute(&s, &r, INFINITY, p, &hb) && badany++ < 5)
+                CHECK(0, "from surfaces (%s) ray %d: any-hit skipping its own triangle disagrees", name, i);
+        }
+        CHECK(bad == 0, "from surfaces (%s): %d of %d rays differ from brute force", name, bad, rays);
+        CHECK(badany == 0, "from surfaces (%s): %d any-hit disagreements", name, badany);
+        /* Some rays hit another slope, few or none their own triangle. */
+        CHECK(hits > rays / 20 && hits < rays - rays / 20, "from surfaces (%s): %d of %d rays hit (test too weak)",
+              name, hits, rays);
+        CHECK(own < rays / 100, "from surfaces (%s): %d rays hit the triangle they leave from", name, own);
+        scn_free(&s);
+        bld_free(&b);
+    }
+    trace_set_wide(wide);
+}
+
 int main(void)
 {
     signed_zeros();
@@ -600,5 +672,6 @@ int main(void)
         bld_free(&b[0]);
         bld_free(&b[1]);
     }
+    from_surfaces();
     return check_done();
 }
