@@ -5,9 +5,9 @@
  * In 4 KiB pages a tree of tens of megabytes needs thousands of TLB
  * entries, so most node visits miss the TLB; the same bytes in 2 MiB pages
  * need a few dozen.  A mapped binary scene gets such pages only where the
- * page cache happens to hold them so (it depends on how the file was
- * written and read), which made the walk of the same tree run up to 0.7
- * times as fast from one load to the next.
+ * page cache happens to hold large folios (which depends on the kernel and
+ * on how the file was written and read), so the walk of the same tree ran
+ * at 0.71 to 1.0 of its speed in large pages from one load to the next.
  *
  * scn_bvh_large_pages copies the nodes and leaf blocks into private
  * anonymous memory, 2 MiB-aligned, that asks the kernel for large pages
