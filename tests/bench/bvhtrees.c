@@ -32,15 +32,16 @@
  * --pages map the stored tree is walked where the scene's file is mapped,
  * as a worker walks it, and the others lie in 2 MiB pages.  The walk's
  * speed depends on the pages (bench_pages.h).  Embree's own traversal of its
- * default scene (embree-rt, rtcIntersect1 and rtcOccluded1) is timed
- * beside them, the reference the goal is measured against.
+ * own scenes (rtcIntersect1 and rtcOccluded1) is timed beside them, the
+ * reference the goal is measured against: embree-rt at the default build
+ * quality, embree-rt-high at RTC_BUILD_QUALITY_HIGH.
  *
  * For each tree: nodes, leaf blocks, filled lanes, the SAH cost in the
  * builder's model (bvh_sah_cost), its build time, and, over the diffuse
  * bounce rays of bench_rays.h, nodes and leaf blocks tested per ray, counted
  * by a scalar copy of the walk's order (nearest entered child first,
  * subtrees beyond the best hit skipped).  Then rays per second of process
- * CPU time, every tree and embree-rt taking turns on chunks of --chunk rays
+ * CPU time, every tree and both Embree scenes taking turns on chunks of --chunk rays
  * (default 4096; the first to run rotates; a chunk larger than the rays
  * makes whole passes), summed over --passes passes (default 5), so that a
  * busy machine's drift falls on all alike.  Every tree must give every
@@ -622,7 +623,7 @@ static int paged(const fr_scene *s, int huge, fr_scene *out)
     return out->nodes && out->leaves ? 0 : -1;
 }
 
-enum { KINDS = 9, MAX_RUNS = KINDS + 1 };
+enum { KINDS = 9, EMBREE_RUNS = 2, MAX_RUNS = KINDS + EMBREE_RUNS };
 static const char *kind_names[KINDS] = {"file", "build", "emb-med", "emb-high", "grouped", "sorted", "copy-4k", "copy-2m", "file2"};
 
 int main(int argc, char **argv)
@@ -713,7 +714,8 @@ int main(int argc, char **argv)
         }
     }
     names[n_trees] = "embree-rt";
-    /* Embree's own scene (default quality) for its own traversal. */
+    names[n_trees + 1] = "embree-rt-high";
+    /* Embree's own scenes (default and high build quality) for its own traversal. */
     float *vx = malloc(((size_t)s.n_positions * 3 + 1) * sizeof *vx);
     uint32_t *ix = malloc((size_t)s.n_triangles * 3 * sizeof *ix);
     if (!vx || !ix)
@@ -725,14 +727,21 @@ int main(int argc, char **argv)
     for (uint32_t i = 0; i < s.n_triangles; i++)
         for (int k = 0; k < 3; k++)
             ix[3 * i + k] = s.triangles[i].v[k];
-    RTCScene es = rtcNewScene(dev);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vx, 0, 12, s.n_positions);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, ix, 0, 12, s.n_triangles);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(es, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(es);
+    RTCScene es[EMBREE_RUNS];
+    for (int e = 0; e < EMBREE_RUNS; e++) {
+        es[e] = rtcNewScene(dev);
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vx, 0, 12, s.n_positions);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, ix, 0, 12, s.n_triangles);
+        if (e == 1) {
+            rtcSetSceneBuildQuality(es[e], RTC_BUILD_QUALITY_HIGH);
+            rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+        }
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(es[e], g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(es[e]);
+    }
 
     uint32_t np = 0, nb = 0;
     fr_ray *all = make_rays(&s, w, h, &np, &nb);
@@ -765,21 +774,22 @@ int main(int argc, char **argv)
         for (int p = 0; p < passes; p++)
             for (uint32_t c = 0; c < nb; c += chunk, turn++) {
                 uint32_t n = nb - c < chunk ? nb - c : chunk;
-                for (int j = 0; j <= n_trees; j++) {
-                    int k = (int)((turn + (uint32_t)j) % (uint32_t)(n_trees + 1));
+                for (int j = 0; j < n_trees + EMBREE_RUNS; j++) {
+                    int k = (int)((turn + (uint32_t)j) % (uint32_t)(n_trees + EMBREE_RUNS));
                     sum[k] += k < n_trees ? franja_chunk(&tree[k], rays + c, n, any, &acc)
-                                        : embree_chunk(es, rays + c, n, any, &acc);
+                                        : embree_chunk(es[k - n_trees], rays + c, n, any, &acc);
                 }
             }
         printf("bounce %s, %d passes, Mrays/s (ratio to file):", any ? "any-hit" : "closest", passes);
-        for (int k = 0; k <= n_trees; k++)
+        for (int k = 0; k < n_trees + EMBREE_RUNS; k++)
             printf("  %s %.3f (%.3f)", names[k], (double)nb * passes / sum[k] / 1e6, sum[0] / sum[k]);
         printf("\n");
         fflush(stdout);
     }
     if (acc == 1)
         printf(" \n");   /* keeps the answers live */
-    rtcReleaseScene(es);
+    for (int e = 0; e < EMBREE_RUNS; e++)
+        rtcReleaseScene(es[e]);
     rtcReleaseDevice(dev);
     free(all);
     free(vx);
