@@ -280,6 +280,20 @@ static void *tree_copy(const void *p, size_t n, size_t size)
     return page_copy(p, bytes ? bytes : 1, g_huge);
 }
 
+/* *out becomes s with the tree of nodes and leaves, copied as tree_copy
+ * does; the arrays are freed.  -1 if a copy failed. */
+static int adopt_tree(const fr_scene *s, fr_array *nodes, fr_array *leaves, fr_scene *out)
+{
+    *out = *s;
+    out->nodes = tree_copy(nodes->data, nodes->count, sizeof(fr_bvh_node));
+    out->n_nodes = nodes->count;
+    out->leaves = tree_copy(leaves->data, leaves->count, sizeof(fr_bvh_leaf));
+    out->n_leaves = leaves->count;
+    free(nodes->data);
+    free(leaves->data);
+    return out->nodes && out->leaves ? 0 : -1;
+}
+
 /* A tree made by Embree's builder at quality q over the triangles of s, in
  * Franja's layout: *out is s with that tree (its arrays malloc'd). */
 static int embree_tree(RTCDevice dev, const fr_scene *s, enum RTCBuildQuality q, unsigned max_leaf, int bfs,
@@ -339,14 +353,7 @@ static int embree_tree(RTCDevice dev, const fr_scene *s, enum RTCBuildQuality q,
     int rc = bld_push(&C.nodes, &blank) == FR_NONE || fill_node(&C, 0, top) < 0 ? -1 : 0;
     rtcReleaseBVH(bvh);
     free(p);
-    *out = *s;
-    out->nodes = tree_copy(C.nodes.data, C.nodes.count, sizeof(fr_bvh_node));
-    out->n_nodes = C.nodes.count;
-    out->leaves = tree_copy(C.leaves.data, C.leaves.count, sizeof(fr_bvh_leaf));
-    out->n_leaves = C.leaves.count;
-    free(C.nodes.data);
-    free(C.leaves.data);
-    return rc < 0 || !out->nodes || !out->leaves ? -1 : 0;
+    return adopt_tree(s, &C.nodes, &C.leaves, out) < 0 || rc < 0 ? -1 : 0;
 }
 
 /* The tree bvh_build makes now over the triangles of s: *out is s with it
@@ -373,16 +380,10 @@ static int franja_tree(const fr_scene *s, fr_scene *out, double *ms)
         fprintf(stderr, "bvhtrees: %s\n", err.msg);
         return -1;
     }
-    *out = *s;
+    rc = adopt_tree(s, &nodes, &leaves, out);
     out->prims = tree_copy(b.prims.data, b.prims.count, sizeof(fr_prim));
     bld_free(&b);
-    out->nodes = tree_copy(nodes.data, nodes.count, sizeof(fr_bvh_node));
-    out->n_nodes = nodes.count;
-    out->leaves = tree_copy(leaves.data, leaves.count, sizeof(fr_bvh_leaf));
-    out->n_leaves = leaves.count;
-    free(nodes.data);
-    free(leaves.data);
-    return out->prims && out->nodes && out->leaves ? 0 : -1;
+    return rc < 0 || !out->prims ? -1 : 0;
 }
 
 /* ---- another layout of the same tree ---- */
@@ -447,14 +448,7 @@ static int relayout(const fr_scene *s, int sort, fr_scene *out)
 {
     relay R = {s, {NULL, 0, 0, sizeof(fr_bvh_node)}, {NULL, 0, 0, sizeof(fr_bvh_leaf)}, sort};
     int rc = bld_push(&R.nodes, &s->nodes[0]) == FR_NONE || relay_node(&R, 0, 0) < 0 ? -1 : 0;
-    *out = *s;
-    out->nodes = tree_copy(R.nodes.data, R.nodes.count, sizeof(fr_bvh_node));
-    out->n_nodes = R.nodes.count;
-    out->leaves = tree_copy(R.leaves.data, R.leaves.count, sizeof(fr_bvh_leaf));
-    out->n_leaves = R.leaves.count;
-    free(R.nodes.data);
-    free(R.leaves.data);
-    return rc < 0 || !out->nodes || !out->leaves ? -1 : 0;
+    return adopt_tree(s, &R.nodes, &R.leaves, out) < 0 || rc < 0 ? -1 : 0;
 }
 
 /* ---- what a tree costs a ray, counted ---- */
