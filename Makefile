@@ -31,11 +31,11 @@ ASSIMP_LIBS  := $(shell $(PKG) --libs assimp 2>/dev/null || echo -lassimp)
 MHD_LIBS     := $(shell $(PKG) --libs libmicrohttpd 2>/dev/null || echo -lmicrohttpd)
 
 B = build
-COMMON_SRC  = $(wildcard common/*.c)
+COMMON_SRC  = $(wildcard common/*.c common/compile/*.c)
 COMMON_OBJ  = $(COMMON_SRC:%.c=$(B)/%.o)
 WORKER_SRC  = $(wildcard worker/*.c)
 WORKER_OBJ  = $(WORKER_SRC:%.c=$(B)/%.o)
-COORD_SRC   = $(wildcard coordinator/*.c)
+COORD_SRC   = $(wildcard coordinator/*.c coordinator/*/*.c)
 COORD_OBJ   = $(COORD_SRC:%.c=$(B)/%.o)
 # OpenImageIO's bridge, a plug-in that franja loads when it first reads or
 # writes an image other than PFM (coordinator/imageio_load.c).
@@ -111,7 +111,10 @@ $(COORD_LIB): $(COORD_LIB_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && $(AR) rcs $@ $^
 
-$(TESTSUP_OBJ): CSTD += -iquote coordinator -Itests
+# The coordinator's sources (and the code that uses them) name its headers
+# from coordinator/, as common's from common/: "transport/hosts.h".
+$(COORD_OBJ) $(TESTSUP_OBJ): CSTD += -iquote coordinator
+$(TESTSUP_OBJ): CSTD += -Itests
 
 $(TESTSUP_LIB): $(TESTSUP_OBJ)
 	@mkdir -p $(dir $@)
@@ -169,6 +172,7 @@ FUZZ_COORD_LIB = $(B)/fuzz/libfranja-coord.a
 FUZZ_COORD_OBJ = $(filter-out $(B)/fuzz/coordinator/main.o,$(COORD_SRC:%.c=$(B)/fuzz/%.o))
 .SECONDARY: $(FUZZ_OBJ) $(FUZZ_COORD_OBJ)
 
+$(FUZZ_COORD_OBJ): FUZZ_CFLAGS += -iquote coordinator
 $(B)/fuzz/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -MMD -MP -c $< -o $@
@@ -268,7 +272,7 @@ STATIC_CC_amd64 = x86_64-linux-gnu-gcc
 STATIC_CC_arm64 = aarch64-linux-gnu-gcc
 static: $(STATIC_ARCHS:%=bin/static/%/franja-worker)
 
-bin/static/%/franja-worker: $(COMMON_SRC) $(WORKER_SRC) $(wildcard common/*.h worker/*.h)
+bin/static/%/franja-worker: $(COMMON_SRC) $(WORKER_SRC) $(wildcard common/*.h common/compile/*.h worker/*.h)
 	$(MAKE) --no-print-directory B=$(B)/static-$* CC=$(STATIC_CC_$*) \
 	    AR=$(STATIC_CC_$*:-gcc=-ar) CJSON_CFLAGS= CFLAGS='$(CFLAGS) -DFRANJA_NO_JSON' \
 	    $(B)/static-$*/libfranja.a $(WORKER_SRC:%.c=$(B)/static-$*/%.o)

@@ -55,13 +55,6 @@ vec3 bsdf_sample_phong(float exponent, float u1, float u2)
     return v3(sz * c, sz * s, cz);
 }
 
-float bsdf_phong_pdf(float exponent, float cos_alpha)
-{
-    if (cos_alpha <= 0.0f)
-        return 0.0f;
-    return (exponent + 1.0f) * FM_INV_2PI * fm_powf(cos_alpha, exponent);
-}
-
 float bsdf_fresnel(float cos_i, float eta, float *cos_t) { return mf_fresnel_dielectric(cos_i, eta, cos_t); }
 
 /* Shading normal turned to wo's side of the geometric surface. */

@@ -83,6 +83,5 @@ float bsdf_fresnel(float cos_i, float eta, float *cos_t);
 /** Local-frame samplers (z up), exposed for the chi-square tests. */
 vec3 bsdf_sample_cosine(float u1, float u2);                 /**< pdf cos(theta)/pi */
 vec3 bsdf_sample_phong(float exponent, float u1, float u2);  /**< pdf (n+1)/(2 pi) cos^n around +z */
-float bsdf_phong_pdf(float exponent, float cos_alpha);
 
 #endif

@@ -79,7 +79,8 @@ float lgt_spot_falloff(const fr_light *l, float c)
     return t * t;
 }
 
-vec3 lgt_intensity(const fr_light *l, vec3 w)
+/* Intensity (W/sr) that a point or spot light sends toward unit direction w. */
+static vec3 lgt_intensity(const fr_light *l, vec3 w)
 {
     if (l->kind != FR_LIGHT_SPOT)
         return l->intensity;

@@ -85,9 +85,6 @@ vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf);
  * with geometric normal `ng` (front side only unless two-sided). */
 vec3 lgt_emitted(const fr_material *m, vec3 ng, vec3 w);
 
-/** Intensity (W/sr) that a point or spot light sends toward unit direction w. */
-vec3 lgt_intensity(const fr_light *l, vec3 w);
-
 /** glTF's spot falloff at cosine `c` from the axis: 1 inside the inner cone,
  * 0 outside the outer one, ((c - cos_outer) / (cos_inner - cos_outer))^2
  * between them (KHR_lights_punctual's reference, its denominator at least

@@ -168,10 +168,3 @@ float smp_random(fr_sampler *s)
     uint64_t h = pair_seeds(s, s->dim++, NULL);
     return to_unit((uint32_t)(mix64(h + (uint64_t)(s->index + 1) * 0xd6e8feb86659fd93ull) >> 32));
 }
-
-float smp_1d(fr_sampler *s)
-{
-    float u, v;
-    smp_2d(s, &u, &v);
-    return u;
-}

@@ -54,10 +54,8 @@ void smp_start_shared(fr_sampler *s, smp_shared *shared, uint32_t x, uint32_t y,
 /** Next two numbers in [0, 1), from one stratified 2D pattern. */
 void smp_2d(fr_sampler *s, float *u, float *v);
 /** Next number in [0, 1), not stratified: for decisions that gain nothing
- * from stratification (Russian roulette); cheaper than smp_1d. */
+ * from stratification (Russian roulette); cheaper than a stratified number. */
 float smp_random(fr_sampler *s);
-/** Next number in [0, 1) (uses a whole dimension pair). */
-float smp_1d(fr_sampler *s);
 /** Pass over the next dimension pair without computing it: for a pair
  * that this sample does not use (the lens of a pinhole camera), so that
  * the pairs after it keep their numbers. */

@@ -4,7 +4,10 @@
 #include <stdio.h>
 #include <string.h>
 
-int sug_edits(const char *a, size_t na, const char *b, size_t nb)
+/* Levenshtein distance of a[0..na) and b[0..nb): insertions, deletions
+ * and substitutions of one byte.  Strings longer than 32 bytes are 99 away
+ * from everything. */
+static int sug_edits(const char *a, size_t na, const char *b, size_t nb)
 {
     if (na > 32 || nb > 32)
         return 99;

@@ -9,11 +9,6 @@
 
 #include <stddef.h>
 
-/** Levenshtein distance of a[0..na) and b[0..nb): insertions, deletions
- * and substitutions of one byte.  Strings longer than 32 bytes are 99 away
- * from everything. */
-int sug_edits(const char *a, size_t na, const char *b, size_t nb);
-
 /** The known option nearest to typed (as written: "--samples", "--spp=0",
  * "-x"), among names[0..count) (option names without dashes: "spp", and
  * one letter for a short option: "o").  First a usual synonym from other

@@ -103,11 +103,6 @@ vec3 tex_eval(const fr_scene *s, uint32_t ti, vec2 uv)
     return eval_at(s, t, u, v, &grey);
 }
 
-float tex_eval1(const fr_scene *s, uint32_t ti, vec2 uv)
-{
-    return tex_eval(s, ti, uv).x;
-}
-
 int tex_material_textured(const fr_material *m)
 {
     return (m->tex_diffuse & m->tex_glossy & m->tex_specular & m->tex_transmit & m->tex_emission & m->tex_bump &

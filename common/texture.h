@@ -18,9 +18,6 @@
  * one-channel texture gives its value in all three. */
 vec3 tex_eval(const fr_scene *s, uint32_t t, vec2 uv);
 
-/** First channel of texture `t` at uv (a height, a roughness ...). */
-float tex_eval1(const fr_scene *s, uint32_t t, vec2 uv);
-
 /** 1 if material m has any texture, bump or normal map. */
 int tex_material_textured(const fr_material *m);
 

@@ -25,7 +25,9 @@ float vtx_power_heuristic(float a, float b)
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
-float vtx_power_heuristic3(float a, float b, float c)
+/* The power heuristic among three techniques: a^2 / (a^2 + b^2 + c^2); 0
+ * when all are 0. */
+static float vtx_power_heuristic3(float a, float b, float c)
 {
     float a2 = a * a, sum = a2 + b * b + c * c;
     return sum > 0.0f ? a2 / sum : 0.0f;

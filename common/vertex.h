@@ -50,10 +50,6 @@ typedef struct {
  * density a against a technique of density b; 0 when both are 0. */
 float vtx_power_heuristic(float a, float b);
 
-/** The power heuristic among three techniques: a^2 / (a^2 + b^2 + c^2); 0
- * when all are 0. */
-float vtx_power_heuristic3(float a, float b, float c);
-
 /** Follow *ray, travelling in *medium (1 + index into media, 0: vacuum)
  * with path throughput *beta, to the path's next vertex, into *v; returns
  * v->kind.

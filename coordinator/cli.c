@@ -1,7 +1,6 @@
 /* cli.c -- option parsing shared by the subcommands. */
 #include "cli.h"
 
-#include "transport_backend.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -32,7 +31,8 @@ const char *cli_beside_exe(const char *name, char *buf, size_t cap)
     return len < 0 || (size_t)len >= cap ? NULL : buf;
 }
 
-const char *cli_local_worker(void)
+/* The franja-worker next to this executable, or NULL. */
+static const char *cli_local_worker(void)
 {
     static char path[PATH_MAX];
     return cli_beside_exe("franja-worker", path, sizeof path);
@@ -147,8 +147,7 @@ int cli_slurm_hosts(const char *cmd, const cli_slurm *s, int argc, char **argv, 
             a->shared = s->shared;
         }
         if (slurm_hosts(a, t, &err) == 0) {
-            o->backend = &tr_slurm_backend;
-            o->backend_ctx = a;
+            slurm_serve(a, o);
             return 0;
         }
     }

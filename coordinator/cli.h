@@ -7,10 +7,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "hosts.h"
+#include "transport/hosts.h"
 #include "opt.h"
-#include "slurm.h"
-#include "transport.h"
+#include "transport/slurm.h"
+#include "transport/transport.h"
 
 /** Help text for the transport options (CLI_COMMON_LONGOPTS). */
 extern const char cli_transport_help[];
@@ -105,9 +105,6 @@ int cli_load_hosts(const char *cmd, const char *path, hosts_table *t);
 /** The note_sink function that prints "franja: LINE" on stderr (ctx
  * unused). */
 void cli_note_stderr(void *ctx, const char *line);
-
-/** The franja-worker next to this executable, or NULL. */
-const char *cli_local_worker(void);
 
 /** Writes "<directory of this executable>/name" into buf[cap] and returns
  * buf; NULL when /proc/self/exe cannot be read or the path does not fit. */

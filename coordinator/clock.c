@@ -3,7 +3,7 @@
 
 #include <time.h>
 
-double clk_now(void)
+double clock_now(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);

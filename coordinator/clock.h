@@ -8,6 +8,6 @@
 
 /** Seconds since an arbitrary fixed point (CLOCK_MONOTONIC): differences
  * are elapsed time, unaffected by changes of the wall clock. */
-double clk_now(void);
+double clock_now(void);
 
 #endif

@@ -6,8 +6,8 @@
 #include <string.h>
 
 #include "opt.h"
-#include "compile.h"
-#include "compile_child.h"
+#include "compile/compile.h"
+#include "compile/compile_child.h"
 #include "file.h"
 
 static const char usage[] =

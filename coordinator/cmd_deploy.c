@@ -9,10 +9,10 @@
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "cluster.h"
-#include "hosts.h"
+#include "transport/cluster.h"
+#include "transport/hosts.h"
 #include "protocol.h"
-#include "stage.h"
+#include "transport/stage.h"
 
 static const char usage[] =
     "usage: franja deploy --hosts FILE [--dist DIR] [options]\n"
@@ -95,8 +95,8 @@ static int pick(const char *dist, const char *os, const char *arch, char *path, 
                    "(make dist, or give os= in the host table)", dist, arch);
 }
 
-/* One host's deployment (a cl_step, in the host's own thread). */
-static int deploy_one(cl_host *ch, int i, void *vctx, fr_error *err)
+/* One host's deployment (a cluster_step, in the host's own thread). */
+static int deploy_one(cluster_host *ch, int i, void *vctx, fr_error *err)
 {
     deploy_ctx *c = vctx;
     const hosts_entry *e = ch->entry;
@@ -144,7 +144,7 @@ static int deploy_all(const hosts_table *t, const tr_options *o, const char *dis
     char expect[128];
     proto_version_line("franja-worker", expect, sizeof expect);
     int n = t->n;
-    cl_host *hosts = calloc((size_t)n, sizeof *hosts);
+    cluster_host *hosts = calloc((size_t)n, sizeof *hosts);
     int *remote_of = calloc((size_t)n, sizeof *remote_of);
     deploy_ctx c = {dist, expect, calloc((size_t)n, sizeof *c.report), calloc((size_t)n, sizeof *c.note)};
     if (!hosts || !remote_of || !c.report || !c.note) {
@@ -159,7 +159,7 @@ static int deploy_all(const hosts_table *t, const tr_options *o, const char *dis
             remote_of[i] = remote;
             hosts[remote++].entry = &t->v[i];
         }
-    cl_each(hosts, remote, o, deploy_one, &c);
+    cluster_each(hosts, remote, o, deploy_one, &c);
     int done = 0;
     for (int i = 0; i < n; i++) {
         const hosts_entry *e = &t->v[i];
@@ -179,7 +179,7 @@ static int deploy_all(const hosts_table *t, const tr_options *o, const char *dis
         printf("no SSH host in %s: nothing to deploy\n", t->path);
     else
         printf("deployed to %d of %d SSH host%s\n", done, remote, remote == 1 ? "" : "s");
-    cl_close(hosts, remote);
+    cluster_close(hosts, remote);
     free(hosts), free(remote_of), free(c.report), free(c.note);
     return done == remote ? 0 : 1;
 }

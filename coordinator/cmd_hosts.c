@@ -7,8 +7,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "cluster.h"
-#include "stage.h"
+#include "transport/cluster.h"
+#include "transport/stage.h"
 
 static const char usage[] =
     "usage: franja hosts check --hosts FILE [options]\n"
@@ -47,18 +47,18 @@ static void list(const hosts_table *t)
 
 static int check(const hosts_table *t, const tr_options *o, int slurm)
 {
-    cl_host *cl = calloc((size_t)t->n, sizeof *cl);
+    cluster_host *cl = calloc((size_t)t->n, sizeof *cl);
     if (!cl)
         return 1;
     for (int i = 0; i < t->n; i++)
         cl[i].entry = &t->v[i];
-    cl_open(cl, t->n, o, NULL, 0);
+    cluster_open(cl, t->n, o, NULL, 0);
     if (slurm)
-        cl_drop_other_versions(cl, t->n);
+        cluster_drop_other_versions(cl, t->n);
     int bad = 0;
     printf("%-16s %-6s %-8s %-9s %5s  %-36s %s\n", "host", "state", "arch", "os", "cores", "worker", "scene cache");
     for (int i = 0; i < t->n; i++) {
-        cl_host *h = &cl[i];
+        cluster_host *h = &cl[i];
         if (!h->tr) {
             bad++;
             printf("%-16s %-6s %s\n", h->entry->name, "FAIL", h->err.msg);
@@ -100,11 +100,11 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
                h->info.version, cache, warn);
     }
     fr_error err;
-    if (cl_check_versions(cl, t->n, &err)) {
+    if (cluster_check_versions(cl, t->n, &err)) {
         printf("problem: %s\n", err.msg);
         bad++;
     }
-    cl_close(cl, t->n);
+    cluster_close(cl, t->n);
     free(cl);
     if (bad)
         printf("%d problem%s found\n", bad, bad == 1 ? "" : "s");
@@ -113,14 +113,14 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
     return bad ? 1 : 0;
 }
 
-static int clean_step(cl_host *h, int i, void *ctx, fr_error *err)
+static int clean_step(cluster_host *h, int i, void *ctx, fr_error *err)
 {
     return stage_clean(h->tr, &((stage_cleaned *)ctx)[i], err);
 }
 
 static int clean(const hosts_table *t, const tr_options *o)
 {
-    cl_host *cl = calloc((size_t)t->n, sizeof *cl);
+    cluster_host *cl = calloc((size_t)t->n, sizeof *cl);
     stage_cleaned *done = calloc((size_t)t->n, sizeof *done);
     if (!cl || !done) {
         free(cl);
@@ -129,7 +129,7 @@ static int clean(const hosts_table *t, const tr_options *o)
     }
     for (int i = 0; i < t->n; i++)
         cl[i].entry = &t->v[i];
-    cl_each(cl, t->n, o, clean_step, done);
+    cluster_each(cl, t->n, o, clean_step, done);
     int bad = 0;
     for (int i = 0; i < t->n; i++) {
         const stage_cleaned *d = &done[i];
@@ -148,7 +148,7 @@ static int clean(const hosts_table *t, const tr_options *o)
             printf("\n");
         }
     }
-    cl_close(cl, t->n);
+    cluster_close(cl, t->n);
     free(cl);
     free(done);
     return bad ? 1 : 0;

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "cmd_frames.h"
+#include "framewalk.h"
 #include "crop.h"
 #include "frame.h"
 #include "monitor.h"
@@ -105,7 +105,7 @@ enum {
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
-static int parse(int argc, char **argv, render_args *a)
+static int parse(int argc, char **argv, frame_settings *a)
 {
     static const struct option longopts[] = {
         CLI_COMMON_LONGOPTS,
@@ -334,7 +334,7 @@ static frame_image *image_parse(int argc, char **argv, int *status)
     }
     im->argc = argc;
     im->argv = argv;
-    im->stop = &rr_stop;
+    im->stop = &render_run_stop;
     return im;
 }
 
@@ -344,13 +344,13 @@ int cmd_render(int argc, char **argv)
     frame_image *im = image_parse(argc, argv, &status);
     if (!im)
         return status;
-    render_args *a = &im->a;
+    frame_settings *a = &im->a;
     if (a->frames) {
-        int rc = ra_render(argc, argv, a, image_parse);
+        int rc = render_anim(argc, argv, a, image_parse);
         free(im);
         return rc;
     }
-    if (frames_check_plain(a->scene)) {
+    if (framewalk_check_plain(a->scene)) {
         free(im);
         return 2;
     }
@@ -365,7 +365,7 @@ int cmd_render(int argc, char **argv)
         frame_close(im, rc);
         return rc;
     }
-    rr_signals();
+    render_run_signals();
     uint32_t probe = UINT32_MAX;
     if (quick_spp(&probe, &err) < 0) {
         fprintf(stderr, "franja render: %s\n", err.msg);
@@ -374,7 +374,7 @@ int cmd_render(int argc, char **argv)
     }
     hosts_table table;
     slurm_alloc alloc;
-    if ((rc = rr_hosts(a, argc, argv, &table, &alloc))) {
+    if ((rc = render_run_hosts(a, argc, argv, &table, &alloc))) {
         frame_close(im, rc);
         return rc;
     }
@@ -382,7 +382,7 @@ int cmd_render(int argc, char **argv)
     if (rc)
         goto done;
     rc = 1;
-    if (a->json && !(im->pg = pg_start(stdout, PG_NO_FRAME, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job, &err))) {
+    if (a->json && !(im->pg = progress_start(stdout, PG_NO_FRAME, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job, &err))) {
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         goto done;
     }
@@ -394,24 +394,24 @@ int cmd_render(int argc, char **argv)
         mon_status(im->mon, "rendering");
         fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(im->mon));
     }
-    pv_writer *pv = NULL;
-    if (a->preview && !(pv = pv_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,
+    preview_writer *pv = NULL;
+    if (a->preview && !(pv = preview_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,
                                       (note_sink){cli_note_stderr, NULL}, &err))) {
         fprintf(stderr, "franja render: --preview: %s\n", err.msg);
         goto done;
     }
     char used[1024] = "";
     int slabs_rc = im->rows_have < im->rows_job
-                       ? rr_run(a, &table, im->fbin, &im->ps, im->pg, im->mon, used, sizeof used, NULL, &err)
+                       ? render_run(a, &table, im->fbin, &im->ps, im->pg, im->mon, used, sizeof used, NULL, &err)
                        : 0;
-    pv_stop(pv);
+    preview_stop(pv);
     if (slabs_rc) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         goto done;
     }
     rc = frame_write(im, used);
 done:
-    if (rc && rr_stop)
+    if (rc && render_run_stop)
         rc = 130;
     frame_close(im, rc);
     hosts_free(&table);

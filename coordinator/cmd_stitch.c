@@ -104,7 +104,7 @@ int cmd_stitch(int argc, char **argv)
         fprintf(stderr, "franja stitch: out of memory for a %ux%u image\n", spec.width, spec.height);
         goto done;
     }
-    int rows = pv_image(dir, &spec, rgb, have, &skipped, &err);
+    int rows = preview_image(dir, &spec, rgb, have, &skipped, &err);
     if (rows >= 0 && spec.integrator == FR_INTEGRATOR_BDPT) {
         /* A bidirectional job: the rows lack the light traced from the
          * lights (every slab's splats over the whole image), so only a

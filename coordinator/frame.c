@@ -11,8 +11,8 @@
 
 #include "bdpt.h"
 #include "clock.h"
-#include "compile.h"
-#include "compile_child.h"
+#include "compile/compile.h"
+#include "compile/compile_child.h"
 #include "fbin.h"
 #include "opt.h"
 #include "protocol.h"
@@ -41,7 +41,7 @@ static void print_warning(void *user, const char *msg)
 
 /* Gets the binary scene: loads an .fbin, or compiles a JSON scene into the
  * job directory.  *path receives the .fbin to ship. */
-static int scene_binary(const render_args *a, const char *jobdir, char *path, size_t cap, fr_scene *sc,
+static int scene_binary(const frame_settings *a, const char *jobdir, char *path, size_t cap, fr_scene *sc,
                         volatile sig_atomic_t *stop, fr_error *err)
 {
     if (!ends_with(a->scene, ".json") && !compile_is_gltf(a->scene)) {
@@ -65,13 +65,13 @@ static int scene_binary(const render_args *a, const char *jobdir, char *path, si
 /* After a failure: a job directory with no finished slab holds nothing
  * worth keeping (a compiled scene at most), so it goes; one with slabs
  * stays for --resume.  Then the lock is given up.  Returns rc. */
-static int unlock_with(job_lock *lk, int rc)
+static int unlock_with(joblock *lk, int rc)
 {
     if (lk->fd >= 0 && job_rows_present(lk->dir) == 0) {
         job_remove(lk->dir);
-        jlk_release(lk, 1);
+        joblock_release(lk, 1);
     }
-    jlk_release(lk, 0);
+    joblock_release(lk, 0);
     return rc;
 }
 
@@ -99,7 +99,7 @@ static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_wind
 
 
 /* Whether the render needs row y (a crop needs its window's). */
-static int needed(const passes *ps, uint32_t y)
+static int needed(const frame_passes *ps, uint32_t y)
 {
     return !ps->crop_rows || (y >= ps->a->win.y0 && y < ps->a->win.y1);
 }
@@ -107,7 +107,7 @@ static int needed(const passes *ps, uint32_t y)
 /* What a pass to spp samples per pixel renders: the rows the job
  * directory does not hold with spp samples, each from the most samples
  * kept for it with their sums. */
-int frame_plan(passes *ps, uint32_t spp, fr_error *err)
+int frame_plan(frame_passes *ps, uint32_t spp, fr_error *err)
 {
     ps->spec.spp = spp;
     int sums = job_sums(&ps->spec);
@@ -127,7 +127,7 @@ int frame_plan(passes *ps, uint32_t spp, fr_error *err)
 
 /* The fewest and the most samples per pixel kept for a needed row (with
  * their sums, or the samples asked for), from a plan to ps->cap. */
-static void kept_range(const passes *ps, uint32_t *lo, uint32_t *hi)
+static void kept_range(const frame_passes *ps, uint32_t *lo, uint32_t *hi)
 {
     *lo = UINT32_MAX;
     *hi = 0;
@@ -144,7 +144,7 @@ static void kept_range(const passes *ps, uint32_t *lo, uint32_t *hi)
 
 /* The samples per pixel of the next pass of a --time-limit render, 0 when
  * every needed row has the samples asked for. */
-int frame_next_pass(passes *ps, uint32_t *spp, fr_error *err)
+int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err)
 {
     if (frame_plan(ps, ps->cap, err))
         return -1;
@@ -159,7 +159,7 @@ int frame_next_pass(passes *ps, uint32_t *spp, fr_error *err)
 }
 
 /* The image of the pass just planned and complete into ps->rgb. */
-int frame_pass_image(passes *ps, fr_error *err)
+int frame_pass_image(frame_passes *ps, fr_error *err)
 {
     if (ps->crop_rows)
         return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->scratch, err);
@@ -171,7 +171,7 @@ int frame_pass_image(passes *ps, fr_error *err)
  * against --resume and --fresh.  0, or the exit status (said). */
 int frame_lock(frame_image *im)
 {
-    render_args *a = &im->a;
+    frame_settings *a = &im->a;
     fr_error err;
     if (a->jobdir)
         snprintf(im->jobdir, sizeof im->jobdir, "%s", a->jobdir);
@@ -188,7 +188,7 @@ int frame_lock(frame_image *im)
     size_t cl = (size_t)snprintf(cmdline, sizeof cmdline, "franja");
     for (int i = 0; i < im->argc && cl < sizeof cmdline; i++)
         cl += (size_t)snprintf(cmdline + cl, sizeof cmdline - cl, " %s", im->argv[i]);
-    int lr = jlk_acquire(im->jobdir, a->out, cmdline, a->no_lock, &im->lk, &err);
+    int lr = joblock_acquire(im->jobdir, a->out, cmdline, a->no_lock, &im->lk, &err);
     if (lr) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return lr == JLK_BUSY || lr == JLK_NOLOCKS ? 2 : 1;
@@ -202,7 +202,7 @@ int frame_lock(frame_image *im)
         if (rows > 0) {
             fprintf(stderr, "franja render: %s holds %d finished rows of an earlier render of %s; rerun with "
                     "--resume to finish it, or with --fresh to discard them\n", im->jobdir, rows, a->out);
-            jlk_release(&im->lk, 0);
+            joblock_release(&im->lk, 0);
             im->locked = 0;
             return 2;
         }
@@ -230,9 +230,9 @@ int frame_lock(frame_image *im)
  * holds, the passes of --time-limit.  0, or the exit status (said). */
 int frame_open(frame_image *im)
 {
-    render_args *a = &im->a;
+    frame_settings *a = &im->a;
     fr_error err;
-    im->t0 = clk_now();
+    im->t0 = clock_now();
     fr_scene sc;
     if (scene_binary(a, im->jobdir, im->fbin, sizeof im->fbin, &sc, im->stop, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
@@ -300,8 +300,8 @@ int frame_open(frame_image *im)
     im->have = calloc(spec.height, 1);
     im->base = calloc(spec.height, sizeof *im->base);
     im->rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *im->rgb);
-    passes *ps = &im->ps;
-    *ps = (passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
+    frame_passes *ps = &im->ps;
+    *ps = (frame_passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
                    .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL};
     if (!im->have || !im->base || !im->rgb || !(ps->scratch = calloc(spec.height, 1))) {
         fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
@@ -366,8 +366,8 @@ int frame_open(frame_image *im)
  * (said). */
 int frame_write(frame_image *im, const char *used)
 {
-    render_args *a = &im->a;
-    passes *ps = &im->ps;
+    frame_settings *a = &im->a;
+    frame_passes *ps = &im->ps;
     job_spec spec = im->spec;
     fr_error err;
     if (a->time_limit > 0 && ps->reached) {
@@ -402,7 +402,7 @@ int frame_write(frame_image *im, const char *used)
         }
     }
     out_meta meta;
-    out_meta_make(&meta, &spec, a->reproducible ? -1 : clk_now() - im->t0, a->reproducible ? NULL : used);
+    out_meta_make(&meta, &spec, a->reproducible ? -1 : clock_now() - im->t0, a->reproducible ? NULL : used);
     if (a->reproducible)
         out_meta_set_time(&meta, reproducible_epoch());
     a->io.attrs = meta.attrs;
@@ -418,7 +418,7 @@ int frame_write(frame_image *im, const char *used)
         }
         return 1;
     }
-    pg_stop(im->pg, "ok", spec.spp);
+    progress_stop(im->pg, "ok", spec.spp);
     im->pg = NULL;
     mon_status(im->mon, "done");
     mon_stop(im->mon);
@@ -427,10 +427,10 @@ int frame_write(frame_image *im, const char *used)
         job_remove(im->jobdir);
     else if (job_sums(&spec))
         job_prune(im->jobdir, &spec); /* rows kept with more samples make the fewer useless */
-    jlk_release(&im->lk, !a->keep_job);
+    joblock_release(&im->lk, !a->keep_job);
     im->locked = 0;
     fprintf(stderr, "franja: wrote %s (%ux%u, %u spp) in %.2f s\n", a->out, out_spec.width, out_spec.height, spec.spp,
-            clk_now() - im->t0);
+            clock_now() - im->t0);
     return 0;
 }
 
@@ -438,7 +438,7 @@ int frame_write(frame_image *im, const char *used)
  * --resume if it holds rows and the lock is given up; frees it. */
 void frame_close(frame_image *im, int rc)
 {
-    pg_stop(im->pg, *im->stop ? "interrupted" : "failed", im->spec.spp);
+    progress_stop(im->pg, *im->stop ? "interrupted" : "failed", im->spec.spp);
     mon_stop(im->mon);
     if (rc && im->locked)
         unlock_with(&im->lk, rc);

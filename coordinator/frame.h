@@ -53,7 +53,7 @@ typedef struct {
     double time_limit;         /* --time-limit, seconds; 0 when not given */
     tr_options tr;
     cli_slurm slurm;
-} render_args;
+} frame_settings;
 
 /** The passes of a render.  Without --time-limit there is one, to the
  * samples asked for.  With it, each pass brings every row the render needs
@@ -62,7 +62,7 @@ typedef struct {
  * to the kept sums, and the image of each complete pass is kept in memory:
  * when the limit stops a pass, that image is written. */
 typedef struct {
-    const render_args *a;
+    const frame_settings *a;
     const char *jobdir;
     job_spec spec;             /* the pass being planned or run (spp) */
     uint32_t cap;              /* the samples per pixel asked for */
@@ -71,26 +71,26 @@ typedef struct {
     uint32_t *base;            /* samples with sums that each row goes on from (job_scan) */
     int rows_job, rows_missing;
     int rows_kept;             /* rows the job directory holds at spec.spp, needed or not */
-    double deadline;           /* clk_now() time of --time-limit; 0 = none */
+    double deadline;           /* clock_now() time of --time-limit; 0 = none */
     float *rgb;                /* --time-limit: the image of the last complete pass */
     unsigned char *scratch;    /* height bytes */
     uint32_t reached;          /* the samples per pixel of rgb; 0 = none yet */
     int npass;                 /* passes run */
     uint32_t stopped;          /* the samples per pixel of the pass the limit stopped; 0 = none */
-    sched_stats total;         /* over the passes */
+    sched_stats total;         /* over the frame_passes */
     const char *label;         /* an animation's frame: "frame N"; NULL otherwise */
-} passes;
+} frame_passes;
 
 /** One image of a render, from its job lock to its output: the render of
  * one scene, or one frame of an animation.  The caller fills a (parsed),
  * argc, argv and stop; the rest is frame_lock's and frame_open's. */
 typedef struct {
-    render_args a;
+    frame_settings a;
     volatile sig_atomic_t *stop; /* set on SIGINT/SIGTERM (not owned) */
     int argc;
     char **argv;               /* as typed, for the lock file (not owned) */
     char jobdir[4096], fbin[4200];
-    job_lock lk;
+    joblock lk;
     int locked;
     job_spec spec;
     fr_tonemap tm;
@@ -98,10 +98,10 @@ typedef struct {
     unsigned char *have;
     uint32_t *base;
     float *rgb;
-    passes ps;
+    frame_passes ps;
     int rows_job, rows_have;
     double t0;
-    pg_reporter *pg;           /* --progress json, or NULL */
+    progress_reporter *pg;           /* --progress json, or NULL */
     mon_server *mon;           /* --monitor, or NULL */
 } frame_image;
 
@@ -109,16 +109,16 @@ typedef struct {
  * directory does not hold with spp samples (ps->have), each from the most
  * samples kept for it with their sums (ps->base).  -1 with err when the
  * job directory cannot be read. */
-int frame_plan(passes *ps, uint32_t spp, fr_error *err);
+int frame_plan(frame_passes *ps, uint32_t spp, fr_error *err);
 
 /** The samples per pixel of the next pass of a --time-limit render into
  * *spp, 0 when every needed row has the samples asked for.  -1 with err
  * when the job directory cannot be read. */
-int frame_next_pass(passes *ps, uint32_t *spp, fr_error *err);
+int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err);
 
 /** The image of the pass just planned and complete into ps->rgb.  -1 with
  * err when a row is missing or unreadable. */
-int frame_pass_image(passes *ps, fr_error *err);
+int frame_pass_image(frame_passes *ps, fr_error *err);
 
 /** Takes im's job lock (its job directory: --job, else OUT.franja-job)
  * and refuses a job directory with finished rows unless --resume or

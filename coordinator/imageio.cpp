@@ -26,12 +26,6 @@ using namespace OIIO;
 // of disk space, and the caller then writes the bytes with every write
 // checked.  The writer is chosen by the extension of `name`, and opens the
 // memory file through /proc/self/fd.
-extern "C" int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
-                          unsigned char **data, size_t *len, fr_error *err)
-{
-    return iio_encode_with(name, pixels, type, width, height, nullptr, data, len, err);
-}
-
 extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                                const iio_options *o, unsigned char **data, size_t *len, fr_error *err)
 {

@@ -17,19 +17,8 @@
 
 #include "error.h"
 
-/** Pixel types iio_encode accepts. */
+/** Pixel types iio_encode_with accepts. */
 typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32 } iio_type;
-
-/** Encodes width x height RGB pixels (top row first, 3 values of `type`
- * per pixel) in the format the extension of `name` names (png, exr, tif,
- * jpg, hdr, bmp, tga, ppm ...), into memory: *data (malloc'd, the caller
- * frees) receives the *len bytes of the file, which the caller writes.
- * Nothing is written to disk, so a full file system cannot truncate the
- * image or end the process (libjpeg exits on a failed write).  Fails,
- * naming `name`, with OpenImageIO's message or for lack of memory; *data
- * is then NULL. */
-int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
-               unsigned char **data, size_t *len, fr_error *err);
 
 /** How iio_encode_with stores an image, where the format allows. */
 typedef struct {
@@ -43,8 +32,15 @@ typedef struct {
                                     "franja:spp") only formats with free-form attributes (OpenEXR) */
 } iio_options;
 
-/** iio_encode with options (NULL: none); options a format does not have
- * are ignored by its writer. */
+/** Encodes width x height RGB pixels (top row first, 3 values of `type`
+ * per pixel) in the format the extension of `name` names (png, exr, tif,
+ * jpg, hdr, bmp, tga, ppm ...), into memory: *data (malloc'd, the caller
+ * frees) receives the *len bytes of the file, which the caller writes.
+ * Nothing is written to disk, so a full file system cannot truncate the
+ * image or end the process (libjpeg exits on a failed write).  Options
+ * (o; NULL: none) a format does not have are ignored by its writer.
+ * Fails, naming `name`, with OpenImageIO's message or for lack of memory;
+ * *data is then NULL. */
 int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                     const iio_options *o, unsigned char **data, size_t *len, fr_error *err);
 

@@ -91,12 +91,6 @@ static const char *plug_ready(void)
 
 const char *iio_unavailable(void) { return plug_ready(); }
 
-int iio_encode(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
-               unsigned char **data, size_t *len, fr_error *err)
-{
-    return iio_encode_with(name, pixels, type, width, height, NULL, data, len, err);
-}
-
 int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                     const iio_options *o, unsigned char **data, size_t *len, fr_error *err)
 {

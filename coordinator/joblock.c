@@ -9,7 +9,10 @@
 #include <time.h>
 #include <unistd.h>
 
-int jlk_check_dir(const char *dir, fr_error *err)
+/* Checks that dir, if it exists, is a directory (not a link) owned by this
+ * user and not writable by group or others.  0 when it is, or does not
+ * exist; otherwise -1 with the reason and what to do. */
+static int joblock_check_dir(const char *dir, fr_error *err)
 {
     struct stat st;
     if (lstat(dir, &st)) {
@@ -92,7 +95,7 @@ static void note(int fd, const char *cmdline)
         fsync(fd);
 }
 
-int jlk_acquire(const char *dir, const char *what, const char *cmdline, int unlocked_ok, job_lock *lk,
+int joblock_acquire(const char *dir, const char *what, const char *cmdline, int unlocked_ok, joblock *lk,
                 fr_error *err)
 {
     lk->fd = -1;
@@ -105,7 +108,7 @@ int jlk_acquire(const char *dir, const char *what, const char *cmdline, int unlo
         lk->created = 1;
     else if (errno != EEXIST)
         return fr_fail(err, "%s: cannot create job directory: %s", dir, strerror(errno));
-    if (jlk_check_dir(dir, err))
+    if (joblock_check_dir(dir, err))
         return -1;
     /* The holder removes the lock file as it finishes: a file opened just
      * before that is no longer the lock, so check the name still leads to
@@ -163,13 +166,13 @@ int jlk_acquire(const char *dir, const char *what, const char *cmdline, int unlo
         close(fd);
         if (mkdir(dir, 0700) == 0)
             lk->created = 1;
-        if (jlk_check_dir(dir, err))
+        if (joblock_check_dir(dir, err))
             return -1;
     }
     return fr_fail(err, "%s: could not take the lock (the directory keeps being removed)", dir);
 }
 
-void jlk_release(job_lock *lk, int remove_dir)
+void joblock_release(joblock *lk, int remove_dir)
 {
     if (lk->fd < 0)
         return;

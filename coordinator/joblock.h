@@ -24,35 +24,30 @@ typedef struct {
     int fd;                    /**< the lock file, open; -1 when not held */
     char path[4200];           /**< DIR/lock */
     char dir[4096];            /**< the job directory */
-    int created;               /**< 1 if jlk_acquire created the directory */
+    int created;               /**< 1 if joblock_acquire created the directory */
     int unlocked;              /**< 1 if used without a lock (file system without locks, --no-lock) */
-} job_lock;
+} joblock;
 
-/** jlk_acquire's results besides 0 (held) and -1 (an error, err says which). */
+/** joblock_acquire's results besides 0 (held) and -1 (an error, err says which). */
 enum {
     JLK_BUSY = -2,             /**< another live process holds the lock */
     JLK_NOLOCKS = -3           /**< the file system refuses locks */
 };
 
-/** Checks that dir, if it exists, is a directory (not a link) owned by this
- * user and not writable by group or others.  0 when it is, or does not
- * exist; otherwise -1 with the reason and what to do. */
-int jlk_check_dir(const char *dir, fr_error *err);
-
-/** Creates dir if needed, checks it (jlk_check_dir) and takes the lock.
+/** Creates dir if needed, checks it (joblock_check_dir) and takes the lock.
  * `what` names the render's output in the busy message ("OUT is being
  * rendered by another franja (pid P on host H, since T)"); cmdline is
  * recorded in the lock file.  Where the file system refuses locks:
  * JLK_NOLOCKS (a directory this call created is removed again), unless
  * unlocked_ok, in which case the directory is used without a lock (the
  * caller warns).  On 0, lk must be given to
- * jlk_release. */
-int jlk_acquire(const char *dir, const char *what, const char *cmdline, int unlocked_ok, job_lock *lk,
+ * joblock_release. */
+int joblock_acquire(const char *dir, const char *what, const char *cmdline, int unlocked_ok, joblock *lk,
                 fr_error *err);
 
 /** Gives the lock up.  With remove_dir, first removes the lock file and
  * then the directory (which must be empty of everything else by then; if
  * it is not, it stays). */
-void jlk_release(job_lock *lk, int remove_dir);
+void joblock_release(joblock *lk, int remove_dir);
 
 #endif

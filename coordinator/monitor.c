@@ -304,11 +304,11 @@ static void refresh_image(mon_server *m)
     if (!m->dir)
         return;
     int rows = job_rows_present(m->dir);
-    double now = clk_now();
+    double now = clock_now();
     if (m->png && (rows == m->png_rows || now - m->png_at < 1.0))
         return;
     fr_error err;
-    if (pv_image(m->dir, &m->spec, m->rgb, m->have, NULL, &err) < 0)
+    if (preview_image(m->dir, &m->spec, m->rgb, m->have, NULL, &err) < 0)
         return; /* the last image stays */
     unsigned char *data = NULL;
     size_t len = 0;

@@ -156,14 +156,9 @@ static int encode_pfm(const char *path, const float *rgb, const job_spec *spec, 
     return 0;
 }
 
-int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
-               size_t *len, fr_error *err)
-{
-    return out_encode_with(path, rgb, spec, tm, NULL, data, len, err);
-}
-
-int out_encode_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
-                    const iio_options *o, unsigned char **data, size_t *len, fr_error *err)
+/* out_encode with the writer's options o (imageio.h; NULL: none). */
+static int out_encode_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
+                           const iio_options *o, unsigned char **data, size_t *len, fr_error *err)
 {
     /* Encoded in memory: OpenImageIO's writers do not all report a failed
      * write, and libjpeg's exits. */
@@ -188,6 +183,12 @@ int out_encode_with(const char *path, const float *rgb, const job_spec *spec, co
     int rc = iio_encode_with(path, px, wide ? IIO_U16 : IIO_U8, spec->width, spec->height, o, data, len, err);
     free(px);
     return rc;
+}
+
+int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
+               size_t *len, fr_error *err)
+{
+    return out_encode_with(path, rgb, spec, tm, NULL, data, len, err);
 }
 
 int out_write(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, fr_error *err)

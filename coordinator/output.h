@@ -61,10 +61,6 @@ int out_check(const char *path, fr_error *err);
 int out_encode(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm, unsigned char **data,
                size_t *len, fr_error *err);
 
-/** out_encode with the writer's options o (imageio.h; NULL: none). */
-int out_encode_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
-                    const iio_options *o, unsigned char **data, size_t *len, fr_error *err);
-
 /** out_write with the writer's options o (imageio.h; NULL: none). */
 int out_write_with(const char *path, const float *rgb, const job_spec *spec, const fr_tonemap *tm,
                    const iio_options *o, fr_error *err);

@@ -9,7 +9,7 @@
 
 #include "output.h"
 
-int pv_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped, fr_error *err)
+int preview_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped, fr_error *err)
 {
     int bad = 0;
     int rows = job_gather(dir, spec, rgb, have, &bad, err);
@@ -31,7 +31,7 @@ int pv_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *h
     return rows;
 }
 
-struct pv_writer {
+struct preview_writer {
     char *path, *dir;
     job_spec spec;
     fr_tonemap tm;
@@ -48,10 +48,10 @@ struct pv_writer {
 };
 
 /* One image of the job directory as it is now. */
-static void write_once(pv_writer *w)
+static void write_once(preview_writer *w)
 {
     fr_error err;
-    int rows = pv_image(w->dir, &w->spec, w->rgb, w->have, NULL, &err);
+    int rows = preview_image(w->dir, &w->spec, w->rgb, w->have, NULL, &err);
     if (rows >= 0 && out_write(w->path, w->rgb, &w->spec, &w->tm, &err) == 0) {
         w->written++;
         w->failing = 0;
@@ -64,7 +64,7 @@ static void write_once(pv_writer *w)
 
 static void *run(void *arg)
 {
-    pv_writer *w = arg;
+    preview_writer *w = arg;
     pthread_mutex_lock(&w->lock);
     while (!w->stop) {
         pthread_mutex_unlock(&w->lock);
@@ -86,7 +86,7 @@ static void *run(void *arg)
     return NULL;
 }
 
-static void release(pv_writer *w)
+static void release(preview_writer *w)
 {
     free(w->path);
     free(w->dir);
@@ -95,10 +95,10 @@ static void release(pv_writer *w)
     free(w);
 }
 
-pv_writer *pv_start(const char *path, const char *dir, const job_spec *spec, const fr_tonemap *tm, double period_s,
+preview_writer *preview_start(const char *path, const char *dir, const job_spec *spec, const fr_tonemap *tm, double period_s,
                     note_sink notes, fr_error *err)
 {
-    pv_writer *w = calloc(1, sizeof *w);
+    preview_writer *w = calloc(1, sizeof *w);
     if (!w) {
         fr_fail(err, "out of memory");
         return NULL;
@@ -133,7 +133,7 @@ pv_writer *pv_start(const char *path, const char *dir, const job_spec *spec, con
     return w;
 }
 
-int pv_stop(pv_writer *w)
+int preview_stop(preview_writer *w)
 {
     if (!w)
         return 0;

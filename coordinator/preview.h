@@ -28,10 +28,10 @@
  * bidirectional job the light-traced splats are in the image only once
  * every row is there (job_stitch); until then the rows have the camera
  * paths' part alone. */
-int pv_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped, fr_error *err);
+int preview_image(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped, fr_error *err);
 
 /** A running preview writer. */
-typedef struct pv_writer pv_writer;
+typedef struct preview_writer preview_writer;
 
 /** Starts a thread that writes the image so far of the job directory dir
  * to path (out_write: atomically, in the format of its extension, tone
@@ -39,11 +39,11 @@ typedef struct pv_writer pv_writer;
  * is handed to notes (from that thread) once, until a write succeeds again.
  * Returns NULL with err set when the thread cannot be started.  The strings
  * are copied. */
-pv_writer *pv_start(const char *path, const char *dir, const job_spec *spec, const fr_tonemap *tm, double period_s,
+preview_writer *preview_start(const char *path, const char *dir, const job_spec *spec, const fr_tonemap *tm, double period_s,
                     note_sink notes, fr_error *err);
 
 /** Writes the image once more (the last state of dir), stops the thread
  * and frees w (NULL: nothing).  Returns the number of images written. */
-int pv_stop(pv_writer *w);
+int preview_stop(preview_writer *w);
 
 #endif

@@ -9,7 +9,7 @@
 
 #include "clock.h"
 
-struct pg_reporter {
+struct progress_reporter {
     FILE *out;
     long frame;                /* the frame every event carries; PG_NO_FRAME: none */
     char *dir;                 /* NULL: an animation's own reporter (no thread) */
@@ -26,7 +26,8 @@ struct pg_reporter {
     int stop;
 };
 
-void pg_json_string(FILE *out, const char *s)
+/* Writes s to out as a JSON string, quoted and escaped. */
+static void progress_json_string(FILE *out, const char *s)
 {
     fputc('"', out);
     for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
@@ -49,7 +50,7 @@ static void begin(FILE *out, const char *event, long frame)
 }
 
 /* Prints a progress event if the count of finished rows changed. */
-static void poll_once(pg_reporter *r)
+static void poll_once(progress_reporter *r)
 {
     pthread_mutex_lock(&r->lock);
     uint32_t spp = r->spp;
@@ -61,8 +62,8 @@ static void poll_once(pg_reporter *r)
         return;
     }
     r->rows = rows;
-    double t = clk_now() - r->t0;
-    double tp = clk_now() - r->tp;
+    double t = clock_now() - r->t0;
+    double tp = clock_now() - r->tp;
     double rate = tp > 0 ? (rows - r->rows0) / tp : 0;
     begin(r->out, "progress", r->frame);
     fprintf(r->out, ",\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,\"eta_s\":", rows,
@@ -75,7 +76,7 @@ static void poll_once(pg_reporter *r)
     funlockfile(r->out);
 }
 
-void pg_event(pg_reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
+void progress_event(progress_reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
               const char *text)
 {
     if (!r)
@@ -83,14 +84,14 @@ void pg_event(pg_reporter *r, long frame, const char *what, const char *host, ui
     flockfile(r->out);
     begin(r->out, "host", frame);
     fputs(",\"what\":", r->out);
-    pg_json_string(r->out, what);
+    progress_json_string(r->out, what);
     fputs(",\"host\":", r->out);
-    pg_json_string(r->out, host);
-    fprintf(r->out, ",\"elapsed_s\":%.3f", clk_now() - r->t0);
+    progress_json_string(r->out, host);
+    fprintf(r->out, ",\"elapsed_s\":%.3f", clock_now() - r->t0);
     if (y1 > y0)
         fprintf(r->out, ",\"y0\":%u,\"y1\":%u", y0, y1);
     fputs(",\"text\":", r->out);
-    pg_json_string(r->out, text);
+    progress_json_string(r->out, text);
     fputs("}\n", r->out);
     fflush(r->out);
     funlockfile(r->out);
@@ -98,7 +99,7 @@ void pg_event(pg_reporter *r, long frame, const char *what, const char *host, ui
 
 static void *run(void *arg)
 {
-    pg_reporter *r = arg;
+    progress_reporter *r = arg;
     pthread_mutex_lock(&r->lock);
     while (!r->stop) {
         pthread_mutex_unlock(&r->lock);
@@ -118,10 +119,10 @@ static void *run(void *arg)
     return NULL;
 }
 
-pg_reporter *pg_start(FILE *out, long frame, const char *output, const char *dir, const job_spec *spec,
+progress_reporter *progress_start(FILE *out, long frame, const char *output, const char *dir, const job_spec *spec,
                       uint32_t rows, fr_error *err)
 {
-    pg_reporter *r = calloc(1, sizeof *r);
+    progress_reporter *r = calloc(1, sizeof *r);
     if (!r || !(r->dir = strdup(dir))) {
         free(r);
         fr_fail(err, "out of memory");
@@ -131,13 +132,13 @@ pg_reporter *pg_start(FILE *out, long frame, const char *output, const char *dir
     r->frame = frame;
     r->spec = *spec;
     r->total = rows;
-    r->t0 = r->tp = clk_now();
+    r->t0 = r->tp = clock_now();
     r->spp = spec->spp;
     r->rows0 = r->rows = job_rows_at(dir, spec->spp);
     flockfile(out);
     begin(out, "start", frame);
     fputs(",\"output\":", out);
-    pg_json_string(out, output);
+    progress_json_string(out, output);
     fprintf(out, ",\"width\":%u,\"height\":%u,\"spp\":%u,\"rows\":%u,\"rows_done\":%d,\"time\":%lld}\n",
             spec->width, spec->height, spec->spp, rows, r->rows0, (long long)time(NULL));
     fflush(out);
@@ -160,7 +161,7 @@ pg_reporter *pg_start(FILE *out, long frame, const char *output, const char *dir
     return r;
 }
 
-void pg_pass(pg_reporter *r, int k, uint32_t spp)
+void progress_pass(progress_reporter *r, int k, uint32_t spp)
 {
     if (!r)
         return;
@@ -169,15 +170,15 @@ void pg_pass(pg_reporter *r, int k, uint32_t spp)
     pthread_mutex_lock(&r->lock);
     r->spp = spp;
     pthread_mutex_unlock(&r->lock);
-    r->tp = clk_now();
+    r->tp = clock_now();
     r->rows0 = r->rows = rows;
     begin(r->out, "pass", r->frame);
-    fprintf(r->out, ",\"pass\":%d,\"spp\":%u,\"rows_done\":%d,\"elapsed_s\":%.3f}\n", k, spp, rows, clk_now() - r->t0);
+    fprintf(r->out, ",\"pass\":%d,\"spp\":%u,\"rows_done\":%d,\"elapsed_s\":%.3f}\n", k, spp, rows, clock_now() - r->t0);
     fflush(r->out);
     funlockfile(r->out);
 }
 
-void pg_stop(pg_reporter *r, const char *status, uint32_t spp)
+void progress_stop(progress_reporter *r, const char *status, uint32_t spp)
 {
     if (!r)
         return;
@@ -189,17 +190,17 @@ void pg_stop(pg_reporter *r, const char *status, uint32_t spp)
     flockfile(r->out);
     if (!strcmp(status, "ok") && r->rows != (int)r->total) {
         /* Every row is in the image now, whatever the directory shows. */
-        double t = clk_now() - r->t0;
+        double t = clock_now() - r->t0;
         begin(r->out, "progress", r->frame);
         fprintf(r->out, ",\"rows_done\":%u,\"rows\":%u,\"elapsed_s\":%.3f,\"rows_per_s\":%.3f,\"eta_s\":0}\n", r->total,
-                r->total, t, clk_now() > r->tp ? (r->total - (uint32_t)r->rows0) / (clk_now() - r->tp) : 0.0);
+                r->total, t, clock_now() > r->tp ? (r->total - (uint32_t)r->rows0) / (clock_now() - r->tp) : 0.0);
         r->rows = (int)r->total;
     } else if (strcmp(status, "ok")) {
         poll_once(r);
     }
     begin(r->out, "done", r->frame);
     fprintf(r->out, ",\"status\":\"%s\",\"spp\":%u,\"rows_done\":%d,\"rows\":%u,\"elapsed_s\":%.3f}\n", status, spp,
-            r->rows, r->total, clk_now() - r->t0);
+            r->rows, r->total, clock_now() - r->t0);
     fflush(r->out);
     funlockfile(r->out);
     pthread_cond_destroy(&r->wake);
@@ -208,46 +209,46 @@ void pg_stop(pg_reporter *r, const char *status, uint32_t spp)
     free(r);
 }
 
-pg_reporter *pg_run_start(FILE *out, const char *list, size_t n, fr_error *err)
+progress_reporter *progress_run_start(FILE *out, const char *list, size_t n, fr_error *err)
 {
-    pg_reporter *r = calloc(1, sizeof *r);
+    progress_reporter *r = calloc(1, sizeof *r);
     if (!r) {
         fr_fail(err, "out of memory");
         return NULL;
     }
     r->out = out;
     r->frame = PG_NO_FRAME;
-    r->t0 = r->tp = clk_now();
+    r->t0 = r->tp = clock_now();
     flockfile(out);
     fputs("{\"event\":\"frames\",\"list\":", out);
-    pg_json_string(out, list);
+    progress_json_string(out, list);
     fprintf(out, ",\"frames\":%zu,\"time\":%lld}\n", n, (long long)time(NULL));
     fflush(out);
     funlockfile(out);
     return r;
 }
 
-void pg_skipped(pg_reporter *r, long frame, const char *output)
+void progress_skipped(progress_reporter *r, long frame, const char *output)
 {
     if (!r)
         return;
     flockfile(r->out);
     begin(r->out, "skipped", frame);
     fputs(",\"output\":", r->out);
-    pg_json_string(r->out, output);
+    progress_json_string(r->out, output);
     fputs("}\n", r->out);
     fflush(r->out);
     funlockfile(r->out);
 }
 
-void pg_run_end(pg_reporter *r, const char *status, size_t n, size_t rendered, size_t skipped)
+void progress_run_end(progress_reporter *r, const char *status, size_t n, size_t rendered, size_t skipped)
 {
     if (!r)
         return;
     flockfile(r->out);
     fprintf(r->out, "{\"event\":\"frames_done\",\"status\":\"%s\",\"frames\":%zu,\"rendered\":%zu,\"skipped\":%zu,"
                     "\"elapsed_s\":%.3f}\n",
-            status, n, rendered, skipped, clk_now() - r->t0);
+            status, n, rendered, skipped, clock_now() - r->t0);
     fflush(r->out);
     funlockfile(r->out);
     free(r);

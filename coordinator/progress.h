@@ -53,7 +53,7 @@
 #include "jobdir.h"
 
 /** A running JSON progress reporter. */
-typedef struct pg_reporter pg_reporter;
+typedef struct progress_reporter progress_reporter;
 
 /** No frame: the events of a single image, or the run's own. */
 #define PG_NO_FRAME (-1L)
@@ -61,43 +61,40 @@ typedef struct pg_reporter pg_reporter;
 /** Prints the start event to out and starts the thread that prints the
  * progress events of the job directory dir.  frame: the frame number that
  * every event of this image carries, or PG_NO_FRAME for a single image.
- * Strings are copied; out must stay open until pg_stop.  NULL with err set
+ * Strings are copied; out must stay open until progress_stop.  NULL with err set
  * if the thread cannot start. */
-pg_reporter *pg_start(FILE *out, long frame, const char *output, const char *dir, const job_spec *spec,
+progress_reporter *progress_start(FILE *out, long frame, const char *output, const char *dir, const job_spec *spec,
                       uint32_t rows, fr_error *err);
 
 /** An animation's own reporter (no thread, no job directory): prints the
- * frames event (list as given, n frames) to out; its pg_event lines are
- * the run's host events.  End it with pg_run_end.  NULL with err when out
+ * frames event (list as given, n frames) to out; its progress_event lines are
+ * the run's host events.  End it with progress_run_end.  NULL with err when out
  * of memory. */
-pg_reporter *pg_run_start(FILE *out, const char *list, size_t n, fr_error *err);
+progress_reporter *progress_run_start(FILE *out, const char *list, size_t n, fr_error *err);
 
 /** Prints the skipped event of frame (its output exists).  r NULL:
  * nothing. */
-void pg_skipped(pg_reporter *r, long frame, const char *output);
+void progress_skipped(progress_reporter *r, long frame, const char *output);
 
 /** Prints the frames_done event (status "ok", "failed", "interrupted" or
  * "time_limit"; n frames in the list, rendered and skipped of them) and
  * frees r (NULL: nothing). */
-void pg_run_end(pg_reporter *r, const char *status, size_t n, size_t rendered, size_t skipped);
+void progress_run_end(progress_reporter *r, const char *status, size_t n, size_t rendered, size_t skipped);
 
 /** Prints the pass event of pass k to spp samples per pixel; from then on
  * rows count when they have spp samples.  r NULL: nothing. */
-void pg_pass(pg_reporter *r, int k, uint32_t spp);
+void progress_pass(progress_reporter *r, int k, uint32_t spp);
 
 /** Stops the thread, prints the last progress (if the count changed) and
  * the done event with status ("ok", "failed", "interrupted", and for a
  * frame "time_limit") and spp, the
  * samples per pixel of the image written, and frees r (NULL: nothing). */
-void pg_stop(pg_reporter *r, const char *status, uint32_t spp);
+void progress_stop(progress_reporter *r, const char *status, uint32_t spp);
 
 /** Prints a host event (see above) from the calling thread; lines of
  * the reporters' threads and of this one never mix.  frame: the frame
  * whose rows y0:y1 it is about, or PG_NO_FRAME.  r NULL: nothing. */
-void pg_event(pg_reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
+void progress_event(progress_reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
               const char *text);
-
-/** Writes s to out as a JSON string, quoted and escaped. */
-void pg_json_string(FILE *out, const char *s);
 
 #endif

@@ -8,35 +8,35 @@
 #include <unistd.h>
 
 #include "clock.h"
-#include "cluster.h"
+#include "transport/cluster.h"
 #include "cmd.h"
-#include "cmd_frames.h"
+#include "framewalk.h"
 #include "preview.h"
 #include "quick.h"
 #include "render_run.h"
 
 /* One frame of an animation run together with the others. */
 typedef struct {
-    frames_one one;            /* its number, files and command line */
+    framewalk_one one;            /* its number, files and command line */
     frame_image *im;           /* NULL once closed */
     int written;
     int failed;                /* the exit status it failed with (said when the run ends); 0 = none */
     char label[32];            /* "frame N" */
     unsigned char *rendered_on; /* per host: it rendered rows of this frame */
-    pv_writer *pv;             /* its --preview writer, or NULL */
+    preview_writer *pv;             /* its --preview writer, or NULL */
     int rows_done;             /* rows in its job directory (for the monitor) */
 } frame_slot;
 
 typedef struct {
-    frames_iter it;
-    ra_parse_fn parse;         /* a frame's command line */
-    const render_args *a;      /* the command's own */
+    framewalk_iter it;
+    render_anim_parse_fn parse;         /* a frame's command line */
+    const frame_settings *a;      /* the command's own */
     const hosts_table *table;
     frame_slot **fr;           /* by the scheduler's frame index */
     int nfr, capfr;
     int failed;                /* a frame failed: no frame is opened after it */
-    double deadline;           /* --time-limit: clk_now() time the run stops at; 0 = none */
-    pg_reporter *pg;           /* the run's --progress json, or NULL */
+    double deadline;           /* --time-limit: clock_now() time the run stops at; 0 = none */
+    progress_reporter *pg;           /* the run's --progress json, or NULL */
     mon_server *mon;           /* the run's --monitor, or NULL */
 } anim_run;
 
@@ -51,7 +51,7 @@ static void show_state(anim_run *fx, const frame_slot *fs, char st)
 static void on_skip(void *ctx, size_t index, uint32_t number, const char *out)
 {
     anim_run *fx = ctx;
-    pg_skipped(fx->pg, number, out);
+    progress_skipped(fx->pg, number, out);
     mon_frame(fx->mon, index, number, 's', out, 0, 0);
 }
 
@@ -62,7 +62,7 @@ static void preview_take_over(anim_run *fx, const frame_slot *fs)
     for (int i = 0; i < fx->nfr; i++) {
         frame_slot *o = fx->fr[i];
         if (o != fs && o->pv && o->im && !strcmp(o->im->a.preview, fs->im->a.preview)) {
-            pv_stop(o->pv);
+            preview_stop(o->pv);
             o->pv = NULL;
         }
     }
@@ -73,10 +73,10 @@ static void preview_take_over(anim_run *fx, const frame_slot *fs)
 static int frame_reporters(anim_run *fx, frame_slot *fs)
 {
     frame_image *im = fs->im;
-    render_args *a = &im->a;
+    frame_settings *a = &im->a;
     fr_error err;
     fs->rows_done = im->rows_have;
-    if (fx->pg && !(im->pg = pg_start(stdout, fs->one.number, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job,
+    if (fx->pg && !(im->pg = progress_start(stdout, fs->one.number, a->out, im->jobdir, &im->spec, (uint32_t)im->rows_job,
                                       &err))) {
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         return 1;
@@ -88,7 +88,7 @@ static int frame_reporters(anim_run *fx, frame_slot *fs)
     }
     if (a->preview) {
         preview_take_over(fx, fs);
-        if (!(fs->pv = pv_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,
+        if (!(fs->pv = preview_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,
                                 (note_sink){cli_note_stderr, NULL}, &err))) {
             fprintf(stderr, "franja render: --preview: %s\n", err.msg);
             return 1;
@@ -120,7 +120,7 @@ static int rf_open(anim_run *fx, sched_frame *next)
         fx->failed = 1;
         return -1;
     }
-    int r = frames_next(&fx->it, &fs->one);
+    int r = framewalk_next(&fx->it, &fs->one);
     if (r) {
         free(fs);
         if (r == 1)
@@ -150,13 +150,13 @@ static int rf_open(anim_run *fx, sched_frame *next)
         rc = frame_reporters(fx, fs);
     if (rc) {
         if (fs->im) {
-            pv_stop(fs->pv);
+            preview_stop(fs->pv);
             fs->pv = NULL;
             frame_close(fs->im, rc);
         }
         fs->im = NULL;
-        fs->failed = fx->failed = rr_stop ? 130 : rc;
-        show_state(fx, fs, rr_stop ? 'x' : 'f');
+        fs->failed = fx->failed = render_run_stop ? 130 : rc;
+        show_state(fx, fs, render_run_stop ? 'x' : 'f');
         return -1;
     }
     frame_image *im = fs->im;
@@ -172,9 +172,9 @@ static int rf_next(void *ctx, int frame, sched_frame *next, fr_error *err)
 {
     anim_run *fx = ctx;
     (void)frame, (void)err; /* frames are opened in the scheduler's order: frame == fx->nfr */
-    if (rr_stop || (fx->deadline > 0 && clk_now() >= fx->deadline))
+    if (render_run_stop || (fx->deadline > 0 && clock_now() >= fx->deadline))
         return 1; /* no new frame once interrupted or at the time limit */
-    rr_clear_line();
+    render_run_clear_line();
     return rf_open(ctx, next) ? 1 : 0;
 }
 
@@ -184,15 +184,15 @@ static int rf_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene
     anim_run *fx = ctx;
     frame_slot *fs = fx->fr[frame];
     const hosts_entry *e = &fx->table->v[host_i];
-    double t0 = clk_now();
+    double t0 = clock_now();
     int uploaded = 0;
     fr_error e2;
-    if (cl_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, scene, scene_cap, lease, lease_cap, &uploaded, &e2))
+    if (cluster_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, scene, scene_cap, lease, lease_cap, &uploaded, &e2))
         return fr_fail(err, "%s: %s", fs->label, e2.msg);
     if (fx->table->path[0] != '(' || !isatty(2)) {
-        rr_clear_line();
+        render_run_clear_line();
         fprintf(stderr, "franja: host %s: %s: scene %s (%.2f s)\n", h->name, fs->label,
-                hosts_is_local(e) ? "local" : uploaded ? "uploaded" : "already there", clk_now() - t0);
+                hosts_is_local(e) ? "local" : uploaded ? "uploaded" : "already there", clock_now() - t0);
     }
     return 0;
 }
@@ -235,8 +235,8 @@ static int rf_done(void *ctx, int frame, fr_error *err)
     for (int i = 0, k = 0; i < fx->table->n; i++)
         if (fs->rendered_on[i] && (size_t)k < sizeof used)
             k += snprintf(used + k, sizeof used - (size_t)k, "%s%s", k ? "," : "", fx->table->v[i].name);
-    rr_clear_line();
-    pv_stop(fs->pv); /* its last image: the whole frame */
+    render_run_clear_line();
+    preview_stop(fs->pv); /* its last image: the whole frame */
     fs->pv = NULL;
     if (frame_write(fs->im, used)) {
         fs->failed = fx->failed = 1;
@@ -245,17 +245,17 @@ static int rf_done(void *ctx, int frame, fr_error *err)
     }
     fs->written = 1;
     show_state(fx, fs, 'd');
-    frames_wrote(&fx->it);
+    framewalk_wrote(&fx->it);
     frame_shrink(fs->im); /* the settings stay: the scheduler's run may still read the first frame's */
     return 0;
 }
 
 /* The run's reporters: --progress json's frames event and the monitor.
  * 0, or the exit status (said). */
-static int run_reporters(anim_run *fx, const render_args *a)
+static int run_reporters(anim_run *fx, const frame_settings *a)
 {
     fr_error err;
-    if (a->json && !(fx->pg = pg_run_start(stdout, a->frames, fx->it.fl.n, &err))) {
+    if (a->json && !(fx->pg = progress_run_start(stdout, a->frames, fx->it.fl.n, &err))) {
         fprintf(stderr, "franja render: --progress json: %s\n", err.msg);
         return 1;
     }
@@ -272,40 +272,40 @@ static int run_reporters(anim_run *fx, const render_args *a)
 
 /* `franja render PATTERN --frames LIST`: the frames run together over one
  * set of hosts, each written as soon as its rows are in. */
-int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
+int render_anim(int argc, char **argv, frame_settings *a, render_anim_parse_fn parse)
 {
-    double t_start = clk_now();
-    frames_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview};
+    double t_start = clock_now();
+    framewalk_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview};
     anim_run fx;
     memset(&fx, 0, sizeof fx);
     fx.parse = parse;
     fx.a = a;
-    if (frames_begin(&fx.it, argc, argv, &fj))
+    if (framewalk_begin(&fx.it, argc, argv, &fj))
         return 2;
     fx.it.on_skip = on_skip;
     fx.it.skip_ctx = &fx;
     if (a->time_limit > 0)
         fx.deadline = t_start + a->time_limit;
-    rr_signals();
+    render_run_signals();
     fr_error err;
     uint32_t probe = UINT32_MAX;
     if (quick_spp(&probe, &err) < 0) {
         fprintf(stderr, "franja render: %s\n", err.msg);
-        return frames_end(&fx.it, 2);
+        return framewalk_end(&fx.it, 2);
     }
     int rc = run_reporters(&fx, a);
     hosts_table table = {0};
     slurm_alloc alloc = {0};
     if (!rc)
-        rc = rr_hosts(a, argc, argv, &table, &alloc);
+        rc = render_run_hosts(a, argc, argv, &table, &alloc);
     int timed_out = 0, hosts_ok = !rc;
     fx.table = &table;
     sched_frame first;
     if (!rc && rf_open(&fx, &first) == 0) {
         char used[1024];
-        rr_frames hooks = {rf_next,   rf_stage, rf_done,     rf_rendered, rf_number,
+        render_run_frames hooks = {rf_next,   rf_stage, rf_done,     rf_rendered, rf_number,
                            rf_counts, &fx,      fx.deadline, &timed_out};
-        if (rr_run(a, &table, NULL, &fx.fr[0]->im->ps, fx.pg, fx.mon, used, sizeof used, &hooks, &err)) {
+        if (render_run(a, &table, NULL, &fx.fr[0]->im->ps, fx.pg, fx.mon, used, sizeof used, &hooks, &err)) {
             if (!timed_out)
                 fprintf(stderr, "franja render: %s\n", err.msg);
             rc = 1;
@@ -316,12 +316,12 @@ int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
      * first not written. */
     frame_slot *named = NULL;
     for (int i = 0; i < fx.nfr && !named; i++)
-        if (fx.fr[i]->failed && !rr_stop)
+        if (fx.fr[i]->failed && !render_run_stop)
             named = fx.fr[i];
     for (int i = 0; i < fx.nfr && !named; i++)
         if (!fx.fr[i]->written)
             named = fx.fr[i];
-    if (rr_stop && (rc || fx.failed))
+    if (render_run_stop && (rc || fx.failed))
         rc = 130;
     else if (fx.failed)
         rc = fx.failed;
@@ -330,31 +330,31 @@ int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse)
     if (timed_out && rc == FRAMES_TIME_LIMIT)
         fprintf(stderr, "franja: time limit of %g s reached\n", a->time_limit);
     if (rc && named)
-        frames_failed(&fx.it, named->one.number, named->one.scene, named->one.out, rc);
+        framewalk_failed(&fx.it, named->one.number, named->one.scene, named->one.out, rc);
     /* The frames still open are closed; their finished slabs stay for
      * --resume. */
     const char *how = rc == 130 ? "interrupted" : rc == FRAMES_TIME_LIMIT ? "time_limit" : "failed";
     for (int i = 0; i < fx.nfr; i++) {
         frame_slot *fs = fx.fr[i];
-        pv_stop(fs->pv);
+        preview_stop(fs->pv);
         if (fs->im && !fs->written) {
-            pg_stop(fs->im->pg, how, fs->im->spec.spp);
+            progress_stop(fs->im->pg, how, fs->im->spec.spp);
             fs->im->pg = NULL;
             show_state(&fx, fs, fs->failed && rc != 130 ? 'f' : 'x');
         }
         if (fs->im)
             frame_close(fs->im, fs->written ? 0 : rc ? rc : 1);
-        frames_put(&fs->one);
+        framewalk_put(&fs->one);
         free(fs->rendered_on);
         free(fs);
     }
     free(fx.fr);
-    pg_run_end(fx.pg, rc == 0 ? "ok" : how, fx.it.fl.n, fx.it.rendered, fx.it.skipped);
+    progress_run_end(fx.pg, rc == 0 ? "ok" : how, fx.it.fl.n, fx.it.rendered, fx.it.skipped);
     mon_status(fx.mon, rc == 0 ? "done" : rc == 130 ? "interrupted" : rc == FRAMES_TIME_LIMIT ? "stopped" : "failed");
     mon_stop(fx.mon);
     if (hosts_ok) {
         hosts_free(&table);
         slurm_close(&alloc);
     }
-    return frames_end(&fx.it, rc);
+    return framewalk_end(&fx.it, rc);
 }

@@ -20,13 +20,13 @@
 /** Parses one frame's command line (argv[0] is the command's name) into a
  * new image whose stop flag is set; NULL with *status set (0 after --help,
  * 2 on a usage error). */
-typedef frame_image *(*ra_parse_fn)(int argc, char **argv, int *status);
+typedef frame_image *(*render_anim_parse_fn)(int argc, char **argv, int *status);
 
 /** Renders the frames of a->frames; argv is the command line as typed,
  * each frame's own made from it by cmd_frames.h's rules and parsed with
  * parse.  Returns the exit status of `franja render` (130 when
  * interrupted, FRAMES_TIME_LIMIT when stopped by --time-limit: the frames
  * in flight keep their finished slabs for --resume). */
-int ra_render(int argc, char **argv, render_args *a, ra_parse_fn parse);
+int render_anim(int argc, char **argv, frame_settings *a, render_anim_parse_fn parse);
 
 #endif

@@ -10,18 +10,18 @@
 
 #include "cli.h"
 #include "clock.h"
-#include "cluster.h"
+#include "transport/cluster.h"
 #include "statusline.h"
 
-volatile sig_atomic_t rr_stop;
+volatile sig_atomic_t render_run_stop;
 
 static void on_signal(int sig)
 {
     (void)sig;
-    rr_stop = 1;
+    render_run_stop = 1;
 }
 
-void rr_signals(void)
+void render_run_signals(void)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -33,7 +33,7 @@ void rr_signals(void)
 
 /* The hosts of the render: the table, a Slurm allocation or this
  * machine.  0, or 2 (said). */
-int rr_hosts(render_args *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc)
+int render_run_hosts(frame_settings *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc)
 {
     memset(alloc, 0, sizeof *alloc);
     if (a->slurm.on)
@@ -110,12 +110,12 @@ typedef struct {
     double t;                  /* the latest progress report */
     int done, total;
     struct joiner *join;       /* hosts joining the render */
-    pg_reporter *pg;           /* --progress json, or NULL */
+    progress_reporter *pg;           /* --progress json, or NULL */
     mon_server *mon;           /* --monitor, or NULL */
     int rows_before;           /* rows done before this run (resumed) */
     mon_host *mh;              /* nhosts entries for the monitor */
     char (*mstate)[320];       /* their state strings */
-    const rr_frames *fx;       /* the frames of an animation run together, or NULL */
+    const render_run_frames *fx;       /* the frames of an animation run together, or NULL */
 } reporter;
 
 /* A host's event to the JSON stream and the monitor; frame: the frame
@@ -123,13 +123,13 @@ typedef struct {
 static void host_event(reporter *r, long frame, const char *what, const char *host, uint32_t y0, uint32_t y1,
                        double t, const char *text)
 {
-    pg_event(r->pg, frame, what, host, y0, y1, text);
+    progress_event(r->pg, frame, what, host, y0, y1, text);
     mon_event(r->mon, t, host, what, text);
 }
 
 static int line_drawn;          /* a live status line is on the terminal */
 
-void rr_clear_line(void)
+void render_run_clear_line(void)
 {
     if (line_drawn) {
         fputs("\r\033[K", stderr);
@@ -152,7 +152,7 @@ static void on_event(void *ctx, const sched_event *ev)
         r->fx->rendered(r->fx->ctx, ev->frame, ev->host, ev->y0, ev->y1);
     if (ev->kind == SCHED_SLAB_DONE || (r->tty && ev->kind == SCHED_COPY))
         return;
-    rr_clear_line();
+    render_run_clear_line();
     fprintf(stderr, "franja: [%6.1fs] %s\n", ev->t, ev->text);
 }
 
@@ -162,10 +162,10 @@ static void draw(reporter *r, int force)
         return;
     r->last_draw = r->t;
     char line[1024];
-    sl_figures f = {r->t, r->done, r->total, (double)r->spec->width * r->spec->spp, 0, 0, 0};
+    statusline_figures f = {r->t, r->done, r->total, (double)r->spec->width * r->spec->spp, 0, 0, 0};
     if (r->fx)
         r->fx->counts(r->fx->ctx, &f.frames_done, &f.frames, &f.rows_ahead);
-    sl_format(line, sizeof line, r->tty ? sl_columns(2) : 0, &f, r->hosts, r->nhosts);
+    statusline_format(line, sizeof line, r->tty ? statusline_columns(2) : 0, &f, r->hosts, r->nhosts);
     if (r->tty) {
         fprintf(stderr, "\r\033[K%s", line);
         fflush(stderr);
@@ -206,9 +206,9 @@ static void on_progress(void *ctx, double t, int done, int total)
 /* Hosts joining the render as they become ready (the scheduler's admit
  * hook): each is checked (version), given its slots and announced. */
 typedef struct joiner {
-    const render_args *a;
-    cl_group *g;
-    cl_host *cl;
+    const frame_settings *a;
+    cluster_group *g;
+    cluster_host *cl;
     reporter *rep;
     int ready;                 /* hosts handed over ready */
 } joiner;
@@ -217,17 +217,17 @@ typedef struct joiner {
  * first one. */
 static void join_hosts(joiner *j, sched_host *sh, int ms)
 {
-    cl_host h;
+    cluster_host h;
     int i;
-    while ((i = cl_next_ready(j->g, &h, ms)) >= 0) {
+    while ((i = cluster_next_ready(j->g, &h, ms)) >= 0) {
         ms = 0;
         j->cl[i] = h;
         sched_host *s = &sh[i];
         s->pending = 0;
         if (j->rep)
-            rr_clear_line();
+            render_run_clear_line();
         if (j->cl[i].tr)
-            cl_check_version(&j->cl[i]);
+            cluster_check_version(&j->cl[i]);
         if (!j->cl[i].tr) {
             fprintf(stderr, "franja: host %s is not used: %s\n", h.entry->name, j->cl[i].err.msg);
             if (j->rep) {
@@ -240,7 +240,7 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
             continue;
         }
         j->ready++;
-        const render_args *a = j->a;
+        const frame_settings *a = j->a;
         int slots = h.entry->cores ? h.entry->cores : h.info.cores;
         if (!h.entry->cores && h.info.cores_reported > (uint32_t)h.info.cores)
             fprintf(stderr, "franja: host %s reports %u processors; using %d (give its cores in the host table "
@@ -252,7 +252,7 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
         s->slots = slots > 0 ? slots : 1;
         snprintf(s->scene, sizeof s->scene, "%s", h.scene);
         snprintf(s->lease, sizeof s->lease, "%s", h.lease);
-        s->lease_t = clk_now();
+        s->lease_t = clock_now();
         if ((table || !isatty(2)) && j->rep && j->rep->fx) /* each frame's scene is said as it is staged */
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s (%.2f s)\n", s->name, h.info.os, h.info.arch,
                     s->slots, h.info.version, h.ready_s);
@@ -292,39 +292,39 @@ static void add_stats(sched_stats *to, const sched_stats *st)
  * context. */
 static int fx_next(void *ctx, int frame, sched_frame *next, fr_error *err)
 {
-    const rr_frames *fx = ((reporter *)ctx)->fx;
+    const render_run_frames *fx = ((reporter *)ctx)->fx;
     return fx->next_frame(fx->ctx, frame, next, err);
 }
 
 static int fx_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
                     size_t lease_cap, fr_error *err)
 {
-    const rr_frames *fx = ((reporter *)ctx)->fx;
+    const render_run_frames *fx = ((reporter *)ctx)->fx;
     return fx->stage(fx->ctx, frame, h, host_i, scene, scene_cap, lease, lease_cap, err);
 }
 
 static int fx_done(void *ctx, int frame, fr_error *err)
 {
-    const rr_frames *fx = ((reporter *)ctx)->fx;
+    const render_run_frames *fx = ((reporter *)ctx)->fx;
     return fx->frame_done(fx->ctx, frame, err);
 }
 
-int rr_run(const render_args *a, const hosts_table *table, const char *fbin, passes *ps, pg_reporter *pg,
-           mon_server *mon, char *used, size_t used_cap, const rr_frames *fx, fr_error *err)
+int render_run(const frame_settings *a, const hosts_table *table, const char *fbin, frame_passes *ps, progress_reporter *pg,
+           mon_server *mon, char *used, size_t used_cap, const render_run_frames *fx, fr_error *err)
 {
     const job_spec *spec = &ps->spec;
     const char *jobdir = ps->jobdir;
     int rows_job = ps->rows_job, rows_missing = ps->rows_missing;
     int n = table->n;
-    cl_host *cl = calloc((size_t)n, sizeof *cl);
+    cluster_host *cl = calloc((size_t)n, sizeof *cl);
     sched_host *sh = calloc((size_t)n, sizeof *sh);
     mon_host *mh = calloc((size_t)n, sizeof *mh);
     char(*mstate)[320] = calloc((size_t)n, sizeof *mstate);
-    cl_group *g = NULL;
+    cluster_group *g = NULL;
     if (cl && sh && mh && mstate) {
         for (int i = 0; i < n; i++)
             cl[i].entry = &table->v[i];
-        g = cl_start(cl, n, &a->tr, fx ? NULL : fbin, spec->hash);
+        g = cluster_start(cl, n, &a->tr, fx ? NULL : fbin, spec->hash);
     }
     if (!g) {
         free(cl);
@@ -345,7 +345,7 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
     rep.join = &j;
     monitor_update(&rep);
     /* The first host (or the end of them all). */
-    while (!j.ready && cl_pending(g)) {
+    while (!j.ready && cluster_pending(g)) {
         join_hosts(&j, sh, 1000);
         monitor_update(&rep);
     }
@@ -362,7 +362,7 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
         for (int i = 0; i < n; i++)
             if (sh[i].pending && sh[i].slots < 1)
                 sh[i].slots = guess;
-        double t0 = clk_now();
+        double t0 = clock_now();
         sched_stats st;
         memset(&ps->total, 0, sizeof ps->total);
         for (;;) {
@@ -374,7 +374,7 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
                 }
                 if (spp == 0)
                     break;
-                if (ps->reached && clk_now() >= ps->deadline) {
+                if (ps->reached && clock_now() >= ps->deadline) {
                     ps->stopped = spp;
                     break;
                 }
@@ -383,10 +383,10 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
                     break;
                 }
                 ps->npass++;
-                rr_clear_line();
+                render_run_clear_line();
                 fprintf(stderr, "franja: pass %d: %u samples per pixel, %d rows to render\n", ps->npass, spp,
                         ps->rows_missing);
-                pg_pass(pg, ps->npass, spp);
+                progress_pass(pg, ps->npass, spp);
             } else if (ps->npass++ > 0) {
                 break;
             }
@@ -406,7 +406,7 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
                               .slab_rows = (int)a->slab_rows,
                               .max_attempts = (int)a->retries,
                               .max_host_failures = 3,
-                              .stop = &rr_stop,
+                              .stop = &render_run_stop,
                               /* An SSH channel closed (a losing copy, a dropped
                                * host, this process gone) ends the worker, even
                                * where signals do not reach it (worker/lifeline.h). */
@@ -420,13 +420,13 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
             }
             rc = sched_run(&p, sh, n, &st, err);
             add_stats(&ps->total, &st);
-            if (rc && st.timed_out && !rr_stop && fx) {
+            if (rc && st.timed_out && !render_run_stop && fx) {
                 /* An animation's limit: the frames in flight stop, their
                  * finished slabs stay. */
                 *fx->timed_out = 1;
                 break;
             }
-            if (rc && st.timed_out && !rr_stop) {
+            if (rc && st.timed_out && !render_run_stop) {
                 /* The pass in flight is given up; its finished slabs stay. */
                 ps->stopped = spp;
                 rc = 0;
@@ -440,9 +440,9 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
             }
             ps->reached = spp;
             draw(&rep, 1);
-            rr_clear_line();
+            render_run_clear_line();
             fprintf(stderr, "franja: pass %d done: %u samples per pixel at %.2f s\n", ps->npass, spp,
-                    clk_now() - t0);
+                    clock_now() - t0);
         }
         draw(&rep, 1);
         if (line_drawn) {
@@ -452,10 +452,10 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
         job_spec shown = *spec;
         if (ps->deadline > 0 && ps->reached)
             shown.spp = ps->reached;
-        const char *ended = rc == 0 ? NULL : rr_stop ? "interrupted" : "failed";
-        if (rc && !rr_stop && fx && ps->total.timed_out)
+        const char *ended = rc == 0 ? NULL : render_run_stop ? "interrupted" : "failed";
+        if (rc && !render_run_stop && fx && ps->total.timed_out)
             ended = "stopped by the time limit";
-        summary(sh, n, &shown, &ps->total, rep.done, rows_missing, clk_now() - t0, ended);
+        summary(sh, n, &shown, &ps->total, rep.done, rows_missing, clock_now() - t0, ended);
         /* The hosts that rendered rows, for the image's metadata. */
         for (int i = 0, k = 0; i < n && used_cap; i++)
             if (sh[i].rows > 0 && k >= 0 && (size_t)k < used_cap)
@@ -470,11 +470,11 @@ int rr_run(const render_args *a, const hosts_table *table, const char *fbin, pas
             fr_error e;
             tr_remove(cl[i].tr, cl[i].lease, &e);
         }
-    cl_close(cl, n);
+    cluster_close(cl, n);
     /* A host still being prepared is not waited for (its time-out would
      * add to the render), except under Slurm, whose shared state goes with
      * the allocation. */
-    cl_end(g, a->slurm.on);
+    cluster_end(g, a->slurm.on);
     free(cl);
     free(sh);
     free(mh);

@@ -16,31 +16,31 @@
 
 #include "error.h"
 #include "frame.h"
-#include "hosts.h"
+#include "transport/hosts.h"
 #include "monitor.h"
 #include "progress.h"
 #include "sched.h"
-#include "slurm.h"
+#include "transport/slurm.h"
 
-/** Set by SIGINT and SIGTERM once rr_signals has run: stop and keep the
+/** Set by SIGINT and SIGTERM once render_run_signals has run: stop and keep the
  * finished slabs. */
-extern volatile sig_atomic_t rr_stop;
+extern volatile sig_atomic_t render_run_stop;
 
-/** Catches SIGINT and SIGTERM (they set rr_stop) and ignores SIGPIPE. */
-void rr_signals(void);
+/** Catches SIGINT and SIGTERM (they set render_run_stop) and ignores SIGPIPE. */
+void render_run_signals(void);
 
 /** The hosts of a render into *table (hosts_free frees it): a's host
  * table, the nodes of a Slurm allocation (*alloc, which slurm_close ends;
  * zeroed when a is not under Slurm), or this machine as "local".  argv is
  * the command line as typed (for the salloc hint).  0, or the exit status
  * with the reason said on stderr. */
-int rr_hosts(render_args *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc);
+int render_run_hosts(frame_settings *a, int argc, char **argv, hosts_table *table, slurm_alloc *alloc);
 
 /** An animation's part of a run: the scheduler's frame hooks (sched.h,
  * called here with ctx); `number`, the frame number of the scheduler's
  * frame index (for the reporters' events); `rendered`, told of each
  * accepted slab which host rendered rows y0:y1 of which frame; `counts`,
- * the frames for the status line; and the run's --time-limit.  The hooks print after rr_clear_line. */
+ * the frames for the status line; and the run's --time-limit.  The hooks print after render_run_clear_line. */
 typedef struct {
     int (*next_frame)(void *ctx, int frame, sched_frame *next, fr_error *err);
     int (*stage)(void *ctx, int frame, sched_host *h, int host_i, char *scene, size_t scene_cap, char *lease,
@@ -52,9 +52,9 @@ typedef struct {
      * and the rows of those not started yet (estimated). */
     void (*counts)(void *ctx, int *done, int *frames, double *rows_ahead);
     void *ctx;
-    double deadline;           /**< clk_now() time at which the run stops (--time-limit); 0 = none */
+    double deadline;           /**< clock_now() time at which the run stops (--time-limit); 0 = none */
     int *timed_out;            /**< set to 1 when the run stopped at deadline */
-} rr_frames;
+} render_run_frames;
 
 /** Connects the hosts of table and renders the rows of ps (its passes,
  * with --time-limit) that its job directory lacks; fbin is the scene the
@@ -67,13 +67,13 @@ typedef struct {
  * -1 and *fx->timed_out set); fbin is then not used.  used
  * (used_cap bytes) gets the names of the hosts that rendered rows,
  * comma-separated, for the image's metadata.  Prints the summary.  0, or
- * -1 with *err set (the slabs finished stay in the job directory; rr_stop
+ * -1 with *err set (the slabs finished stay in the job directory; render_run_stop
  * says whether it was interrupted). */
-int rr_run(const render_args *a, const hosts_table *table, const char *fbin, passes *ps, pg_reporter *pg,
-           mon_server *mon, char *used, size_t used_cap, const rr_frames *fx, fr_error *err);
+int render_run(const frame_settings *a, const hosts_table *table, const char *fbin, frame_passes *ps, progress_reporter *pg,
+           mon_server *mon, char *used, size_t used_cap, const render_run_frames *fx, fr_error *err);
 
 /** Ends the live status line on a terminal, if one is drawn, so that a
  * log line can follow. */
-void rr_clear_line(void);
+void render_run_clear_line(void);
 
 #endif

@@ -75,7 +75,7 @@ typedef struct {
 static double now(const sched *s)
 {
     const sched_hooks *k = &s->p->hooks;
-    return k->now ? k->now(k->ctx) : clk_now();
+    return k->now ? k->now(k->ctx) : clock_now();
 }
 
 /* Reports an event with a one-line text (printf-style). */
@@ -329,7 +329,7 @@ static void remote_name(const sched *s, int host_i, const slab *sl, char *out, s
     else
         dir[0] = 0;
     snprintf(out, cap, "%scont-%016llx-%u-%u-%u-%ld-%.0f-%u.pf", dir, (unsigned long long)s->frames[sl->frame].f.spec.hash, sl->y0,
-             sl->y1, sl->base, (long)getpid(), clk_now() * 1e3, counter++);
+             sl->y1, sl->base, (long)getpid(), clock_now() * 1e3, counter++);
 }
 
 /* The sums file of slab sl, made once; NULL when it cannot be made: the
@@ -411,7 +411,7 @@ static int stage(sched *s, int host_i, const slab *sl, fr_error *err)
                  sizeof fh->lease, err))
         return -1;
     fh->staged = 1;
-    fh->lease_t = clk_now();
+    fh->lease_t = clock_now();
     return 0;
 }
 
@@ -755,7 +755,7 @@ static void lease_tick(sched *s, int i)
         tr_proc_free(h->lease_proc);
         h->lease_proc = NULL;
     }
-    double t = clk_now();
+    double t = clock_now();
     if (h->lease_proc || h->dropped || h->pending)
         return;
     const char *lease = NULL;

@@ -54,7 +54,7 @@
 #include <signal.h>
 
 #include "jobdir.h"
-#include "transport.h"
+#include "transport/transport.h"
 
 /** One host as the scheduler uses it; the caller fills the first fields,
  * the scheduler the statistics. */
@@ -65,7 +65,7 @@ typedef struct {
     char lease[1200];          /**< the render's lease on that scene (stage_scene), "" if none: the
                                     scheduler renews it about every minute (no new worker starts on
                                     the host during the renewal's moment) */
-    double lease_t;            /**< clk_now() of its last renewal (or taking) */
+    double lease_t;            /**< clock_now() of its last renewal (or taking) */
     tr_proc *lease_proc;       /**< private: the renewal running now, NULL if none */
     int slots;                 /**< worker processes at once (lowered when the host refuses more) */
     /* statistics */
@@ -123,7 +123,7 @@ typedef struct {
     /** Called after every turn of the loop (about every 100 ms) and once at
      * the end: rows done of the total; the hosts' statistics are current. */
     void (*progress)(void *ctx, double t, int rows_done, int rows_total);
-    /** The clock in seconds; NULL = clk_now (clock.h). */
+    /** The clock in seconds; NULL = clock_now (clock.h). */
     double (*now)(void *ctx);
     /** Waits up to ms milliseconds for activity on pfd[0..n); NULL = poll. */
     int (*wait)(void *ctx, struct pollfd *pfd, int n, int ms);

@@ -6,7 +6,7 @@
 #include <string.h>
 #include <sys/ioctl.h>
 
-void sl_duration(double s, char *out, size_t cap)
+void statusline_duration(double s, char *out, size_t cap)
 {
     long t = s > 0 ? (long)(s + 0.5) : 0;
     if (t < 60)
@@ -17,7 +17,7 @@ void sl_duration(double s, char *out, size_t cap)
         snprintf(out, cap, "%ld:%02ld:%02ld", t / 3600, t / 60 % 60, t % 60);
 }
 
-int sl_columns(int fd)
+int statusline_columns(int fd)
 {
     struct winsize ws;
     if (ioctl(fd, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0)
@@ -42,7 +42,7 @@ static int append(char *out, size_t cap, size_t *len, size_t limit, const char *
     return 1;
 }
 
-size_t sl_format(char *out, size_t cap, int cols, const sl_figures *f, const sched_host *hosts, int nhosts)
+size_t statusline_format(char *out, size_t cap, int cols, const statusline_figures *f, const sched_host *hosts, int nhosts)
 {
     if (cap == 0)
         return 0;
@@ -63,13 +63,13 @@ size_t sl_format(char *out, size_t cap, int cols, const sl_figures *f, const sch
         out[n] = '\0';
         return n;
     }
-    sl_duration(t, d, sizeof d);
+    statusline_duration(t, d, sizeof d);
     snprintf(part, sizeof part, "  elapsed %s", d);
     if (!append(out, cap, &len, limit, part))
         return len;
     double left = f->total - f->done + (f->frames > 0 && f->rows_ahead > 0 ? f->rows_ahead : 0);
     if (rate > 0 && left > 0) {
-        sl_duration(left / rate, d, sizeof d);
+        statusline_duration(left / rate, d, sizeof d);
         snprintf(part, sizeof part, "  ETA %s", d);
         if (!append(out, cap, &len, limit, part))
             return len;

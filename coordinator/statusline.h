@@ -21,7 +21,7 @@ typedef struct {
                                     frames: a single image */
     double rows_ahead;         /**< an animation: rows of the frames not started yet, estimated (for the
                                     ETA) */
-} sl_figures;
+} statusline_figures;
 
 /** Writes the line into out[cap] (always terminated): "rows D/T (P%)
  * elapsed M:SS  ETA M:SS  R Msamples/s" (an animation: "frames F/N rows
@@ -31,14 +31,14 @@ typedef struct {
  * that do not fit are left out from the end, hosts left out are counted as
  * "+N" when that fits, and the first part is cut if even it does not fit.
  * Returns the line's length. */
-size_t sl_format(char *out, size_t cap, int cols, const sl_figures *f, const sched_host *hosts, int nhosts);
+size_t statusline_format(char *out, size_t cap, int cols, const statusline_figures *f, const sched_host *hosts, int nhosts);
 
 /** The width of the terminal on fd (TIOCGWINSZ), else $COLUMNS when it is
  * a number from 10 to 1000, else 80. */
-int sl_columns(int fd);
+int statusline_columns(int fd);
 
 /** Formats seconds as "S s" below a minute, "M:SS" below an hour, else
  * "H:MM:SS", into out[cap]. */
-void sl_duration(double s, char *out, size_t cap);
+void statusline_duration(double s, char *out, size_t cap);
 
 #endif

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "scene_hooks.h"
+#include "compile/scene_hooks.h"
 
 /* Write w x h RGB floats, given top row first, as a little-endian PFM
  * (which stores the bottom row first).  Returns 0 or -1. */
@@ -24,7 +24,7 @@ static inline int pfm_write(const char *path, uint32_t w, uint32_t h, const floa
 }
 
 /* A texture hook for the files pfm_write makes. */
-static inline int pfm_hook(const char *path, scn_image *img, fr_error *err)
+static inline int pfm_hook(const char *path, scene_image *img, fr_error *err)
 {
     FILE *f = fopen(path, "rb");
     unsigned w, h;
@@ -47,6 +47,6 @@ static inline int pfm_hook(const char *path, scn_image *img, fr_error *err)
     return ok ? 0 : fr_fail(err, "%s: short PFM", path);
 }
 
-static const scn_hooks pfm_hooks = {.texture = pfm_hook};
+static const scene_hooks pfm_hooks = {.texture = pfm_hook};
 
 #endif

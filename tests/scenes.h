@@ -5,18 +5,18 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "freeze.h"
-#include "scene_json.h"
+#include "compile/freeze.h"
+#include "compile/json_scene.h"
 
 /* Parse and freeze a scene from JSON text as if read from `file` (relative
  * names resolve beside it), with asset loaders `hooks` (may be NULL);
  * aborts the test on error since every later check would be meaningless. */
-static inline void test_scene_with(const char *json, const char *file, const scn_hooks *hooks, fr_scene *out)
+static inline void test_scene_with(const char *json, const char *file, const scene_hooks *hooks, fr_scene *out)
 {
     fr_builder b;
     fr_error err;
     bld_init(&b);
-    if (scn_parse_json(json, file, hooks, &b, &err) < 0 || frz_scene(&b, out, &err) < 0) {
+    if (json_scene_parse(json, file, hooks, &b, &err) < 0 || frz_scene(&b, out, &err) < 0) {
         printf("FAIL scene: %s\n", err.msg);
         exit(1);
     }

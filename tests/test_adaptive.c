@@ -103,7 +103,7 @@ int main(void)
         fr_builder b;
         fr_error err;
         bld_init(&b);
-        int rc = scn_parse_json(json, "(test)", NULL, &b, &err);
+        int rc = json_scene_parse(json, "(test)", NULL, &b, &err);
         CHECK(rc < 0 && strstr(err.msg, "noise_threshold"), "noise_threshold %s accepted (%s)", bad[i],
               rc < 0 ? err.msg : "no error");
         bld_free(&b);

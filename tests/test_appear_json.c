@@ -6,12 +6,12 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "scene_json.h"
+#include "compile/json_scene.h"
 
 static char dir[64];
 
 /* A hook that decodes every file as a 2x2 RGB image. */
-static int fake_image(const char *path, scn_image *img, fr_error *err)
+static int fake_image(const char *path, scene_image *img, fr_error *err)
 {
     (void)path;
     (void)err;
@@ -20,11 +20,11 @@ static int fake_image(const char *path, scn_image *img, fr_error *err)
     img->pixels = calloc(12, sizeof(float));
     return 0;
 }
-static const scn_hooks hooks = {.texture = fake_image};
+static const scene_hooks hooks = {.texture = fake_image};
 
 /* Parse a scene made of the fixed parts plus `extra` top-level members and
  * material `mat`; return the error message ("" on success). */
-static const char *parse(const char *extra, const char *mat, const char *camera_extra, const scn_hooks *h)
+static const char *parse(const char *extra, const char *mat, const char *camera_extra, const scene_hooks *h)
 {
     static fr_error err;
     char json[4096], file[128];
@@ -38,7 +38,7 @@ static const char *parse(const char *extra, const char *mat, const char *camera_
     snprintf(file, sizeof file, "%s/scene.json", dir);
     fr_builder b;
     bld_init(&b);
-    int rc = scn_parse_json(json, file, h, &b, &err);
+    int rc = json_scene_parse(json, file, h, &b, &err);
     bld_free(&b);
     return rc == 0 ? "" : err.msg;
 }
@@ -138,7 +138,7 @@ int main(void)
     fr_builder b;
     fr_error err;
     bld_init(&b);
-    int rc = scn_parse_json("{\"image\": {\"width\": 4, \"height\": 4},"
+    int rc = json_scene_parse("{\"image\": {\"width\": 4, \"height\": 4},"
                             " \"camera\": {\"position\": [0, 0, 5], \"target\": [0, 0, 0], \"fov\": 40},"
                             " \"materials\": {\"lamp\": {\"type\": \"emitter\", \"emission\": [1, 1, 1]}},"
                             " \"shapes\": [{\"type\": \"box\", \"min\": [0, 0, 0], \"max\": [1, -1, 1], \"material\": \"lamp\"}]}",

@@ -160,7 +160,7 @@ static double median_rel_se(const blocks *b)
 static void load_file(const char *path, uint32_t w, uint32_t h, fr_scene *s)
 {
     fr_error err;
-    if (scn_load_json(path, NULL, s, &err) < 0) {
+    if (json_scene_load(path, NULL, s, &err) < 0) {
         printf("FAIL %s\n", err.msg);
         exit(1);
     }
@@ -362,7 +362,7 @@ static void through_glass(void)
 
 /* Shading normals: a bump-mapped floor (a synthetic egg-crate height map)
  * lit by a panel; light tracing's splats need the adjoint correction. */
-static int bumps(const char *path, scn_image *img, fr_error *err)
+static int bumps(const char *path, scene_image *img, fr_error *err)
 {
     (void)path;
     (void)err;
@@ -405,12 +405,12 @@ static void shading_normals(void)
     int fd = open(file, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW, 0600);
     if (fd >= 0)
         close(fd);
-    const scn_hooks hooks = {.texture = bumps};
+    const scene_hooks hooks = {.texture = bumps};
     fr_builder b;
     fr_error err;
     fr_scene s;
     bld_init(&b);
-    int rc = scn_parse_json(bumpy_floor, scene, &hooks, &b, &err);
+    int rc = json_scene_parse(bumpy_floor, scene, &hooks, &b, &err);
     if (rc == 0)
         rc = frz_scene(&b, &s, &err);
     bld_free(&b);

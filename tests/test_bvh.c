@@ -25,11 +25,11 @@
 
 #include "bsdf.h"
 #include "bvh.h"
-#include "bvh_build.h"
-#include "bvh_reinsert.h"
+#include "compile/bvh_build.h"
+#include "compile/bvh_reinsert.h"
 #include "check.h"
 #include "fbin.h"
-#include "freeze.h"
+#include "compile/freeze.h"
 #include "trace.h"
 
 static uint64_t rng_state = 0x853c49e6748fea9bull;

@@ -15,7 +15,7 @@
 #include "bvh.h"
 #include "check.h"
 #include "fbin.h"
-#include "freeze.h"
+#include "compile/freeze.h"
 #include "pathtrace.h"
 #include "pfmmap.h"
 #include "scenes.h"
@@ -512,7 +512,7 @@ static int textured_scene(fr_scene *out, fr_error *err)
         " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"}]}";
     fr_builder b;
     bld_init(&b);
-    int rc = scn_parse_json(json, "(test)", NULL, &b, err);
+    int rc = json_scene_parse(json, "(test)", NULL, &b, err);
     if (rc == 0 && b.textures.count != 1)
         rc = fr_fail(err, "%u textures, expected 1", b.textures.count);
     if (rc == 0) {

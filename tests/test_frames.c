@@ -3,7 +3,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "frames.h"
+#include "framelist.h"
 
 /* Parses spec and compares with want[0..n) (n < 0: must fail with a
  * message holding frag). */
@@ -11,23 +11,23 @@ static void list(const char *spec, const uint32_t *want, int n, const char *frag
 {
     frame_list l;
     fr_error e = {{0}};
-    int rc = frames_parse(spec, &l, &e);
+    int rc = framelist_parse(spec, &l, &e);
     if (n < 0) {
         CHECK(rc == -1 && l.n == 0 && l.v == NULL, "'%s' accepted (%zu frames)", spec, l.n);
         CHECK(strstr(e.msg, frag) != NULL, "'%s': message '%s' lacks '%s'", spec, e.msg, frag);
-        frames_free(&l);
+        framelist_free(&l);
         return;
     }
     CHECK(rc == 0 && l.n == (size_t)n, "'%s': rc %d, %zu frames, want %d (%s)", spec, rc, l.n, n, e.msg);
     for (size_t i = 0; want && rc == 0 && i < l.n && i < (size_t)n; i++)
         CHECK(l.v[i] == want[i], "'%s': frame %zu is %u, want %u", spec, i, l.v[i], want[i]);
-    frames_free(&l);
+    framelist_free(&l);
 }
 
 static void subst(const char *pat, uint32_t f, size_t cap, const char *want)
 {
     char buf[64];
-    int rc = frames_subst(pat, f, buf, cap);
+    int rc = framelist_subst(pat, f, buf, cap);
     if (!want)
         CHECK(rc == -1, "'%s' %u into %zu bytes: accepted as '%s'", pat, f, cap, buf);
     else
@@ -66,6 +66,6 @@ int main(void)
     subst("f.####", 7, 6, NULL);
     subst("ab", 1, 2, NULL);
     subst("ab", 1, 3, "ab");
-    CHECK(frames_is_pattern("a#b") && !frames_is_pattern("ab"), "frames_is_pattern");
+    CHECK(framelist_is_pattern("a#b") && !framelist_is_pattern("ab"), "framelist_is_pattern");
     return check_done();
 }

@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "gltf_doc.h"
-#include "gltf_scene.h"
+#include "compile/gltf_doc.h"
+#include "compile/gltf_scene.h"
 
 /* A check that prints its own condition when it fails. */
 #define T(c) CHECK(c, "%s", #c)
@@ -53,7 +53,7 @@ static void on_warn(void *user, const char *msg)
     n_warnings++;
     snprintf(last_warning, sizeof last_warning, "%s", msg);
 }
-static const scn_hooks warn_hooks = {.warn = on_warn};
+static const scene_hooks warn_hooks = {.warn = on_warn};
 
 /* Imports text into a fresh builder; returns the import's status. */
 static int import(const char *text, fr_builder *b, gltf_options *o, fr_error *err)
@@ -351,7 +351,7 @@ static void test_lights(void)
 }
 
 /* An image decoder for tests: any bytes give a 2x2 RGB image of 0.5. */
-static int fake_image(const void *data, size_t len, const char *mime, scn_image *img, fr_error *err)
+static int fake_image(const void *data, size_t len, const char *mime, scene_image *img, fr_error *err)
 {
     (void)data;
     (void)len;
@@ -393,7 +393,7 @@ static void test_materials(void)
         "\"textures\":[{\"source\":0,\"sampler\":0},{\"source\":0}],"
         "\"samplers\":[{\"magFilter\":9728,\"wrapS\":33071,\"wrapT\":33071}],"
         "\"images\":[{\"uri\":\"data:image/png;base64,AAAA\"}]");
-    scn_hooks h = {.image_mem = fake_image, .warn = on_warn};
+    scene_hooks h = {.image_mem = fake_image, .warn = on_warn};
     gltf_options o;
     gltf_options_default(&o);
     fr_builder b;
@@ -462,7 +462,7 @@ static void test_uv_rotation(void)
             "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,AAAA\"}]",
             mixed ? "" : ",\"extensions\":{\"KHR_texture_transform\":{\"rotation\":1.5707963267948966,\"offset\":[0,0.5]}}");
         const char *t = docf(bin, sizeof bin, body);
-        scn_hooks h = {.image_mem = fake_image, .warn = on_warn};
+        scene_hooks h = {.image_mem = fake_image, .warn = on_warn};
         gltf_options o;
         gltf_options_default(&o);
         fr_builder b;

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "scene_json.h"
+#include "compile/json_scene.h"
 
 #define HEAD                                                                                            \
     "{\"image\": {\"width\": 4, \"height\": 4},\n"                                                      \
@@ -21,7 +21,7 @@ static int parse(const char *text, fr_error *err)
 {
     fr_builder b;
     bld_init(&b);
-    int rc = scn_parse_json(text, "scene.json", NULL, &b, err);
+    int rc = json_scene_parse(text, "scene.json", NULL, &b, err);
     bld_free(&b);
     return rc;
 }

@@ -7,7 +7,7 @@
 
 #include "check.h"
 #include "file.h"
-#include "jsoncheck.h"
+#include "compile/jsoncheck.h"
 
 static int check(const char *text, size_t len, fr_error *err) { return jc_check(text, len, "t.json", err); }
 

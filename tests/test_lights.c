@@ -5,10 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "builder_light.h"
+#include "compile/builder_light.h"
 #include "check.h"
 #include "stats.h"
-#include "freeze.h"
+#include "compile/freeze.h"
 #include "light.h"
 #include "pathtrace.h"
 #include "sampler.h"
@@ -355,7 +355,7 @@ static void json_errors(void)
         fr_builder b;
         fr_error err = {{0}};
         bld_init(&b);
-        int rc = scn_parse_json(json, "x.json", NULL, &b, &err);
+        int rc = json_scene_parse(json, "x.json", NULL, &b, &err);
         CHECK(rc < 0 && strstr(err.msg, cases[k].want) && strstr(err.msg, "x.json"), "case %zu: %s (want '%s')", k,
               rc < 0 ? err.msg : "accepted", cases[k].want);
         bld_free(&b);
@@ -381,7 +381,7 @@ static void json_errors(void)
         fr_error err = {{0}};
         fr_scene s;
         bld_init(&b);
-        int rc = scn_parse_json(json, "x.json", NULL, &b, &err);
+        int rc = json_scene_parse(json, "x.json", NULL, &b, &err);
         if (rc == 0) {
             rc = frz_scene(&b, &s, &err);
             if (rc == 0)

@@ -10,9 +10,9 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "obj.h"
+#include "compile/obj.h"
 
-static int parse(const char *text, obj_mesh *m, fr_error *err)
+static int parse(const char *text, mesh_data *m, fr_error *err)
 {
     return obj_parse(text, strlen(text), "t.obj", NULL, m, err);
 }
@@ -20,17 +20,17 @@ static int parse(const char *text, obj_mesh *m, fr_error *err)
 /* Parsing must fail with a message containing `want`. */
 static void bad(const char *text, const char *want)
 {
-    obj_mesh m;
+    mesh_data m;
     fr_error err = {{0}};
     int rc = parse(text, &m, &err);
     CHECK(rc < 0, "accepted: %s", text);
     if (rc == 0)
-        obj_free(&m);
+        mesh_data_free(&m);
     else
         CHECK(strstr(err.msg, want) != NULL, "message \"%s\" lacks \"%s\"", err.msg, want);
 }
 
-static double tri_area2(const obj_mesh *m, uint32_t t, vec3 n)
+static double tri_area2(const mesh_data *m, uint32_t t, vec3 n)
 {
     vec3 a = m->pos[m->tri[t][0]], b = m->pos[m->tri[t][1]], c = m->pos[m->tri[t][2]];
     return v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), n);
@@ -38,17 +38,17 @@ static double tri_area2(const obj_mesh *m, uint32_t t, vec3 n)
 
 static void test_basic(void)
 {
-    obj_mesh m;
+    mesh_data m;
     fr_error err;
     CHECK(parse("# a triangle\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 1 && m.n_vert == 3 && !m.nrm && !m.uv && m.tri_flags[0] == 0, "plain triangle");
-    obj_free(&m);
+    mesh_data_free(&m);
 
     /* Negative indices count back from the last vertex defined so far. */
     CHECK(parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf -4 -3 -1\n", &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 2 && m.tri[0][0] == m.tri[1][0] && m.tri[0][1] == m.tri[1][1], "negative indices resolve");
     CHECK(m.n_vert == 4 && m.pos[m.tri[1][2]].x == 5.0f, "relative to the count so far");
-    obj_free(&m);
+    mesh_data_free(&m);
 
     /* CRLF, tabs, comments, w and vertex colours, 1-3 component vt. */
     CHECK(parse("v\t0 0 0 1\r\nv 1 0 0 0.5 0.5 0.5\r\nv 0 1 0 # corner\r\nvt 0.5\nvt 1 0 0\nvt 0 1\n"
@@ -58,12 +58,12 @@ static void test_basic(void)
     CHECK(m.n_tri == 1 && m.uv && m.tri_flags[0] == FR_TRI_UVS && m.uv[m.tri[0][0]].u == 0.5f &&
               m.uv[m.tri[0][2]].v == 1.0f,
           "texture coordinates");
-    obj_free(&m);
+    mesh_data_free(&m);
 }
 
 static void test_corners(void)
 {
-    obj_mesh m;
+    mesh_data m;
     fr_error err;
     const char *text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
                        "f 1/1/1 2/2/1 3/3/1\n"    /* all three */
@@ -79,17 +79,17 @@ static void test_corners(void)
     CHECK(m.tri[2][0] != m.tri[0][0], "a different corner triple is another vertex");
     CHECK(m.n_vert == 4 + 3 + 3, "vertices: %u", m.n_vert);
     CHECK(m.nrm && m.nrm[m.tri[0][0]].z == 1.0f && v3_is_zero(m.nrm[m.tri[3][0]]), "normals (zero where absent)");
-    obj_free(&m);
+    mesh_data_free(&m);
 }
 
 static void test_polygons(void)
 {
-    obj_mesh m;
+    mesh_data m;
     fr_error err;
     /* Convex pentagon: a fan from the first corner, in file order. */
     CHECK(parse("v 0 0 0\nv 2 0 0\nv 3 1 0\nv 1 2 0\nv -1 1 0\nf 1 2 3 4 5\n", &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 3 && m.tri[0][0] == m.tri[1][0] && m.tri[1][0] == m.tri[2][0], "pentagon fan: %u", m.n_tri);
-    obj_free(&m);
+    mesh_data_free(&m);
     /* Concave: an L of area 3 (counter-clockwise seen from +z) whose fan
      * from the first corner would leave the shape. */
     const char *arrow = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
@@ -104,7 +104,7 @@ static void test_polygons(void)
     }
     CHECK(m.n_tri == 4 && all_ccw && sum == 6.0, "concave L: %u triangles, doubled area %g, all ccw %d", m.n_tri, sum,
           all_ccw);
-    obj_free(&m);
+    mesh_data_free(&m);
     /* Clockwise concave polygon keeps its (clockwise) winding. */
     CHECK(parse("v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 6 5 4 3 2 1\n", &m, &err) == 0, "%s",
           err.msg);
@@ -116,10 +116,10 @@ static void test_polygons(void)
         all_cw &= a < 0.0;
     }
     CHECK(m.n_tri == 4 && all_cw && sum == -6.0, "clockwise L: doubled area %g", sum);
-    obj_free(&m);
+    mesh_data_free(&m);
     /* A polygon in a tilted plane. */
     CHECK(parse("v 0 0 0\nv 1 0 1\nv 1 1 1\nv 0 1 0\nf 1 2 3 4\n", &m, &err) == 0 && m.n_tri == 2, "tilted quad");
-    obj_free(&m);
+    mesh_data_free(&m);
 }
 
 /* Writes text into the file dir/name; its path is left in path[cap]. */
@@ -152,7 +152,7 @@ static void test_groups_materials(void)
              "f 1 2 3\n"                                        /* before any usemtl: default */
              "g left\nusemtl red\nf 1 2 3\ng right top\nusemtl shiny\nf 2 4 3\n"
              "usemtl lamp\nf 1 2 4\ns 1\nusemtl glass\nf 1 3 4\nusemtl mirror\nf 3 2 1\nusemtl red\nf 4 3 2\n");
-    obj_mesh m;
+    mesh_data m;
     fr_error err;
     CHECK(obj_read(path, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 7, "faces in every group: %u", m.n_tri);
@@ -161,26 +161,26 @@ static void test_groups_materials(void)
         CHECK(!strcmp(m.mats[m.tri_mat[t]].name, names[t]) && m.mats[m.tri_mat[t]].defined,
               "face %u: material %s, expected %s", t, m.mats[m.tri_mat[t]].name, names[t]);
     fr_material fm;
-    obj_material_convert(&m.mats[m.tri_mat[1]], &fm);
+    mesh_data_material(&m.mats[m.tri_mat[1]], &fm);
     CHECK(fm.diffuse.x == 0.8f && v3_is_zero(fm.glossy) && fm.tex_diffuse == FR_NONE, "red: Lambert");
-    obj_material_convert(&m.mats[m.tri_mat[2]], &fm);
+    mesh_data_material(&m.mats[m.tri_mat[2]], &fm);
     CHECK(fm.exponent == 200.0f && fm.glossy.x > 0.0f && v3_max(v3_add(fm.diffuse, fm.glossy)) <= 1.0f &&
               fm.glossy.x / fm.diffuse.x > 1.79f && fm.glossy.x / fm.diffuse.x < 1.81f,
           "shiny: Phong scaled to conserve energy (%g %g)", (double)fm.diffuse.x, (double)fm.glossy.x);
-    obj_material_convert(&m.mats[m.tri_mat[3]], &fm);
+    mesh_data_material(&m.mats[m.tri_mat[3]], &fm);
     CHECK(fm.emission.x == 4.0f && fm.emission.z == 3.0f, "lamp: emission");
-    obj_material_convert(&m.mats[m.tri_mat[4]], &fm);
+    mesh_data_material(&m.mats[m.tri_mat[4]], &fm);
     CHECK(fm.transmit.z == 1.0f && fm.ior == 1.45f, "glass: transmit %g ior %g", (double)fm.transmit.z,
           (double)fm.ior);
-    obj_material_convert(&m.mats[m.tri_mat[5]], &fm);
+    mesh_data_material(&m.mats[m.tri_mat[5]], &fm);
     CHECK(fm.specular.x == 0.95f && v3_is_zero(fm.glossy), "mirror: specular");
-    obj_free(&m);
+    mesh_data_free(&m);
 
     /* A usemtl without a definition is kept, marked undefined, with its line. */
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf 1 2 3\n");
     CHECK(obj_read(path, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 1 && !m.mats[m.tri_mat[0]].defined && m.mats[m.tri_mat[0]].line == 5, "undefined material");
-    obj_free(&m);
+    mesh_data_free(&m);
     /* Missing MTL file, and MTL errors, name their file and line. */
     put_file(path, sizeof path, dir, "m.obj", "v 0 0 0\nmtllib missing.mtl\n");
     CHECK(obj_read(path, &m, &err) < 0 && strstr(err.msg, "m.obj:2:") && strstr(err.msg, "missing.mtl"),
@@ -215,12 +215,12 @@ static void test_mtl_errors(void)
         {"newmtl a\nd 2\n", "t.mtl:2: d: expected a number in [0, 1]"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        obj_mesh m;
+        mesh_data m;
         memset(&m, 0, sizeof m);
         fr_error err = {{0}};
         int rc = obj_parse_mtl(cases[i].text, strlen(cases[i].text), "t.mtl", &m, &err);
         CHECK(rc < 0 && strstr(err.msg, cases[i].want), "MTL \"%s\": %s", cases[i].text, rc < 0 ? err.msg : "accepted");
-        obj_free(&m);
+        mesh_data_free(&m);
     }
 }
 
@@ -247,7 +247,7 @@ static void test_errors(void)
     bad("v 0 0 0\nfoo 1 2\n", "t.obj:2: unknown OBJ statement 'foo'");
     bad("usemtl\n", "t.obj:1: usemtl: expected a material name");
     bad("mtllib\n", "t.obj:1: mtllib: expected a file name");
-    obj_mesh m;
+    mesh_data m;
     fr_error err;
     const char nul[] = "v 0 0 0\nv 1 0 0\n\0v 0 1 0\nf 1 2 3\n";
     CHECK(obj_parse(nul, sizeof nul - 1, "t.obj", NULL, &m, &err) < 0 && strstr(err.msg, "t.obj:3: NUL byte"),
@@ -256,7 +256,7 @@ static void test_errors(void)
     CHECK(parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvp 0.5\nl 1 2\np 1\ns off\ncstype bezier\nf 1 2 3\n", &m, &err) == 0 &&
               m.n_tri == 1,
           "ignored statements: %s", err.msg);
-    obj_free(&m);
+    mesh_data_free(&m);
 }
 
 int main(void)

@@ -35,7 +35,7 @@ static const char *parse(const char *extra, const char *mat, fr_material *m_out)
              extra, extra[0] ? "," : "", mat);
     fr_builder b;
     bld_init(&b);
-    int rc = scn_parse_json(json, "(test)", NULL, &b, &err);
+    int rc = json_scene_parse(json, "(test)", NULL, &b, &err);
     if (rc == 0 && m_out)
         *m_out = ((const fr_material *)b.materials.data)[0];
     bld_free(&b);

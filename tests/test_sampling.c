@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "bsdf.h"
-#include "builder.h"
+#include "compile/builder.h"
 #include "check.h"
 #include "stats.h"
 #include "fmath.h"

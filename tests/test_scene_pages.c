@@ -7,10 +7,10 @@
 #include <unistd.h>
 
 #include "bsdf.h"
-#include "builder.h"
+#include "compile/builder.h"
 #include "check.h"
 #include "fbin.h"
-#include "freeze.h"
+#include "compile/freeze.h"
 #include "scene_pages.h"
 #include "trace.h"
 

@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "slurm.h"
+#include "transport/slurm.h"
 
 static char dir[] = "/tmp/franja-test-slurm-XXXXXX";
 

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "stage.h"
+#include "transport/stage.h"
 
 static void evicted(void)
 {

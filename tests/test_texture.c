@@ -18,7 +18,7 @@
 /* The image behind every file name the scene uses: `grid` is 4x2 RGB with
  * texel (x, y) = (x/4, y/2, 0.25) (y = 0 the top row), `flat` a constant
  * grey 0.5, `ramp` an 8x8 grey ramp with value x/8 along x. */
-static int synthetic(const char *path, scn_image *img, fr_error *err)
+static int synthetic(const char *path, scene_image *img, fr_error *err)
 {
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
@@ -44,7 +44,7 @@ static int synthetic(const char *path, scn_image *img, fr_error *err)
     return 0;
 }
 
-static const scn_hooks hooks = {.texture = synthetic};
+static const scene_hooks hooks = {.texture = synthetic};
 static char dir[64];
 
 /* Parse a scene whose image files live in dir (they exist, empty, so the
@@ -55,7 +55,7 @@ static int load(const char *json, fr_scene *out, fr_error *err)
     bld_init(&b);
     char file[128];
     snprintf(file, sizeof file, "%s/scene.json", dir);
-    int rc = scn_parse_json(json, file, &hooks, &b, err);
+    int rc = json_scene_parse(json, file, &hooks, &b, err);
     if (rc == 0)
         rc = frz_scene(&b, out, err);
     bld_free(&b);

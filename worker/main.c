@@ -19,7 +19,7 @@
 #include "quick.h"
 #include "splat.h"
 #ifndef FRANJA_NO_JSON
-#include "scene_json.h"
+#include "compile/json_scene.h"
 #endif
 
 static const char usage[] =
@@ -72,7 +72,7 @@ static int load_scene(const char *path, fr_scene *s, fr_error *err)
 #ifdef FRANJA_NO_JSON
     return fr_fail(err, "%s: this worker reads binary scenes only; run `franja compile` first", path);
 #else
-    return scn_load_json(path, NULL, s, err);
+    return json_scene_load(path, NULL, s, err);
 #endif
 }
 

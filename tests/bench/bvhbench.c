@@ -36,7 +36,7 @@
 
 #include "bench_pages.h"
 #include "bench_rays.h"
-#include "bvh_build.h"
+#include "compile/bvh_build.h"
 #include "fbin.h"
 #include "scene_pages.h"
 #include "geom.h"

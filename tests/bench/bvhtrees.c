@@ -56,9 +56,9 @@
 
 #include "bench_pages.h"
 #include "bench_rays.h"
-#include "builder.h"
+#include "compile/builder.h"
 #include "bvh.h"
-#include "bvh_build.h"
+#include "compile/bvh_build.h"
 #include "fbin.h"
 #include "trace.h"
 

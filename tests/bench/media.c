@@ -13,7 +13,7 @@
 #include <time.h>
 
 #include "pathtrace.h"
-#include "scene_json.h"
+#include "compile/json_scene.h"
 
 static double now(void)
 {
@@ -54,7 +54,7 @@ int main(int argc, char **argv)
     }
     fr_scene s;
     fr_error err;
-    if (scn_load_json(argv[1], NULL, &s, &err) < 0) {
+    if (json_scene_load(argv[1], NULL, &s, &err) < 0) {
         fprintf(stderr, "media: %s\n", err.msg);
         return 1;
     }

@@ -3,8 +3,8 @@
  * is the value (up to its first NUL), or for 5 and 6 a command line (its
  * words separated by NUL bytes):
  *
- *   0  --frames (frames_parse), then the frames put into a '#' pattern
- *   1  a '#' file-name pattern (frames_subst) into buffers of many sizes
+ *   0  --frames (framelist_parse), then the frames put into a '#' pattern
+ *   1  a '#' file-name pattern (framelist_subst) into buffers of many sizes
  *   2  --crop (crop_parse, crop_check against a few image sizes)
  *   3  the option values of opt.h (opt_uint, opt_float, opt_fraction,
  *      opt_size, opt_scale, opt_duration, opt_choice) and the scaled size
@@ -23,11 +23,11 @@
 #include <string.h>
 
 #include "crop.h"
-#include "frames.h"
-#include "hosts.h"
+#include "framelist.h"
+#include "transport/hosts.h"
 #include "opt.h"
 #include "protocol.h"
-#include "slurm.h"
+#include "transport/slurm.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -49,17 +49,17 @@ static void frames(const char *v)
 {
     frame_list l;
     fr_error err;
-    if (frames_parse(v, &l, &err) == 0) {
+    if (framelist_parse(v, &l, &err) == 0) {
         if (l.n == 0 || l.n > FRAMES_MAX)
             abort();
         char name[64];
         for (size_t i = 0; i < l.n; i++) {
             if (l.v[i] > FRAMES_MAX_NUMBER)
                 abort();
-            if (i < 16 && frames_subst("f.####.json", l.v[i], name, sizeof name))
+            if (i < 16 && framelist_subst("f.####.json", l.v[i], name, sizeof name))
                 abort();
         }
-        frames_free(&l);
+        framelist_free(&l);
     } else if (l.v || l.n) {
         abort();
     }
@@ -71,9 +71,9 @@ static void pattern(const char *v)
     char buf[300];
     for (size_t cap = 1; cap <= sizeof buf; cap += cap < 40 ? 1 : 37)
         for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++)
-            if (frames_subst(v, numbers[k], buf, cap) == 0 && strlen(buf) >= cap)
+            if (framelist_subst(v, numbers[k], buf, cap) == 0 && strlen(buf) >= cap)
                 abort();
-    (void)frames_is_pattern(v);
+    (void)framelist_is_pattern(v);
 }
 
 static void crop(const char *v)

@@ -5,8 +5,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "freeze.h"
-#include "gltf_scene.h"
+#include "compile/freeze.h"
+#include "compile/gltf_scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

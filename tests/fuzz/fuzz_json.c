@@ -17,9 +17,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "freeze.h"
-#include "mesh.h"
-#include "scene_json.h"
+#include "compile/freeze.h"
+#include "compile/mesh.h"
+#include "compile/json_scene.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -77,7 +77,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 }
 
 /* Pixels for the image files of the directory, by name. */
-static int texture(const char *path, scn_image *img, fr_error *err)
+static int texture(const char *path, scene_image *img, fr_error *err)
 {
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
@@ -128,11 +128,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     memcpy(text, data, size);
     text[size] = 0;
-    const scn_hooks hooks = {mesh, texture};
+    const scene_hooks hooks = {mesh, texture};
     fr_builder b;
     fr_error err;
     bld_init(&b);
-    if (scn_parse_json(text, scene_path, &hooks, &b, &err) == 0) {
+    if (json_scene_parse(text, scene_path, &hooks, &b, &err) == 0) {
         fr_scene s;
         if (frz_scene(&b, &s, &err) == 0)
             scn_free(&s);

@@ -14,10 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "freeze.h"
-#include "mesh.h"
-#include "obj.h"
-#include "scene_json.h"
+#include "compile/freeze.h"
+#include "compile/mesh.h"
+#include "compile/obj.h"
+#include "compile/json_scene.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -62,20 +62,20 @@ static const char *const shapes[] = {
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    obj_mesh m;
+    mesh_data m;
     fr_error err;
     if (size > 0 && data[0] == 'M') {
         memset(&m, 0, sizeof m);
         if (obj_parse_mtl((const char *)data + 1, size - 1, "fuzz.mtl", &m, &err) == 0)
             for (uint32_t i = 0; i < m.n_mats; i++) {
                 fr_material fm;
-                obj_material_convert(&m.mats[i], &fm);
+                mesh_data_material(&m.mats[i], &fm);
             }
-        obj_free(&m);
+        mesh_data_free(&m);
         return 0;
     }
     if (obj_parse((const char *)data, size, "fuzz.obj", NULL, &m, &err) == 0)
-        obj_free(&m);
+        mesh_data_free(&m);
     FILE *f = fopen(obj_path, "wb");
     if (!f)
         return 0;
@@ -90,10 +90,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              " \"lights\": [{\"type\": \"point\", \"position\": [0, 4, -2], \"intensity\": [9, 9, 9]}],"
              " \"shapes\": [%s]}",
              shapes[(size ? data[0] : 0) % (sizeof shapes / sizeof shapes[0])]);
-    const scn_hooks hooks = {mesh_add, NULL};
+    const scene_hooks hooks = {mesh_add, NULL};
     fr_builder b;
     bld_init(&b);
-    if (scn_parse_json(json, scene_path, &hooks, &b, &err) == 0) {
+    if (json_scene_parse(json, scene_path, &hooks, &b, &err) == 0) {
         fr_scene s;
         if (frz_scene(&b, &s, &err) == 0)
             scn_free(&s);

@@ -5,7 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "plyhead.h"
+#include "compile/plyhead.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -16,6 +16,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     uint32_t file_size;
     memcpy(&file_size, data, 4);
     fr_error err;
-    ply_check("fuzz.ply", (const char *)data + 4, size - 4, (size_t)file_size, &err);
+    plyhead_check("fuzz.ply", (const char *)data + 4, size - 4, (size_t)file_size, &err);
     return 0;
 }

@@ -21,8 +21,8 @@
 #include <string.h>
 
 #include "protocol.h"
-#include "stage.h"
-#include "transport_backend.h"
+#include "transport/stage.h"
+#include "transport/transport_backend.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -17,7 +17,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "transport_backend.h"
+#include "transport/transport_backend.h"
 
 enum { FAKE_MAX_HOSTS = 8, FAKE_MAX_SPAWNS = 4096 };
 

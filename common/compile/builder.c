@@ -1,0 +1,139 @@
+#include "compile/builder.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmath.h"
+#include "geom.h"
+
+static void array_init(fr_array *a, uint32_t elem) { memset(a, 0, sizeof *a); a->elem = elem; }
+
+void bld_init(fr_builder *b)
+{
+    memset(b, 0, sizeof *b);
+    array_init(&b->materials, sizeof(fr_material));
+    array_init(&b->prims, sizeof(fr_prim));
+    array_init(&b->spheres, sizeof(fr_sphere));
+    array_init(&b->rects, sizeof(fr_rect));
+    array_init(&b->triangles, sizeof(fr_triangle));
+    array_init(&b->positions, sizeof(vec3));
+    array_init(&b->normals, sizeof(vec3));
+    array_init(&b->uvs, sizeof(vec2));
+    array_init(&b->planes, sizeof(fr_plane));
+    array_init(&b->lights, sizeof(fr_light));
+    array_init(&b->textures, sizeof(fr_texture));
+    array_init(&b->texels, sizeof(float));
+    array_init(&b->media, sizeof(fr_medium));
+    array_init(&b->distrib, sizeof(float));
+    b->world.env_light = b->world.env_texture = FR_NONE;
+    b->world.rot_cos = 1.0f;
+}
+
+void bld_free(fr_builder *b)
+{
+    fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
+                       &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
+                       &b->textures, &b->texels, &b->media, &b->distrib};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        free(all[i]->data);
+    memset(b, 0, sizeof *b);
+}
+
+uint32_t bld_push(fr_array *a, const void *elem)
+{
+    if (a->count == a->cap) {
+        uint32_t cap = a->cap ? a->cap * 2 : 16;
+        if (cap <= a->cap || cap >= FR_NONE / 2)
+            return FR_NONE;
+        void *p = realloc(a->data, (size_t)cap * a->elem);
+        if (!p)
+            return FR_NONE;
+        a->data = p;
+        a->cap = cap;
+    }
+    memcpy((char *)a->data + (size_t)a->count * a->elem, elem, a->elem);
+    return a->count++;
+}
+
+static uint32_t push_prim(fr_builder *b, uint32_t kind, uint32_t index, uint32_t material)
+{
+    if (index == FR_NONE)
+        return FR_NONE;
+    fr_prim p = {kind, index, material, FR_NONE};
+    return bld_push(&b->prims, &p);
+}
+
+uint32_t bld_sphere(fr_builder *b, vec3 center, float radius, uint32_t material)
+{
+    fr_sphere s = {center, radius};
+    return push_prim(b, FR_PRIM_SPHERE, bld_push(&b->spheres, &s), material);
+}
+
+uint32_t bld_rect(fr_builder *b, vec3 origin, vec3 edge_u, vec3 edge_v, uint32_t material)
+{
+    fr_rect r = geo_rect_make(origin, edge_u, edge_v);
+    return push_prim(b, FR_PRIM_RECT, bld_push(&b->rects, &r), material);
+}
+
+uint32_t bld_triangle(fr_builder *b, vec3 p0, vec3 p1, vec3 p2, uint32_t material)
+{
+    uint32_t i0 = bld_push(&b->positions, &p0);
+    uint32_t i1 = bld_push(&b->positions, &p1);
+    uint32_t i2 = bld_push(&b->positions, &p2);
+    if (i0 == FR_NONE || i1 == FR_NONE || i2 == FR_NONE)
+        return FR_NONE;
+    fr_triangle t = {{i0, i1, i2}, 0};
+    return push_prim(b, FR_PRIM_TRIANGLE, bld_push(&b->triangles, &t), material);
+}
+
+void bld_material_init(fr_material *m)
+{
+    memset(m, 0, sizeof *m);
+    m->tex_diffuse = m->tex_glossy = m->tex_specular = m->tex_transmit = m->tex_emission = FR_NONE;
+    m->tex_bump = m->tex_normal = m->tex_roughness = m->tex_metallic = m->tex_transmission = FR_NONE;
+    m->ior = 1.5f;
+    m->normal_strength = 1.0f;
+}
+
+int bld_pad(fr_array *a, uint32_t count)
+{
+    char zero[32] = {0};
+    while (a->count < count)
+        if (bld_push(a, zero) == FR_NONE)
+            return -1;
+    return 0;
+}
+
+uint32_t bld_triangle_uv(fr_builder *b, const vec3 p[3], const vec2 uv[3], uint32_t material)
+{
+    if (bld_pad(&b->uvs, b->positions.count) < 0)
+        return FR_NONE;
+    for (int k = 0; k < 3; k++)
+        if (bld_push(&b->uvs, &uv[k]) == FR_NONE)
+            return FR_NONE;
+    uint32_t t = bld_triangle(b, p[0], p[1], p[2], material);
+    if (t != FR_NONE)
+        ((fr_triangle *)b->triangles.data)[((fr_prim *)b->prims.data)[t].index].flags |= FR_TRI_UVS;
+    return t;
+}
+
+int bld_camera_finish(fr_camera *c, fr_error *err)
+{
+    vec3 f = v3_sub(c->target, c->position);
+    if (!(v3_len2(f) > 0.0f))
+        return fr_fail(err, "camera: target equals position");
+    f = v3_norm(f);
+    vec3 r = v3_cross(f, c->up);
+    if (!(v3_len2(r) > 1e-12f * v3_len2(c->up)))
+        return fr_fail(err, "camera: up is parallel to the viewing direction (or zero)");
+    r = v3_norm(r);
+    /* Image +x is right = forward x up seen from behind the camera; with
+     * +y up and view along +z that is world -x, as the Cornell convention says. */
+    c->forward = f;
+    c->right = r;
+    c->upv = v3_cross(r, f);
+    if (!(c->vfov > 0.0f && c->vfov < FM_PI))
+        return fr_fail(err, "camera: fov must be in (0, 180) degrees");
+    c->tan_half = fm_tanf(0.5f * c->vfov);
+    return 0;
+}

@@ -1,0 +1,24 @@
+/** @file freeze.h
+ * Freezing a builder into a scene, at compile time: the step between the
+ * scene readers and the binary scene.
+ *
+ * It finishes the camera, builds the BVH (bvh_build.h, which reorders the
+ * primitives), derives the light table (every primitive with an emissive
+ * material becomes an area light of its surface area; each light is picked
+ * with probability proportional to its power), serializes the arrays into
+ * the binary-scene layout (fbin.h) and opens those bytes, so the result is
+ * exactly what loading the written .fbin gives.
+ */
+#ifndef FRANJA_FREEZE_H
+#define FRANJA_FREEZE_H
+
+#include "compile/builder.h"
+
+/** Freeze the builder into *out, which then owns its bytes (release with
+ * scn_free).  The builder's arrays stay allocated (free them with
+ * bld_free); its prims are left in BVH order and its lights include the
+ * area lights.  Returns 0, or -1 with *err set (degenerate camera, memory,
+ * non-finite geometry, a scene the binary format refuses). */
+int frz_scene(fr_builder *b, fr_scene *out, fr_error *err);
+
+#endif

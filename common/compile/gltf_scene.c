@@ -1,0 +1,746 @@
+/* gltf_scene.c -- a glTF 2.0 scene into a builder (gltf_scene.h): nodes and
+ * their transforms, meshes, the camera, punctual lights. */
+#include "compile/gltf_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmath.h"
+#include "compile/builder_light.h"
+#include "compile/freeze.h"
+#include "compile/gltf_doc.h"
+#include "compile/gltf_mat.h"
+
+/* Extensions read here or in gltf_mat.c; any other one used is reported. */
+static const char *const known_extensions[] = {
+    "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_lights_punctual", "KHR_mesh_quantization",
+    "KHR_materials_transmission", "KHR_materials_ior", NULL};
+
+enum { MODE_POINTS = 0, MODE_TRIANGLES = 4, MODE_STRIP = 5, MODE_FAN = 6 };
+
+/* p' = M p + t, row-major; in double so that deep hierarchies keep their
+ * precision until the vertices are rounded to float. */
+typedef struct { double m[3][4]; } affine;
+
+static void af_identity(affine *a)
+{
+    memset(a, 0, sizeof *a);
+    a->m[0][0] = a->m[1][1] = a->m[2][2] = 1.0;
+}
+
+static void af_mul(affine *r, const affine *a, const affine *b)
+{
+    affine t;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 4; j++) {
+            double s = a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] + a->m[i][2] * b->m[2][j];
+            t.m[i][j] = j == 3 ? s + a->m[i][3] : s;
+        }
+    }
+    *r = t;
+}
+
+static void af_apply(const affine *a, const double p[3], double w, double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = a->m[i][0] * p[0] + a->m[i][1] * p[1] + a->m[i][2] * p[2] + w * a->m[i][3];
+}
+
+static double af_det(const affine *a)
+{
+    const double (*m)[4] = a->m;
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* Cofactor matrix of the linear part: the inverse transpose up to the
+ * determinant's factor (normals are normalized afterwards; a negative
+ * determinant is handled by the caller's sign). */
+static void af_cofactor(const affine *a, double n[3][3])
+{
+    const double (*m)[4] = a->m;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+            n[i][j] = m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1];
+        }
+}
+
+typedef struct {
+    gltf_doc *d;
+    const scene_hooks *hooks;
+    const gltf_options *o;
+    fr_builder *b;
+    gltf_result *r;
+    gmat_ctx mat;
+    uint32_t max_tri, vertices;
+    int cam_node;              /* node whose camera was taken, or -1 */
+} imp;
+
+/* ---- nodes ------------------------------------------------------------ */
+
+static int local_transform(imp *c, uint32_t n, affine *out, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+    const cJSON *o = d->nodes.v[n];
+    double mx[16], t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    int has_m, has_t, has_r, has_s;
+    if (gdoc_numbers(d, o, ptr, "matrix", 16, mx, &has_m, err) < 0 ||
+        gdoc_numbers(d, o, ptr, "translation", 3, t, &has_t, err) < 0 ||
+        gdoc_numbers(d, o, ptr, "rotation", 4, q, &has_r, err) < 0 ||
+        gdoc_numbers(d, o, ptr, "scale", 3, s, &has_s, err) < 0)
+        return -1;
+    af_identity(out);
+    if (has_m) {
+        if (has_t || has_r || has_s)
+            return gdoc_fail(d, err, ptr, "both matrix and translation/rotation/scale");
+        /* Column-major: element (row i, column j) is mx[4 j + i]. */
+        if (mx[3] != 0.0 || mx[7] != 0.0 || mx[11] != 0.0 || mx[15] != 1.0)
+            return gdoc_fail(d, err, ptr, "matrix: the last row must be 0 0 0 1 (no projective transforms)");
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++)
+                out->m[i][j] = mx[4 * j + i];
+        return 0;
+    }
+    double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(l > 1e-12))
+        return gdoc_fail(d, err, ptr, "rotation: a zero quaternion");
+    double x = q[0] / l, y = q[1] / l, z = q[2] / l, w = q[3] / l;
+    const double r[3][3] = {
+        {1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+        {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+        {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            out->m[i][j] = has_r ? r[i][j] * s[j] : (i == j ? s[j] : 0.0);
+        out->m[i][3] = t[i];
+    }
+    return 0;
+}
+
+/* ---- meshes ----------------------------------------------------------- */
+
+/* Vertex k of triangle t of a primitive with `n` indices in `mode`. */
+static uint32_t corner(uint32_t mode, uint32_t t, int k)
+{
+    if (mode == MODE_TRIANGLES)
+        return 3 * t + (uint32_t)k;
+    if (mode == MODE_STRIP) {
+        static const uint32_t even[3] = {0, 1, 2}, odd[3] = {0, 2, 1};
+        return t + (t % 2 ? odd[k] : even[k]);
+    }
+    return k == 0 ? t + 1 : k == 1 ? t + 2 : 0; /* fan */
+}
+
+static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const affine *w, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    fr_builder *b = c->b;
+    char ptr[80], ap[96];
+    snprintf(ptr, sizeof ptr, "/meshes/%u/primitives/%u", mesh, pi);
+    snprintf(ap, sizeof ap, "%s/attributes", ptr);
+    if (!cJSON_IsObject(p))
+        return gdoc_fail(d, err, ptr, "expected an object");
+    const cJSON *attrs;
+    uint64_t mode;
+    uint32_t ipos, inrm, iuv, iidx, imat;
+    if (gdoc_object(d, p, ptr, "attributes", &attrs, err) < 0 ||
+        gdoc_uint(d, p, ptr, "mode", MODE_TRIANGLES, 6, &mode, err) < 0 ||
+        gdoc_index(d, p, ptr, "indices", 0, d->accessors.n, "accessors", &iidx, err) < 0 ||
+        gdoc_index(d, p, ptr, "material", 0, d->materials.n, "materials", &imat, err) < 0)
+        return -1;
+    if (!attrs)
+        return gdoc_fail(d, err, ptr, "attributes is missing");
+    if (gdoc_index(d, attrs, ap, "POSITION", 0, d->accessors.n, "accessors", &ipos, err) < 0 ||
+        gdoc_index(d, attrs, ap, "NORMAL", 0, d->accessors.n, "accessors", &inrm, err) < 0 ||
+        gdoc_index(d, attrs, ap, "TEXCOORD_0", 0, d->accessors.n, "accessors", &iuv, err) < 0)
+        return -1;
+    if (cJSON_GetObjectItemCaseSensitive(attrs, "TANGENT"))
+        gdoc_warn(d, "tangent", "%s/TANGENT: vertex tangents are not used (normal maps use tangents derived from "
+                  "the UVs of each triangle)", ap);
+    if (cJSON_GetObjectItemCaseSensitive(attrs, "COLOR_0"))
+        gdoc_warn(d, "color", "%s/COLOR_0: vertex colours are not supported: ignored", ap);
+    if (cJSON_GetObjectItemCaseSensitive(p, "targets"))
+        gdoc_warn(d, "morph", "%s/targets: morph targets are not supported: the base mesh is drawn", ptr);
+    if (mode < MODE_TRIANGLES) {
+        gdoc_warn(d, "points", "%s/mode: points and lines are not rendered", ptr);
+        return 0;
+    }
+    if (ipos == UINT32_MAX) {
+        gdoc_warn(d, "noposition", "%s: a primitive without POSITION is skipped", ptr);
+        return 0;
+    }
+    gdoc_acc pos, nrm, uv, idx;
+    static const uint32_t index_types[] = {GDOC_U8, GDOC_U16, GDOC_U32, 0};
+    if (gdoc_accessor(d, ipos, ap, 3, NULL, &pos, err) < 0 ||
+        (inrm != UINT32_MAX && gdoc_accessor(d, inrm, ap, 3, NULL, &nrm, err) < 0) ||
+        (iuv != UINT32_MAX && gdoc_accessor(d, iuv, ap, 2, NULL, &uv, err) < 0) ||
+        (iidx != UINT32_MAX && gdoc_accessor(d, iidx, ptr, 1, index_types, &idx, err) < 0))
+        return -1;
+    uint32_t nv = pos.count;
+    if ((inrm != UINT32_MAX && nrm.count != nv) || (iuv != UINT32_MAX && uv.count != nv))
+        return gdoc_fail(d, err, ap, "attributes of different counts (POSITION has %u)", nv);
+    uint32_t n = iidx != UINT32_MAX ? idx.count : nv;
+    uint32_t ntri = mode == MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;
+    if (mode == MODE_TRIANGLES && n % 3)
+        gdoc_warn(d, "partial", "%s: %u indices is not a whole number of triangles: the last %u ignored", ptr, n,
+                  n % 3);
+    if (ntri == 0)
+        return 0;
+    if (ntri > c->max_tri - c->r->triangles || nv > 3 * (uint64_t)c->max_tri - c->vertices)
+        return gdoc_fail(d, err, ptr, "the scene would have more than %u triangles", c->max_tri);
+    /* Indices checked before anything is added. */
+    for (uint32_t i = 0; iidx != UINT32_MAX && i < idx.count; i++) {
+        uint32_t v = gdoc_get_uint(&idx, i);
+        if (v >= nv)
+            return gdoc_fail(d, err, ptr, "indices: accessor %u element %u is %u, not below the vertex count %u",
+                             iidx, i, v, nv);
+    }
+    uint32_t mat = c->o->material;
+    const double *uvxf = NULL;
+    if (mat == FR_NONE && gmat_material(&c->mat, imat, &mat, &uvxf, err) < 0)
+        return -1;
+
+    double det = af_det(w), cof[3][3];
+    af_cofactor(w, cof);
+    uint32_t base = b->positions.count;
+    int use_n = inrm != UINT32_MAX, use_uv = iuv != UINT32_MAX;
+    if ((use_n && bld_pad(&b->normals, base) < 0) || (use_uv && bld_pad(&b->uvs, base) < 0))
+        return gdoc_fail(d, err, ptr, "out of memory");
+    for (uint32_t i = 0; i < nv; i++) {
+        double in[3] = {gdoc_get(&pos, i, 0), gdoc_get(&pos, i, 1), gdoc_get(&pos, i, 2)}, o[3];
+        af_apply(w, in, 1.0, o);
+        vec3 p = v3((float)o[0], (float)o[1], (float)o[2]);
+        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+            return gdoc_fail(d, err, ap, "POSITION: accessor %u element %u is not finite once placed", ipos, i);
+        if (bld_push(&b->positions, &p) == FR_NONE)
+            return gdoc_fail(d, err, ptr, "out of memory");
+        if (use_n) {
+            double nn[3] = {gdoc_get(&nrm, i, 0), gdoc_get(&nrm, i, 1), gdoc_get(&nrm, i, 2)}, m[3];
+            for (int k = 0; k < 3; k++)
+                m[k] = (det < 0 ? -1.0 : 1.0) * (cof[k][0] * nn[0] + cof[k][1] * nn[1] + cof[k][2] * nn[2]);
+            double l = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            vec3 q = l > 0 && isfinite(l) ? v3((float)(m[0] / l), (float)(m[1] / l), (float)(m[2] / l)) : v3s(0);
+            if (bld_push(&b->normals, &q) == FR_NONE)
+                return gdoc_fail(d, err, ptr, "out of memory");
+        }
+        if (use_uv) {
+            double u = gdoc_get(&uv, i, 0), v = gdoc_get(&uv, i, 1);
+            if (uvxf) {
+                double tu = uvxf[0] * u + uvxf[1] * v + uvxf[2];
+                v = uvxf[3] * u + uvxf[4] * v + uvxf[5];
+                u = tu;
+            }
+            vec2 t = {(float)u, (float)(1.0 - v)};
+            if (!isfinite(t.u) || !isfinite(t.v))
+                t = (vec2){0, 0};
+            if (bld_push(&b->uvs, &t) == FR_NONE)
+                return gdoc_fail(d, err, ptr, "out of memory");
+        }
+    }
+    c->vertices += nv;
+    /* Triangles: a mirroring transform swaps two corners so that the front
+     * stays the counter-clockwise side; zero-area ones are dropped. */
+    const vec3 *ps = b->positions.data;
+    uint32_t flags = (use_n ? FR_TRI_NORMALS : 0) | (use_uv ? FR_TRI_UVS : 0);
+    for (uint32_t t = 0; t < ntri; t++) {
+        uint32_t v[3];
+        for (int k = 0; k < 3; k++) {
+            uint32_t e = corner((uint32_t)mode, t, k);
+            v[k] = base + (iidx != UINT32_MAX ? gdoc_get_uint(&idx, e) : e);
+        }
+        if (det < 0) {
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+        }
+        if (!(v3_len2(v3_cross(v3_sub(ps[v[1]], ps[v[0]]), v3_sub(ps[v[2]], ps[v[0]]))) > 0.0f))
+            continue;
+        fr_triangle tri = {{v[0], v[1], v[2]}, flags};
+        uint32_t ti = bld_push(&b->triangles, &tri);
+        fr_prim pr = {FR_PRIM_TRIANGLE, ti, mat, FR_NONE};
+        if (ti == FR_NONE || bld_push(&b->prims, &pr) == FR_NONE)
+            return gdoc_fail(d, err, ptr, "out of memory");
+        c->r->triangles++;
+    }
+    return 0;
+}
+
+static int mesh(imp *c, uint32_t m, const affine *w, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/meshes/%u", m);
+    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(d->meshes.v[m], "primitives");
+    if (!cJSON_IsArray(prims))
+        return gdoc_fail(d, err, ptr, "primitives: expected an array");
+    uint32_t i = 0;
+    for (const cJSON *p = prims->child; p; p = p->next, i++)
+        if (primitive(c, m, i, p, w, err) < 0)
+            return -1;
+    return 0;
+}
+
+/* ---- camera and lights ------------------------------------------------ */
+
+static const char *name_of(const cJSON *o)
+{
+    const cJSON *n = cJSON_GetObjectItemCaseSensitive(o, "name");
+    return cJSON_IsString(n) ? n->valuestring : NULL;
+}
+
+/* Node n refers to camera `cam`: take it if it is the one asked for. */
+static int camera(imp *c, uint32_t n, uint32_t cam, const affine *w, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    if (!c->o->take_camera || c->cam_node >= 0)
+        return 0;
+    const cJSON *co = d->cameras.v[cam];
+    const char *want = c->o->camera, *nn = name_of(d->nodes.v[n]), *cn = name_of(co);
+    if (want && !(nn && !strcmp(nn, want)) && !(cn && !strcmp(cn, want)))
+        return 0;
+    char ptr[48], pp[80];
+    snprintf(ptr, sizeof ptr, "/cameras/%u", cam);
+    snprintf(pp, sizeof pp, "%s/perspective", ptr);
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(co, "type"), *persp;
+    if (!cJSON_IsString(type))
+        return gdoc_fail(d, err, ptr, "type: expected \"perspective\" or \"orthographic\"");
+    if (strcmp(type->valuestring, "perspective") != 0) {
+        if (want)
+            return gdoc_fail(d, err, ptr, "camera '%s' is %s: only perspective cameras are supported", want,
+                             type->valuestring);
+        gdoc_warn(d, "ortho", "%s: %s cameras are not supported: skipped", ptr, type->valuestring);
+        return 0;
+    }
+    double yfov, aspect;
+    if (gdoc_object(d, co, ptr, "perspective", &persp, err) < 0)
+        return -1;
+    if (!persp)
+        return gdoc_fail(d, err, ptr, "perspective is missing");
+    if (gdoc_number(d, persp, pp, "yfov", -1, &yfov, err) < 0 || gdoc_number(d, persp, pp, "aspectRatio", 0, &aspect, err) < 0)
+        return -1;
+    if (!(yfov > 0.0 && yfov < FM_PI))
+        return gdoc_fail(d, err, pp, "yfov: expected radians in (0, pi)%s",
+                         cJSON_GetObjectItemCaseSensitive(persp, "yfov") ? "" : " (it is missing)");
+    if (!(aspect >= 0.0))
+        return gdoc_fail(d, err, pp, "aspectRatio: expected a positive number");
+    const double o0[3] = {0, 0, 0}, fw[3] = {0, 0, -1}, up[3] = {0, 1, 0};
+    double p[3], f[3], u[3];
+    af_apply(w, o0, 1.0, p);
+    af_apply(w, fw, 0.0, f);
+    af_apply(w, up, 0.0, u);
+    double lf = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), lu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(lf > 0) || !(lu > 0))
+        return gdoc_fail(d, err, ptr, "the camera's node %u has a singular transform", n);
+    fr_camera *cm = &c->b->camera;
+    memset(cm, 0, sizeof *cm);
+    cm->position = v3((float)p[0], (float)p[1], (float)p[2]);
+    vec3 dir = v3((float)(f[0] / lf), (float)(f[1] / lf), (float)(f[2] / lf));
+    cm->target = v3_add(cm->position, dir);
+    cm->up = v3((float)(u[0] / lu), (float)(u[1] / lu), (float)(u[2] / lu));
+    cm->vfov = (float)yfov;
+    fr_error e;
+    if (bld_camera_finish(cm, &e) < 0)
+        return gdoc_fail(d, err, ptr, "%s", e.msg);
+    cm->focus = v3_len(v3_sub(cm->target, cm->position));
+    c->cam_node = (int)n;
+    c->r->camera_found = 1;
+    c->r->aspect = (float)aspect;
+    return 0;
+}
+
+static int light(imp *c, uint32_t n, const cJSON *ext, const affine *w, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    char np[80];
+    snprintf(np, sizeof np, "/nodes/%u/extensions/KHR_lights_punctual", n);
+    uint32_t li;
+    if (!cJSON_IsObject(ext))
+        return gdoc_fail(d, err, np, "expected an object");
+    if (gdoc_index(d, ext, np, "light", 1, d->lights.n, "the KHR_lights_punctual lights", &li, err) < 0)
+        return -1;
+    if (!c->o->take_lights)
+        return 0;
+    char ptr[64];
+    snprintf(ptr, sizeof ptr, "/extensions/KHR_lights_punctual/lights/%u", li);
+    const cJSON *o = d->lights.v[li];
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(o, "type");
+    double col[3] = {1, 1, 1}, intensity;
+    int has;
+    if (!cJSON_IsString(type))
+        return gdoc_fail(d, err, ptr, "type: expected \"point\", \"spot\" or \"directional\"");
+    if (gdoc_numbers(d, o, ptr, "color", 3, col, &has, err) < 0 ||
+        gdoc_number(d, o, ptr, "intensity", 1, &intensity, err) < 0)
+        return -1;
+    if (!(intensity >= 0) || !(col[0] >= 0 && col[1] >= 0 && col[2] >= 0))
+        return gdoc_fail(d, err, ptr, "color and intensity must be >= 0");
+    if (cJSON_GetObjectItemCaseSensitive(o, "range"))
+        gdoc_warn(d, "range", "%s/range: light ranges are not used (lights fall off with the inverse square)", ptr);
+    /* Candela and lux over 683 lm/W: the watts of Blender's exporter
+     * (builder_light.h, scenes/README.md). */
+    vec3 power = v3((float)(col[0] * intensity / 683.0), (float)(col[1] * intensity / 683.0),
+                    (float)(col[2] * intensity / 683.0));
+    if (v3_is_zero(power))
+        return 0;
+    const double o0[3] = {0, 0, 0}, fw[3] = {0, 0, -1};
+    double p[3], f[3];
+    af_apply(w, o0, 1.0, p);
+    af_apply(w, fw, 0.0, f);
+    vec3 pos = v3((float)p[0], (float)p[1], (float)p[2]), dir = v3((float)f[0], (float)f[1], (float)f[2]);
+    fr_error e;
+    int rc;
+    if (!strcmp(type->valuestring, "point")) {
+        rc = bld_point_light(c->b, pos, power, &e);
+    } else if (!strcmp(type->valuestring, "spot")) {
+        const cJSON *sp;
+        char sptr[80];
+        double inner = 0.0, outer = FM_PI / 4.0;
+        snprintf(sptr, sizeof sptr, "%s/spot", ptr);
+        if (gdoc_object(d, o, ptr, "spot", &sp, err) < 0 ||
+            (sp && (gdoc_number(d, sp, sptr, "innerConeAngle", 0.0, &inner, err) < 0 ||
+                    gdoc_number(d, sp, sptr, "outerConeAngle", FM_PI / 4.0, &outer, err) < 0)))
+            return -1;
+        rc = bld_spot_light(c->b, pos, dir, power, (float)inner, (float)outer, &e);
+    } else if (!strcmp(type->valuestring, "directional")) {
+        rc = bld_sun_light(c->b, dir, power, 0.0f, &e);
+    } else {
+        return gdoc_fail(d, err, ptr, "type: '%s' is not point, spot or directional", type->valuestring);
+    }
+    if (rc < 0)
+        return gdoc_fail(d, err, ptr, "%s", e.msg);
+    c->r->lights++;
+    return 0;
+}
+
+static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+    const cJSON *o = d->nodes.v[n], *ext, *lp = NULL;
+    uint32_t m, cam;
+    if (gdoc_index(d, o, ptr, "mesh", 0, d->meshes.n, "meshes", &m, err) < 0 ||
+        gdoc_index(d, o, ptr, "camera", 0, d->cameras.n, "cameras", &cam, err) < 0 ||
+        gdoc_object(d, o, ptr, "extensions", &ext, err) < 0)
+        return -1;
+    if (ext)
+        lp = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
+    if (cJSON_GetObjectItemCaseSensitive(o, "skin"))
+        gdoc_warn(d, "skin", "%s/skin: skinning is not supported: the mesh is drawn in its bind pose", ptr);
+    if (cJSON_GetObjectItemCaseSensitive(o, "weights"))
+        gdoc_warn(d, "morph", "%s/weights: morph targets are not supported: the base mesh is drawn", ptr);
+    if ((m != UINT32_MAX && mesh(c, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
+        (lp && light(c, n, lp, w, err) < 0))
+        return -1;
+    return 0;
+}
+
+/* Every node's parent, checking that the nodes form a forest. */
+static int parents(imp *c, uint32_t *parent, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    for (uint32_t i = 0; i < d->nodes.n; i++)
+        parent[i] = UINT32_MAX;
+    for (uint32_t i = 0; i < d->nodes.n; i++) {
+        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(d->nodes.v[i], "children");
+        if (!ch)
+            continue;
+        char ptr[48];
+        snprintf(ptr, sizeof ptr, "/nodes/%u/children", i);
+        if (!cJSON_IsArray(ch))
+            return gdoc_fail(d, err, ptr, "expected an array of node indices");
+        int k = 0;
+        for (const cJSON *e = ch->child; e; e = e->next, k++) {
+            double x = e->valuedouble;
+            if (!cJSON_IsNumber(e) || x != floor(x) || !(x >= 0 && x < d->nodes.n))
+                return gdoc_fail(d, err, ptr, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
+            uint32_t j = (uint32_t)x;
+            if (j == i || parent[j] != UINT32_MAX)
+                return gdoc_fail(d, err, ptr, "node %u %s: the nodes must form trees", j,
+                                 j == i ? "is its own child" : "has two parents");
+            parent[j] = i;
+        }
+    }
+    return 0;
+}
+
+/* The scene's root nodes, in order, into roots[] (*n of them). */
+static int scene_roots(imp *c, const uint32_t *parent, uint32_t *roots, uint32_t *n, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    *n = 0;
+    if (d->scenes.n == 0) {
+        gdoc_warn(d, "noscene", "the file has no scenes: every root node is drawn");
+        for (uint32_t i = 0; i < d->nodes.n; i++)
+            if (parent[i] == UINT32_MAX)
+                roots[(*n)++] = i;
+        return 0;
+    }
+    uint32_t s;
+    if (gdoc_index(d, d->root, "", "scene", 0, d->scenes.n, "scenes", &s, err) < 0)
+        return -1;
+    if (s == UINT32_MAX)
+        s = 0;
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/scenes/%u/nodes", s);
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(d->scenes.v[s], "nodes");
+    if (!a)
+        return 0;
+    if (!cJSON_IsArray(a))
+        return gdoc_fail(d, err, ptr, "expected an array of node indices");
+    int k = 0;
+    for (const cJSON *e = a->child; e; e = e->next, k++) {
+        double x = e->valuedouble;
+        if (!cJSON_IsNumber(e) || x != floor(x) || !(x >= 0 && x < d->nodes.n))
+            return gdoc_fail(d, err, ptr, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
+        uint32_t j = (uint32_t)x;
+        if (parent[j] != UINT32_MAX)
+            return gdoc_fail(d, err, ptr, "node %u is the child of node %u, not a root", j, parent[j]);
+        for (uint32_t i = 0; i < *n; i++)
+            if (roots[i] == j)
+                return gdoc_fail(d, err, ptr, "node %u is listed twice", j);
+        if (*n >= d->nodes.n)
+            return gdoc_fail(d, err, ptr, "more roots than nodes");
+        roots[(*n)++] = j;
+    }
+    return 0;
+}
+
+/* Depth first from the roots, in the file's order, with an explicit stack
+ * (each node is on it at most once: the nodes form trees). */
+static int traverse(imp *c, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    uint32_t nn = d->nodes.n ? d->nodes.n : 1;
+    uint32_t *parent = malloc(nn * sizeof *parent), *roots = malloc(nn * sizeof *roots);
+    struct item { uint32_t node; affine w; } *stack = malloc(nn * sizeof *stack);
+    int rc = -1;
+    uint32_t nr, top = 0;
+    if (!parent || !roots || !stack) {
+        gdoc_fail(d, err, NULL, "out of memory");
+        goto done;
+    }
+    if (parents(c, parent, err) < 0 || scene_roots(c, parent, roots, &nr, err) < 0)
+        goto done;
+    affine place;
+    memcpy(place.m, c->o->place, sizeof place.m);
+    for (uint32_t i = nr; i-- > 0;) {
+        affine l;
+        if (local_transform(c, roots[i], &l, err) < 0)
+            goto done;
+        stack[top].node = roots[i];
+        af_mul(&stack[top++].w, &place, &l);
+    }
+    while (top > 0) {
+        struct item it = stack[--top];
+        if (node(c, it.node, &it.w, err) < 0)
+            goto done;
+        const cJSON *ch = cJSON_GetObjectItemCaseSensitive(d->nodes.v[it.node], "children");
+        int k = cJSON_GetArraySize(ch);
+        const cJSON **kids = k > 0 ? malloc((size_t)k * sizeof *kids) : NULL;
+        if (k > 0 && !kids) {
+            gdoc_fail(d, err, NULL, "out of memory");
+            goto done;
+        }
+        int i = 0;
+        for (const cJSON *e = ch ? ch->child : NULL; e; e = e->next)
+            kids[i++] = e;
+        for (int j = k - 1; j >= 0; j--) {
+            uint32_t cn = (uint32_t)kids[j]->valuedouble;
+            affine l;
+            if (local_transform(c, cn, &l, err) < 0) {
+                free(kids);
+                goto done;
+            }
+            stack[top].node = cn;
+            af_mul(&stack[top++].w, &it.w, &l);
+        }
+        free(kids);
+    }
+    rc = 0;
+done:
+    free(parent);
+    free(roots);
+    free(stack);
+    return rc;
+}
+
+/* ---- entry points ------------------------------------------------------ */
+
+void gltf_options_default(gltf_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->take_camera = 1;
+    o->take_lights = 1;
+    o->material = FR_NONE;
+    for (int i = 0; i < 3; i++)
+        o->place[i][i] = 1.0;
+}
+
+static void pass_warnings(gltf_doc *d, const scene_hooks *hooks)
+{
+    if (!hooks || !hooks->warn)
+        return;
+    char line[700];
+    for (uint32_t i = 0; i < d->n_warn; i++) {
+        snprintf(line, sizeof line, "%s: %s", d->path, d->warn[i]);
+        hooks->warn(hooks->user, line);
+    }
+    if (d->n_warn_dropped) {
+        snprintf(line, sizeof line, "%s: %u more warnings", d->path, d->n_warn_dropped);
+        hooks->warn(hooks->user, line);
+    }
+}
+
+/* The camera names of the file, for an error. */
+static void camera_names(gltf_doc *d, char *out, size_t cap)
+{
+    size_t o = 0;
+    out[0] = 0;
+    for (uint32_t i = 0; i < d->nodes.n && o + 1 < cap; i++) {
+        if (!cJSON_GetObjectItemCaseSensitive(d->nodes.v[i], "camera"))
+            continue;
+        const char *n = name_of(d->nodes.v[i]);
+        o += (size_t)snprintf(out + o, cap - o, "%s'%s'", o ? ", " : "", n ? n : "(unnamed)");
+    }
+    if (!out[0])
+        snprintf(out, cap, "none");
+}
+
+static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options *o, fr_builder *b, gltf_result *r,
+                      fr_error *err)
+{
+    memset(r, 0, sizeof *r);
+    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1};
+    gdoc_warn_extensions(d, known_extensions);
+    const cJSON *an = cJSON_GetObjectItemCaseSensitive(d->root, "animations");
+    if (cJSON_GetArraySize(an) > 0)
+        gdoc_warn(d, "animations", "/animations: animations are not supported: the scene is drawn at rest");
+    if (gmat_begin(&c.mat, d, hooks, b, err) < 0)
+        return -1;
+    int rc = traverse(&c, err);
+    gmat_end(&c.mat);
+    if (rc == 0 && o->take_camera && o->camera && c.cam_node < 0) {
+        char names[256];
+        camera_names(d, names, sizeof names);
+        rc = gdoc_fail(d, err, NULL, "no perspective camera named '%s' in the scene (camera nodes: %s)", o->camera,
+                       names);
+    }
+    pass_warnings(d, hooks);
+    return rc;
+}
+
+int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *o, fr_builder *b, gltf_result *r,
+                fr_error *err)
+{
+    gltf_doc d;
+    if (gdoc_open(&d, path, err) < 0)
+        return -1;
+    int rc = import_doc(&d, hooks, o, b, r, err);
+    gdoc_free(&d);
+    return rc;
+}
+
+int gltf_import_mem(const void *bytes, size_t len, const char *name, const scene_hooks *hooks, const gltf_options *o,
+                    fr_builder *b, gltf_result *r, fr_error *err)
+{
+    gltf_doc d;
+    if (gdoc_open_mem(&d, bytes, len, name, NULL, err) < 0)
+        return -1;
+    int rc = import_doc(&d, hooks, o, b, r, err);
+    gdoc_free(&d);
+    return rc;
+}
+
+static void warn(const scene_hooks *hooks, const char *path, const char *msg)
+{
+    if (hooks && hooks->warn) {
+        char line[700];
+        snprintf(line, sizeof line, "%s: %s", path, msg);
+        hooks->warn(hooks->user, line);
+    }
+}
+
+/* A camera from +Z (glTF's front), a little above, framing the bounds. */
+static int frame_bounds(fr_builder *b, vec3 lo, vec3 hi, fr_error *err)
+{
+    vec3 ctr = v3_scale(v3_add(lo, hi), 0.5f);
+    float radius = 0.5f * v3_len(v3_sub(hi, lo)), s, co;
+    if (!(radius > 0.0f))
+        radius = 1.0f;
+    fr_camera *cm = &b->camera;
+    memset(cm, 0, sizeof *cm);
+    cm->vfov = 40.0f * (FM_PI / 180.0f);
+    fm_sincosf(0.5f * cm->vfov, &s, &co);
+    float dist = 1.1f * radius / s;
+    cm->position = v3_add(ctr, v3_scale(v3_norm(v3(0.0f, 0.3f, 1.0f)), dist));
+    cm->target = ctr;
+    cm->up = v3(0, 1, 0);
+    cm->focus = dist;
+    return bld_camera_finish(cm, err);
+}
+
+int gltf_build_scene(const char *path, const void *bytes, size_t len, const scene_hooks *hooks, const char *camera,
+                     uint32_t max_triangles, fr_builder *b, fr_error *err)
+{
+    gltf_options o;
+    gltf_result r;
+    gltf_options_default(&o);
+    o.camera = camera;
+    o.max_triangles = max_triangles;
+    int rc = bytes ? gltf_import_mem(bytes, len, path, hooks, &o, b, &r, err) : gltf_import(path, hooks, &o, b, &r, err);
+    if (rc < 0)
+        return -1;
+    if (r.triangles == 0)
+        return fr_fail(err, "%s: the scene has no triangles to render", path);
+    fr_settings *st = &b->settings;
+    st->width = 640;
+    st->height = 480;
+    if (r.aspect > 0.0f) {
+        float h = 640.0f / r.aspect + 0.5f;
+        st->height = h < 1.0f ? 1 : h > 65536.0f ? 65536 : (uint32_t)h;
+    }
+    st->spp = 64;
+    st->max_depth = 8;
+    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+    const vec3 *p = b->positions.data;
+    for (uint32_t i = 0; i < b->positions.count; i++) {
+        lo = v3_vmin(lo, p[i]);
+        hi = v3_vmax(hi, p[i]);
+    }
+    if (!r.camera_found) {
+        warn(hooks, path, "no perspective camera in the scene: one frames it from +Z");
+        fr_error e;
+        if (frame_bounds(b, lo, hi, &e) < 0)
+            return fr_fail(err, "%s: %s", path, e.msg);
+    }
+    int emissive = 0;
+    const fr_material *m = b->materials.data;
+    for (uint32_t k = 0; k < b->prims.count && !emissive; k++)
+        emissive = !v3_is_zero(m[((const fr_prim *)b->prims.data)[k].material].emission);
+    if (b->lights.count == 0 && !emissive) {
+        warn(hooks, path, "no lights in the scene: a white environment of radiance 1 lights it");
+        fr_error e;
+        if (bld_environment(b, v3s(1.0f), FR_NONE, 0.0f, &e) < 0)
+            return fr_fail(err, "%s: %s", path, e.msg);
+    }
+    return 0;
+}
+
+int gltf_load_scene(const char *path, const scene_hooks *hooks, const char *camera, fr_scene *out, fr_error *err)
+{
+    fr_builder b;
+    bld_init(&b);
+    int rc = gltf_build_scene(path, NULL, 0, hooks, camera, 0, &b, err);
+    if (rc == 0) {
+        fr_error e;
+        if ((rc = frz_scene(&b, out, &e)) < 0)
+            fr_fail(err, "%s: %s", path, e.msg);
+    }
+    bld_free(&b);
+    return rc;
+}

@@ -1,0 +1,45 @@
+/** @file scene_hooks.h
+ * What a caller plugs into the scene readers: the loaders of assets that
+ * need heavy libraries (meshes, image textures).  The coordinator's
+ * compiler passes them; the worker passes none, and scenes that need them
+ * are then refused with a hint to compile them first.
+ */
+#ifndef FRANJA_SCENE_HOOKS_H
+#define FRANJA_SCENE_HOOKS_H
+
+#include <cjson/cJSON.h>
+
+#include "compile/builder.h"
+
+/** An image as a texture hook decodes it: width*height*channels floats,
+ * top row first, the values as stored (8- and 16-bit images scaled to
+ * [0, 1]; no colour conversion).  pixels is malloc'd; the reader frees it. */
+typedef struct {
+    float *pixels;
+    uint32_t width, height, channels;
+} scene_image;
+
+/** The asset loaders; either may be NULL. */
+typedef struct {
+    /** Add the mesh described by JSON object `node` (at JSON path `where`)
+     * to the builder with material `material` (FR_NONE: the mesh's own
+     * materials); `dir` is the scene file's directory, for relative file
+     * names.  Returns 0, or -1 with *err set. */
+    int (*mesh)(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
+                fr_error *err);
+    /** Decode image file `path` (already joined to the scene's directory)
+     * into *img; on failure return -1 and say why (unreadable,
+     * unsupported, corrupt). */
+    int (*texture)(const char *path, scene_image *img, fr_error *err);
+    /** Decode an image held in memory (`len` bytes; `mime` such as
+     * "image/png", or "" when unknown), as `texture` does a file.  May be
+     * NULL: images embedded in glTF files are then not decoded (a warning
+     * says so). */
+    int (*image_mem)(const void *data, size_t len, const char *mime, scene_image *img, fr_error *err);
+    /** Report a warning (a feature of an input file that is not supported
+     * and was ignored, named once); `user` is passed back.  May be NULL. */
+    void (*warn)(void *user, const char *msg);
+    void *user;
+} scene_hooks;
+
+#endif

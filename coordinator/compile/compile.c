@@ -1,0 +1,39 @@
+/* compile.c -- the scene compiler: the JSON reader with the mesh and
+ * texture hooks of the coordinator, and the glTF reader (see compile.h). */
+#include "compile/compile.h"
+
+#include <string.h>
+#include <strings.h>
+
+#include "compile/gltf_scene.h"
+#include "imageio.h"
+#include "compile/mesh.h"
+#include "compile/json_scene.h"
+
+/* The texture hook: images are decoded by OpenImageIO (imageio.h). */
+static int texture_load(const char *path, scene_image *img, fr_error *err)
+{
+    return iio_read(path, &img->pixels, &img->width, &img->height, &img->channels, err);
+}
+
+/* Images embedded in glTF files, likewise. */
+static int image_load(const void *data, size_t len, const char *mime, scene_image *img, fr_error *err)
+{
+    return iio_read_mem(data, len, mime, &img->pixels, &img->width, &img->height, &img->channels, err);
+}
+
+int compile_is_gltf(const char *path)
+{
+    size_t n = strlen(path);
+    return (n > 5 && !strcasecmp(path + n - 5, ".gltf")) || (n > 4 && !strcasecmp(path + n - 4, ".glb"));
+}
+
+int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err)
+{
+    scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL};
+    if (compile_is_gltf(path))
+        return gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
+    if (o && o->camera)
+        return fr_fail(err, "%s: --camera names a camera of a glTF scene; a JSON scene has its own", path);
+    return json_scene_load(path, &hooks, out, err);
+}

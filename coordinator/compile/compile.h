@@ -1,0 +1,32 @@
+/** @file compile.h
+ * The scene compiler: a JSON scene with its meshes, or a glTF scene, becomes
+ * a binary scene (`franja compile`, and `franja render` of such a scene).
+ *
+ * The compiler is the JSON reader (common/scene_json.h) with the mesh hook
+ * of mesh.h: meshes are read (OBJ/MTL by our own reader; PLY, STL, glTF and
+ * other formats through Assimp), placed, given a level of detail and frozen
+ * with the rest into the binary layout of common/FORMAT.md.
+ */
+#ifndef FRANJA_COMPILE_H
+#define FRANJA_COMPILE_H
+
+#include "error.h"
+#include "scene.h"
+
+/** How to compile: the glTF camera to take (NULL: the first), and where
+ * warnings go (NULL: nowhere; `user` is passed back). */
+typedef struct {
+    const char *camera;
+    void (*warn)(void *user, const char *msg);
+    void *user;
+} compile_opts;
+
+/** 1 when `path` names a glTF scene (.gltf or .glb, any case). */
+int compile_is_gltf(const char *path);
+
+/** Compiles the scene `path`: a whole glTF scene (.gltf, .glb;
+ * gltf_scene.h) or a JSON scene.  *out then owns its blob (scn_free).
+ * Returns 0, or -1 with err naming the file and where in it. */
+int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err);
+
+#endif

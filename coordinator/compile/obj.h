@@ -1,0 +1,36 @@
+/** @file obj.h
+ * Wavefront OBJ and MTL files, read into an indexed triangle mesh.
+ *
+ * Supported: v (x y z [w], extra colour numbers ignored), vt, vn, f with
+ * the four corner forms (v, v/vt, v//vn, v/vt/vn), negative (relative)
+ * indices, polygons of any size (triangulated by ear clipping in their own
+ * plane, so concave ones come out right), g, o, s, usemtl and mtllib (one
+ * or more MTL files, found next to the OBJ file).  Statements for curves,
+ * lines and points are skipped; anything else is an error naming the file
+ * and line.  Corners are merged into one vertex per distinct (v, vt, vn)
+ * triple, since a Franja triangle uses one index for all three.
+ */
+#ifndef FRANJA_OBJ_H
+#define FRANJA_OBJ_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "compile/mesh_data.h"
+#include "error.h"
+
+/** Parses OBJ text (`len` bytes, need not be NUL-terminated) named `name`
+ * in messages.  MTL files named by mtllib are read from directory `dir`;
+ * with dir NULL they are skipped (every usemtl name is then undefined).
+ * On failure the mesh is freed and err says file:line and what was
+ * expected. */
+int obj_parse(const char *text, size_t len, const char *name, const char *dir, mesh_data *m, fr_error *err);
+
+/** Reads and parses the OBJ file `path` (see obj_parse). */
+int obj_read(const char *path, mesh_data *m, fr_error *err);
+
+/** Parses MTL text into m's materials (defining those already used and
+ * appending new ones). */
+int obj_parse_mtl(const char *text, size_t len, const char *name, mesh_data *m, fr_error *err);
+
+#endif
