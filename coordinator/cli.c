@@ -9,7 +9,8 @@
 #include <string.h>
 #include <unistd.h>
 
-const char cli_transport_help[] =
+/* Help text for the transport options (CLI_COMMON_LONGOPTS). */
+static const char cli_transport_help[] =
     "  --known-hosts FILE   SSH known_hosts file (default ~/.ssh/known_hosts)\n"
     "  --accept-new-hosts   add the keys of hosts not yet known (never changed ones)\n"
     "  --ssh-config FILE    SSH client configuration (default ~/.ssh/config)\n"

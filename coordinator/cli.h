@@ -12,8 +12,6 @@
 #include "transport/slurm.h"
 #include "transport/transport.h"
 
-/** Help text for the transport options (CLI_COMMON_LONGOPTS). */
-extern const char cli_transport_help[];
 
 /** Sets o's defaults: ~/.ssh/known_hosts, ~/.ssh/config read, 10 s time-out,
  * the worker next to this executable, remarks (tr_options.notes) printed on
@@ -49,12 +47,12 @@ enum {
     CLI_BAD = -1,              /**< a bad value; a message is on stderr */
     CLI_OTHER = 0,             /**< not one of theirs: the caller's */
     CLI_TAKEN = 1,             /**< consumed */
-    CLI_HELP = 2               /**< usage and cli_transport_help printed on stdout */
+    CLI_HELP = 2               /**< usage and the transport options' help printed on stdout */
 };
 
 /** Handles option c (a CLI_COMMON_LONGOPTS value, as opt_next returned it,
  * with its value v) for command cmd: sets o, or *hosts (pointing at v) for
- * --hosts; for --help prints usage, then cli_transport_help.  Returns a
+ * --hosts; for --help prints usage, then the transport options' help.  Returns a
  * CLI_* value. */
 int cli_common_opt(const char *cmd, int c, const char *v, const char *usage, tr_options *o, const char **hosts);
 

@@ -1,4 +1,4 @@
-/* frames.c -- frame lists (--frames) and '#' file-name patterns. */
+/* framelist.c -- frame lists (--frames) and '#' file-name patterns. */
 #include "framelist.h"
 
 #include <stdio.h>

@@ -1,11 +1,11 @@
-/** @file frames.h
+/** @file framelist.h
  * Frame ranges of an animation: the --frames list (which frame numbers)
  * and the file-name patterns in which a run of '#' stands for the frame
  * number, zero-padded to the run's length ("f.####.json", frame 7:
  * "f.0007.json"; a number wider than the run is written whole).
  */
-#ifndef FRANJA_FRAMES_H
-#define FRANJA_FRAMES_H
+#ifndef FRANJA_FRAMELIST_H
+#define FRANJA_FRAMELIST_H
 
 #include <stddef.h>
 #include <stdint.h>

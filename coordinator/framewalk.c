@@ -1,4 +1,4 @@
-/* cmd_frames.c -- `franja render PATTERN --frames LIST`: the walk over
+/* framewalk.c -- `franja render PATTERN --frames LIST`: the walk over
  * the frames (outputs that exist skipped). */
 #include "framewalk.h"
 

@@ -1,4 +1,4 @@
-/** @file cmd_frames.h
+/** @file framewalk.h
  * `franja render PATTERN --frames LIST`: the frames of an animation, each
  * with its own output and job directory (so --resume and the job lock work
  * per frame); a frame whose output exists is skipped unless --overwrite,
@@ -9,8 +9,8 @@
  * each frame announced or skipped, a frame that fails, is interrupted or
  * is stopped by the time limit named, and a summary.
  */
-#ifndef FRANJA_CMD_FRAMES_H
-#define FRANJA_CMD_FRAMES_H
+#ifndef FRANJA_FRAMEWALK_H
+#define FRANJA_FRAMEWALK_H
 
 #include <stddef.h>
 #include <stdint.h>

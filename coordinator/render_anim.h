@@ -1,6 +1,6 @@
 /** @file render_anim.h
  * `franja render PATTERN --frames LIST`: the frames of an animation (see
- * cmd_frames.h for the list, the file names and what is said) rendered
+ * framewalk.h for the list, the file names and what is said) rendered
  * together over one set of hosts, connected once.  Frames are opened
  * (locked, compiled) in the order of the list; once every slab of a frame
  * has started, a slot that comes free starts the next frame's slabs, and
@@ -23,7 +23,7 @@
 typedef frame_image *(*render_anim_parse_fn)(int argc, char **argv, int *status);
 
 /** Renders the frames of a->frames; argv is the command line as typed,
- * each frame's own made from it by cmd_frames.h's rules and parsed with
+ * each frame's own made from it by framewalk.h's rules and parsed with
  * parse.  Returns the exit status of `franja render` (130 when
  * interrupted, FRAMES_TIME_LIMIT when stopped by --time-limit: the frames
  * in flight keep their finished slabs for --resume). */

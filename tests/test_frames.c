@@ -1,4 +1,4 @@
-/* test_frames.c -- frame lists and '#' patterns (coordinator/frames.h). */
+/* test_frames.c -- frame lists and '#' patterns (coordinator/framelist.h). */
 #include <stdio.h>
 #include <string.h>
 

@@ -1,4 +1,4 @@
-/* test_obj.c -- the OBJ/MTL reader (coordinator/obj.h): corner forms, negative
+/* test_obj.c -- the OBJ/MTL reader (coordinator/compile/obj.h): corner forms, negative
  * indices, polygons (convex and concave), groups, several materials per
  * file, MTL statements and their mapping to Franja materials, and errors
  * that name the file, the line and what was expected. */

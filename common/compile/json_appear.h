@@ -1,14 +1,14 @@
-/** @file scene_appear.h
+/** @file json_appear.h
  * The appearance part of the JSON scene format:
  * textures, textured colours, bump and normal maps, participating media,
  * the camera's f-number form and tone-mapping defaults (documented in
- * scenes/README.md).  scene_json.c calls these while it reads a scene.
+ * scenes/README.md).  json_scene.c calls these while it reads a scene.
  *
  * Errors follow the scene reader's style: the JSON path and what was
  * expected, e.g. `materials.floor.albedo: no texture named 'wood'`.
  */
-#ifndef FRANJA_SCENE_APPEAR_H
-#define FRANJA_SCENE_APPEAR_H
+#ifndef FRANJA_JSON_APPEAR_H
+#define FRANJA_JSON_APPEAR_H
 
 #include <cjson/cJSON.h>
 

@@ -1,4 +1,4 @@
-/* scene_gltf.c -- the gltf shape of JSON scenes (scene_gltf.h). */
+/* json_gltf.c -- the gltf shape of JSON scenes (json_gltf.h). */
 #include "compile/json_gltf.h"
 
 #include <math.h>

@@ -1,4 +1,4 @@
-/** @file scene_gltf.h
+/** @file json_gltf.h
  * The `gltf` shape of the JSON scene format (scenes/README.md): a glTF 2.0
  * file placed in a JSON scene with its own transform, so that a glTF asset
  * is lit and framed by the JSON scene's settings.
@@ -10,8 +10,8 @@
  * the scene's camera is the file's, placed by the transform; allowed only
  * when the JSON scene gives no camera of its own).  Compile time only.
  */
-#ifndef FRANJA_SCENE_GLTF_H
-#define FRANJA_SCENE_GLTF_H
+#ifndef FRANJA_JSON_GLTF_H
+#define FRANJA_JSON_GLTF_H
 
 #include <cjson/cJSON.h>
 

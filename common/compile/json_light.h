@@ -1,14 +1,14 @@
-/** @file scene_light.h
+/** @file json_light.h
  * The lights part of the JSON scene format: the "lights" array (point,
  * spot and sun lights) and the "environment" object (documented in
- * scenes/README.md).  scene_json.c calls these while it reads a scene;
+ * scenes/README.md).  json_scene.c calls these while it reads a scene;
  * they check every field and add the lights through builder_light.h.
  *
  * Errors follow the scene reader's style: the JSON path and what was
  * expected, e.g. `lights[2].outer_angle: expected (0, 180] degrees`.
  */
-#ifndef FRANJA_SCENE_LIGHT_H
-#define FRANJA_SCENE_LIGHT_H
+#ifndef FRANJA_JSON_LIGHT_H
+#define FRANJA_JSON_LIGHT_H
 
 #include <cjson/cJSON.h>
 

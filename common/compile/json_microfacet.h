@@ -1,15 +1,15 @@
-/** @file scene_microfacet.h
+/** @file json_microfacet.h
  * The microfacet materials of the JSON scene format (documented in
  * scenes/README.md): the types "conductor" and "principled", and a "glass"
- * with a roughness.  scene_json.c reads the members every material shares
+ * with a roughness.  json_scene.c reads the members every material shares
  * (type, emission, bump ...) and the lobe types; this module checks and
  * reads the rest.
  *
  * Errors follow the scene reader's style: the JSON path and what was
  * expected, e.g. `materials.gold.roughness: expected a number in [0, 1]`.
  */
-#ifndef FRANJA_SCENE_MICROFACET_H
-#define FRANJA_SCENE_MICROFACET_H
+#ifndef FRANJA_JSON_MICROFACET_H
+#define FRANJA_JSON_MICROFACET_H
 
 #include <cjson/cJSON.h>
 

@@ -27,7 +27,7 @@ typedef struct {
     const cJSON *materials;    /* the "materials" object, for name lookup */
     int gltf_camera;           /* the camera comes from a gltf shape */
     fr_error *err;
-    json_appear *look;          /* textures, media (scene_appear.h) */
+    json_appear *look;          /* textures, media (json_appear.h) */
 } ctx;
 
 static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }

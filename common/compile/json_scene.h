@@ -1,4 +1,4 @@
-/** @file scene_json.h
+/** @file json_scene.h
  * Reading a scene description (JSON, see scenes/README.md) at compile time.
  *
  * The reader validates everything: a missing field, a wrong type, an
@@ -6,11 +6,11 @@
  * degenerate camera or a non-finite number is refused with the file, the
  * JSON path (e.g. `shapes[3].radius`) and what was expected.  Shapes,
  * materials, lights, the image and the camera are read here; textures,
- * media, the lens and tone mapping in scene_appear.h; meshes and image
+ * media, the lens and tone mapping in json_appear.h; meshes and image
  * files through the caller's hooks (scene_hooks.h).
  */
-#ifndef FRANJA_SCENE_JSON_H
-#define FRANJA_SCENE_JSON_H
+#ifndef FRANJA_JSON_SCENE_H
+#define FRANJA_JSON_SCENE_H
 
 #include "compile/builder.h"
 #include "compile/scene_hooks.h"

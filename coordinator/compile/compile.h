@@ -2,7 +2,7 @@
  * The scene compiler: a JSON scene with its meshes, or a glTF scene, becomes
  * a binary scene (`franja compile`, and `franja render` of such a scene).
  *
- * The compiler is the JSON reader (common/scene_json.h) with the mesh hook
+ * The compiler is the JSON reader (common/compile/json_scene.h) with the mesh hook
  * of mesh.h: meshes are read (OBJ/MTL by our own reader; PLY, STL, glTF and
  * other formats through Assimp), placed, given a level of detail and frozen
  * with the rest into the binary layout of common/FORMAT.md.

@@ -1,5 +1,5 @@
 /* fuzz_hosts.c -- libFuzzer target for the host table reader
- * (coordinator/hosts.h): any text as a table (hosts_parse, then what a
+ * (coordinator/transport/hosts.h): any text as a table (hosts_parse, then what a
  * render asks of each entry), and the input's first line as a cache=
  * size (hosts_parse_size, hosts_format_size).  A table read from a file
  * never holds a NUL byte (hosts_load refuses one), so the text ends at the

@@ -1,6 +1,6 @@
 /* fuzz_obj.c -- libFuzzer target for the OBJ and MTL readers
- * (coordinator/obj.h) and the mesh shape built from them
- * (coordinator/mesh.h).
+ * (coordinator/compile/obj.h) and the mesh shape built from them
+ * (coordinator/compile/mesh.h).
  *
  * An input whose first byte is 'M' is read as MTL.  Any other is parsed as
  * OBJ text in memory (mtllib skipped), then written to in.obj in a

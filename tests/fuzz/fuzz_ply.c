@@ -1,5 +1,5 @@
 /* fuzz_ply.c -- libFuzzer target for the PLY header check
- * (coordinator/plyhead.h): the input is the start of a file whose whole
+ * (coordinator/compile/plyhead.h): the input is the start of a file whose whole
  * size its first four bytes give (little-endian, up to 4 GiB), the rest
  * the header text. */
 #include <stdint.h>
