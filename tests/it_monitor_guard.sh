@@ -99,8 +99,8 @@ slow_then() {
         i=$((i + 1))
     done
     grep -q connected "$T/slow" && ok || bad "$1 slow clients could not connect"
-    for wait in 0 3 3; do
-        sleep $wait
+    for pause in 0 3 3; do
+        sleep $pause
         t0=$(date +%s.%N)
         c=$(code "$base/state.json?token=$token")
         t1=$(date +%s.%N)
