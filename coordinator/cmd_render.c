@@ -91,8 +91,11 @@ static const char usage[] =
     "                       wrapper tools; a frame's events carry \"frame\")\n"
     "                       (default auto)\n"
     "  --monitor PORT       serve a live page of the render (image so far, hosts,\n"
-    "                       ETA) on http://127.0.0.1:PORT/ (0: a free port, said\n"
-    "                       on stderr); from another machine: ssh -L\n"
+    "                       ETA) on http://127.0.0.1:PORT/?token=... (0: a free\n"
+    "                       port; the address is said on stderr, its random token\n"
+    "                       keeps other users out); from another machine: ssh -L\n"
+    "  --monitor-open       serve the monitor without a token (any local user\n"
+    "                       can watch)\n"
     CLI_SLURM_HELP;
 
 /* render's own options (getopt_long values). */
@@ -101,7 +104,7 @@ enum {
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
     OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
-    OPT_REPRODUCIBLE
+    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -128,6 +131,7 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"progress", required_argument, NULL, OPT_PROGRESS},
         {"noise-threshold", required_argument, NULL, OPT_NOISE},
         {"monitor", required_argument, NULL, OPT_MONITOR},
+        {"monitor-open", no_argument, NULL, OPT_MONITOR_OPEN},
         {"crop", required_argument, NULL, OPT_CROP},
         {"crop-output", no_argument, NULL, OPT_CROP_OUTPUT},
         {"exr-half", no_argument, NULL, OPT_EXR_HALF},
@@ -227,6 +231,9 @@ static int parse(int argc, char **argv, frame_settings *a)
             bad = opt_uint(cmd, "--monitor", v, 0, 65535, &a->monitor_port);
             a->monitor = 1;
             break;
+        case OPT_MONITOR_OPEN:
+            a->monitor_open = 1;
+            break;
         case OPT_CROP: {
             fr_error e;
             bad = crop_parse(v, &a->win, &e);
@@ -300,6 +307,10 @@ static int parse(int argc, char **argv, frame_settings *a)
     }
     if (a->scale > 0 && a->width) {
         fprintf(stderr, "franja render: --scale and --size exclude each other (one image size at a time)\n");
+        return 2;
+    }
+    if (a->monitor_open && !a->monitor) {
+        fprintf(stderr, "franja render: --monitor-open needs --monitor PORT\n");
         return 2;
     }
     if (a->crop_output && !a->crop) {
@@ -387,12 +398,13 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     if (a->monitor) {
-        if (!(im->mon = mon_start((uint16_t)a->monitor_port, a->out, im->jobdir, &im->spec, &im->tm, &err))) {
+        if (!(im->mon = mon_start((uint16_t)a->monitor_port, a->monitor_open, a->out, im->jobdir, &im->spec, &im->tm,
+                                  &err))) {
             fprintf(stderr, "franja render: --monitor: %s\n", err.msg);
             goto done;
         }
         mon_status(im->mon, "rendering");
-        fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(im->mon));
+        fprintf(stderr, "franja: monitor on %s\n", mon_url(im->mon));
     }
     preview_writer *pv = NULL;
     if (a->preview && !(pv = preview_start(a->preview, im->jobdir, &im->spec, &im->tm, a->preview_every,

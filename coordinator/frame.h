@@ -45,6 +45,7 @@ typedef struct {
     double scale;              /* --scale, 0 when not given */
     crop_window win;
     int monitor;               /* --monitor given */
+    int monitor_open;          /* --monitor-open: no token */
     uint32_t monitor_port;
     int resume, keep_job, fresh, no_lock;
     const char *frames;        /* --frames LIST, or NULL */

@@ -15,10 +15,11 @@
 #include <unistd.h>
 
 #include "clock.h"
+#include "monitor_guard.h"
 #include "output.h"
 #include "preview.h"
 
-enum { MON_EVENTS = 50, MON_CONNECTIONS = 16, MON_IDLE_S = 10, MON_CURRENT = 64 };
+enum { MON_EVENTS = 50, MON_CURRENT = 64 };
 
 typedef struct {
     char name[64];
@@ -44,7 +45,9 @@ typedef struct {
 
 struct mon_server {
     struct MHD_Daemon *daemon;
+    mon_guard *guard;          /* the token and the connections' deadlines */
     uint16_t port;
+    char url[96];              /* the page's address, with the token */
     char *output;
     pthread_mutex_t lock;      /* everything below */
     char *dir;                 /* the image's job directory; NULL: no image yet */
@@ -132,7 +135,8 @@ void mon_status(mon_server *m, const char *status)
     pthread_mutex_unlock(&m->lock);
 }
 
-uint16_t mon_port(const mon_server *m) { return m->port; }
+
+const char *mon_url(const mon_server *m) { return m->url; }
 
 void mon_frame(mon_server *m, size_t index, uint32_t number, char state, const char *output, int rows_done,
                int rows)
@@ -344,6 +348,7 @@ static enum MHD_Result reply(struct MHD_Connection *c, unsigned code, const char
     MHD_add_response_header(r, "Content-Type", type);
     MHD_add_response_header(r, "Cache-Control", "no-store");
     MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
+    MHD_add_response_header(r, "Referrer-Policy", "no-referrer");
     MHD_add_response_header(r, "Content-Security-Policy",
                             "default-src 'self'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; "
                             "img-src 'self' blob:");
@@ -364,12 +369,16 @@ static enum MHD_Result handle(void *cls, struct MHD_Connection *c, const char *u
     (void)upload;
     (void)con_cls;
     mon_server *m = cls;
+    mg_request(m->guard, c); /* its header is in: the reply's deadline from now */
     if (strcmp(method, "GET") && strcmp(method, "HEAD"))
         return text_reply(c, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET and HEAD\n");
     if (*upload_len)
         return text_reply(c, MHD_HTTP_BAD_REQUEST, "no request body expected\n");
     if (!local_host_header(MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host")))
         return text_reply(c, MHD_HTTP_FORBIDDEN, "the monitor answers requests for localhost only\n");
+    if (!mg_allowed(m->guard, MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "token")))
+        return text_reply(c, MHD_HTTP_FORBIDDEN,
+                          "this monitor needs its token: open the address franja printed when it started\n");
     if (!strcmp(url, "/") || !strcmp(url, "/index.html"))
         return reply(c, MHD_HTTP_OK, "text/html; charset=utf-8", mon_page_html, strlen(mon_page_html));
     if (!strcmp(url, "/state.json")) {
@@ -407,12 +416,16 @@ static void release(mon_server *m)
 }
 
 /* A server for output, no image yet (mon_show gives it one). */
-static mon_server *start(uint16_t port, const char *output, fr_error *err)
+static mon_server *start(uint16_t port, int open, const char *output, fr_error *err)
 {
     mon_server *m = calloc(1, sizeof *m);
     if (!m || !(m->output = strdup(output))) {
         free(m);
         fr_fail(err, "out of memory");
+        return NULL;
+    }
+    if (!(m->guard = mg_start(open, err))) {
+        release(m);
         return NULL;
     }
     m->shown = -1;
@@ -427,22 +440,31 @@ static mon_server *start(uint16_t port, const char *output, fr_error *err)
     int one = 1;
     socklen_t sl = sizeof sa;
     if (fd < 0 || setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) ||
-        bind(fd, (struct sockaddr *)&sa, sizeof sa) || listen(fd, 16) ||
+        bind(fd, (struct sockaddr *)&sa, sizeof sa) || listen(fd, MG_CONNECTIONS) ||
         getsockname(fd, (struct sockaddr *)&sa, &sl)) {
         fr_fail(err, "cannot listen on 127.0.0.1:%u: %s", port, strerror(errno));
         if (fd >= 0)
             close(fd);
+        mg_stop(m->guard);
         release(m);
         return NULL;
     }
     m->port = ntohs(sa.sin_port);
+    const char *token = mg_token(m->guard);
+    snprintf(m->url, sizeof m->url, "http://127.0.0.1:%u/%s%s", m->port, token ? "?token=" : "", token ? token : "");
     pthread_mutex_init(&m->lock, NULL);
-    m->daemon = MHD_start_daemon(MHD_USE_INTERNAL_POLLING_THREAD, 0, NULL, NULL, handle, m, MHD_OPTION_LISTEN_SOCKET,
-                                 fd, MHD_OPTION_CONNECTION_LIMIT, (unsigned)MON_CONNECTIONS,
-                                 MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)MON_IDLE_S, MHD_OPTION_END);
+    /* One thread polls every connection (epoll where there is one), so a
+     * slow client delays no other; the guard cuts those past their
+     * deadline and keeps the connections within its limits, and
+     * MG_SLOTS is only the hard limit behind it. */
+    m->daemon = MHD_start_daemon(MHD_USE_AUTO_INTERNAL_THREAD, 0, NULL, NULL, handle, m, MHD_OPTION_LISTEN_SOCKET, fd,
+                                 MHD_OPTION_CONNECTION_LIMIT, (unsigned)MG_SLOTS, MHD_OPTION_CONNECTION_TIMEOUT,
+                                 (unsigned)MG_REQUEST_S, MHD_OPTION_NOTIFY_CONNECTION, mg_connection, m->guard,
+                                 MHD_OPTION_NOTIFY_COMPLETED, mg_completed, m->guard, MHD_OPTION_END);
     if (!m->daemon) {
         close(fd);
         pthread_mutex_destroy(&m->lock);
+        mg_stop(m->guard);
         release(m);
         fr_fail(err, "cannot start the web server on 127.0.0.1:%u", port);
         return NULL;
@@ -450,10 +472,10 @@ static mon_server *start(uint16_t port, const char *output, fr_error *err)
     return m;
 }
 
-mon_server *mon_start(uint16_t port, const char *output, const char *dir, const job_spec *spec, const fr_tonemap *tm,
-                      fr_error *err)
+mon_server *mon_start(uint16_t port, int open, const char *output, const char *dir, const job_spec *spec,
+                      const fr_tonemap *tm, fr_error *err)
 {
-    mon_server *m = start(port, output, err);
+    mon_server *m = start(port, open, output, err);
     if (m && mon_show(m, 0, dir, spec, tm, err)) {
         mon_stop(m);
         return NULL;
@@ -467,7 +489,7 @@ mon_server *mon_start(uint16_t port, const char *output, const char *dir, const 
     return m;
 }
 
-mon_server *mon_start_frames(uint16_t port, const char *output, const char *list, size_t n, fr_error *err)
+mon_server *mon_start_frames(uint16_t port, int open, const char *output, const char *list, size_t n, fr_error *err)
 {
     char *states = malloc(n + 1), *l = strdup(list);
     if (!states || !l) {
@@ -478,7 +500,7 @@ mon_server *mon_start_frames(uint16_t port, const char *output, const char *list
     }
     memset(states, 'w', n);
     states[n] = '\0';
-    mon_server *m = start(port, output, err);
+    mon_server *m = start(port, open, output, err);
     if (!m) {
         free(states);
         free(l);
@@ -497,6 +519,7 @@ void mon_stop(mon_server *m)
     if (!m)
         return;
     MHD_stop_daemon(m->daemon); /* closes the listening socket */
+    mg_stop(m->guard);
     pthread_mutex_destroy(&m->lock);
     release(m);
 }

@@ -24,8 +24,14 @@
  *
  * Only GET and HEAD are answered, only for a Host header naming this
  * machine (localhost, 127.0.0.1, [::1], any port: a page of another site
- * cannot read the monitor through a rebound DNS name); at most 16
- * connections, each closed after 10 s of silence.  The image is read from
+ * cannot read the monitor through a rebound DNS name), and unless the
+ * monitor is open only with its token: every request carries
+ * `?token=HEX`, as the address mon_url gives does and the page's script
+ * does after it; others get 403, so another user of this machine cannot
+ * watch the render.  Each connection has 5 s to send a request and 30 s
+ * to take the reply, whatever it trickles, and at most 64 are kept (48
+ * from one address), the longest waiting closed first
+ * (monitor_guard.h).  The image is read from
  * the job directory (like --preview), at most once a second and only when
  * its rows changed; nothing the scheduler owns is touched by the server's
  * thread: the render hands it copies (mon_progress, mon_event).
@@ -50,17 +56,18 @@ typedef struct {
     int rows, failures;        /**< accepted rows, failed attempts */
 } mon_host;
 
-/** Starts serving on 127.0.0.1:port (0: a free port the system picks; see
- * mon_port) the render of output from job directory dir.  Strings are
- * copied.  NULL with err set when the port cannot be bound (in use,
- * privileged) or the server cannot start. */
-mon_server *mon_start(uint16_t port, const char *output, const char *dir, const job_spec *spec, const fr_tonemap *tm,
-                      fr_error *err);
+/** Starts serving on 127.0.0.1:port (0: a free port the system picks, in
+ * mon_url) the render of output from job directory dir; open: without a
+ * token (--monitor-open).  Strings are copied.  NULL with err set when the
+ * port cannot be bound (in use, privileged), there are no random bytes
+ * for the token or the server cannot start. */
+mon_server *mon_start(uint16_t port, int open, const char *output, const char *dir, const job_spec *spec,
+                      const fr_tonemap *tm, fr_error *err);
 
 /** Starts serving an animation on 127.0.0.1:port: output is the output
  * pattern, list the --frames value, n the frames in it (each waiting);
  * there is no image until mon_show.  As mon_start otherwise. */
-mon_server *mon_start_frames(uint16_t port, const char *output, const char *list, size_t n, fr_error *err);
+mon_server *mon_start_frames(uint16_t port, int open, const char *output, const char *list, size_t n, fr_error *err);
 
 /** A frame's state: index is its place in the list (from 0; others are
  * ignored), state one of 'w' waiting, 'r' rendering, 'd' written, 's'
@@ -75,8 +82,9 @@ void mon_frame(mon_server *m, size_t index, uint32_t number, char state, const c
 int mon_show(mon_server *m, uint32_t number, const char *dir, const job_spec *spec, const fr_tonemap *tm,
              fr_error *err);
 
-/** The port the monitor listens on. */
-uint16_t mon_port(const mon_server *m);
+/** The page's address, http://127.0.0.1:PORT/?token=HEX (no token when
+ * open), owned by m: what to print for the user to open. */
+const char *mon_url(const mon_server *m);
 
 /** The render's state now: t seconds since it began, rows done of total
  * (rows_before of them were done before this run: resumed), and the

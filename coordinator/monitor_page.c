@@ -1,7 +1,8 @@
 /* monitor_page.c -- the monitor's page (monitor.h): one HTML file with its
  * style and script, no outside resources.  Its script asks for
  * /state.json every second and for /image.png when the rows done change,
- * and keeps the page current without reloading it.  For an animation it
+ * and keeps the page current without reloading it; both requests carry
+ * the page's own token argument (monitor.h), if it has one.  For an animation it
  * also shows the frames: a strip with a cell a frame (a cell stands for
  * several frames in lists of more than 500), the counts, and the frames
  * rendering with their rows. */
@@ -50,6 +51,8 @@ const char mon_page_html[] =
     "<script>\n"
     "'use strict';\n"
     "const $ = (id) => document.getElementById(id);\n"
+    "const token = new URLSearchParams(location.search).get('token');\n"
+    "const query = token === null ? '' : '?token=' + encodeURIComponent(token);\n"
     "let imageKey = '', imageBusy = false, lastEvents = -1, lastStates = '';\n"
     "const stateNames = {w: 'waiting', r: 'rendering', d: 'written', s: 'skipped', f: 'failed', x: 'stopped'};\n"
     "function dur(s) {\n"
@@ -108,7 +111,7 @@ const char mon_page_html[] =
     "function loadImage(key, label, rows) {\n"
     "  if (imageBusy) return;\n"
     "  imageBusy = true;\n"
-    "  fetch('image.png', {cache: 'no-store'}).then((r) => r.ok ? r.blob() : null).then((b) => {\n"
+    "  fetch('image.png' + query, {cache: 'no-store'}).then((r) => r.ok ? r.blob() : null).then((b) => {\n"
     "    if (!b) return;\n"
     "    const img = $('img'), old = img.src;\n"
     "    img.onload = () => {\n"
@@ -168,7 +171,7 @@ const char mon_page_html[] =
     "  }\n"
     "}\n"
     "function tick() {\n"
-    "  fetch('state.json', {cache: 'no-store'}).then((r) => r.json()).then(show).catch(() => {\n"
+    "  fetch('state.json' + query, {cache: 'no-store'}).then((r) => r.json()).then(show).catch(() => {\n"
     "    const st = $('status');\n"
     "    if (st.className !== 'done') { st.textContent = 'monitor gone (the render ended)'; st.className = 'gone'; }\n"
     "  });\n"

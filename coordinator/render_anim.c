@@ -260,12 +260,13 @@ static int run_reporters(anim_run *fx, const frame_settings *a)
         return 1;
     }
     if (a->monitor) {
-        if (!(fx->mon = mon_start_frames((uint16_t)a->monitor_port, a->out, a->frames, fx->it.fl.n, &err))) {
+        if (!(fx->mon = mon_start_frames((uint16_t)a->monitor_port, a->monitor_open, a->out, a->frames, fx->it.fl.n,
+                                         &err))) {
             fprintf(stderr, "franja render: --monitor: %s\n", err.msg);
             return 1;
         }
         mon_status(fx->mon, "rendering");
-        fprintf(stderr, "franja: monitor on http://127.0.0.1:%u/\n", mon_port(fx->mon));
+        fprintf(stderr, "franja: monitor on %s\n", mon_url(fx->mon));
     }
     return 0;
 }

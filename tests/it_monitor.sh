@@ -1,6 +1,7 @@
 #!/bin/sh
 # it_monitor.sh -- franja render --monitor PORT: a live page on 127.0.0.1,
-# loaded in a real browser (headless chromium) during a render on two
+# at the address with its token that franja prints (it_monitor_guard.sh
+# checks the token and the limits), loaded in a real browser (headless chromium) during a render on two
 # hosts, one of which fails every slab; the page shows the image so far,
 # each host's state, slots, rows and failures, the ETA and the events, and
 # --progress json carries the same host events; for an animation rendered
@@ -40,15 +41,16 @@ pid=$!
 port=""
 i=0
 while [ -z "$port" ] && [ $i -lt 300 ] && kill -0 $pid 2>/dev/null; do
-    port=$(sed -n 's|^franja: monitor on http://127.0.0.1:\([0-9]*\)/$|\1|p' "$T/log")
+    port=$(sed -n 's|^franja: monitor on http://127.0.0.1:\([0-9]*\)/?token=[0-9a-f]*$|\1|p' "$T/log")
     sleep 0.1
     i=$((i + 1))
 done
 [ -n "$port" ] && ok || { bad "no monitor address on stderr: $(cat "$T/log")"; summary; exit 1; }
 URL="http://127.0.0.1:$port"
+Q="?token=$(sed -n 's|^franja: monitor on http://127.0.0.1:[0-9]*/?token=||p' "$T/log")"
 
 # Wait (a minute at most) until two rows are done and host bad is dropped.
-state() { curl -sf "$URL/state.json"; }
+state() { curl -sf "$URL/state.json$Q"; }
 i=0
 until state | jq -e '.rows_done >= 2 and (.hosts[] | select(.name == "bad") | .state | startswith("dropped"))' \
     >/dev/null 2>&1 || [ $i -ge 600 ]; do
@@ -64,18 +66,18 @@ before=$(echo "$s" | jq .rows_done)
 # Only this machine: bound to 127.0.0.1, and a request naming another host is refused.
 ss -ltnH "sport = :$port" | grep -q " 127\.0\.0\.1:$port " && ok ||
     bad "the monitor does not listen on 127.0.0.1 only: $(ss -ltnH "sport = :$port")"
-code=$(curl -s -o /dev/null -w '%{http_code}' -H 'Host: example.com' "$URL/state.json")
+code=$(curl -s -o /dev/null -w '%{http_code}' -H 'Host: example.com' "$URL/state.json$Q")
 [ "$code" = 403 ] && ok || bad "a request for Host example.com got HTTP $code"
-code=$(curl -s -o /dev/null -w '%{http_code}' -X POST "$URL/state.json")
+code=$(curl -s -o /dev/null -w '%{http_code}' -X POST "$URL/state.json$Q")
 [ "$code" = 405 ] && ok || bad "a POST got HTTP $code"
-curl -sf "$URL/image.png" -o "$T/now.png" && [ "$(head -c 8 "$T/now.png" | od -An -c | tr -d ' ')" = '211PNG\r\n032\n' ] &&
+curl -sf "$URL/image.png$Q" -o "$T/now.png" && [ "$(head -c 8 "$T/now.png" | od -An -c | tr -d ' ')" = '211PNG\r\n032\n' ] &&
     ok || bad "image.png is not a PNG"
 
 # The page in a browser, after its script ran: what it shows. Host good is
 # idle for a moment between two slabs; a page caught then is loaded again.
 i=0
 while :; do
-    browse --dump-dom "$URL/" >"$T/dom.html"
+    browse --dump-dom "$URL/$Q" >"$T/dom.html"
     grep -q '<tr><td>good</td><td class="state">idle</td><td>0/1</td>' "$T/dom.html" && [ $i -lt 5 ] || break
     i=$((i + 1))
 done
@@ -93,7 +95,7 @@ grep -Eq '<tr><td>bad</td><td class="state down">dropped: [^<]*</td><td>0/1</td>
 grep -q '<li class="failed">[^<]*bad: rows [0-9]*:[0-9]* failed on bad' "$T/dom.html" && ok || bad "no failure event on the page"
 grep -q '<li class="dropped">[^<]*dropping host bad' "$T/dom.html" && ok || bad "no drop event on the page"
 # A screenshot of it is a PNG of the window's size.
-browse --window-size=800,480 --screenshot="$T/shot.png" "$URL/" >/dev/null
+browse --window-size=800,480 --screenshot="$T/shot.png" "$URL/$Q" >/dev/null
 [ -s "$T/shot.png" ] && [ "$(head -c 4 "$T/shot.png" | od -An -c | tr -d ' ')" = '211PNG' ] && ok ||
     bad "no screenshot: $(tail -n 3 "$T/chrome.log")"
 
@@ -116,7 +118,7 @@ jq -se 'any(.[]; .event == "host" and .what == "ready" and .host == "good")' "$T
     bad "--progress json: no ready event"
 jq -se 'any(.[]; .event == "done" and .status == "interrupted")' "$T/events" >/dev/null && ok ||
     bad "--progress json: no interrupted done event"
-curl -sf "$URL/state.json" >/dev/null && bad "the monitor still answers after the render" || ok
+curl -sf "$URL/state.json$Q" >/dev/null && bad "the monitor still answers after the render" || ok
 
 # An animation: frames 1-3 of a sphere moving; the last slab of frames 2
 # and 3 never ends while "hold" exists, so the page is caught with frame 1
@@ -144,12 +146,13 @@ pid=$!
 port=""
 i=0
 while [ -z "$port" ] && [ $i -lt 300 ] && kill -0 $pid 2>/dev/null; do
-    port=$(sed -n 's|^franja: monitor on http://127.0.0.1:\([0-9]*\)/$|\1|p' "$T/alog")
+    port=$(sed -n 's|^franja: monitor on http://127.0.0.1:\([0-9]*\)/?token=[0-9a-f]*$|\1|p' "$T/alog")
     sleep 0.1
     i=$((i + 1))
 done
 [ -n "$port" ] && ok || bad "an animation: no monitor address on stderr: $(cat "$T/alog")"
 URL="http://127.0.0.1:$port"
+Q="?token=$(sed -n 's|^franja: monitor on http://127.0.0.1:[0-9]*/?token=||p' "$T/alog")"
 i=0
 until state | jq -e '.frames.states == "drr" and ([.frames.current[].rows_done] == [12, 12])' >/dev/null 2>&1 ||
     [ $i -ge 600 ]; do
@@ -162,9 +165,9 @@ echo "$s" | jq -e '.status == "rendering" and .frames.list == "1-3" and .frames.
     ([.frames.current[] | [.frame, .rows_done, .rows]] == [[2, 12, 16], [3, 12, 16]]) and
     .width == 24 and .height == 16 and (.eta_s | type) == "number"' >/dev/null && ok ||
     bad "an animation's state.json: $s"
-curl -sf "$URL/image.png" -o "$T/anim.png" && [ "$(head -c 8 "$T/anim.png" | od -An -c | tr -d ' ')" = '211PNG\r\n032\n' ] &&
+curl -sf "$URL/image.png$Q" -o "$T/anim.png" && [ "$(head -c 8 "$T/anim.png" | od -An -c | tr -d ' ')" = '211PNG\r\n032\n' ] &&
     ok || bad "an animation's image.png is not a PNG"
-browse --dump-dom "$URL/" >"$T/adom.html"
+browse --dump-dom "$URL/$Q" >"$T/adom.html"
 grep -q 'id="fsum">1 written, 2 rendering, 0 skipped, 0 waiting of 3<' "$T/adom.html" && ok ||
     bad "the page does not count the frames: $(grep -o 'id="fsum">[^<]*' "$T/adom.html")"
 grep -q '<div id="strip"><span class="d" title="frame 1: written"></span><span class="r" title="frame 2: rendering"></span><span class="r" title="frame 3: rendering"></span></div>' \
@@ -181,7 +184,7 @@ rm "$T/hold"
 [ $rc = 130 ] && ok || bad "the interrupted animation exited $rc: $(tail -n 3 "$T/alog")"
 [ "$(jq -c 'select(.event == "done") | [.frame, .status]' "$T/aevents" | tr '\n' ' ')" = \
     '[1,"ok"] [2,"interrupted"] [3,"interrupted"] ' ] && ok || bad "an animation's done events: $(cat "$T/aevents")"
-curl -sf "$URL/state.json" >/dev/null && bad "the animation's monitor still answers after the render" || ok
+curl -sf "$URL/state.json$Q" >/dev/null && bad "the animation's monitor still answers after the render" || ok
 
 # Bad values and a port in use.
 expect_error "--monitor x" "--monitor: 'x' is not an integer in 0..65535" "$F" render scenes/spheres.json --monitor x
