@@ -50,8 +50,13 @@ TESTSUP_OBJ = $(TESTSUP_SRC:%.c=$(B)/%.o)
 TESTSUP_LIB = $(B)/libfranja-testsup.a
 TEST_SRC    = $(wildcard tests/test_*.c)
 TEST_BIN    = $(TEST_SRC:tests/%.c=bin/tests/%)
+# Test utilities (tests/tools/) and the generators of files the project
+# ships (tests/gen/: example meshes, textures, the sky, glTF scenes, the
+# microfacet albedo tables), which the tests use too.
 TOOL_SRC    = $(wildcard tests/tools/*.c)
-TOOL_BIN    = $(TOOL_SRC:tests/tools/%.c=bin/tools/%)
+TOOL_BIN    = $(TOOL_SRC:tests/tools/%.c=bin/tools/%) $(GEN_BIN)
+GEN_SRC     = $(wildcard tests/gen/*.c)
+GEN_BIN     = $(GEN_SRC:tests/gen/%.c=bin/gen/%)
 BENCH_SRC   = $(wildcard tests/bench/*.c)
 BENCH_BIN   = $(BENCH_SRC:tests/bench/%.c=bin/bench/%)
 LIB         = $(B)/libfranja.a
@@ -114,7 +119,7 @@ $(COORD_LIB): $(COORD_LIB_OBJ)
 # The coordinator's sources (and the code that uses them) name its headers
 # from coordinator/, as common's from common/: "transport/hosts.h".
 $(COORD_OBJ) $(TESTSUP_OBJ): CSTD += -iquote coordinator
-$(TESTSUP_OBJ): CSTD += -Itests
+$(TESTSUP_OBJ): CSTD += -Itests/support
 
 $(TESTSUP_LIB): $(TESTSUP_OBJ)
 	@mkdir -p $(dir $@)
@@ -124,13 +129,17 @@ bin/franja: $(B)/coordinator/main.o $(COORD_LIB) $(LIB)
 	@mkdir -p bin
 	$(CC) $(CFLAGS) $(LTO_LINK) -o $@ $(B)/coordinator/main.o $(COORD_LIB) $(LIB) $(COORD_LIBS)
 
-# Tests see the headers of common/, coordinator/ and tests/, and link the
+# Tests see the headers of common/, coordinator/ and tests/support/, and link the
 # coordinator's library too; shared libraries that a test does not use are
 # dropped (--as-needed).
 bin/tests/%: tests/%.c $(TESTSUP_LIB) $(COORD_LIB) $(LIB)
 	@mkdir -p bin/tests
-	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -iquote coordinator -Itests -o $@ $< $(TESTSUP_LIB) $(COORD_LIB) $(LIB) \
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -iquote coordinator -Itests/support -o $@ $< $(TESTSUP_LIB) $(COORD_LIB) $(LIB) \
 	    -Wl,--as-needed $(COORD_LIBS)
+
+bin/gen/%: tests/gen/%.c $(LIB)
+	@mkdir -p bin/gen
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm
 
 bin/tools/%: tests/tools/%.c tests/tools/pfmread.h $(LIB)
 	@mkdir -p bin/tools

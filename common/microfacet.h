@@ -34,7 +34,7 @@
  * transmission), which keeps the lobe's shape and its sampling and brings a
  * white surface's albedo to 1 at every angle.  The price: a compensated
  * lobe depends on mu_o, so it is not exactly reciprocal.  The albedo tables
- * were integrated once by tests/tools/genmftab.c and are compiled in
+ * were integrated once by tests/gen/genmftab.c and are compiled in
  * (microfacet_table.c), so they are the same numbers on every host.
  *
  * Everything here uses + - * / and sqrt and the functions of fmath.h only:

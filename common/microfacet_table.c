@@ -1,4 +1,4 @@
-/* microfacet_table.c -- written by tests/tools/genmftab.c; do not edit.
+/* microfacet_table.c -- written by tests/gen/genmftab.c; do not edit.
  * Albedo tables of microfacet energy compensation; the grids are in
  * microfacet_table.h. */
 #include "microfacet_table.h"

@@ -1,8 +1,8 @@
 /** @file microfacet_table.h
  * The grids of the compiled albedo tables that energy compensation
  * and the principled material's layering read (microfacet_table.c, written
- * by tests/tools/genmftab.c; regenerate it with
- * `bin/tools/genmftab > common/microfacet_table.c`).
+ * by tests/gen/genmftab.c; regenerate it with
+ * `bin/gen/genmftab > common/microfacet_table.c`).
  *
  * Entries are fractions of 65535, looked up with linear interpolation in
  * each dimension.  Cosines are indexed by sqrt(mu) in equal steps, nodes

@@ -5,7 +5,7 @@
 # local or over fake SSH hosts, whatever order slabs finish in.  Partial
 # images carry their splats (splat=<paths>:<hash>) and are checked; the
 # worker and the coordinator refuse what bidirectional tracing cannot do.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 W=24 H=21

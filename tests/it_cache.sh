@@ -6,7 +6,7 @@
 # its slabs, when no worker has it mapped); a lease left by a render that
 # died goes stale; `franja hosts clean` empties the cache (scenes in use
 # stay) and removes cut-off uploads; a bad cache= is refused with its line.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 16x12 --spp 1"

@@ -5,7 +5,7 @@
 # kind is refused with a message that says where.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
-F=bin/franja W=bin/franja-worker G=bin/tools/genmesh
+F=bin/franja W=bin/franja-worker G=bin/gen/genmesh
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 

@@ -29,7 +29,7 @@ less() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; }
 # compile takes more than 3 s on this machine (8 M triangles at most).
 tris=1000000
 while :; do
-    bin/tools/genmesh sphere --tris $tris -o "$T/big.obj" >/dev/null || bad "genmesh failed"
+    bin/gen/genmesh sphere --tris $tris -o "$T/big.obj" >/dev/null || bad "genmesh failed"
     t0=$(secs)
     "$F" compile "$T/big.json" -o "$T/full.fbin" >"$T/out" 2>"$T/err" || bad "compile: $(cat "$T/err")"
     full=$(elapsed "$t0")

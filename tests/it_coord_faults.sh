@@ -4,7 +4,7 @@
 # partial images, a host unreachable from the start, a whole host killed
 # mid-render, a host that goes silent (all its processes stopped), and the
 # coordinator killed and resumed.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x32 --spp 4"

@@ -2,7 +2,7 @@
 # Hostile and broken workers on fake SSH hosts: each render still finishes
 # on the healthy host, in bounded time, byte-identical to the one-process
 # render.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x32 --spp 4"

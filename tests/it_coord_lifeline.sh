@@ -6,7 +6,7 @@
 # reaches them), for a root login (OpenSSH passes no channel signals to
 # those) and for an ordinary user's.  Without the lifeline each of them
 # would render its slab to the end: slabs here take minutes.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 need useradd userdel
 fh_init
 cd "$FH" || exit 1

@@ -4,7 +4,7 @@
 # workers (bad output, a stuck process) are survived; Ctrl-C keeps the
 # finished slabs and --resume renders only what is missing; the command line
 # refuses bad input before rendering.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x24 --spp 4"

@@ -4,7 +4,7 @@
 # without any reset.  The coordinator notices the silence (keepalive
 # requests go unanswered), drops the host, re-runs its slabs elsewhere and
 # still writes a byte-identical image.  Needs root (network namespaces).
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 if [ "$(id -u)" != 0 ] || ! command -v ip >/dev/null; then
     echo "FAIL: network namespaces need root and iproute2 (tests/install-deps.sh)"
     echo "0 passed, 1 failed"

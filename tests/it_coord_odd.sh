@@ -6,7 +6,7 @@
 # stderr and version line (never reach the terminal), a work directory the
 # login may not create (the mkdir's own error), and `franja deploy` to a
 # host whose uname -m is a path (refused).
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x32 --spp 4"

@@ -6,7 +6,7 @@
 # out) and a host whose worker's --version hangs (the probe waits three
 # time-outs) must not add their time-outs to a render that the healthy
 # host finishes in about a second.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x32 --spp 4"

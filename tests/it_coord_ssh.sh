@@ -3,7 +3,7 @@
 # stitched image equals the one-process render byte for byte, the scene
 # reaches each host's work directory by SFTP once, a damaged cached copy is
 # replaced, and unknown or changed host keys are refused.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x32 --spp 4"

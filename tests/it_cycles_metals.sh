@@ -18,7 +18,7 @@
 # right) do not pass.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
-. tests/cycles.sh
+. tests/support/cycles.sh
 need oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

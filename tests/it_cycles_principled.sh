@@ -19,7 +19,7 @@
 # metallic copper made a dielectric.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
-. tests/cycles.sh
+. tests/support/cycles.sh
 need oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

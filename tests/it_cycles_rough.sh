@@ -2,7 +2,7 @@
 # Rough metal and rough glass against Cycles: tests/data/cycles-rough.json
 # (a GGX metal sphere without Fresnel factor, a rough glass sphere and a
 # diffuse sphere on a diffuse plane, lit only by scenes/textures/sky.hdr, a
-# sky with a 1-degree sun made by tests/tools/gensky.c), 256x256, rendered
+# sky with a 1-degree sun made by tests/gen/gensky.c), 256x256, rendered
 # by Franja at 128 spp in two slabs against Cycles' render of the same
 # scene (tests/data/cycles-rough.exr, Blender 3.4.1, 256 spp, `make
 # refs`).  Limits (issue 11): each channel's mean within 1.5 %, the worst
@@ -19,7 +19,7 @@
 # and highlights elsewhere) does not pass.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
-. tests/cycles.sh
+. tests/support/cycles.sh
 need oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

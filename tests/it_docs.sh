@@ -89,7 +89,7 @@ E="$T/ex"
 mkdir -p "$E"
 n=0
 for d in $DOCS; do
-    n=$(awk -v out="$E" -v first="$n" -f tests/docex.awk "$d") || { bad "$d: cannot be read"; summary; exit 1; }
+    n=$(awk -v out="$E" -v first="$n" -f tests/support/docex.awk "$d") || { bad "$d: cannot be read"; summary; exit 1; }
 done
 if [ -s "$E/errors" ]; then
     while IFS= read -r line; do bad "$line"; done <"$E/errors"

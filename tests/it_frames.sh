@@ -9,7 +9,7 @@
 # middle of the range is dropped and the others finish); over SSH each
 # frame's scene is uploaded once per host; bad patterns and lists are
 # refused before anything renders.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 24x16 --spp 2"

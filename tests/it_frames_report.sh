@@ -7,7 +7,7 @@
 # --time-limit stops the whole run at the limit, the frames written stay
 # written, those in flight keep their finished slabs for --resume (exit
 # status 124), and --resume finishes them to the bytes of single renders.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 need jq cmp timeout
 fh_init
 cd "$FH" || exit 1

@@ -1,5 +1,5 @@
 #!/bin/sh
-# glTF 2.0 scenes end to end: files written by tests/tools/gengltf compile
+# glTF 2.0 scenes end to end: files written by tests/gen/gengltf compile
 # and render; the same triangles as glTF and as JSON give the same binary
 # scene and image; node transforms, camera framing (yfov, aspectRatio) and
 # UV orientation land on known pixels; the metallicRoughness texture's
@@ -9,7 +9,7 @@
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 need oiiotool cmp
-F=bin/franja W=bin/franja-worker G=bin/tools/gengltf P=bin/tools/pfmpix
+F=bin/franja W=bin/franja-worker G=bin/gen/gengltf P=bin/tools/pfmpix
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 

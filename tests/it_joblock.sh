@@ -6,7 +6,7 @@
 # what was kept stay true when the directory is removed under a render, and
 # a job directory someone else could write into, or a planted link, is
 # refused.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 32x24 --spp 4"

@@ -8,7 +8,7 @@
 # complete one: the bytes of a render with that many samples.  Nothing here
 # depends on how fast the machine is: a pass that must not end is held by a
 # worker that never answers.
-. "$(dirname "$0")/coord/fakehosts.sh"
+. "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
 T=$FH

@@ -56,7 +56,7 @@ readme_rows() {
 # compare_sets WHAT PROGRAM HELPLINES ALLNAMED MANPAGE README_HEADER
 compare_sets() {
     what=$1 help=$3 all=$4 page=$5 header=$6
-    awk -f tests/manopts.awk "$page" >"$T/man"
+    awk -f tests/support/manopts.awk "$page" >"$T/man"
     grep -v '^synopsis' "$T/man" >"$T/man.opts"
     readme_rows "$header" >"$T/readme"
     [ -s "$T/readme" ] && ok || bad "README.md: no table with a header starting '| $header |'"
@@ -122,7 +122,7 @@ compare_sets franja franja "$T/f.opts" "$T/f.named" coordinator/man/franja.1 '`f
 # ... and the top-level usage (franja --help) and franja(1)'s SYNOPSIS list
 # every option of every command.
 named <"$T/f.top" >"$T/top.named"
-awk -f tests/manopts.awk coordinator/man/franja.1 | awk -F '\t' '$1 == "synopsis" { print $2 }' | sort -u >"$T/syn"
+awk -f tests/support/manopts.awk coordinator/man/franja.1 | awk -F '\t' '$1 == "synopsis" { print $2 }' | sort -u >"$T/syn"
 cut -f1 "$T/f.opts" | while read -r opt; do
     grep -qx -- "$opt" "$T/top.named" || echo "franja --help (the top-level usage) does not list $opt"
     grep -qx -- "$opt" "$T/syn" || echo "franja(1): the SYNOPSIS does not list $opt"
@@ -134,7 +134,7 @@ bin/franja-worker --help >"$T/w.help" 2>&1 || bad "franja-worker --help exits no
 named <"$T/w.help" >"$T/w.named"
 help_lines <"$T/w.help" >"$T/w.opts"
 compare_sets franja-worker franja-worker "$T/w.opts" "$T/w.named" coordinator/man/franja-worker.1 '`franja-worker` option'
-awk -f tests/manopts.awk coordinator/man/franja-worker.1 | awk -F '\t' '$1 == "synopsis" { print $2 }' | sort -u >"$T/wsyn"
+awk -f tests/support/manopts.awk coordinator/man/franja-worker.1 | awk -F '\t' '$1 == "synopsis" { print $2 }' | sort -u >"$T/wsyn"
 cut -f1 "$T/w.opts" | while read -r opt; do
     grep -qx -- "$opt" "$T/wsyn" || echo "franja-worker(1): the SYNOPSIS does not list $opt"
 done >"$T/wunlisted"

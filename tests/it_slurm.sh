@@ -1,6 +1,6 @@
 #!/bin/sh
 # franja render --slurm and franja hosts check --slurm on a real Slurm
-# cluster of three nodes on this machine (tests/slurm/cluster.sh): renders
+# cluster of three nodes on this machine (tests/support/slurm_cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process
 # render whatever the node count; the scene is broadcast once per node,
 # found cached later and sent again when the cached copy is damaged; a
@@ -16,7 +16,7 @@
 # each frame's own bytes; outside an
 # allocation --slurm says what to run instead.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-. "$ROOT/tests/slurm/lib.sh"
+. "$ROOT/tests/support/slurm_lib.sh"
 sl_init 3
 cd "$T" || exit 1
 SIZE="--size 40x30 --spp 4"

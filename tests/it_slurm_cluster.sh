@@ -1,10 +1,10 @@
 #!/bin/sh
-# The Slurm test cluster itself (tests/slurm/cluster.sh), before anything is
+# The Slurm test cluster itself (tests/support/slurm_cluster.sh), before anything is
 # rendered on it: three nodes come up idle, a step spans them, a lost node
 # is noticed by the controller and comes back, and stop leaves no daemon and
 # no step process behind.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-. "$ROOT/tests/slurm/lib.sh"
+. "$ROOT/tests/support/slurm_lib.sh"
 sl_init 3
 
 idle=$(sl_q sinfo -h -N -t idle -o %N | sort -u | tr '\n' ' ')

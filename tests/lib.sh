@@ -1,5 +1,5 @@
 # lib.sh -- sourced by the shell tests (tests/it_*.sh, and through
-# tests/coord/fakehosts.sh and tests/cross/lib.sh by the others): counts the
+# tests/support/fakehosts.sh and tests/cross/lib.sh by the others): counts the
 # checks and prints the closing line that tests/run.sh reads.
 #
 #   ok                      counts a passed check

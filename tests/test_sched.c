@@ -15,7 +15,7 @@
 
 #include "check.h"
 #include "sched.h"
-#include "support/fakehost.h"
+#include "fakehost.h"
 
 enum { W = 8, MAX_EVENTS = 4096, MAX_FRAMES = 4 };
 

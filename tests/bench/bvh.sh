@@ -24,7 +24,7 @@ echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -
 echo "reproduce: REPS=$REPS RAYS=$RAYS MESHES='$MESHES' SIZES='$SIZES' sh tests/bench/bvh.sh"
 for mesh in $MESHES; do
     for n in $SIZES; do
-        bin/tools/genmesh "$mesh" --tris "$n" -o "$T/mesh.obj" || exit 1
+        bin/gen/genmesh "$mesh" --tris "$n" -o "$T/mesh.obj" || exit 1
         cat >"$T/mesh.json" <<JSON
 {"image": {"width": 512, "height": 512, "spp": 1},
  "camera": {"position": [0, 1.2, -2.6], "target": [0, 0, 0], "fov": 45},
@@ -33,7 +33,7 @@ for mesh in $MESHES; do
  "shapes": [{"type": "mesh", "file": "mesh.obj", "material": "m"}]}
 JSON
         echo "-- $mesh, $n triangles requested (load $(cut -d' ' -f1 /proc/loadavg))"
-        echo "\$ bin/tools/genmesh $mesh --tris $n -o mesh.obj && bin/franja compile mesh.json -o mesh.fbin"
+        echo "\$ bin/gen/genmesh $mesh --tris $n -o mesh.obj && bin/franja compile mesh.json -o mesh.fbin"
         bin/franja compile "$T/mesh.json" -o "$T/mesh.fbin" || exit 1
         echo "\$ bin/bench/bvhbench mesh.fbin --reps $REPS --size $RAYS --worker bin/franja-worker"
         bin/bench/bvhbench "$T/mesh.fbin" --reps "$REPS" --size "$RAYS" --worker bin/franja-worker || exit 1

@@ -17,7 +17,7 @@
 #   The efficiency over this ceiling is the part the coordinator can reach.
 # - paired efficiency: each -j 1 run against the -j N run that follows it.
 cd "$(dirname "$0")/../.." || exit 1
-. tests/coord/bench_common.sh
+. tests/support/bench_common.sh
 N=$(nproc)
 SCENE=${SCENE:-scenes/cornell.json}
 ARGS="--size ${SIZE:-192x192} --spp ${SPP:-64}"

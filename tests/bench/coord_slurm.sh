@@ -1,6 +1,6 @@
 #!/bin/sh
 # The cost of Slurm: the same render as job steps in an allocation of a
-# real Slurm cluster on this machine (tests/slurm/cluster.sh: one node per
+# real Slurm cluster on this machine (tests/support/slurm_cluster.sh: one node per
 # core, one CPU each) against local worker processes with the same number
 # of slots, alternated inside one allocation.  ratio = T(slurm) / T(local).
 # Each job step runs in a session of its own, which Linux's autogroup
@@ -14,8 +14,8 @@
 # finds it cached).
 cd "$(dirname "$0")/../.." || exit 1
 ROOT=$(pwd)
-. tests/coord/bench_common.sh
-. tests/slurm/lib.sh
+. tests/support/bench_common.sh
+. tests/support/slurm_lib.sh
 N=$(nproc)
 ARGS="--size ${SIZE:-256x256} --spp ${SPP:-128}"
 sl_init "$N" 1
@@ -64,7 +64,7 @@ printf '#!/bin/sh\nexec setsid %s "$@"\n' "$ROOT/bin/franja-worker" >"$T/setsid-
 chmod +x "$T/setsid-worker"
 echo "here local - $N worker=$T/setsid-worker" >"$T/local.hosts"
 cat >"$T/compare.sh" <<SH
-. tests/coord/bench_common.sh
+. tests/support/bench_common.sh
 RUNS=${RUNS:-3}
 compare "bin/franja render $SCENE -o $T/l.pfm $ARGS --hosts $T/local.hosts" \
     "bin/franja render $SCENE -o $T/s.pfm $ARGS --slurm --workdir $T/work" || exit 1

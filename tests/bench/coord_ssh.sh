@@ -6,8 +6,8 @@
 # is uploaded once per host (the second run finds it cached).
 cd "$(dirname "$0")/../.." || exit 1
 ROOT=$(pwd)
-. tests/coord/bench_common.sh
-. tests/coord/fakehosts.sh
+. tests/support/bench_common.sh
+. tests/support/fakehosts.sh
 N=$(nproc)
 ARGS="--size ${SIZE:-256x256} --spp ${SPP:-128}"
 fh_init

@@ -7,7 +7,7 @@
 # frames as separate renders one after another.  Every frame of B must be
 # the bytes of A's.  Prints both medians and the time B saves.
 cd "$(dirname "$0")/../.." || exit 1
-. tests/coord/bench_common.sh
+. tests/support/bench_common.sh
 FRAMES=${FRAMES:-5}
 ARGS="--size ${SIZE:-128x128} --spp ${SPP:-16} -j ${JOBS:-2} ${OPTS:-}"
 T=$(mktemp -d /tmp/franja-bench.XXXXXX)

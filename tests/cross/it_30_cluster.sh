@@ -1,5 +1,5 @@
 #!/bin/sh
-# A mixed cluster of fake SSH hosts (tests/coord/fakehosts.sh): host "arm"
+# A mixed cluster of fake SSH hosts (tests/support/fakehosts.sh): host "arm"
 # runs the static arm64 worker under qemu, "old" the Debian 11 amd64 build and
 # "armdeb" the Debian 12 arm64 build under qemu against that release's own
 # arm64 libraries.  The stitched image must be byte-identical to the

@@ -1,5 +1,5 @@
 #!/bin/sh
-# franja deploy over fake SSH hosts (tests/coord/fakehosts.sh): each host gets
+# franja deploy over fake SSH hosts (tests/support/fakehosts.sh): each host gets
 # the build that matches the os= and arch= of its table line, or what it
 # reports, falling back to the static build; the installed worker is checked
 # through the host's worker command (qemu for the arm64 hosts), and the

@@ -4,7 +4,7 @@
 #                        the reference slabs DIR/ref-json.pf and DIR/ref-fbin.pf
 #                        with this machine's bin/franja-worker
 #   cross_fakehosts      starts the coordinator tests' fake-host harness
-#                        (tests/coord/fakehosts.sh: fh_start, fr ...) in $FH
+#                        (tests/support/fakehosts.sh: fh_start, fr ...) in $FH
 #                        and makes it the current directory
 #
 # The checks and the closing line are tests/lib.sh's (check, need, summary).
@@ -34,7 +34,7 @@ cross_refs() {
 }
 
 cross_fakehosts() {
-    . "$ROOT/tests/coord/fakehosts.sh"
+    . "$ROOT/tests/support/fakehosts.sh"
     need "$QEMU" cmp
     fh_init
     cd "$FH" || exit 1

@@ -3,7 +3,7 @@
  * equirectangular layout (scenes/README.md, "environment"): nothing can be
  * downloaded, so the example skies are made here.
  *
- *   bin/tools/gensky [--width W] [--sun-elevation DEG] [--sun-azimuth DEG]
+ *   bin/gen/gensky [--width W] [--sun-elevation DEG] [--sun-azimuth DEG]
  *                    [--sun-angle DEG] [--sun-irradiance E] [--sky S] -o sky.hdr
  *
  * The image is W x W/2 (default 1024).  The sky above the horizon fades

@@ -1,5 +1,5 @@
 #!/bin/sh
-# cluster.sh -- a real Slurm cluster on this one machine, for tests and
+# slurm_cluster.sh -- a real Slurm cluster on this one machine, for tests and
 # benchmarks: a private munged, one slurmctld and N slurmd, each slurmd a
 # node of its own (n1 .. nN) with its own port on 127.0.0.1.  Everything
 # (configuration, keys, sockets, state, logs, PIDs) lives under DIR; the
@@ -125,7 +125,7 @@ write_conf() {
     dir=$1 n=$2 cpus=$3 port=$4
     host=$(hostname -s)
     cat >"$dir/slurm.conf" <<CONF
-# A test cluster of $n nodes on this machine (tests/slurm/cluster.sh).
+# A test cluster of $n nodes on this machine (tests/support/slurm_cluster.sh).
 ClusterName=franjatest
 SlurmctldHost=$host(127.0.0.1)
 SlurmctldPort=$port

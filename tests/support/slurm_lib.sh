@@ -1,5 +1,5 @@
-# lib.sh -- sourced by the Slurm tests (tests/it_slurm*.sh) and benchmark:
-# a private cluster from tests/slurm/cluster.sh, stopped on exit whatever
+# slurm_lib.sh -- sourced by the Slurm tests (tests/it_slurm*.sh) and benchmark:
+# a private cluster from tests/support/slurm_cluster.sh, stopped on exit whatever
 # happens, and Slurm clients that can neither hang nor read the test's stdin.
 #
 #   sl_init N [CPUS]        make $T (scratch directory), start an N-node
@@ -26,7 +26,7 @@
 
 ROOT=${ROOT:-$(cd "$(dirname "$0")/.." && pwd)}
 . "$ROOT/tests/lib.sh"
-CLUSTER="$ROOT/tests/slurm/cluster.sh"
+CLUSTER="$ROOT/tests/support/slurm_cluster.sh"
 FRANJA="$ROOT/bin/franja"
 WORKER="$ROOT/bin/franja-worker"
 

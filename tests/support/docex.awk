@@ -1,7 +1,7 @@
 # docex.awk -- pulls the examples and their expect annotations out of the
 # documentation, for tests/it_docs.sh (which describes the annotations).
 #
-#   awk -v out=DIR -v first=N -f tests/docex.awk DOC
+#   awk -v out=DIR -v first=N -f tests/support/docex.awk DOC
 #
 # For the k-th example (numbered from first) it writes DIR/k.where
 # ("file:line" of the opening fence or .nf/.EX request), DIR/k.lang (the

@@ -1,6 +1,6 @@
 # manopts.awk -- the options a man page documents, for tests/it_options.sh.
 #
-#   awk -f tests/manopts.awk PAGE.1
+#   awk -f tests/support/manopts.awk PAGE.1
 #
 # Prints "OPTION<TAB>TEXT" for each .TP entry of the OPTIONS section whose
 # tag starts with an option (TEXT: the entry's words as plain text, roff

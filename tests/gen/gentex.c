@@ -1,7 +1,7 @@
 /* gentex -- writes the example scenes' textures (nothing can be
  * downloaded, so they are made here) as binary PPM/PGM files:
  *
- *   bin/tools/gentex DIR
+ *   bin/gen/gentex DIR
  *
  * and the PNG files in scenes/textures are these converted by OpenImageIO's
  * oiiotool (`oiiotool DIR/bricks.ppm -o scenes/textures/bricks.png`, ...).

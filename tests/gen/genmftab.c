@@ -1,7 +1,7 @@
 /* genmftab -- integrates the albedo tables of microfacet energy compensation
  * and prints them as C source:
  *
- *   bin/tools/genmftab > common/microfacet_table.c
+ *   bin/gen/genmftab > common/microfacet_table.c
  *
  * Each entry is the single-scattering albedo of a GGX surface for one
  * incidence cosine and roughness (and relative index, for dielectrics),
@@ -128,7 +128,7 @@ static void reflector(const char *name, int power)
 
 int main(void)
 {
-    printf("/* microfacet_table.c -- written by tests/tools/genmftab.c; do not edit.\n"
+    printf("/* microfacet_table.c -- written by tests/gen/genmftab.c; do not edit.\n"
            " * Albedo tables of microfacet energy compensation; the grids are in\n"
            " * microfacet_table.h. */\n"
            "#include \"microfacet_table.h\"\n\n");
