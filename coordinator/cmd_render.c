@@ -51,6 +51,9 @@ static const char usage[] =
     "  --overwrite          with --frames: render frames whose output exists\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
+    "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
+    "                       (repeatable); by default a scene reads only files in\n"
+    "                       its own folder\n"
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
     "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
     "                       the relative error of its mean is below E, in (0, 1]\n"
@@ -101,7 +104,7 @@ enum {
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
     OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
-    OPT_REPRODUCIBLE
+    OPT_REPRODUCIBLE, OPT_ALLOW_PATH
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -113,6 +116,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"spp", required_argument, NULL, OPT_SPP},
         {"size", required_argument, NULL, OPT_SIZE},
         {"camera", required_argument, NULL, OPT_CAMERA},
+        {"allow-path", required_argument, NULL, OPT_ALLOW_PATH},
         {"exposure", required_argument, NULL, OPT_EXPOSURE},
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"resume", no_argument, NULL, OPT_RESUME},
@@ -171,6 +175,13 @@ static int parse(int argc, char **argv, render_args *a)
             break;
         case OPT_CAMERA:
             a->camera = v;
+            break;
+        case OPT_ALLOW_PATH:
+            if (a->n_allow == CONFINE_MAX_ALLOW) {
+                fprintf(stderr, "franja render: --allow-path: at most %d folders\n", CONFINE_MAX_ALLOW);
+                return 2;
+            }
+            a->allow[a->n_allow++] = v;
             break;
         case OPT_EXPOSURE:
             bad = opt_float(cmd, "--exposure", v, -64, 64, &a->exposure);

@@ -18,14 +18,15 @@
 #include "obj.h"
 
 /** The scn_hooks mesh hook: reads shape `node` (JSON path `where`), with
- * file names relative to `dir`, and appends its triangles (and their
+ * file names relative to `dir` read through `scope` (confine.h), and appends its triangles (and their
  * materials, unless `material` is not FR_NONE) to b.  Errors start with
  * `where` or the mesh file's name and line. */
-int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
-             fr_error *err);
+int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
+             uint32_t material, fr_error *err);
 
-/** Reads a mesh file by its extension: OBJ by obj_read, others by
- * mesh_import into the same structure (free with obj_free). */
-int mesh_read(const char *path, obj_mesh *m, fr_error *err);
+/** Reads a mesh file by its extension, through `scope` (NULL: its own
+ * folder): OBJ by obj_read, others by mesh_import into the same structure
+ * (free with obj_free). */
+int mesh_read(const char *path, const confine *scope, obj_mesh *m, fr_error *err);
 
 #endif
