@@ -27,8 +27,8 @@ static const char usage[] =
     "                  current directory)\n"
     "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
     "                  name (default: the first in the scene)\n"
-    "  --allow-path DIR  let the scene read files in DIR too (repeatable); by\n"
-    "                  default a scene reads only files in its own folder\n";
+    "  --allow-path DIR  let the scene read files in DIR too (repeatable);\n"
+    "                  without it, a scene reads only files in its own folder\n";
 
 static volatile sig_atomic_t stop_flag;
 
