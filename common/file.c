@@ -41,18 +41,6 @@ int file_open_regular(const char *path, size_t max, int *fd, size_t *size, fr_er
     return 0;
 }
 
-int file_check_regular(const char *path, size_t max, size_t *size, fr_error *err)
-{
-    int fd;
-    size_t n;
-    if (file_open_regular(path, max, &fd, &n, err) < 0)
-        return -1;
-    close(fd);
-    if (size)
-        *size = n;
-    return 0;
-}
-
 int file_read(const char *path, char **text, size_t *len, fr_error *err)
 {
     int fd;

@@ -31,10 +31,6 @@
  * the M this reader takes"; *fd is then -1. */
 int file_open_regular(const char *path, size_t max, int *fd, size_t *size, fr_error *err);
 
-/** file_open_regular, then close: for files a library opens by name
- * (images, Assimp meshes).  *size (may be NULL) receives the size. */
-int file_check_regular(const char *path, size_t max, size_t *size, fr_error *err);
-
 /** Read the whole regular file at path (file_open_regular with
  * FILE_READ_MAX) into a new malloc'd buffer with a NUL after its *len bytes
  * (the file may hold NULs of its own).  The caller frees *text.  Fails with

@@ -8,10 +8,12 @@
 #include "opt.h"
 #include "compile/compile.h"
 #include "compile/compile_child.h"
+#include "compile/confine.h"
 #include "file.h"
 
 static const char usage[] =
     "usage: franja compile SCENE(.json|.gltf|.glb) [-o SCENE.fbin] [--camera NAME]\n"
+    "                      [--allow-path DIR]...\n"
     "\n"
     "Reads a JSON scene and the meshes it names (OBJ with MTL; PLY, STL, glTF\n"
     "and other formats through Assimp), or a whole glTF 2.0 scene, builds the\n"
@@ -24,7 +26,9 @@ static const char usage[] =
     "  -o FILE         the binary scene to write (without -o: SCENE.fbin in the\n"
     "                  current directory)\n"
     "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
-    "                  name (default: the first in the scene)\n";
+    "                  name (default: the first in the scene)\n"
+    "  --allow-path DIR  let the scene read files in DIR too (repeatable);\n"
+    "                  without it, a scene reads only files in its own folder\n";
 
 static volatile sig_atomic_t stop_flag;
 
@@ -41,13 +45,15 @@ static void print_warning(void *user, const char *msg)
 
 int cmd_compile(int argc, char **argv)
 {
-    enum { CAMERA = 0x100 };
+    enum { CAMERA = 0x100, ALLOW };
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"camera", required_argument, NULL, CAMERA},
+        {"allow-path", required_argument, NULL, ALLOW},
         {NULL, 0, NULL, 0},
     };
-    const char *in = NULL, *out = NULL, *camera = NULL;
+    const char *in = NULL, *out = NULL, *camera = NULL, *allow[CONFINE_MAX_ALLOW];
+    unsigned n_allow = 0;
     int c;
     optind = 0;
     while ((c = opt_next("compile", argc, argv, "ho:", longopts)) != -1) {
@@ -60,6 +66,13 @@ int cmd_compile(int argc, char **argv)
             break;
         case CAMERA:
             camera = optarg;
+            break;
+        case ALLOW:
+            if (n_allow == CONFINE_MAX_ALLOW) {
+                fprintf(stderr, "franja compile: --allow-path: at most %d folders\n", CONFINE_MAX_ALLOW);
+                return 2;
+            }
+            allow[n_allow++] = optarg;
             break;
         default:
             return 2;
@@ -92,7 +105,7 @@ int cmd_compile(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
     fr_error err;
     compile_child_stats st;
-    compile_opts co = {camera, print_warning, (void *)"franja compile"};
+    compile_opts co = {camera, print_warning, (void *)"franja compile", allow, n_allow};
     if (compile_child(in, &co, out, &stop_flag, &st, &err) < 0) {
         fprintf(stderr, "franja compile: %s\n", err.msg);
         return stop_flag ? 130 : 1;

@@ -51,6 +51,9 @@ static const char usage[] =
     "  --overwrite          with --frames: render frames whose output exists\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
+    "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
+    "                       (repeatable); without it, a scene reads only files\n"
+    "                       in its own folder\n"
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
     "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
     "                       the relative error of its mean is below E, in (0, 1]\n"
@@ -104,7 +107,7 @@ enum {
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
     OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
-    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN
+    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -116,6 +119,7 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"spp", required_argument, NULL, OPT_SPP},
         {"size", required_argument, NULL, OPT_SIZE},
         {"camera", required_argument, NULL, OPT_CAMERA},
+        {"allow-path", required_argument, NULL, OPT_ALLOW_PATH},
         {"exposure", required_argument, NULL, OPT_EXPOSURE},
         {"tonemap", required_argument, NULL, OPT_TONEMAP},
         {"resume", no_argument, NULL, OPT_RESUME},
@@ -175,6 +179,13 @@ static int parse(int argc, char **argv, frame_settings *a)
             break;
         case OPT_CAMERA:
             a->camera = v;
+            break;
+        case OPT_ALLOW_PATH:
+            if (a->n_allow == CONFINE_MAX_ALLOW) {
+                fprintf(stderr, "franja render: --allow-path: at most %d folders\n", CONFINE_MAX_ALLOW);
+                return 2;
+            }
+            a->allow[a->n_allow++] = v;
             break;
         case OPT_EXPOSURE:
             bad = opt_float(cmd, "--exposure", v, -64, 64, &a->exposure);

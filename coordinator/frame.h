@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "cli.h"
+#include "compile/confine.h"
 #include "crop.h"
 #include "jobdir.h"
 #include "joblock.h"
@@ -30,6 +31,8 @@
 /** `franja render`'s command line, parsed (cmd_render.c). */
 typedef struct {
     const char *scene, *out, *hosts, *jobdir, *camera;
+    const char *allow[CONFINE_MAX_ALLOW]; /* --allow-path folders */
+    unsigned n_allow;
     uint32_t jobs, spp, width, height, slab_rows, retries;
     float exposure;
     int exposure_set;          /* --exposure given: overrides the scene's */

@@ -44,13 +44,15 @@ typedef struct {
 int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                     const iio_options *o, unsigned char **data, size_t *len, fr_error *err);
 
-/** Reads the first image of `path` as floats: *pixels (malloc'd, the
- * caller frees) holds width*height*channels values, top row first, as
- * stored (integer formats scaled to [0, 1], no colour conversion).  Fails
- * with OpenImageIO's message for a missing, unreadable or unsupported file,
- * and for images over 2^29 values. */
-int iio_read(const char *path, float **pixels, uint32_t *width, uint32_t *height, uint32_t *channels,
-             fr_error *err);
+/** Decodes the first image of the file `name`, whose `len` bytes the
+ * caller has read into `data` (OpenImageIO opens no file: the reader is
+ * chosen by name's extension), as floats: *pixels (malloc'd, the caller
+ * frees) holds width*height*channels values, top row first, as stored
+ * (integer formats scaled to [0, 1], no colour conversion).  Fails for an
+ * unknown extension, undecodable bytes (without quoting them) and images
+ * over 2^29 values. */
+int iio_read(const char *name, const void *data, size_t len, float **pixels, uint32_t *width, uint32_t *height,
+             uint32_t *channels, fr_error *err);
 
 /** Reads an image held in memory (`len` bytes of a PNG or JPEG file, told
  * apart by their signatures, else by `mime`) as iio_read does a file.

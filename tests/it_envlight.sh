@@ -28,7 +28,7 @@ scene() {
  "materials": {"d": {"type": "lambert", "albedo": [0.5, 0.5, 0.5]}},
  "shapes": [${10}]}
 J
-    bin/franja render "$T/$1.json" -o "$T/$1.pfm" >"$T/log" 2>&1 || bad "$1: render: $(tail -3 "$T/log")"
+    bin/franja render "$T/$1.json" --allow-path scenes/textures -o "$T/$1.pfm" >"$T/log" 2>&1 || bad "$1: render: $(tail -3 "$T/log")"
 }
 
 # field NAME LINE: the value of NAME= in an imgstat line.

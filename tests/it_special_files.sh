@@ -79,7 +79,7 @@ printf 'mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$T/b.obj"
 mesh mtl-fifo a.obj
 refused "FIFO as mtllib" "fifo.mtl: not a regular file (a FIFO)" $F compile "$T/mtl-fifo.json" -o "$T/x.fbin"
 mesh mtl-zero b.obj
-refused "/dev/zero as mtllib" "zero.mtl: not a regular file (a character device)" $F compile "$T/mtl-zero.json" -o "$T/x.fbin"
+refused "/dev/zero as mtllib" "zero.mtl: outside the scene's folder" $F compile "$T/mtl-zero.json" -o "$T/x.fbin"
 cat >"$T/tex-fifo.json" <<'JSON'
 {"image": {"width": 8, "height": 8, "spp": 1},
  "camera": {"position": [0, 0, -5], "target": [0, 0, 0], "fov": 40},
@@ -90,7 +90,7 @@ cat >"$T/tex-fifo.json" <<'JSON'
 JSON
 sed 's/fifo.png/zero.png/' "$T/tex-fifo.json" >"$T/tex-zero.json"
 refused "FIFO as texture" "textures.i.file: cannot read $T/fifo.png: not a regular file (a FIFO)" $F compile "$T/tex-fifo.json" -o "$T/x.fbin"
-refused "symlink to /dev/zero as texture" "zero.png: not a regular file (a character device)" $F compile "$T/tex-zero.json" -o "$T/x.fbin"
+refused "symlink to /dev/zero as texture" "zero.png: outside the scene's folder" $F compile "$T/tex-zero.json" -o "$T/x.fbin"
 
 # --- Assimp: a header that promises 10^8 faces, files that abort or crash it ---
 H='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n'

@@ -11,8 +11,10 @@
 static char dir[64];
 
 /* A hook that decodes every file as a 2x2 RGB image. */
-static int fake_image(const char *path, scene_image *img, fr_error *err)
+static int fake_image(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
+    (void)data;
+    (void)len;
     (void)path;
     (void)err;
     img->width = img->height = 2;

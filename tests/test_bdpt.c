@@ -362,8 +362,10 @@ static void through_glass(void)
 
 /* Shading normals: a bump-mapped floor (a synthetic egg-crate height map)
  * lit by a panel; light tracing's splats need the adjoint correction. */
-static int bumps(const char *path, scene_image *img, fr_error *err)
+static int bumps(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
+    (void)data;
+    (void)len;
     (void)path;
     (void)err;
     img->width = img->height = 32;

@@ -18,8 +18,10 @@
 /* The image behind every file name the scene uses: `grid` is 4x2 RGB with
  * texel (x, y) = (x/4, y/2, 0.25) (y = 0 the top row), `flat` a constant
  * grey 0.5, `ramp` an 8x8 grey ramp with value x/8 along x. */
-static int synthetic(const char *path, scene_image *img, fr_error *err)
+static int synthetic(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
+    (void)data;
+    (void)len;
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     if (!strncmp(base, "grid", 4)) {

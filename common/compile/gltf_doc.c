@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "compile/confine.h"
 #include "file.h"
 
 #define GLB_MAGIC 0x46546C67u  /* "glTF" */
@@ -54,6 +55,7 @@ void gdoc_warn(gltf_doc *d, const char *key, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    fr_escape_controls(msg, sizeof msg); /* names from the file reach a terminal */
     char *k = strdup(key), *m = strdup(msg);
     if (!k || !m) {
         free(k);
@@ -278,28 +280,25 @@ int gdoc_uri_path(const gltf_doc *d, const char *uri, const char *ptr, char *out
 
 /* ---- opening ---------------------------------------------------------- */
 
-/* Reads exactly `need` bytes of regular file `path`: its size is checked
- * first, so a short file fails before anything is allocated. */
-static int read_exact(const char *path, size_t need, unsigned char **out, fr_error *err)
+/* Reads exactly `need` bytes of the file `path`, which must lie in the
+ * document's scope (confine.h) and be a regular file: its size is checked
+ * first, so a short file fails before anything is allocated, and no more
+ * than `need` bytes are read of a longer one. */
+static int read_exact(const gltf_doc *d, const char *path, size_t need, unsigned char **out, fr_error *err)
 {
     *out = NULL;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return fr_fail(err, "cannot open '%s': %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) < 0 || !S_ISREG(st.st_mode)) {
+    int fd;
+    size_t size;
+    if (confine_open(d->scope, path, SIZE_MAX, &fd, &size, err) < 0)
+        return -1;
+    if (size < need) {
         close(fd);
-        return fr_fail(err, "'%s' is not a regular file", path);
-    }
-    if ((uint64_t)st.st_size < need) {
-        close(fd);
-        return fr_fail(err, "'%s' has %lld bytes, fewer than the %zu the glTF file says", path,
-                       (long long)st.st_size, need);
+        return fr_fail(err, "%s has %zu bytes, fewer than the %zu the glTF file says", path, size, need);
     }
     unsigned char *buf = malloc(need ? need : 1);
     if (!buf) {
         close(fd);
-        return fr_fail(err, "'%s': out of memory", path);
+        return fr_fail(err, "%s: out of memory", path);
     }
     size_t got = 0;
     while (got < need) {
@@ -309,7 +308,7 @@ static int read_exact(const char *path, size_t need, unsigned char **out, fr_err
         if (r <= 0) {
             free(buf);
             close(fd);
-            return fr_fail(err, "'%s': read error after %zu bytes", path, got);
+            return fr_fail(err, "%s: read error after %zu bytes", path, got);
         }
         got += (size_t)r;
     }
@@ -386,7 +385,7 @@ static int load_buffers(gltf_doc *d, const unsigned char *bin, size_t bin_len, i
             fr_error e;
             if ((rc = gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err)) < 0)
                 break;
-            if (read_exact(path, b->len, &b->owned, &e) < 0)
+            if (read_exact(d, path, b->len, &b->owned, &e) < 0)
                 rc = gdoc_fail(d, err, ptr, "%s", e.msg);
             b->data = b->owned;
         }
@@ -506,12 +505,14 @@ int gdoc_open_mem(gltf_doc *d, const void *bytes, size_t len, const char *name, 
     return 0;
 }
 
-int gdoc_open(gltf_doc *d, const char *path, fr_error *err)
+int gdoc_open(gltf_doc *d, const char *path, const confine *scope, int referenced, fr_error *err)
 {
     memset(d, 0, sizeof *d);
+    d->scope = scope;
     char *text;
     size_t len;
-    if (file_read(path, &text, &len, err) < 0)
+    if ((referenced ? confine_read(scope, path, FILE_READ_MAX, &text, &len, err)
+                    : file_read(path, &text, &len, err)) < 0)
         return -1;
     snprintf(d->path, sizeof d->path, "%s", path);
     file_dir(path, d->dir, sizeof d->dir);

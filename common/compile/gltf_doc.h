@@ -23,6 +23,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "compile/confine.h"
 #include "error.h"
 
 /** Most distinct warnings kept for one document (later ones are counted). */
@@ -45,6 +46,7 @@ typedef struct {
 typedef struct {
     char path[4096];           /**< the file as given (messages) */
     char dir[4096];            /**< its directory (relative URIs) */
+    const confine *scope;      /**< where its external files may be read (the caller's; NULL in memory) */
     unsigned char *file;       /**< the whole file */
     size_t file_len;
     cJSON *root;
@@ -57,13 +59,16 @@ typedef struct {
     uint32_t n_warn, n_warn_dropped;
 } gltf_doc;
 
-/** Reads and checks the document at `path`: the GLB header and chunks,
+/** Reads and checks the document at `path` (through `scope` when it is
+ * `referenced` by another scene file, else as it is named): the GLB
+ * header and chunks,
  * `asset.version` (2.x), `extensionsRequired` (each must be one this reader
  * supports), the top-level arrays' types, and every buffer (each loaded and
- * at least byteLength long).  Accessors and views are checked when used.
- * Returns 0, or -1 with err naming the file (and byte offset or JSON
- * pointer); *d is then freed. */
-int gdoc_open(gltf_doc *d, const char *path, fr_error *err);
+ * at least byteLength long; external buffers and images are opened
+ * through `scope`, which must outlive d: confine.h).  Accessors and views
+ * are checked when used.  Returns 0, or -1 with err naming the file (and
+ * byte offset or JSON pointer); *d is then freed. */
+int gdoc_open(gltf_doc *d, const char *path, const confine *scope, int referenced, fr_error *err);
 
 /** Reads the document from bytes already in memory (`name` for messages,
  * `dir` for external URIs: NULL refuses them).  The bytes are copied. */

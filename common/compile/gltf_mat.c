@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "bsdf.h"
+#include "file.h"
 #include "fmath.h"
 #include "compile/json_appear.h"
 
@@ -97,10 +98,14 @@ static int image(gmat_ctx *c, uint32_t i, int srgb, fr_texture *t, fr_error *err
         rc = c->hooks->image_mem(bytes, len, type, &img, &e);
         free(bytes);
     } else {
-        char path[4096];
+        char path[4096], *data;
+        size_t len;
         if (gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err) < 0)
             return -1;
-        rc = c->hooks->texture(path, &img, &e);
+        if (confine_read(d->scope, path, FILE_READ_MAX, &data, &len, &e) < 0)
+            return gdoc_fail(d, err, ptr, "uri: %s", e.msg);
+        rc = c->hooks->texture(path, data, len, &img, &e);
+        free(data);
     }
     if (rc < 0) {
         free(img.pixels);

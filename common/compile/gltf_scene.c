@@ -588,6 +588,7 @@ static void pass_warnings(gltf_doc *d, const scene_hooks *hooks)
     char line[700];
     for (uint32_t i = 0; i < d->n_warn; i++) {
         snprintf(line, sizeof line, "%s: %s", d->path, d->warn[i]);
+        fr_escape_controls(line, sizeof line);
         hooks->warn(hooks->user, line);
     }
     if (d->n_warn_dropped) {
@@ -638,7 +639,14 @@ int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *
                 fr_error *err)
 {
     gltf_doc d;
-    if (gdoc_open(&d, path, err) < 0)
+    confine own;
+    const confine *scope = o->scope;
+    if (!scope) {
+        if (confine_init(&own, path, hooks ? hooks->allow : NULL, hooks ? hooks->n_allow : 0, err) < 0)
+            return -1;
+        scope = &own;
+    }
+    if (gdoc_open(&d, path, scope, o->scope != NULL, err) < 0)
         return -1;
     int rc = import_doc(&d, hooks, o, b, r, err);
     gdoc_free(&d);
@@ -661,6 +669,7 @@ static void warn(const scene_hooks *hooks, const char *path, const char *msg)
     if (hooks && hooks->warn) {
         char line[700];
         snprintf(line, sizeof line, "%s: %s", path, msg);
+        fr_escape_controls(line, sizeof line);
         hooks->warn(hooks->user, line);
     }
 }

@@ -32,6 +32,9 @@ typedef struct {
     double place[3][4];        /**< row-major affine transform applied to the whole scene */
     uint32_t material;         /**< FR_NONE: the file's materials; else this one for every triangle */
     uint32_t max_triangles;    /**< 0: GLTF_MAX_TRIANGLES */
+    const confine *scope;      /**< the file is named by a scene with this scope (confine.h): it, its
+                                    buffers and images are read through it; NULL: the file is the scene,
+                                    read as named, with its own folder and the hooks' allow list */
 } gltf_options;
 
 /** Options for a file rendered alone: its first camera, its lights, no

@@ -134,11 +134,15 @@ static int check_texture(const json_appear *a, const cJSON *t, const char *where
     if (image_format(path) < 0)
         return fr_fail(err, "%s.file: '%s': unsupported image format (expected png, jpg, exr, tif, hdr, bmp, tga, "
                        "ppm, pgm or pfm)", where, f->valuestring);
-    /* OpenImageIO opens the file by name: make sure first that it is a
-     * regular file (a FIFO would block it, a device feed it forever). */
+    /* The file must be a regular file in the scene's folders (a FIFO
+     * would block a reader, a device feed it forever, a name outside the
+     * folder read another file): checked now, read when first used. */
     fr_error e;
-    if (file_check_regular(path, IMAGE_MAX_BYTES, NULL, &e) < 0)
+    int fd;
+    size_t size;
+    if (confine_open(a->scope, path, IMAGE_MAX_BYTES, &fd, &size, &e) < 0)
         return fr_fail(err, "%s.file: cannot read %s", where, e.msg);
+    close(fd);
     return 0;
 }
 
@@ -206,7 +210,13 @@ static int texture_ref(json_appear *a, const char *name, int as_colour, const ch
         scene_image img;
         memset(&img, 0, sizeof img);
         fr_error e;
-        if (a->hooks->texture(path, &img, &e) < 0) {
+        char *data;
+        size_t len;
+        if (confine_read(a->scope, path, IMAGE_MAX_BYTES, &data, &len, &e) < 0)
+            return fr_fail(err, "%s.file: cannot read %s", tw, e.msg);
+        int bad = a->hooks->texture(path, data, len, &img, &e);
+        free(data);
+        if (bad < 0) {
             free(img.pixels);
             return fr_fail(err, "%s.file: %s", tw, e.msg);
         }
@@ -270,11 +280,12 @@ static int medium_ref(const json_appear *a, const cJSON *obj, const char *key, c
 
 /* ---- the interface ------------------------------------------------------- */
 
-int json_appear_begin(json_appear *a, const cJSON *root, const char *dir, const scene_hooks *hooks, fr_builder *b,
-                     fr_error *err)
+int json_appear_begin(json_appear *a, const cJSON *root, const char *dir, const confine *scope, const scene_hooks *hooks,
+                     fr_builder *b, fr_error *err)
 {
     memset(a, 0, sizeof *a);
     a->dir = dir;
+    a->scope = scope;
     a->hooks = hooks;
     a->b = b;
     a->textures = cJSON_GetObjectItemCaseSensitive(root, "textures");

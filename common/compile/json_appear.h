@@ -25,6 +25,7 @@ typedef struct {
 
 typedef struct {
     const char *dir;           /**< the scene file's directory */
+    const confine *scope;      /**< where image files may be read (confine.h) */
     const scene_hooks *hooks;    /**< may be NULL: image textures then refused */
     fr_builder *b;
     const cJSON *textures;     /**< the "textures" object, or NULL */
@@ -34,11 +35,12 @@ typedef struct {
 } json_appear;
 
 /** Check the top-level "textures" and "media" objects of `root` (every
- * field; image files must exist and have a supported extension) and add
+ * field; image files must have a supported extension and be regular
+ * files in `scope`, checked before anything is read) and add
  * the media to b.  Textures are decoded when a material first uses them.
  * Release with json_appear_free. */
-int json_appear_begin(json_appear *a, const cJSON *root, const char *dir, const scene_hooks *hooks, fr_builder *b,
-                     fr_error *err);
+int json_appear_begin(json_appear *a, const cJSON *root, const char *dir, const confine *scope, const scene_hooks *hooks,
+                     fr_builder *b, fr_error *err);
 void json_appear_free(json_appear *a);
 
 /** Read colour member `key` of obj (at path `where`): [r, g, b], a texture

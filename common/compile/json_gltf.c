@@ -81,12 +81,13 @@ static int placement(const cJSON *o, const char *where, double m[3][4], fr_error
 }
 
 /* The shape's options, everything but geometry. */
-static int options(const cJSON *o, const char *where, const char *dir, gltf_options *g, char *path, size_t cap,
-                   fr_error *err)
+static int options(const cJSON *o, const char *where, const char *dir, const confine *scope, gltf_options *g,
+                   char *path, size_t cap, fr_error *err)
 {
     static const char *const fields[] = {"type", "file", "material", "scale", "rotate", "translate", "matrix",
                                          "lights", "camera", NULL};
     gltf_options_default(g);
+    g->scope = scope;
     if (jv_only_fields(o, where, fields, err) < 0 || placement(o, where, g->place, err) < 0)
         return -1;
     const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "file");
@@ -107,12 +108,12 @@ static int options(const cJSON *o, const char *where, const char *dir, gltf_opti
     return 0;
 }
 
-int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char *dir, const scene_hooks *hooks,
-                   uint32_t material, int take_camera, fr_error *err)
+int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char *dir, const confine *scope,
+                   const scene_hooks *hooks, uint32_t material, int take_camera, fr_error *err)
 {
     gltf_options g;
     char path[4096];
-    if (options(o, where, dir, &g, path, sizeof path, err) < 0)
+    if (options(o, where, dir, scope, &g, path, sizeof path, err) < 0)
         return -1;
     const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "camera");
     if (c && cJSON_IsTrue(c) == 0 && !cJSON_IsString(c))
@@ -132,7 +133,7 @@ int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char
     return 0;
 }
 
-int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, fr_error *err)
+int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const confine *scope, fr_error *err)
 {
     int i = 0;
     for (const cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s; s = s->next, i++) {
@@ -143,7 +144,7 @@ int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, fr_err
         char where[64], path[4096];
         snprintf(where, sizeof where, "shapes[%d]", i);
         gltf_options g;
-        if (options(s, where, dir, &g, path, sizeof path, err) < 0)
+        if (options(s, where, dir, scope, &g, path, sizeof path, err) < 0)
             return -1;
         /* The camera alone: a builder of its own takes the rest. */
         fr_builder tmp;

@@ -19,15 +19,15 @@
 #include "compile/scene_hooks.h"
 
 /** Adds gltf shape `o` (at JSON path `where`; file names relative to
- * `dir`) to b, with `material` (FR_NONE: the file's).  `take_camera`: set
+ * `dir`, the file and what it names read through `scope`: confine.h) to b, with `material` (FR_NONE: the file's).  `take_camera`: set
  * b->camera from the file as the shape's `camera` field asks.  Errors start
  * with `where` or name the glTF file and JSON pointer. */
-int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char *dir, const scene_hooks *hooks,
-                   uint32_t material, int take_camera, fr_error *err);
+int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char *dir, const confine *scope,
+                   const scene_hooks *hooks, uint32_t material, int take_camera, fr_error *err);
 
 /** The scene's camera from the first gltf shape of array `shapes` with a
- * `camera` field, for a JSON scene without "camera".  Returns 0, or -1 when
+ * `camera` field (read through `scope`), for a JSON scene without "camera".  Returns 0, or -1 when
  * there is none (saying so) or the file's camera cannot be taken. */
-int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, fr_error *err);
+int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const confine *scope, fr_error *err);
 
 #endif

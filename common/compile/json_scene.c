@@ -22,6 +22,7 @@
 typedef struct {
     const char *file;
     const char *dir;
+    const confine *scope;      /* the folders its files may be read from */
     const scene_hooks *hooks;
     fr_builder *b;
     const cJSON *materials;    /* the "materials" object, for name lookup */
@@ -96,7 +97,7 @@ static int camera(ctx *c, const cJSON *root)
     if (cam)
         return parse_camera(c, cam);
     c->gltf_camera = 1;
-    return json_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->err);
+    return json_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->scope, c->err);
 }
 
 #define TYPES "lambert, phong, mirror, glass, mix, conductor, principled, emitter or interface"
@@ -320,14 +321,14 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
         if (!c->hooks || !c->hooks->mesh)
             return fr_fail(c->err, "%s: meshes need the scene compiler: run `franja compile` and render the .fbin", where);
         fr_error e;
-        if (c->hooks->mesh(c->b, o, where, c->dir, mat, &e) < 0)
+        if (c->hooks->mesh(c->b, o, where, c->dir, c->scope, mat, &e) < 0)
             return fr_fail(c->err, "%s", e.msg);
     } else if (!strcmp(type, "gltf")) {
         /* Without the compiler's image decoder its textures would be lost. */
         if (!c->hooks || !c->hooks->image_mem || !c->hooks->texture)
             return fr_fail(c->err, "%s: glTF files need the scene compiler: run `franja compile` and render the .fbin",
                            where);
-        if (json_gltf_shape(c->b, o, where, c->dir, c->hooks, mat, c->gltf_camera, c->err) < 0)
+        if (json_gltf_shape(c->b, o, where, c->dir, c->scope, c->hooks, mat, c->gltf_camera, c->err) < 0)
             return -1;
         c->gltf_camera = 0;            /* taken by the first that asks */
     } else {
@@ -352,9 +353,15 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
         return fr_fail(err, "%s: the JSON reader failed (out of memory?)", file);
     char dir[4096];
     file_dir(file, dir, sizeof dir);
+    /* Every file the scene names is read from its folder (confine.h). */
+    confine scope;
+    if (confine_init(&scope, file, hooks ? hooks->allow : NULL, hooks ? hooks->n_allow : 0, err) < 0) {
+        cJSON_Delete(root);
+        return -1;
+    }
     json_appear look;
     memset(&look, 0, sizeof look);
-    ctx c = {file, dir, hooks, b, NULL, 0, &e, &look};
+    ctx c = {file, dir, &scope, hooks, b, NULL, 0, &e, &look};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
                                       "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
@@ -363,7 +370,7 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
     } else if (jv_only_fields(root, "(top level)", top, &e) == 0 &&
                parse_image(&c, cJSON_GetObjectItemCaseSensitive(root, "image")) == 0 &&
                camera(&c, root) == 0 &&
-               json_appear_begin(&look, root, dir, hooks, b, &e) == 0 &&
+               json_appear_begin(&look, root, dir, &scope, hooks, b, &e) == 0 &&
                parse_materials(&c, cJSON_GetObjectItemCaseSensitive(root, "materials")) == 0 &&
                json_lights(&look, cJSON_GetObjectItemCaseSensitive(root, "lights"), &e) == 0 &&
                json_environment(&look, cJSON_GetObjectItemCaseSensitive(root, "environment"), &e) == 0) {

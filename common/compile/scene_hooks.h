@@ -10,6 +10,7 @@
 #include <cjson/cJSON.h>
 
 #include "compile/builder.h"
+#include "compile/confine.h"
 
 /** An image as a texture hook decodes it: width*height*channels floats,
  * top row first, the values as stored (8- and 16-bit images scaled to
@@ -24,13 +25,16 @@ typedef struct {
     /** Add the mesh described by JSON object `node` (at JSON path `where`)
      * to the builder with material `material` (FR_NONE: the mesh's own
      * materials); `dir` is the scene file's directory, for relative file
-     * names.  Returns 0, or -1 with *err set. */
-    int (*mesh)(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
-                fr_error *err);
-    /** Decode image file `path` (already joined to the scene's directory)
-     * into *img; on failure return -1 and say why (unreadable,
-     * unsupported, corrupt). */
-    int (*texture)(const char *path, scene_image *img, fr_error *err);
+     * names, and every file the mesh reads is opened through `scope`
+     * (confine.h).  Returns 0, or -1 with *err set. */
+    int (*mesh)(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
+                uint32_t material, fr_error *err);
+    /** Decode the image file `path` (already joined to the scene's
+     * directory; its extension names the format), whose `len` bytes the
+     * reader has read through its confine.h scope into `data`, into *img;
+     * on failure return -1 and say why (unsupported, corrupt) without
+     * quoting the bytes. */
+    int (*texture)(const char *path, const void *data, size_t len, scene_image *img, fr_error *err);
     /** Decode an image held in memory (`len` bytes; `mime` such as
      * "image/png", or "" when unknown), as `texture` does a file.  May be
      * NULL: images embedded in glTF files are then not decoded (a warning
@@ -40,6 +44,10 @@ typedef struct {
      * and was ignored, named once); `user` is passed back.  May be NULL. */
     void (*warn)(void *user, const char *msg);
     void *user;
+    /** Folders besides the scene's own that its files may lie in
+     * (`--allow-path`; n_allow of them, may be NULL when 0). */
+    const char *const *allow;
+    unsigned n_allow;
 } scene_hooks;
 
 #endif

@@ -11,9 +11,9 @@
 #include "compile/json_scene.h"
 
 /* The texture hook: images are decoded by OpenImageIO (imageio.h). */
-static int texture_load(const char *path, scene_image *img, fr_error *err)
+static int texture_load(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
-    return iio_read(path, &img->pixels, &img->width, &img->height, &img->channels, err);
+    return iio_read(path, data, len, &img->pixels, &img->width, &img->height, &img->channels, err);
 }
 
 /* Images embedded in glTF files, likewise. */
@@ -30,7 +30,8 @@ int compile_is_gltf(const char *path)
 
 int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err)
 {
-    scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL};
+    scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
+                       o ? o->allow : NULL, o ? o->n_allow : 0};
     if (compile_is_gltf(path))
         return gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
     if (o && o->camera)

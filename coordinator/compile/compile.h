@@ -2,6 +2,9 @@
  * The scene compiler: a JSON scene with its meshes, or a glTF scene, becomes
  * a binary scene (`franja compile`, and `franja render` of such a scene).
  *
+ * Every file a scene names is read from the scene file's folder, or one
+ * the options allow (common/compile/confine.h).
+ *
  * The compiler is the JSON reader (common/compile/json_scene.h) with the mesh hook
  * of mesh.h: meshes are read (OBJ/MTL by our own reader; PLY, STL, glTF and
  * other formats through Assimp), placed, given a level of detail and frozen
@@ -13,12 +16,16 @@
 #include "error.h"
 #include "scene.h"
 
-/** How to compile: the glTF camera to take (NULL: the first), and where
- * warnings go (NULL: nowhere; `user` is passed back). */
+/** How to compile: the glTF camera to take (NULL: the first), where
+ * warnings go (NULL: nowhere; `user` is passed back), and the folders
+ * besides the scene's own that its files may lie in (`--allow-path`;
+ * confine.h). */
 typedef struct {
     const char *camera;
     void (*warn)(void *user, const char *msg);
     void *user;
+    const char *const *allow;
+    unsigned n_allow;
 } compile_opts;
 
 /** 1 when `path` names a glTF scene (.gltf or .glb, any case). */

@@ -15,14 +15,15 @@ enum { LOD_MAX = 16 };
 
 /* ---- reading files ---- */
 
-/* Reads a mesh file by its extension: OBJ by obj_read, others by
- * mesh_import into the same structure (free with mesh_data_free). */
-static int mesh_read(const char *path, mesh_data *m, fr_error *err)
+/* Reads a mesh file by its extension, through `scope` (NULL: its own
+ * folder): OBJ by obj_read, others by mesh_import into the same structure
+ * (free with mesh_data_free). */
+static int mesh_read(const char *path, const confine *scope, mesh_data *m, fr_error *err)
 {
     const char *dot = strrchr(path, '.');
     if (dot && !strcasecmp(dot, ".obj"))
-        return obj_read(path, m, err);
-    return mesh_import(path, m, err);
+        return obj_read(path, scope, m, err);
+    return mesh_import(path, scope, m, err);
 }
 
 /* ---- placement ---- */
@@ -194,7 +195,8 @@ static int level_paths(const cJSON *o, const char *where, const char *dir, char 
     return 0;
 }
 
-int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, uint32_t material, fr_error *err)
+int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, const confine *scope, uint32_t material,
+             fr_error *err)
 {
     char paths[LOD_MAX][4096];
     int levels;
@@ -219,12 +221,12 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
      * triangles for the mesh's size on screen; the finest if none is. */
     mesh_data m;
     int level = levels - 1;
-    if (mesh_read(paths[level], &m, err) < 0)
+    if (mesh_read(paths[level], scope, &m, err) < 0)
         return -1;
     float need = density * projected_pixels(b, &m, &x);
     while (level > 0 && (float)m.n_tri < need) {
         mesh_data_free(&m);
-        if (mesh_read(paths[--level], &m, err) < 0)
+        if (mesh_read(paths[--level], scope, &m, err) < 0)
             return -1;
     }
 
@@ -244,8 +246,8 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
             if (mat_of[k] != FR_NONE)
                 continue;
             if (!m.mats[k].defined) {
-                rc = fr_fail(err, "%s:%d: usemtl '%s': no such material in the mtllib files (or give the shape a "
-                             "material)", paths[level], m.mats[k].line, m.mats[k].name);
+                rc = fr_fail(err, "%s:%d: usemtl: no such material in the mtllib files (or give the shape a "
+                             "material)", paths[level], m.mats[k].line);
                 break;
             }
             fr_material fm;

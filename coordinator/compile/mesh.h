@@ -15,13 +15,15 @@
 #include <cjson/cJSON.h>
 
 #include "compile/builder.h"
+#include "compile/confine.h"
 #include "compile/mesh_data.h"
 
 /** The scene_hooks mesh hook: reads shape `node` (JSON path `where`), with
- * file names relative to `dir`, and appends its triangles (and their
- * materials, unless `material` is not FR_NONE) to b.  Errors start with
+ * file names relative to `dir` read through `scope` (confine.h), and
+ * appends its triangles (and their materials, unless `material` is not
+ * FR_NONE) to b.  Errors start with
  * `where` or the mesh file's name and line. */
-int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
-             fr_error *err);
+int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
+             uint32_t material, fr_error *err);
 
 #endif

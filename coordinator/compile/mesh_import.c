@@ -20,6 +20,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "compile/confine.h"
 #include "file.h"
 #include "compile/plyhead.h"
 #include "clock.h"
@@ -158,6 +159,7 @@ static int convert(const struct aiScene *sc, const char *path, mesh_data *m, fr_
 typedef struct { FILE *f; size_t size; } io_handle;
 
 static char open_refused[sizeof ((fr_error *)0)->msg];   /* why the last refused open was refused */
+static const confine *io_scope;                          /* where every file Assimp opens must lie */
 
 static io_handle *handle(struct aiFile *f) { return (io_handle *)(void *)f->UserData; }
 
@@ -198,7 +200,7 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *name, const char 
     int fd;
     size_t size;
     fr_error e;
-    if (file_open_regular(name, MESH_IMPORT_MAX_BYTES, &fd, &size, &e) < 0) {
+    if (confine_open(io_scope, name, MESH_IMPORT_MAX_BYTES, &fd, &size, &e) < 0) {
         snprintf(open_refused, sizeof open_refused, "%s", e.msg);
         return NULL;
     }
@@ -275,8 +277,9 @@ static void send_mesh(int fd, const mesh_data *m)
 }
 
 /* The child's whole life: limits, the import, the answer. */
-static void child(const char *path, size_t size, int out)
+static void child(const char *path, const confine *scope, size_t size, int out)
 {
+    io_scope = scope;
     /* Assimp prints its assertion failures and logs: the parent's message
      * says what happened. */
     int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
@@ -317,7 +320,9 @@ static void child(const char *path, size_t size, int out)
             fr_fail(&e, "%s: the mesh importer (Assimp) ran out of its %zu MiB of memory (does the file declare "
                     "more than it holds?)", path, (BUDGET_BASE + BUDGET_PER_BYTE * size) >> 20);
         else
-            fr_fail(&e, "%s: %s", path, why);
+            /* Assimp's messages quote tokens of the file: only the words
+             * before the first quote are its own. */
+            fr_fail(&e, "%s: the mesh importer (Assimp) cannot read it: %.*s", path, (int)strcspn(why, "'\"`"), why);
         send_error(out, &e);
     } else if (convert(sc, path, &m, &e) < 0) {
         send_error(out, &e);
@@ -444,10 +449,10 @@ static int receive(int fd, const char *path, size_t budget, double deadline, mes
 
 /* The file is a regular file of at most MESH_IMPORT_MAX_BYTES (*size), and
  * a PLY header in it declares no more than the file can hold. */
-static int check_header(const char *path, size_t *size, fr_error *err)
+static int check_header(const char *path, const confine *scope, size_t *size, fr_error *err)
 {
     int fd;
-    if (file_open_regular(path, MESH_IMPORT_MAX_BYTES, &fd, size, err) < 0)
+    if (confine_open(scope, path, MESH_IMPORT_MAX_BYTES, &fd, size, err) < 0)
         return -1;
     char *head = malloc(PLY_HEADER_MAX);
     if (!head) {
@@ -475,11 +480,17 @@ static int check_header(const char *path, size_t *size, fr_error *err)
     return rc;
 }
 
-int mesh_import(const char *path, mesh_data *m, fr_error *err)
+int mesh_import(const char *path, const confine *scope, mesh_data *m, fr_error *err)
 {
     memset(m, 0, sizeof *m);
+    confine own;
+    if (!scope) {
+        if (confine_init(&own, path, NULL, 0, err) < 0)
+            return -1;
+        scope = &own;
+    }
     size_t size;
-    if (check_header(path, &size, err) < 0)
+    if (check_header(path, scope, &size, err) < 0)
         return -1;
     int p[2];
     if (pipe2(p, O_CLOEXEC) < 0)
@@ -494,7 +505,7 @@ int mesh_import(const char *path, mesh_data *m, fr_error *err)
     }
     if (pid == 0) {
         close(p[0]);
-        child(path, size, p[1]);
+        child(path, scope, size, p[1]);
         _exit(0);
     }
     close(p[1]);

@@ -190,7 +190,7 @@ static int parse_mtl(const char *text, const char *name, mesh_data *m, uint32_t 
                     return -1;
                 cur = &m->mats[i];
                 if (cur->defined)
-                    return fr_fail(err, "%s:%d: material '%s' is defined twice", name, c.line, arg);
+                    return fr_fail(err, "%s:%d: newmtl: the material is defined twice", name, c.line);
                 int line = cur->line;
                 mat_defaults(cur, arg);
                 cur->line = line;
@@ -198,7 +198,7 @@ static int parse_mtl(const char *text, const char *name, mesh_data *m, uint32_t 
             } else if (mtl_ignored(kw)) {
                 /* skipped */
             } else if (!cur) {
-                return fr_fail(err, "%s:%d: '%s' before any newmtl", name, c.line, kw);
+                return fr_fail(err, "%s:%d: a material statement before any newmtl", name, c.line);
             } else if (!strcmp(kw, "Kd")) {
                 if (read_color(&c, &cur->kd, "Kd") < 0) return -1;
             } else if (!strcmp(kw, "Ks")) {
@@ -224,7 +224,8 @@ static int parse_mtl(const char *text, const char *name, mesh_data *m, uint32_t 
                     return fr_fail(err, "%s:%d: illum: expected an integer 0..10", name, c.line);
                 cur->illum = (int)v;
             } else {
-                return fr_fail(err, "%s:%d: unknown MTL statement '%s'", name, c.line, kw);
+                return fr_fail(err, "%s:%d: unknown MTL statement (expected newmtl, Kd, Ks, Ke, Tf, Ns, Ni, d, Tr, "
+                               "illum or map_*)", name, c.line);
             }
         }
         if (!next)
@@ -240,6 +241,7 @@ typedef struct {
     mesh_data *m;
     cursor c;
     const char *dir;
+    const confine *scope;       /* where mtllib files may be read */
     /* raw attribute lists of the file */
     vec3 *v; uint32_t n_v, cap_v;
     vec2 *vt; uint32_t n_vt, cap_vt;
@@ -521,7 +523,7 @@ static int load_mtllib(parser *P, const char *file)
     char *text;
     size_t len;
     fr_error e;
-    if (file_read(path, &text, &len, &e) < 0)
+    if (confine_read(P->scope, path, FILE_READ_MAX, &text, &len, &e) < 0)
         return fr_fail(P->c.err, "%s:%d: mtllib: %s", P->c.name, P->c.line, e.msg);
     int rc = memchr(text, 0, len) ? fr_fail(P->c.err, "%s: NUL byte in a text file", path)
                                    : parse_mtl(text, path, P->m, &P->cap_mats, P->c.err);
@@ -594,14 +596,24 @@ static int parse_line(parser *P, const char *kw)
         if (n == 0)
             return fr_fail(c->err, "%s:%d: mtllib: expected a file name", c->name, c->line);
     } else if (!obj_ignored(kw)) {
-        return fr_fail(c->err, "%s:%d: unknown OBJ statement '%s'", c->name, c->line, kw);
+        return fr_fail(c->err, "%s:%d: unknown OBJ statement (expected v, vt, vn, f, g, o, s, usemtl or "
+                       "mtllib)", c->name, c->line);
     }
     return 0;
 }
 
-int obj_parse(const char *text, size_t len, const char *name, const char *dir, mesh_data *m, fr_error *err)
+int obj_parse(const char *text, size_t len, const char *name, const char *dir, const confine *scope, mesh_data *m,
+              fr_error *err)
 {
     memset(m, 0, sizeof *m);
+    confine own;
+    if (dir && !scope) {
+        char here[4200];
+        snprintf(here, sizeof here, "%s/.", dir);
+        if (confine_init(&own, here, NULL, 0, err) < 0)
+            return -1;
+        scope = &own;
+    }
     /* A private NUL-terminated copy: the number parser needs the NUL, and
      * fuzzers hand over bare bytes. */
     char *buf = malloc(len + 1);
@@ -614,6 +626,7 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, m
     P.m = m;
     P.c = (cursor){buf, name, 0, err};
     P.dir = dir;
+    P.scope = scope;
     int rc = 0;
     const char *nul = memchr(text, 0, len);
     if (nul) {
@@ -681,15 +694,15 @@ int obj_parse_mtl(const char *text, size_t len, const char *name, mesh_data *m, 
     return rc;
 }
 
-int obj_read(const char *path, mesh_data *m, fr_error *err)
+int obj_read(const char *path, const confine *scope, mesh_data *m, fr_error *err)
 {
     char *text;
     size_t len;
-    if (file_read(path, &text, &len, err) < 0)
+    if ((scope ? confine_read(scope, path, FILE_READ_MAX, &text, &len, err) : file_read(path, &text, &len, err)) < 0)
         return -1;
     char dir[4096];
     file_dir(path, dir, sizeof dir);
-    int rc = obj_parse(text, len, path, dir, m, err);
+    int rc = obj_parse(text, len, path, dir, scope, m, err);
     free(text);
     return rc;
 }

@@ -16,18 +16,23 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "compile/confine.h"
 #include "compile/mesh_data.h"
 #include "error.h"
 
 /** Parses OBJ text (`len` bytes, need not be NUL-terminated) named `name`
- * in messages.  MTL files named by mtllib are read from directory `dir`;
- * with dir NULL they are skipped (every usemtl name is then undefined).
- * On failure the mesh is freed and err says file:line and what was
- * expected. */
-int obj_parse(const char *text, size_t len, const char *name, const char *dir, mesh_data *m, fr_error *err);
+ * in messages.  MTL files named by mtllib are read from directory `dir`
+ * through `scope` (confine.h; NULL: `dir` and below); with dir NULL they
+ * are skipped (every usemtl name is then undefined).  On failure the mesh
+ * is freed and err says file:line and what was expected, never quoting
+ * the text of the OBJ or MTL file. */
+int obj_parse(const char *text, size_t len, const char *name, const char *dir, const confine *scope, mesh_data *m,
+              fr_error *err);
 
-/** Reads and parses the OBJ file `path` (see obj_parse). */
-int obj_read(const char *path, mesh_data *m, fr_error *err);
+/** Reads and parses the OBJ file `path` (see obj_parse): through `scope`
+ * when a scene names it, or as named with its own folder as the scope
+ * (scope NULL). */
+int obj_read(const char *path, const confine *scope, mesh_data *m, fr_error *err);
 
 /** Parses MTL text into m's materials (defining those already used and
  * appending new ones). */

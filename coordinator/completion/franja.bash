@@ -56,7 +56,7 @@ _franja()
         COMPREPLY=($(compgen -W "none rle zips zip piz pxr24 b44 b44a dwaa dwab" -- "$cur")); return 0 ;;
     --hosts | --known-hosts | --ssh-config | --preview | -o)
         _franja_files "$cur" ""; return 0 ;;
-    --job | --dist | --workdir | --shared-workdir)
+    --job | --dist | --workdir | --shared-workdir | --allow-path)
         COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     --worker) _franja_files "$cur" ""; return 0 ;;
     -j | --spp | --size | --scale | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \

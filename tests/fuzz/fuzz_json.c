@@ -77,8 +77,10 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 }
 
 /* Pixels for the image files of the directory, by name. */
-static int texture(const char *path, scene_image *img, fr_error *err)
+static int texture(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
+    (void)data;
+    (void)len;
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     uint32_t w, h, c;
@@ -109,7 +111,8 @@ static int is_obj(const cJSON *s)
 }
 
 /* The compiler's mesh hook, for OBJ files only (see the top). */
-static int mesh(fr_builder *b, const cJSON *node, const char *where, const char *d, uint32_t material, fr_error *err)
+static int mesh(fr_builder *b, const cJSON *node, const char *where, const char *d, const confine *scope,
+                uint32_t material, fr_error *err)
 {
     const cJSON *file = cJSON_GetObjectItemCaseSensitive(node, "file");
     const cJSON *lod = cJSON_GetObjectItemCaseSensitive(node, "lod");
@@ -118,7 +121,7 @@ static int mesh(fr_builder *b, const cJSON *node, const char *where, const char 
     for (const cJSON *l = cJSON_IsArray(lod) ? lod->child : NULL; l; l = l->next)
         if (!is_obj(l))
             return fr_fail(err, "%s.lod: only OBJ meshes here", where);
-    return mesh_add(b, node, where, d, material, err);
+    return mesh_add(b, node, where, d, scope, material, err);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

@@ -23,10 +23,11 @@ static inline int pfm_write(const char *path, uint32_t w, uint32_t h, const floa
     return fclose(f) == 0 ? 0 : -1;
 }
 
-/* A texture hook for the files pfm_write makes. */
-static inline int pfm_hook(const char *path, scene_image *img, fr_error *err)
+/* A texture hook for the files pfm_write makes (the reader hands over
+ * their bytes). */
+static inline int pfm_hook(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f = len ? fmemopen((void *)data, len, "rb") : NULL;
     unsigned w, h;
     float scale;
     if (!f)
