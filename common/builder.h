@@ -13,6 +13,7 @@
 #ifndef FRANJA_BUILDER_H
 #define FRANJA_BUILDER_H
 
+#include "budget.h"
 #include "error.h"
 #include "scene.h"
 
@@ -37,9 +38,11 @@ typedef struct {
     fr_tonemap tonemap;
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
     fr_array distrib;          /**< float: filled by frz_scene */
+    fr_budget *budget;         /**< the compile's limits (budget.h), not owned; NULL: none */
 } fr_builder;
 
-/** An empty builder: every array empty, settings and camera zero. */
+/** An empty builder: every array empty, settings and camera zero, no
+ * budget. */
 void bld_init(fr_builder *b);
 /** Free every array and zero *b. */
 void bld_free(fr_builder *b);

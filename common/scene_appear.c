@@ -206,6 +206,8 @@ static int texture_ref(scn_appear *a, const char *name, int as_colour, const cha
         scn_image img;
         memset(&img, 0, sizeof img);
         fr_error e;
+        if (budget_take_file(a->b->budget, path, tw, err) < 0)
+            return -1;
         if (a->hooks->texture(path, &img, &e) < 0) {
             free(img.pixels);
             return fr_fail(err, "%s.file: %s", tw, e.msg);

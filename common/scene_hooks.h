@@ -9,6 +9,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "budget.h"
 #include "builder.h"
 
 /** An image as a texture hook decodes it: width*height*channels floats,
@@ -19,7 +20,7 @@ typedef struct {
     uint32_t width, height, channels;
 } scn_image;
 
-/** The asset loaders; either may be NULL. */
+/** The asset loaders (any may be NULL) and the compile's budget. */
 typedef struct {
     /** Add the mesh described by JSON object `node` (at JSON path `where`)
      * to the builder with material `material` (FR_NONE: the mesh's own
@@ -40,6 +41,10 @@ typedef struct {
      * and was ignored, named once); `user` is passed back.  May be NULL. */
     void (*warn)(void *user, const char *msg);
     void *user;
+    /** The compile's limits (budget.h): the scene readers give it to their
+     * builder, and count what they read and build against it.  May be
+     * NULL: no limits. */
+    fr_budget *budget;
 } scn_hooks;
 
 #endif

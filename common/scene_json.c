@@ -412,6 +412,11 @@ int scn_load_json(const char *path, const scn_hooks *hooks, fr_scene *out, fr_er
     }
     fr_builder b;
     bld_init(&b);
+    b.budget = hooks ? hooks->budget : NULL;
+    if (budget_take(b.budget, BUDGET_READ, len, path, err) < 0) {
+        free(text);
+        return -1;
+    }
     int rc = scn_parse_json(text, path, hooks, &b, err);
     free(text);
     if (rc == 0) {

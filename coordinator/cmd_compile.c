@@ -12,6 +12,7 @@
 
 static const char usage[] =
     "usage: franja compile SCENE(.json|.gltf|.glb) [-o SCENE.fbin] [--camera NAME]\n"
+    "                      [--limit NAME=VALUE]...\n"
     "\n"
     "Reads a JSON scene and the meshes it names (OBJ with MTL; PLY, STL, glTF\n"
     "and other formats through Assimp), or a whole glTF 2.0 scene, builds the\n"
@@ -24,7 +25,8 @@ static const char usage[] =
     "  -o FILE         the binary scene to write (without -o: SCENE.fbin in the\n"
     "                  current directory)\n"
     "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
-    "                  name (default: the first in the scene)\n";
+    "                  name (default: the first in the scene)\n"
+    COMPILE_LIMIT_HELP;
 
 static volatile sig_atomic_t stop_flag;
 
@@ -41,13 +43,17 @@ static void print_warning(void *user, const char *msg)
 
 int cmd_compile(int argc, char **argv)
 {
-    enum { CAMERA = 0x100 };
+    enum { CAMERA = 0x100, LIMIT };
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"camera", required_argument, NULL, CAMERA},
+        {"limit", required_argument, NULL, LIMIT},
         {NULL, 0, NULL, 0},
     };
     const char *in = NULL, *out = NULL, *camera = NULL;
+    fr_budget limits;
+    fr_error err;
+    budget_init(&limits);
     int c;
     optind = 0;
     while ((c = opt_next("compile", argc, argv, "ho:", longopts)) != -1) {
@@ -60,6 +66,12 @@ int cmd_compile(int argc, char **argv)
             break;
         case CAMERA:
             camera = optarg;
+            break;
+        case LIMIT:
+            if (budget_set(&limits, optarg, &err) < 0) {
+                fprintf(stderr, "franja compile: --limit %s\n", err.msg);
+                return 2;
+            }
             break;
         default:
             return 2;
@@ -90,9 +102,8 @@ int cmd_compile(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    fr_error err;
     compile_child_stats st;
-    compile_opts co = {camera, print_warning, (void *)"franja compile"};
+    compile_opts co = {camera, print_warning, (void *)"franja compile", &limits};
     if (compile_child(in, &co, out, &stop_flag, &st, &err) < 0) {
         fprintf(stderr, "franja compile: %s\n", err.msg);
         return stop_flag ? 130 : 1;

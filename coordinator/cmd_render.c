@@ -13,6 +13,7 @@
 
 #include "cli.h"
 #include "cmd_frames.h"
+#include "compile.h"
 #include "crop.h"
 #include "frame.h"
 #include "monitor.h"
@@ -51,6 +52,7 @@ static const char usage[] =
     "  --overwrite          with --frames: render frames whose output exists\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
+    COMPILE_LIMIT_HELP
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
     "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
     "                       the relative error of its mean is below E, in (0, 1]\n"
@@ -101,7 +103,7 @@ enum {
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
     OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
-    OPT_REPRODUCIBLE
+    OPT_REPRODUCIBLE, OPT_LIMIT
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -138,6 +140,7 @@ static int parse(int argc, char **argv, render_args *a)
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -146,6 +149,7 @@ static int parse(int argc, char **argv, render_args *a)
     memset(a, 0, sizeof *a);
     a->retries = 5;
     a->preview_every = 5;
+    budget_init(&a->limits);
     cli_transport_defaults(&a->tr);
     int c, bad = 0;
     optind = 0;
@@ -263,6 +267,12 @@ static int parse(int argc, char **argv, render_args *a)
         case OPT_TIME_LIMIT:
             bad = opt_duration(cmd, "--time-limit", v, &a->time_limit);
             break;
+        case OPT_LIMIT: {
+            fr_error e;
+            if ((bad = budget_set(&a->limits, v, &e)) < 0)
+                fprintf(stderr, "franja %s: --limit %s\n", cmd, e.msg);
+            break;
+        }
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;

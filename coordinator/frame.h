@@ -17,6 +17,7 @@
 #include <signal.h>
 #include <stdint.h>
 
+#include "budget.h"
 #include "cli.h"
 #include "crop.h"
 #include "jobdir.h"
@@ -51,6 +52,7 @@ typedef struct {
     int overwrite;             /* --overwrite */
     int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
+    fr_budget limits;          /* --limit: the compile's (budget.h) */
     tr_options tr;
     cli_slurm slurm;
 } render_args;

@@ -217,13 +217,19 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
      * triangles for the mesh's size on screen; the finest if none is. */
     obj_mesh m;
     int level = levels - 1;
-    if (mesh_read(paths[level], &m, err) < 0)
+    if (budget_take_file(b->budget, paths[level], paths[level], err) < 0 || mesh_read(paths[level], &m, err) < 0)
         return -1;
     float need = density * projected_pixels(b, &m, &x);
     while (level > 0 && (float)m.n_tri < need) {
         obj_free(&m);
-        if (mesh_read(paths[--level], &m, err) < 0)
+        --level;
+        if (budget_take_file(b->budget, paths[level], paths[level], err) < 0 || mesh_read(paths[level], &m, err) < 0)
             return -1;
+    }
+    if (budget_take(b->budget, BUDGET_VERTICES, m.n_vert, paths[level], err) < 0 ||
+        budget_take(b->budget, BUDGET_TRIANGLES, m.n_tri, paths[level], err) < 0) {
+        obj_free(&m);
+        return -1;
     }
 
     int rc = 0;

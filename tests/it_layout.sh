@@ -19,7 +19,7 @@ need nm tsort cc doxygen
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
-COMPILE_TIME="builder builder_light freeze freeze_light bvh_build bvh2 bvh_reinsert scene_hooks scene_json scene_appear scene_light scene_microfacet jsonval gltf_doc gltf_mat gltf_scene scene_gltf"
+COMPILE_TIME="budget builder builder_light freeze freeze_light bvh_build bvh2 bvh_reinsert scene_hooks scene_json scene_appear scene_light scene_microfacet jsonval gltf_doc gltf_mat gltf_scene scene_gltf"
 B=build
 
 is_compile_time() {
