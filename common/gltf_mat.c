@@ -98,7 +98,8 @@ static int image(gmat_ctx *c, uint32_t i, int srgb, fr_texture *t, fr_error *err
         free(bytes);
     } else {
         char path[4096];
-        if (gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err) < 0)
+        if (gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err) < 0 ||
+            budget_take_file(d->budget, path, path, err) < 0)
             return -1;
         rc = c->hooks->texture(path, &img, &e);
     }

@@ -150,6 +150,12 @@ int scn_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, fr_erro
         gltf_result r;
         fr_error e;
         bld_init(&tmp);
+        /* The same limits, counted apart: this import is looked at once more. */
+        fr_budget own;
+        if (b->budget) {
+            own = *b->budget;
+            tmp.budget = &own;
+        }
         g.take_camera = 1;
         g.take_lights = 0;
         int rc = gltf_import(path, NULL, &g, &tmp, &r, &e);
