@@ -68,6 +68,14 @@ uint32_t bld_triangle_uv(fr_builder *b, const vec3 p[3], const vec2 uv[3], uint3
  * Returns 0, or -1 when memory runs out. */
 int bld_pad(fr_array *a, uint32_t count);
 
+/** Drops the vertices no triangle uses (a mesh file may hold many more
+ * than its triangles need): the kept ones stay in their order, with their
+ * normals and UVs, and triangles are renumbered to them, so the geometry,
+ * and every image of it, is unchanged.  A builder whose vertices are all
+ * used is left as it is.  Returns 0, or -1 when memory runs out (the
+ * builder then unchanged). */
+int bld_drop_unused_vertices(fr_builder *b, fr_error *err);
+
 /** A material with no lobe, no emission and no texture (every texture index
  * FR_NONE, ior 1.5, normal-map strength 1): start every material here, and
  * once its colours are set, call bsdf_lobe_probs() (bsdf.h). */
