@@ -509,22 +509,25 @@ static int scene_roots(imp *c, const uint32_t *parent, uint32_t *roots, uint32_t
         return 0;
     if (!cJSON_IsArray(a))
         return gdoc_fail(d, err, ptr, "expected an array of node indices");
-    int k = 0;
-    for (const cJSON *e = a->child; e; e = e->next, k++) {
+    /* Whether each node is listed already: one byte a node. */
+    unsigned char *listed = calloc(d->nodes.n ? d->nodes.n : 1, 1);
+    if (!listed)
+        return gdoc_fail(d, err, ptr, "out of memory");
+    int k = 0, rc = 0;
+    for (const cJSON *e = a->child; e && rc == 0; e = e->next, k++) {
         double x = e->valuedouble;
+        uint32_t j = 0;
         if (!cJSON_IsNumber(e) || x != floor(x) || !(x >= 0 && x < d->nodes.n))
-            return gdoc_fail(d, err, ptr, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
-        uint32_t j = (uint32_t)x;
-        if (parent[j] != UINT32_MAX)
-            return gdoc_fail(d, err, ptr, "node %u is the child of node %u, not a root", j, parent[j]);
-        for (uint32_t i = 0; i < *n; i++)
-            if (roots[i] == j)
-                return gdoc_fail(d, err, ptr, "node %u is listed twice", j);
-        if (*n >= d->nodes.n)
-            return gdoc_fail(d, err, ptr, "more roots than nodes");
-        roots[(*n)++] = j;
+            rc = gdoc_fail(d, err, ptr, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
+        else if (parent[j = (uint32_t)x] != UINT32_MAX)
+            rc = gdoc_fail(d, err, ptr, "node %u is the child of node %u, not a root", j, parent[j]);
+        else if (listed[j])
+            rc = gdoc_fail(d, err, ptr, "node %u is listed twice", j);
+        else
+            listed[j] = 1, roots[(*n)++] = j;
     }
-    return 0;
+    free(listed);
+    return rc;
 }
 
 /* Depth first from the roots, in the file's order, with an explicit stack
