@@ -258,8 +258,10 @@ int compile_child(const char *scene, const compile_opts *o, const char *out, vol
             budget_init(&def);
             lim = &def;
         }
-        if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL) &&
-            cpu_seconds(pid_usage) >= (double)lim->limit[BUDGET_CPU])
+        /* SIGXCPU at the soft limit; SIGKILL at the hard one, 5 s later. */
+        if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU ||
+                                    (WTERMSIG(status) == SIGKILL &&
+                                     cpu_seconds(pid_usage) >= (double)lim->limit[BUDGET_CPU])))
             rc = fr_fail(err, "%s: the compile used its %llu s of CPU time (--limit cpu=SECONDS raises it)", scene,
                          (unsigned long long)lim->limit[BUDGET_CPU]);
         else if (WIFSIGNALED(status))

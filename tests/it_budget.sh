@@ -138,6 +138,8 @@ gen repeated-used
 refused "20 used buffers naming one 100 MB file, --limit read=150M" "(--limit read=BYTES raises it)" \
     $F compile "$T/repeated-used/s.gltf" -o "$T/x.fbin" --limit read=150M
 grep -qF "/buffers/" "$T/err" && ok || bad "repeated-used: no buffer named: $(cat "$T/err")"
+refused "a used 100 MB buffer, --limit memory=64M" "(the compile may map 64 MiB: --limit memory=BYTES raises it)" \
+    $F compile "$T/repeated-used/s.gltf" -o "$T/x.fbin" --limit memory=64M
 gen oversized
 refused "a 1.5 GiB buffer" "more than the 1073741824 bytes a buffer file may have" \
     $F compile "$T/oversized/s.gltf" -o "$T/x.fbin"
