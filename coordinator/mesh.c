@@ -15,11 +15,13 @@ enum { LOD_MAX = 16 };
 
 /* ---- reading files ---- */
 
-int mesh_read(const char *path, obj_mesh *m, fr_error *err)
+int mesh_read(const char *path, fr_budget *budget, obj_mesh *m, fr_error *err)
 {
     const char *dot = strrchr(path, '.');
+    if (budget_take_file(budget, path, path, err) < 0)
+        return -1;
     if (dot && !strcasecmp(dot, ".obj"))
-        return obj_read(path, m, err);
+        return obj_read_within(path, budget, m, err);
     return mesh_import(path, m, err);
 }
 
@@ -217,13 +219,13 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
      * triangles for the mesh's size on screen; the finest if none is. */
     obj_mesh m;
     int level = levels - 1;
-    if (budget_take_file(b->budget, paths[level], paths[level], err) < 0 || mesh_read(paths[level], &m, err) < 0)
+    if (mesh_read(paths[level], b->budget, &m, err) < 0)
         return -1;
     float need = density * projected_pixels(b, &m, &x);
     while (level > 0 && (float)m.n_tri < need) {
         obj_free(&m);
         --level;
-        if (budget_take_file(b->budget, paths[level], paths[level], err) < 0 || mesh_read(paths[level], &m, err) < 0)
+        if (mesh_read(paths[level], b->budget, &m, err) < 0)
             return -1;
     }
     if (budget_take(b->budget, BUDGET_VERTICES, m.n_vert, paths[level], err) < 0 ||

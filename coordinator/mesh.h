@@ -25,7 +25,9 @@ int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *di
              fr_error *err);
 
 /** Reads a mesh file by its extension: OBJ by obj_read, others by
- * mesh_import into the same structure (free with obj_free). */
-int mesh_read(const char *path, obj_mesh *m, fr_error *err);
+ * mesh_import into the same structure (free with obj_free).  The file's
+ * size, and each MTL file an OBJ names, count against budget's read limit
+ * first (NULL: no limit). */
+int mesh_read(const char *path, fr_budget *budget, obj_mesh *m, fr_error *err);
 
 #endif

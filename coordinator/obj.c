@@ -280,6 +280,7 @@ typedef struct {
     obj_mesh *m;
     cursor c;
     const char *dir;
+    fr_budget *budget;         /* counts the MTL files read (NULL: no limit) */
     /* raw attribute lists of the file */
     vec3 *v; uint32_t n_v, cap_v;
     vec2 *vt; uint32_t n_vt, cap_vt;
@@ -558,9 +559,12 @@ static int load_mtllib(parser *P, const char *file)
     if (snprintf(path, sizeof path, "%s%s%s", file[0] == '/' ? "" : P->dir, file[0] == '/' ? "" : "/", file) >=
         (int)sizeof path)
         return fr_fail(P->c.err, "%s:%d: mtllib path too long", P->c.name, P->c.line);
-    char *text;
+    char *text, where[4200];
     size_t len;
     fr_error e;
+    snprintf(where, sizeof where, "%s:%d: mtllib", P->c.name, P->c.line);
+    if (budget_take_file(P->budget, path, where, P->c.err) < 0)
+        return -1;
     if (file_read(path, &text, &len, &e) < 0)
         return fr_fail(P->c.err, "%s:%d: mtllib: %s", P->c.name, P->c.line, e.msg);
     int rc = memchr(text, 0, len) ? fr_fail(P->c.err, "%s: NUL byte in a text file", path)
@@ -639,7 +643,8 @@ static int parse_line(parser *P, const char *kw)
     return 0;
 }
 
-int obj_parse(const char *text, size_t len, const char *name, const char *dir, obj_mesh *m, fr_error *err)
+static int parse_obj(const char *text, size_t len, const char *name, const char *dir, fr_budget *budget,
+                     obj_mesh *m, fr_error *err)
 {
     memset(m, 0, sizeof *m);
     /* A private NUL-terminated copy: the number parser needs the NUL, and
@@ -654,6 +659,7 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, o
     P.m = m;
     P.c = (cursor){buf, name, 0, err};
     P.dir = dir;
+    P.budget = budget;
     int rc = 0;
     const char *nul = memchr(text, 0, len);
     if (nul) {
@@ -696,6 +702,11 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, o
     return 0;
 }
 
+int obj_parse(const char *text, size_t len, const char *name, const char *dir, obj_mesh *m, fr_error *err)
+{
+    return parse_obj(text, len, name, dir, NULL, m, err);
+}
+
 int obj_parse_mtl(const char *text, size_t len, const char *name, obj_mesh *m, fr_error *err)
 {
     char *buf = malloc(len + 1);
@@ -723,13 +734,18 @@ int obj_parse_mtl(const char *text, size_t len, const char *name, obj_mesh *m, f
 
 int obj_read(const char *path, obj_mesh *m, fr_error *err)
 {
+    return obj_read_within(path, NULL, m, err);
+}
+
+int obj_read_within(const char *path, fr_budget *budget, obj_mesh *m, fr_error *err)
+{
     char *text;
     size_t len;
     if (file_read(path, &text, &len, err) < 0)
         return -1;
     char dir[4096];
     file_dir(path, dir, sizeof dir);
-    int rc = obj_parse(text, len, path, dir, m, err);
+    int rc = parse_obj(text, len, path, dir, budget, m, err);
     free(text);
     return rc;
 }

@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "budget.h"
 #include "error.h"
 #include "scene.h"
 #include "vec.h"
@@ -56,6 +57,11 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, o
 
 /** Reads and parses the OBJ file `path` (see obj_parse). */
 int obj_read(const char *path, obj_mesh *m, fr_error *err);
+
+/** obj_read within a compile's budget (budget.h; NULL: no limit): each
+ * MTL file is counted against its read limit before it is read, as often
+ * as mtllib names it.  The OBJ file itself is the caller's to count. */
+int obj_read_within(const char *path, fr_budget *budget, obj_mesh *m, fr_error *err);
 
 /** Parses MTL text into m's materials (defining those already used and
  * appending new ones). */

@@ -144,6 +144,22 @@ gen oversized
 refused "a 1.5 GiB buffer" "more than the 1073741824 bytes a buffer file may have" \
     $F compile "$T/oversized/s.gltf" -o "$T/x.fbin"
 
+# An OBJ naming one 1 MB MTL file 200 times: every read counts.
+mkdir "$T/obj"
+awk 'BEGIN { for (i = 0; i < 16384; i++) printf "# %062d\n", i }' >"$T/obj/big.mtl"
+{ i=0; while [ $i -lt 200 ]; do echo "mtllib big.mtl"; i=$((i + 1)); done
+  printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n'; } >"$T/obj/m.obj"
+cat >"$T/obj/s.json" <<'JSON'
+{"image": {"width": 4, "height": 4, "spp": 1},
+ "camera": {"position": [0, 0, -5], "target": [0, 0, 0], "fov": 40},
+ "materials": {"m": {"type": "lambert", "albedo": [0.5, 0.5, 0.5]}},
+ "lights": [{"type": "point", "position": [0, 3, -3], "intensity": [10, 10, 10]}],
+ "shapes": [{"type": "mesh", "file": "m.obj", "material": "m"}]}
+JSON
+refused "one MTL file named 200 times, --limit read=20M" "m.obj:20: mtllib: " \
+    $F compile "$T/obj/s.json" -o "$T/x.fbin" --limit read=20M
+grep -qF "(--limit read=BYTES raises it)" "$T/err" && ok || bad "mtllib: no option named: $(cat "$T/err")"
+
 # Linear lookups.
 gen roots
 compiled "200 000 glTF root nodes" $F compile "$T/roots/s.gltf" -o "$T/x.fbin"
