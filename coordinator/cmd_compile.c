@@ -13,7 +13,7 @@
 
 static const char usage[] =
     "usage: franja compile SCENE(.json|.gltf|.glb) [-o SCENE.fbin] [--camera NAME]\n"
-    "                      [--allow-path DIR]...\n"
+    "                      [--allow-path DIR]... [--limit NAME=VALUE]...\n"
     "\n"
     "Reads a JSON scene and the meshes it names (OBJ with MTL; PLY, STL, glTF\n"
     "and other formats through Assimp), or a whole glTF 2.0 scene, builds the\n"
@@ -28,7 +28,8 @@ static const char usage[] =
     "  --camera NAME   glTF scenes: the camera to use, by its node's or its own\n"
     "                  name (default: the first in the scene)\n"
     "  --allow-path DIR  let the scene read files in DIR too (repeatable);\n"
-    "                  without it, a scene reads only files in its own folder\n";
+    "                  without it, a scene reads only files in its own folder\n"
+    COMPILE_LIMIT_HELP;
 
 static volatile sig_atomic_t stop_flag;
 
@@ -45,15 +46,19 @@ static void print_warning(void *user, const char *msg)
 
 int cmd_compile(int argc, char **argv)
 {
-    enum { CAMERA = 0x100, ALLOW };
+    enum { CAMERA = 0x100, ALLOW, LIMIT };
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"camera", required_argument, NULL, CAMERA},
         {"allow-path", required_argument, NULL, ALLOW},
+        {"limit", required_argument, NULL, LIMIT},
         {NULL, 0, NULL, 0},
     };
     const char *in = NULL, *out = NULL, *camera = NULL, *allow[CONFINE_MAX_ALLOW];
     unsigned n_allow = 0;
+    fr_budget limits;
+    fr_error err;
+    budget_init(&limits);
     int c;
     optind = 0;
     while ((c = opt_next("compile", argc, argv, "ho:", longopts)) != -1) {
@@ -73,6 +78,12 @@ int cmd_compile(int argc, char **argv)
                 return 2;
             }
             allow[n_allow++] = optarg;
+            break;
+        case LIMIT:
+            if (budget_set(&limits, optarg, &err) < 0) {
+                fprintf(stderr, "franja compile: --limit %s\n", err.msg);
+                return 2;
+            }
             break;
         default:
             return 2;
@@ -103,9 +114,8 @@ int cmd_compile(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    fr_error err;
     compile_child_stats st;
-    compile_opts co = {camera, print_warning, (void *)"franja compile", allow, n_allow};
+    compile_opts co = {camera, print_warning, (void *)"franja compile", allow, n_allow, &limits};
     if (compile_child(in, &co, out, &stop_flag, &st, &err) < 0) {
         fprintf(stderr, "franja compile: %s\n", err.msg);
         return stop_flag ? 130 : 1;

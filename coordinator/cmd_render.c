@@ -13,6 +13,7 @@
 
 #include "cli.h"
 #include "framewalk.h"
+#include "compile/compile.h"
 #include "crop.h"
 #include "frame.h"
 #include "monitor.h"
@@ -54,6 +55,7 @@ static const char usage[] =
     "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
     "                       (repeatable); without it, a scene reads only files\n"
     "                       in its own folder\n"
+    COMPILE_LIMIT_HELP
     "  --integrator I       path or bdpt (default: the scene's, else path)\n"
     "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
     "                       the relative error of its mean is below E, in (0, 1]\n"
@@ -107,7 +109,7 @@ enum {
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
     OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
-    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH
+    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH, OPT_LIMIT
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -146,6 +148,7 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
+        {"limit", required_argument, NULL, OPT_LIMIT},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -154,6 +157,7 @@ static int parse(int argc, char **argv, frame_settings *a)
     memset(a, 0, sizeof *a);
     a->retries = 5;
     a->preview_every = 5;
+    budget_init(&a->limits);
     cli_transport_defaults(&a->tr);
     int c, bad = 0;
     optind = 0;
@@ -281,6 +285,12 @@ static int parse(int argc, char **argv, frame_settings *a)
         case OPT_TIME_LIMIT:
             bad = opt_duration(cmd, "--time-limit", v, &a->time_limit);
             break;
+        case OPT_LIMIT: {
+            fr_error e;
+            if ((bad = budget_set(&a->limits, v, &e)) < 0)
+                fprintf(stderr, "franja %s: --limit %s\n", cmd, e.msg);
+            break;
+        }
         case OPT_PREVIEW_EVERY:
             bad = opt_uint(cmd, "--preview-every", v, 1, 3600, &a->preview_every);
             break;

@@ -17,6 +17,7 @@
 #include <signal.h>
 #include <stdint.h>
 
+#include "compile/budget.h"
 #include "cli.h"
 #include "compile/confine.h"
 #include "crop.h"
@@ -55,6 +56,7 @@ typedef struct {
     int overwrite;             /* --overwrite */
     int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
+    fr_budget limits;          /* --limit: the compile's (budget.h) */
     tr_options tr;
     cli_slurm slurm;
 } frame_settings;

@@ -12,7 +12,7 @@ apt-get install -y --no-install-recommends \
     libcjson-dev libxxhash-dev libassimp-dev libembree-dev clang libclang-rt-14-dev \
     libssh-dev libmicrohttpd-dev libopenimageio-dev openimageio-tools assimp-testmodels \
     openssh-server openssh-client iproute2 procps doxygen pandoc man-db groff-base jq chromium curl \
-    libfuse3-dev fuse3 \
+    libfuse3-dev fuse3 time python3 \
     slurmctld slurmd slurm-client munge \
     docker.io debootstrap qemu-user-static \
     gcc-aarch64-linux-gnu libc6-dev-arm64-cross

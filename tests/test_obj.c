@@ -154,7 +154,7 @@ static void test_groups_materials(void)
              "usemtl lamp\nf 1 2 4\ns 1\nusemtl glass\nf 1 3 4\nusemtl mirror\nf 3 2 1\nusemtl red\nf 4 3 2\n");
     mesh_data m;
     fr_error err;
-    CHECK(obj_read(path, NULL, &m, &err) == 0, "%s", err.msg);
+    CHECK(obj_read(path, NULL, NULL, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 7, "faces in every group: %u", m.n_tri);
     const char *names[] = {"(default)", "red", "shiny", "lamp", "glass", "mirror", "red"};
     for (uint32_t t = 0; t < m.n_tri && t < 7; t++)
@@ -178,22 +178,22 @@ static void test_groups_materials(void)
 
     /* A usemtl without a definition is kept, marked undefined, with its line. */
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf 1 2 3\n");
-    CHECK(obj_read(path, NULL, &m, &err) == 0, "%s", err.msg);
+    CHECK(obj_read(path, NULL, NULL, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 1 && !m.mats[m.tri_mat[0]].defined && m.mats[m.tri_mat[0]].line == 5, "undefined material");
     mesh_data_free(&m);
     /* Missing MTL file, and MTL errors, name their file and line. */
     put_file(path, sizeof path, dir, "m.obj", "v 0 0 0\nmtllib missing.mtl\n");
-    CHECK(obj_read(path, NULL, &m, &err) < 0 && strstr(err.msg, "m.obj:2:") && strstr(err.msg, "missing.mtl"),
+    CHECK(obj_read(path, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "m.obj:2:") && strstr(err.msg, "missing.mtl"),
           "missing mtllib: %s", err.msg);
     put_file(path, sizeof path, dir, "a.mtl", "newmtl x\nKd 1 1\n");
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\n");
-    CHECK(obj_read(path, NULL, &m, &err) < 0 && strstr(err.msg, "a.mtl:2:") && strstr(err.msg, "Kd"), "MTL error: %s",
+    CHECK(obj_read(path, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "a.mtl:2:") && strstr(err.msg, "Kd"), "MTL error: %s",
           err.msg);
     /* Two MTL files of one OBJ defining one name: which was meant? */
     put_file(path, sizeof path, dir, "a.mtl", "newmtl red\nKd 0.8 0.1 0.1\n");
     put_file(path, sizeof path, dir, "b.mtl", "newmtl blue\nKd 0.1 0.1 0.8\nnewmtl red\nKd 0.9 0 0\n");
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
-    CHECK(obj_read(path, NULL, &m, &err) < 0 && strstr(err.msg, "b.mtl:3:") && strstr(err.msg, "newmtl: the material is defined twice"),
+    CHECK(obj_read(path, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "b.mtl:3:") && strstr(err.msg, "newmtl: the material is defined twice"),
           "one material name in two MTL files: %s", err.msg);
     const char *files[] = {"a.mtl", "b.mtl", "m.obj"};
     for (int i = 0; i < 3; i++) {

@@ -137,3 +137,48 @@ int bld_camera_finish(fr_camera *c, fr_error *err)
     c->tan_half = fm_tanf(0.5f * c->vfov);
     return 0;
 }
+
+/* Moves the elements of a whose index i (below a->count) has keep[i] set
+ * to the front, in order. */
+static void compact(fr_array *a, const uint32_t *keep, uint32_t n)
+{
+    uint32_t o = 0, lim = a->count < n ? a->count : n;
+    char *d = a->data;
+    for (uint32_t i = 0; i < lim; i++)
+        if (keep[i] != FR_NONE) {
+            if (o != i)
+                memcpy(d + (size_t)o * a->elem, d + (size_t)i * a->elem, a->elem);
+            o++;
+        }
+    a->count = o;
+}
+
+int bld_drop_unused_vertices(fr_builder *b, fr_error *err)
+{
+    uint32_t n = b->positions.count;
+    if (n == 0)
+        return 0;
+    uint32_t *to = malloc((size_t)n * sizeof *to);
+    if (!to)
+        return fr_fail(err, "out of memory (%u vertices)", n);
+    for (uint32_t i = 0; i < n; i++)
+        to[i] = FR_NONE;
+    fr_triangle *t = b->triangles.data;
+    for (uint32_t k = 0; k < b->triangles.count; k++)
+        for (int c = 0; c < 3; c++)
+            to[t[k].v[c]] = 0;
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (to[i] != FR_NONE)
+            to[i] = m++;
+    if (m < n) {
+        compact(&b->positions, to, n);
+        compact(&b->normals, to, n);
+        compact(&b->uvs, to, n);
+        for (uint32_t k = 0; k < b->triangles.count; k++)
+            for (int c = 0; c < 3; c++)
+                t[k].v[c] = to[t[k].v[c]];
+    }
+    free(to);
+    return 0;
+}

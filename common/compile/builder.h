@@ -13,6 +13,7 @@
 #ifndef FRANJA_BUILDER_H
 #define FRANJA_BUILDER_H
 
+#include "compile/budget.h"
 #include "error.h"
 #include "scene.h"
 
@@ -37,9 +38,11 @@ typedef struct {
     fr_tonemap tonemap;
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
     fr_array distrib;          /**< float: filled by frz_scene */
+    fr_budget *budget;         /**< the compile's limits (budget.h), not owned; NULL: none */
 } fr_builder;
 
-/** An empty builder: every array empty, settings and camera zero. */
+/** An empty builder: every array empty, settings and camera zero, no
+ * budget. */
 void bld_init(fr_builder *b);
 /** Free every array and zero *b. */
 void bld_free(fr_builder *b);
@@ -64,6 +67,14 @@ uint32_t bld_triangle_uv(fr_builder *b, const vec3 p[3], const vec2 uv[3], uint3
  * arrays are indexed like positions, so they are padded before use).
  * Returns 0, or -1 when memory runs out. */
 int bld_pad(fr_array *a, uint32_t count);
+
+/** Drops the vertices no triangle uses (a mesh file may hold many more
+ * than its triangles need): the kept ones stay in their order, with their
+ * normals and UVs, and triangles are renumbered to them, so the geometry,
+ * and every image of it, is unchanged.  A builder whose vertices are all
+ * used is left as it is.  Returns 0, or -1 when memory runs out (the
+ * builder then unchanged). */
+int bld_drop_unused_vertices(fr_builder *b, fr_error *err);
 
 /** A material with no lobe, no emission and no texture (every texture index
  * FR_NONE, ior 1.5, normal-map strength 1): start every material here, and

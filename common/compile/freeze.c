@@ -10,7 +10,7 @@
 int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (bld_camera_finish(&b->camera, err) < 0)
+    if (bld_camera_finish(&b->camera, err) < 0 || bld_drop_unused_vertices(b, err) < 0)
         return -1;
     fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
     /* The BVH reorders prims, so lights (which point at prims) come after. */

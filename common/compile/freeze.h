@@ -16,8 +16,9 @@
 
 /** Freeze the builder into *out, which then owns its bytes (release with
  * scn_free).  The builder's arrays stay allocated (free them with
- * bld_free); its prims are left in BVH order and its lights include the
- * area lights.  Returns 0, or -1 with *err set (degenerate camera, memory,
+ * bld_free); its prims are left in BVH order, its lights include the
+ * area lights and the vertices no triangle uses are gone
+ * (bld_drop_unused_vertices).  Returns 0, or -1 with *err set (degenerate camera, memory,
  * non-finite geometry, a scene the binary format refuses). */
 int frz_scene(fr_builder *b, fr_scene *out, fr_error *err);
 

@@ -343,6 +343,9 @@ static int collect(gltf_doc *d, const cJSON *parent, const char *key, const char
     return 0;
 }
 
+/* Checks every buffer's byteLength and uri, and takes the GLB chunk and
+ * data: URIs (which the file itself holds).  External files are read
+ * when an accessor or view first needs them (buffer_data). */
 static int load_buffers(gltf_doc *d, const unsigned char *bin, size_t bin_len, int glb, fr_error *err)
 {
     gdoc_array bufs;
@@ -382,16 +385,36 @@ static int load_buffers(gltf_doc *d, const unsigned char *bin, size_t bin_len, i
             b->data = b->owned;
         } else {
             char path[4096];
-            fr_error e;
             if ((rc = gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err)) < 0)
                 break;
-            if (read_exact(d, path, b->len, &b->owned, &e) < 0)
-                rc = gdoc_fail(d, err, ptr, "%s", e.msg);
-            b->data = b->owned;
+            b->uri = uri->valuestring;
         }
     }
     free(bufs.v);
     return rc;
+}
+
+/* Buffer i's bytes, reading its file the first time one is needed: its
+ * byteLength counted against the budget first, at most FILE_READ_MAX. */
+static int buffer_data(gltf_doc *d, uint32_t i, fr_error *err)
+{
+    gdoc_buffer *b = &d->buffers[i];
+    if (b->data || b->len == 0)
+        return 0;
+    char ptr[64], where[4200], path[4096];
+    snprintf(ptr, sizeof ptr, "/buffers/%u", i);
+    snprintf(where, sizeof where, "%s: %s", d->path, ptr);
+    if (b->len > FILE_READ_MAX)
+        return gdoc_fail(d, err, ptr, "byteLength %zu: more than the %zu bytes a buffer file may have", b->len,
+                         FILE_READ_MAX);
+    if (gdoc_uri_path(d, b->uri, ptr, path, sizeof path, err) < 0 ||
+        budget_take(d->budget, BUDGET_READ, b->len, where, err) < 0)
+        return -1;
+    fr_error e;
+    if (read_exact(d, path, b->len, &b->owned, &e) < 0)
+        return gdoc_fail(d, err, ptr, "%s", e.msg);
+    b->data = b->owned;
+    return 0;
 }
 
 static int check_required(gltf_doc *d, fr_error *err)
@@ -564,6 +587,8 @@ static int view_range(gltf_doc *d, uint32_t view, const unsigned char **data, si
     if (off + n > d->buffers[buf].len)
         return gdoc_fail(d, err, ptr, "bytes %llu to %llu lie outside buffer %u (%zu bytes)", (unsigned long long)off,
                          (unsigned long long)(off + n), buf, d->buffers[buf].len);
+    if (n && buffer_data(d, buf, err) < 0)
+        return -1;
     *data = d->buffers[buf].data + off;
     *len = (size_t)n;
     *stride = (size_t)st;
@@ -642,6 +667,19 @@ static int sparse(gltf_doc *d, const cJSON *sp, const char *ptr, gdoc_acc *a, si
             return gdoc_fail(d, err, pi, "index %u (%u): not increasing or not below count %u", i, k, a->count);
         prev = k;
     }
+    return 0;
+}
+
+int gdoc_count(const gltf_doc *d, uint32_t index, const char *from, uint32_t *count, fr_error *err)
+{
+    if (index >= d->accessors.n)
+        return gdoc_fail(d, err, from, "accessor %u does not exist (the file has %u)", index, d->accessors.n);
+    char ptr[64];
+    uint64_t n;
+    snprintf(ptr, sizeof ptr, "/accessors/%u", index);
+    if (gdoc_uint(d, d->accessors.v[index], ptr, "count", -1, 0x7fffffff, &n, err) < 0)
+        return -1;
+    *count = (uint32_t)n;
     return 0;
 }
 

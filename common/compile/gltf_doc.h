@@ -23,6 +23,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "compile/budget.h"
 #include "compile/confine.h"
 #include "error.h"
 
@@ -31,9 +32,10 @@
 
 /** One buffer's bytes (into the file for a GLB chunk, else malloc'd). */
 typedef struct {
-    const unsigned char *data;
+    const unsigned char *data; /**< NULL until read (an external file is read when first used) */
     size_t len;                /**< the buffer's byteLength */
     unsigned char *owned;      /**< what to free, or NULL */
+    const char *uri;           /**< an external file's URI (in the JSON tree), or NULL */
 } gdoc_buffer;
 
 /** The top-level arrays of the document, each as a vector of its elements
@@ -57,6 +59,7 @@ typedef struct {
     char *warn[GDOC_MAX_WARN]; /**< distinct warnings, in order (malloc'd) */
     char *warn_key[GDOC_MAX_WARN];
     uint32_t n_warn, n_warn_dropped;
+    fr_budget *budget;         /**< counts the buffer files read (NULL: no limit); not owned */
 } gltf_doc;
 
 /** Reads and checks the document at `path` (through `scope` when it is
@@ -135,6 +138,11 @@ typedef struct {
  * supported (indices strictly increasing, inside count). */
 int gdoc_accessor(gltf_doc *d, uint32_t index, const char *from, uint32_t comps, const uint32_t *ctypes,
                   gdoc_acc *a, fr_error *err);
+
+/** The `count` of accessor `index` (referred to from `from`), without
+ * reading anything: for budgets checked before an accessor's buffer is
+ * read. */
+int gdoc_count(const gltf_doc *d, uint32_t index, const char *from, uint32_t *count, fr_error *err);
 
 /** Component c of element i as a float (normalized integers mapped to
  * [0, 1] or [-1, 1] as glTF defines; others converted). */

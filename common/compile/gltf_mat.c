@@ -100,7 +100,8 @@ static int image(gmat_ctx *c, uint32_t i, int srgb, fr_texture *t, fr_error *err
     } else {
         char path[4096], *data;
         size_t len;
-        if (gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err) < 0)
+        if (gdoc_uri_path(d, uri->valuestring, ptr, path, sizeof path, err) < 0 ||
+            budget_take_file(d->budget, path, path, err) < 0)
             return -1;
         if (confine_read(d->scope, path, FILE_READ_MAX, &data, &len, &e) < 0)
             return gdoc_fail(d, err, ptr, "uri: %s", e.msg);

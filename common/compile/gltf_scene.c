@@ -176,22 +176,39 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
     }
     gdoc_acc pos, nrm, uv, idx;
     static const uint32_t index_types[] = {GDOC_U8, GDOC_U16, GDOC_U32, 0};
+    /* The counts first: the budget is checked before any buffer is read or
+     * anything allocated. */
+    uint32_t nv, n;
+    if (gdoc_count(d, ipos, ap, &nv, err) < 0 || (iidx != UINT32_MAX && gdoc_count(d, iidx, ptr, &n, err) < 0))
+        return -1;
+    if (iidx == UINT32_MAX)
+        n = nv;
+    uint32_t ntri = mode == MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;
+    char where[4200];
+    snprintf(where, sizeof where, "%s: %s", d->path, ptr);
+    if (budget_take(b->budget, BUDGET_VERTICES, nv, where, err) < 0 ||
+        budget_take(b->budget, BUDGET_TRIANGLES, ntri, where, err) < 0)
+        return -1;
     if (gdoc_accessor(d, ipos, ap, 3, NULL, &pos, err) < 0 ||
         (inrm != UINT32_MAX && gdoc_accessor(d, inrm, ap, 3, NULL, &nrm, err) < 0) ||
         (iuv != UINT32_MAX && gdoc_accessor(d, iuv, ap, 2, NULL, &uv, err) < 0) ||
         (iidx != UINT32_MAX && gdoc_accessor(d, iidx, ptr, 1, index_types, &idx, err) < 0))
         return -1;
-    uint32_t nv = pos.count;
     if ((inrm != UINT32_MAX && nrm.count != nv) || (iuv != UINT32_MAX && uv.count != nv))
         return gdoc_fail(d, err, ap, "attributes of different counts (POSITION has %u)", nv);
-    uint32_t n = iidx != UINT32_MAX ? idx.count : nv;
-    uint32_t ntri = mode == MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;
     if (mode == MODE_TRIANGLES && n % 3)
         gdoc_warn(d, "partial", "%s: %u indices is not a whole number of triangles: the last %u ignored", ptr, n,
                   n % 3);
     if (ntri == 0)
         return 0;
-    if (ntri > c->max_tri - c->r->triangles || nv > 3 * (uint64_t)c->max_tri - c->vertices)
+    /* Accessors without a bufferView or sparse values are all zeros: every
+     * position at the origin, or every index 0, makes every triangle
+     * zero-area (dropped below), whatever the count. */
+    if ((!pos.base && !pos.n_sparse) || (iidx != UINT32_MAX && !idx.base && !idx.n_sparse)) {
+        gdoc_warn(d, "zeros", "%s: every triangle has zero area (an accessor of zeros): skipped", ptr);
+        return 0;
+    }
+    if (!b->budget && (ntri > c->max_tri - c->r->triangles || nv > 3 * (uint64_t)c->max_tri - c->vertices))
         return gdoc_fail(d, err, ptr, "the scene would have more than %u triangles", c->max_tri);
     /* Indices checked before anything is added. */
     for (uint32_t i = 0; iidx != UINT32_MAX && i < idx.count; i++) {
@@ -492,22 +509,25 @@ static int scene_roots(imp *c, const uint32_t *parent, uint32_t *roots, uint32_t
         return 0;
     if (!cJSON_IsArray(a))
         return gdoc_fail(d, err, ptr, "expected an array of node indices");
-    int k = 0;
-    for (const cJSON *e = a->child; e; e = e->next, k++) {
+    /* Whether each node is listed already: one byte a node. */
+    unsigned char *listed = calloc(d->nodes.n ? d->nodes.n : 1, 1);
+    if (!listed)
+        return gdoc_fail(d, err, ptr, "out of memory");
+    int k = 0, rc = 0;
+    for (const cJSON *e = a->child; e && rc == 0; e = e->next, k++) {
         double x = e->valuedouble;
+        uint32_t j = 0;
         if (!cJSON_IsNumber(e) || x != floor(x) || !(x >= 0 && x < d->nodes.n))
-            return gdoc_fail(d, err, ptr, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
-        uint32_t j = (uint32_t)x;
-        if (parent[j] != UINT32_MAX)
-            return gdoc_fail(d, err, ptr, "node %u is the child of node %u, not a root", j, parent[j]);
-        for (uint32_t i = 0; i < *n; i++)
-            if (roots[i] == j)
-                return gdoc_fail(d, err, ptr, "node %u is listed twice", j);
-        if (*n >= d->nodes.n)
-            return gdoc_fail(d, err, ptr, "more roots than nodes");
-        roots[(*n)++] = j;
+            rc = gdoc_fail(d, err, ptr, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
+        else if (parent[j = (uint32_t)x] != UINT32_MAX)
+            rc = gdoc_fail(d, err, ptr, "node %u is the child of node %u, not a root", j, parent[j]);
+        else if (listed[j])
+            rc = gdoc_fail(d, err, ptr, "node %u is listed twice", j);
+        else
+            listed[j] = 1, roots[(*n)++] = j;
     }
-    return 0;
+    free(listed);
+    return rc;
 }
 
 /* Depth first from the roots, in the file's order, with an explicit stack
@@ -648,6 +668,11 @@ int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *
     }
     if (gdoc_open(&d, path, scope, o->scope != NULL, err) < 0)
         return -1;
+    d.budget = b->budget;
+    if (budget_take(d.budget, BUDGET_READ, d.file_len, path, err) < 0) {
+        gdoc_free(&d);
+        return -1;
+    }
     int rc = import_doc(&d, hooks, o, b, r, err);
     gdoc_free(&d);
     return rc;
@@ -659,6 +684,7 @@ int gltf_import_mem(const void *bytes, size_t len, const char *name, const scene
     gltf_doc d;
     if (gdoc_open_mem(&d, bytes, len, name, NULL, err) < 0)
         return -1;
+    d.budget = b->budget;
     int rc = import_doc(&d, hooks, o, b, r, err);
     gdoc_free(&d);
     return rc;
@@ -744,6 +770,7 @@ int gltf_load_scene(const char *path, const scene_hooks *hooks, const char *came
 {
     fr_builder b;
     bld_init(&b);
+    b.budget = hooks ? hooks->budget : NULL;
     int rc = gltf_build_scene(path, NULL, 0, hooks, camera, 0, &b, err);
     if (rc == 0) {
         fr_error e;

@@ -212,6 +212,8 @@ static int texture_ref(json_appear *a, const char *name, int as_colour, const ch
         fr_error e;
         char *data;
         size_t len;
+        if (budget_take_file(a->b->budget, path, tw, err) < 0)
+            return -1;
         if (confine_read(a->scope, path, IMAGE_MAX_BYTES, &data, &len, &e) < 0)
             return fr_fail(err, "%s.file: cannot read %s", tw, e.msg);
         int bad = a->hooks->texture(path, data, len, &img, &e);

@@ -151,6 +151,12 @@ int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const 
         gltf_result r;
         fr_error e;
         bld_init(&tmp);
+        /* The same limits, counted apart: this import is looked at once more. */
+        fr_budget own;
+        if (b->budget) {
+            own = *b->budget;
+            tmp.budget = &own;
+        }
         g.take_camera = 1;
         g.take_lights = 0;
         int rc = gltf_import(path, NULL, &g, &tmp, &r, &e);

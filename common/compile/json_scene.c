@@ -25,7 +25,9 @@ typedef struct {
     const confine *scope;      /* the folders its files may be read from */
     const scene_hooks *hooks;
     fr_builder *b;
-    const cJSON *materials;    /* the "materials" object, for name lookup */
+    const cJSON *materials;    /* the "materials" object */
+    struct mat_name { const char *name; uint32_t index; } *by_name; /* its names, sorted: lookups in log time */
+    uint32_t n_names;
     int gltf_camera;           /* the camera comes from a gltf shape */
     fr_error *err;
     json_appear *look;          /* textures, media (json_appear.h) */
@@ -168,6 +170,11 @@ static int parse_material(ctx *c, const cJSON *o, const char *where, fr_material
     return 0;
 }
 
+static int by_name_cmp(const void *a, const void *b)
+{
+    return strcmp(((const struct mat_name *)a)->name, ((const struct mat_name *)b)->name);
+}
+
 static int parse_materials(ctx *c, const cJSON *o)
 {
     if (!cJSON_IsObject(o))
@@ -182,6 +189,16 @@ static int parse_materials(ctx *c, const cJSON *o)
             return fr_fail(c->err, "%s: out of memory", where);
     }
     c->materials = o;
+    uint32_t n = 0;
+    for (const cJSON *m = o->child; m; m = m->next)
+        n++;
+    if ((c->by_name = malloc((n ? n : 1) * sizeof *c->by_name)) == NULL)
+        return fr_fail(c->err, "materials: out of memory");
+    n = 0;
+    for (const cJSON *m = o->child; m; m = m->next, n++)
+        c->by_name[n] = (struct mat_name){m->string, n};
+    qsort(c->by_name, n, sizeof *c->by_name, by_name_cmp);
+    c->n_names = n;
     return 0;
 }
 
@@ -190,12 +207,12 @@ static int material_ref(ctx *c, const cJSON *shape, const char *where, uint32_t 
     const cJSON *n = cJSON_GetObjectItemCaseSensitive(shape, "material");
     if (!cJSON_IsString(n))
         return fr_fail(c->err, "%s.material: missing (expected a material name)", where);
-    uint32_t i = 0;
-    for (const cJSON *m = c->materials->child; m; m = m->next, i++) {
-        if (!strcmp(m->string, n->valuestring)) {
-            *out = i;
-            return 0;
-        }
+    /* Names are unique (jsoncheck refuses a repeated member). */
+    struct mat_name key = {n->valuestring, 0};
+    const struct mat_name *m = bsearch(&key, c->by_name, c->n_names, sizeof key, by_name_cmp);
+    if (m) {
+        *out = m->index;
+        return 0;
     }
     return fr_fail(c->err, "%s.material: no material named '%s'", where, n->valuestring);
 }
@@ -361,7 +378,7 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
     }
     json_appear look;
     memset(&look, 0, sizeof look);
-    ctx c = {file, dir, &scope, hooks, b, NULL, 0, &e, &look};
+    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
                                       "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
@@ -402,6 +419,7 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
         }
     }
     json_appear_free(&look);
+    free(c.by_name);
     cJSON_Delete(root);
     return rc < 0 ? fr_fail(err, "%s: %s", file, e.msg) : 0;
 }
@@ -419,6 +437,11 @@ int json_scene_load(const char *path, const scene_hooks *hooks, fr_scene *out, f
     }
     fr_builder b;
     bld_init(&b);
+    b.budget = hooks ? hooks->budget : NULL;
+    if (budget_take(b.budget, BUDGET_READ, len, path, err) < 0) {
+        free(text);
+        return -1;
+    }
     int rc = json_scene_parse(text, path, hooks, &b, err);
     free(text);
     if (rc == 0) {

@@ -9,6 +9,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "compile/budget.h"
 #include "compile/builder.h"
 #include "compile/confine.h"
 
@@ -20,7 +21,7 @@ typedef struct {
     uint32_t width, height, channels;
 } scene_image;
 
-/** The asset loaders; either may be NULL. */
+/** The asset loaders (any may be NULL) and the compile's budget. */
 typedef struct {
     /** Add the mesh described by JSON object `node` (at JSON path `where`)
      * to the builder with material `material` (FR_NONE: the mesh's own
@@ -48,6 +49,10 @@ typedef struct {
      * (`--allow-path`; n_allow of them, may be NULL when 0). */
     const char *const *allow;
     unsigned n_allow;
+    /** The compile's limits (budget.h): the scene readers give it to their
+     * builder, and count what they read and build against it.  May be
+     * NULL: no limits. */
+    fr_budget *budget;
 } scene_hooks;
 
 #endif

@@ -2,6 +2,7 @@
  * texture hooks of the coordinator, and the glTF reader (see compile.h). */
 #include "compile/compile.h"
 
+#include <stdio.h>
 #include <string.h>
 #include <strings.h>
 
@@ -30,11 +31,26 @@ int compile_is_gltf(const char *path)
 
 int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err)
 {
+    fr_budget budget;
+    if (o && o->limits)
+        memcpy(budget.limit, o->limits->limit, sizeof budget.limit);
+    else
+        budget_init(&budget);
+    memset(budget.used, 0, sizeof budget.used);
     scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
-                       o ? o->allow : NULL, o ? o->n_allow : 0};
+                         o ? o->allow : NULL, o ? o->n_allow : 0, &budget};
+    int rc;
     if (compile_is_gltf(path))
-        return gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
-    if (o && o->camera)
+        rc = gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
+    else if (o && o->camera)
         return fr_fail(err, "%s: --camera names a camera of a glTF scene; a JSON scene has its own", path);
-    return json_scene_load(path, &hooks, out, err);
+    else
+        rc = json_scene_load(path, &hooks, out, err);
+    char where[4200];
+    snprintf(where, sizeof where, "%s: the binary scene", path);
+    if (rc == 0 && budget_take(&budget, BUDGET_FBIN, out->blob_size, where, err) < 0) {
+        scn_free(out);
+        return -1;
+    }
+    return rc;
 }

@@ -13,27 +13,40 @@
 #ifndef FRANJA_COMPILE_H
 #define FRANJA_COMPILE_H
 
+#include "compile/budget.h"
 #include "error.h"
 #include "scene.h"
 
 /** How to compile: the glTF camera to take (NULL: the first), where
- * warnings go (NULL: nowhere; `user` is passed back), and the folders
+ * warnings go (NULL: nowhere; `user` is passed back), the folders
  * besides the scene's own that its files may lie in (`--allow-path`;
- * confine.h). */
+ * confine.h), and the limits (budget.h; NULL: the defaults). */
 typedef struct {
     const char *camera;
     void (*warn)(void *user, const char *msg);
     void *user;
     const char *const *allow;
     unsigned n_allow;
+    const fr_budget *limits;
 } compile_opts;
+
+/** Help text for --limit (franja compile and franja render). */
+#define COMPILE_LIMIT_HELP                                                                 \
+    "  --limit NAME=VALUE   one of the compile's limits (repeatable): read=BYTES\n"        \
+    "                       (files read in all), vertices=N and triangles=N (across\n"    \
+    "                       all meshes), fbin=BYTES (the binary scene), cpu=SECONDS,\n"   \
+    "                       memory=BYTES (address space); K M G T are powers of 1024\n"   \
+    "                       (default read=4G, vertices=128M, triangles=128M,\n"          \
+    "                       fbin=16G, cpu=1h, memory=32G)\n"
 
 /** 1 when `path` names a glTF scene (.gltf or .glb, any case). */
 int compile_is_gltf(const char *path);
 
 /** Compiles the scene `path`: a whole glTF scene (.gltf, .glb;
- * gltf_scene.h) or a JSON scene.  *out then owns its blob (scn_free).
- * Returns 0, or -1 with err naming the file and where in it. */
+ * gltf_scene.h) or a JSON scene, within o's limits (read, vertices,
+ * triangles, fbin: a scene whose binary form passes the fbin limit is
+ * refused).  *out then owns its blob (scn_free).  Returns 0, or -1 with
+ * err naming the file and where in it, or the limit passed. */
 int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err);
 
 #endif

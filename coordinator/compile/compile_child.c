@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -27,13 +28,47 @@ typedef struct {
     compile_child_stats st;
 } answer;
 
+/* The compile's own limits: CPU seconds, and address space beyond what
+ * the process maps already (libraries, the copy of the parent). */
+static void set_limits(const fr_budget *lim)
+{
+    struct rlimit r = {0, 0};
+    setrlimit(RLIMIT_CORE, &r);
+    long pages = 0, page = sysconf(_SC_PAGESIZE);
+    FILE *statm = fopen("/proc/self/statm", "r");
+    if (statm) {
+        if (fscanf(statm, "%ld", &pages) != 1)
+            pages = 0;
+        fclose(statm);
+    }
+    if (pages > 0 && page > 0 && lim->limit[BUDGET_MEMORY] < RLIM_INFINITY / 2) {
+        r.rlim_cur = r.rlim_max = (rlim_t)pages * (rlim_t)page + (rlim_t)lim->limit[BUDGET_MEMORY];
+        setrlimit(RLIMIT_AS, &r);
+    }
+    /* SIGXCPU at the limit; SIGKILL a little later if that is caught. */
+    r.rlim_cur = (rlim_t)lim->limit[BUDGET_CPU];
+    r.rlim_max = r.rlim_cur + 5;
+    setrlimit(RLIMIT_CPU, &r);
+}
+
 static void child(const char *scene, const compile_opts *o, const char *file, int fd)
 {
     answer a;
     memset(&a, 0, sizeof a);
     fr_scene s;
+    fr_budget lim;
+    if (o && o->limits)
+        lim = *o->limits;
+    else
+        budget_init(&lim);
+    set_limits(&lim);
     double t0 = clock_now();
     a.rc = compile_scene(scene, o, &s, &a.err);
+    if (a.rc && strstr(a.err.msg, "out of memory")) {
+        size_t n = strlen(a.err.msg);
+        snprintf(a.err.msg + n, sizeof a.err.msg - n, " (the compile may map %llu MiB: --limit memory=BYTES raises it)",
+                 (unsigned long long)(lim.limit[BUDGET_MEMORY] >> 20));
+    }
     if (a.rc == 0) {
         a.st.seconds = clock_now() - t0;
         a.rc = fbin_write(&s, file, &a.err);
@@ -57,6 +92,13 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
         p += k;
         left -= (size_t)k;
     }
+}
+
+/* CPU seconds (user and system) of a child's usage. */
+static double cpu_seconds(struct rusage u)
+{
+    return (double)u.ru_utime.tv_sec + (double)u.ru_stime.tv_sec +
+           1e-6 * (double)(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 /* Removes the private directory and whatever the child left in it. */
@@ -196,13 +238,27 @@ int compile_child(const char *scene, const compile_opts *o, const char *out, vol
     if (got < 0)
         kill(pid, SIGKILL);
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    struct rusage pid_usage;
+    memset(&pid_usage, 0, sizeof pid_usage);
+    while (wait4(pid, &status, 0, &pid_usage) < 0 && errno == EINTR) {
     }
     int rc;
     if (got < 0) {
         rc = fr_fail(err, "%s: compile interrupted", scene);
     } else if (got == 0) {
-        if (WIFSIGNALED(status))
+        const fr_budget *lim = o ? o->limits : NULL;
+        fr_budget def;
+        if (!lim) {
+            budget_init(&def);
+            lim = &def;
+        }
+        /* SIGXCPU at the soft limit; SIGKILL at the hard one, 5 s later. */
+        if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU ||
+                                    (WTERMSIG(status) == SIGKILL &&
+                                     cpu_seconds(pid_usage) >= (double)lim->limit[BUDGET_CPU])))
+            rc = fr_fail(err, "%s: the compile used its %llu s of CPU time (--limit cpu=SECONDS raises it)", scene,
+                         (unsigned long long)lim->limit[BUDGET_CPU]);
+        else if (WIFSIGNALED(status))
             rc = fr_fail(err, "%s: the compiling process died (signal %d: %s)", scene, WTERMSIG(status),
                          strsignal(WTERMSIG(status)));
         else

@@ -18,6 +18,11 @@
  * private directory is left.  The caller must have no other threads
  * running (fork).  compile_child_sweep removes such leftovers where the
  * caller knows no other compile into the same output can be running.
+ *
+ * The child runs within the compile's limits (budget.h): RLIMIT_CPU at the
+ * cpu limit, RLIMIT_AS at what it maps when it starts plus the memory
+ * limit, no core file.  Passing one fails with a message that names the
+ * limit and the option that raises it.
  */
 #ifndef FRANJA_COMPILE_CHILD_H
 #define FRANJA_COMPILE_CHILD_H
@@ -39,8 +44,9 @@ typedef struct {
  * through o->warn) into the .fbin file `out`, replaced atomically.  stop
  * (may be NULL) is polled; once it is non-zero the compile is abandoned.
  * st (may be NULL) receives the summary.  Returns 0; -1 with err: the
- * compiler's error, "PATH: compile interrupted", or "PATH: the compiling
- * process died (signal N: NAME)"; the output is then untouched and nothing
+ * compiler's error, "PATH: compile interrupted", "PATH: the compile used
+ * its N s of CPU time (--limit cpu=SECONDS raises it)", or "PATH: the
+ * compiling process died (signal N: NAME)"; the output is then untouched and nothing
  * of the attempt is left on disk. */
 int compile_child(const char *scene, const compile_opts *o, const char *out, volatile sig_atomic_t *stop,
                   compile_child_stats *st, fr_error *err);

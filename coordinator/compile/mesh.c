@@ -17,12 +17,15 @@ enum { LOD_MAX = 16 };
 
 /* Reads a mesh file by its extension, through `scope` (NULL: its own
  * folder): OBJ by obj_read, others by mesh_import into the same structure
- * (free with mesh_data_free). */
-static int mesh_read(const char *path, const confine *scope, mesh_data *m, fr_error *err)
+ * (free with mesh_data_free).  The file's size, and each MTL file an OBJ
+ * names, count against budget's read limit first (NULL: no limit). */
+static int mesh_read(const char *path, const confine *scope, fr_budget *budget, mesh_data *m, fr_error *err)
 {
     const char *dot = strrchr(path, '.');
+    if (budget_take_file(budget, path, path, err) < 0)
+        return -1;
     if (dot && !strcasecmp(dot, ".obj"))
-        return obj_read(path, scope, m, err);
+        return obj_read(path, scope, budget, m, err);
     return mesh_import(path, scope, m, err);
 }
 
@@ -221,13 +224,19 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
      * triangles for the mesh's size on screen; the finest if none is. */
     mesh_data m;
     int level = levels - 1;
-    if (mesh_read(paths[level], scope, &m, err) < 0)
+    if (mesh_read(paths[level], scope, b->budget, &m, err) < 0)
         return -1;
     float need = density * projected_pixels(b, &m, &x);
     while (level > 0 && (float)m.n_tri < need) {
         mesh_data_free(&m);
-        if (mesh_read(paths[--level], scope, &m, err) < 0)
+        --level;
+        if (mesh_read(paths[level], scope, b->budget, &m, err) < 0)
             return -1;
+    }
+    if (budget_take(b->budget, BUDGET_VERTICES, m.n_vert, paths[level], err) < 0 ||
+        budget_take(b->budget, BUDGET_TRIANGLES, m.n_tri, paths[level], err) < 0) {
+        mesh_data_free(&m);
+        return -1;
     }
 
     int rc = 0;

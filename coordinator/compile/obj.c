@@ -242,6 +242,7 @@ typedef struct {
     cursor c;
     const char *dir;
     const confine *scope;       /* where mtllib files may be read */
+    fr_budget *budget;         /* counts the MTL files read (NULL: no limit) */
     /* raw attribute lists of the file */
     vec3 *v; uint32_t n_v, cap_v;
     vec2 *vt; uint32_t n_vt, cap_vt;
@@ -520,9 +521,12 @@ static int load_mtllib(parser *P, const char *file)
     if (snprintf(path, sizeof path, "%s%s%s", file[0] == '/' ? "" : P->dir, file[0] == '/' ? "" : "/", file) >=
         (int)sizeof path)
         return fr_fail(P->c.err, "%s:%d: mtllib path too long", P->c.name, P->c.line);
-    char *text;
+    char *text, where[4200];
     size_t len;
     fr_error e;
+    snprintf(where, sizeof where, "%s:%d: mtllib", P->c.name, P->c.line);
+    if (budget_take_file(P->budget, path, where, P->c.err) < 0)
+        return -1;
     if (confine_read(P->scope, path, FILE_READ_MAX, &text, &len, &e) < 0)
         return fr_fail(P->c.err, "%s:%d: mtllib: %s", P->c.name, P->c.line, e.msg);
     int rc = memchr(text, 0, len) ? fr_fail(P->c.err, "%s: NUL byte in a text file", path)
@@ -602,8 +606,8 @@ static int parse_line(parser *P, const char *kw)
     return 0;
 }
 
-int obj_parse(const char *text, size_t len, const char *name, const char *dir, const confine *scope, mesh_data *m,
-              fr_error *err)
+static int parse_obj(const char *text, size_t len, const char *name, const char *dir, const confine *scope,
+                     fr_budget *budget, mesh_data *m, fr_error *err)
 {
     memset(m, 0, sizeof *m);
     confine own;
@@ -627,6 +631,7 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, c
     P.c = (cursor){buf, name, 0, err};
     P.dir = dir;
     P.scope = scope;
+    P.budget = budget;
     int rc = 0;
     const char *nul = memchr(text, 0, len);
     if (nul) {
@@ -669,6 +674,12 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, c
     return 0;
 }
 
+int obj_parse(const char *text, size_t len, const char *name, const char *dir, const confine *scope, mesh_data *m,
+              fr_error *err)
+{
+    return parse_obj(text, len, name, dir, scope, NULL, m, err);
+}
+
 int obj_parse_mtl(const char *text, size_t len, const char *name, mesh_data *m, fr_error *err)
 {
     char *buf = malloc(len + 1);
@@ -694,7 +705,7 @@ int obj_parse_mtl(const char *text, size_t len, const char *name, mesh_data *m, 
     return rc;
 }
 
-int obj_read(const char *path, const confine *scope, mesh_data *m, fr_error *err)
+int obj_read(const char *path, const confine *scope, fr_budget *budget, mesh_data *m, fr_error *err)
 {
     char *text;
     size_t len;
@@ -702,7 +713,7 @@ int obj_read(const char *path, const confine *scope, mesh_data *m, fr_error *err
         return -1;
     char dir[4096];
     file_dir(path, dir, sizeof dir);
-    int rc = obj_parse(text, len, path, dir, scope, m, err);
+    int rc = parse_obj(text, len, path, dir, scope, budget, m, err);
     free(text);
     return rc;
 }

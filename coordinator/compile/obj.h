@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "compile/budget.h"
 #include "compile/confine.h"
 #include "compile/mesh_data.h"
 #include "error.h"
@@ -31,8 +32,9 @@ int obj_parse(const char *text, size_t len, const char *name, const char *dir, c
 
 /** Reads and parses the OBJ file `path` (see obj_parse): through `scope`
  * when a scene names it, or as named with its own folder as the scope
- * (scope NULL). */
-int obj_read(const char *path, const confine *scope, mesh_data *m, fr_error *err);
+ * (scope NULL).  Each MTL file it names counts against budget's read
+ * limit first (NULL: no limit). */
+int obj_read(const char *path, const confine *scope, fr_budget *budget, mesh_data *m, fr_error *err);
 
 /** Parses MTL text into m's materials (defining those already used and
  * appending new ones). */
