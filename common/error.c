@@ -1,3 +1,6 @@
+/* error.c -- fr_fail, the one way an error message is written into an fr_error
+ * (see error.h). */
+
 #include "error.h"
 
 #include <stdarg.h>

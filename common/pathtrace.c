@@ -1,3 +1,6 @@
+/* pathtrace.c -- the path tracer: camera rays, one pixel sample, and rows of
+ * an image (see pathtrace.h). */
+
 #include "pathtrace.h"
 
 #include "camera.h"

@@ -1,3 +1,6 @@
+/* bvh_build.c -- the BVH build: binned SAH binary tree collapsed to the 8-wide
+ * layout (see bvh_build.h). */
+
 #include "compile/bvh_build.h"
 
 #include <math.h>
