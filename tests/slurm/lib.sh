@@ -1,4 +1,6 @@
-# lib.sh -- sourced by the Slurm tests (tests/it_slurm*.sh) and benchmark:
+# lib.sh -- helpers sourced by the Slurm tests and benchmark.
+#
+# Sourced by the Slurm tests (tests/it_slurm*.sh) and benchmark:
 # a private cluster from tests/slurm/cluster.sh, stopped on exit whatever
 # happens, and Slurm clients that can neither hang nor read the test's stdin.
 #
