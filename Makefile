@@ -68,19 +68,21 @@ COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) -ldl -lm -pth
 all: bin/franja-worker bin/franja $(IIO_PLUGIN)
 
 # The modules a pixel sample runs through are built at -O3 (more inlining
-# and unrolling: 2.7 % fewer instructions a sample on the Cornell
-# box, the same bits, since -ffp-contract=off and no fast-math keep every
-# rounding where the source puts it); the rest stays at $(OPT).
+# and unrolling: fewer instructions a sample on the Cornell box,
+# tests/bench/README.md, "-O3 on the render path"; the same bits, since
+# -ffp-contract=off and no fast-math keep every rounding where the source
+# puts it); the rest stays at $(OPT).
 HOT_SRC = $(addprefix common/,bsdf.c camera.c envmap.c fmath.c geom.c light.c medium.c microfacet.c \
           pathtrace.c sampler.c texture.c trace.c vertex.c)
 # They also carry GCC's intermediate code beside the machine code (fat LTO
 # objects), and the two programs are linked with link-time optimisation:
 # calls from one of these modules into another (the sampler, the own
 # math, a hit point's offset, a light sample) are inlined across files,
-# for 5 % fewer instructions a sample, again the same bits (the link step
-# repeats the floating-point flags).  Tests, tools and benchmarks link the
-# machine code as before (-fno-lto: GCC's linker plugin would otherwise
-# optimise them at link time too, slowly, and under their -Werror).
+# for fewer instructions a sample (tests/bench/README.md, "Link-time optimisation"),
+# again the same bits (the link step repeats the floating-point flags).
+# Tests, tools and benchmarks link the machine code as before (-fno-lto:
+# GCC's linker plugin would otherwise optimise them at link time too,
+# slowly, and under their -Werror).
 # make LTO= builds without it.
 LTO     ?= -flto=auto
 LTO_OBJ  = $(if $(LTO),$(LTO) -ffat-lto-objects)
@@ -154,10 +156,10 @@ bin/tools/nolockfs: tests/tools/nolockfs.c
 # Their segments are aligned to 2 MiB, so the kernel places them at a random
 # multiple of 2 MiB and the low 21 bits of each code address are the link's.
 # At the default 4 KiB those bits were random per process, and so was the
-# walk's speed in bvhbench: 3 of 10 processes ran its closest hits on the
-# 100 k terrain some 10 % slower than the rest, while 30 of 30 with the code
-# placed alike did not (tests/bench/README.md).  The code is the same; the
-# file is sparse where it is padded.
+# walk's speed in bvhbench: some processes ran its closest hits on the
+# 100 k terrain slower than the rest, while none did with the code placed
+# alike (tests/bench/README.md, "Benchmarks linked with 2 MiB segments").
+# The code is the same; the file is sparse where it is padded.
 BENCH_LDFLAGS = -Wl,-z,max-page-size=0x200000
 bin/bench/%: tests/bench/%.c $(wildcard tests/bench/*.h) $(LIB)
 	@mkdir -p bin/bench

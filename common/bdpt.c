@@ -1,3 +1,6 @@
+/* bdpt.c -- bidirectional path tracing: camera and light subpaths joined with
+ * MIS weights (see bdpt.h). */
+
 #include "bdpt.h"
 
 #include <stdlib.h>

@@ -1,3 +1,6 @@
+/* bsdf.c -- the lobe materials' scattering: evaluation, pdf and sampling of
+ * their BSDFs (see bsdf.h). */
+
 #include "bsdf.h"
 
 #include "fmath.h"

@@ -1,3 +1,6 @@
+/* bvh.c -- the check that a loaded 8-wide BVH is sound before any ray walks it
+ * (see bvh.h). */
+
 #include "bvh.h"
 
 #include <math.h>

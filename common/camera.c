@@ -1,3 +1,6 @@
+/* camera.c -- the camera as a sensor: lens points, raster positions and
+ * importance (see camera.h). */
+
 #include "camera.h"
 
 #include "fmath.h"

@@ -1,3 +1,6 @@
+/* envmap.c -- the environment light: radiance from a direction, its sampling
+ * and pdf (see envmap.h). */
+
 #include "envmap.h"
 
 #include "fmath.h"

@@ -1,3 +1,6 @@
+/* fbin.c -- the binary scene: serialized, written, and loaded and checked by
+ * mapping (see fbin.h). */
+
 #include "fbin.h"
 
 #include "bvh.h"

@@ -2,7 +2,8 @@
  * The transcendental functions of the render path.
  *
  * libm's sin, cos, exp, log ... differ in their last bits between C
- * libraries (glibc 2.31 and 2.36 disagree on ~0.07 % of sin/cos inputs), so
+ * libraries (glibc 2.31 and 2.36 disagree on some sin/cos inputs;
+ * tests/bench/README.md, "libm across C libraries"), so
  * a slab rendered on one host would not match the same slab rendered on
  * another.  These versions use only + - * / and sqrt, which IEEE 754 rounds
  * exactly, so they give the same bits on every machine and C library.

@@ -1,3 +1,6 @@
+/* geom.c -- ray/sphere, plane, rectangle and triangle intersection, and hit
+ * points (see geom.h). */
+
 #include "geom.h"
 
 #include <string.h>

@@ -1,3 +1,6 @@
+/* image.c -- partial images of the PPM family: written by workers, read back
+ * strictly (see image.h). */
+
 #include "image.h"
 
 #include <errno.h>

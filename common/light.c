@@ -1,3 +1,6 @@
+/* light.c -- lights for next-event estimation and as the start of light paths
+ * (see light.h). */
+
 #include "light.h"
 
 #include "envmap.h"

@@ -1,3 +1,6 @@
+/* medium.c -- homogeneous media: transmittance, phase function, distance and
+ * equiangular sampling (see medium.h). */
+
 #include "medium.h"
 
 #include "fmath.h"

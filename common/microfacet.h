@@ -222,9 +222,9 @@ enum {
  *  MF_COUPLE_GLTF) reflects more than it receives at grazing angles, so the
  *  default weights the base by what the layer lets through on the way in and
  *  out, with E_s the layer's directional albedo (MF_COUPLE_ALBEDO).
- *  Measured on a base of 0.8: the albedos agree within 3 % up to 45 degrees
- *  of incidence; at 75 degrees glTF's is up to 19 % higher and at 88
- *  degrees it exceeds 1 (1.59 at roughness 0.05).
+ *  On a base of 0.8 the two albedos agree near normal incidence and part
+ *  toward grazing, where glTF's exceeds 1
+ *  (tests/bench/README.md, "glTF's fresnel_mix against albedo coupling").
  *  KHR_materials_transmission replaces the share @p transmission of the
  *  dielectric by refraction through a rough dielectric boundary of the
  *  given ior (exact Fresnel, its own reflection untinted and transmission

@@ -1,3 +1,6 @@
+/* pathtrace.c -- the path tracer: camera rays, one pixel sample, and rows of
+ * an image (see pathtrace.h). */
+
 #include "pathtrace.h"
 
 #include "camera.h"
@@ -5,11 +8,12 @@
 #include "vertex.h"
 
 /* Scattering vertices a path passes before Russian roulette may end it.
- * Measured on the noise benches (tests/bench/noise.sh): starting at the
- * second vertex, as Cycles does, saves time but adds 5-9 % RMSE per sample;
+ * On the noise benches (tests/bench/noise.sh), starting at the second
+ * vertex, as Cycles does, saves time but leaves more noise per sample;
  * from the fourth on, with the policy below, the mirror and glass box is
- * 8 % less noisy than with the former policy (cap 0.95, no square root,
- * from the fifth vertex) and renders about 10 % faster. */
+ * both less noisy and faster than with the former policy (cap 0.95, no
+ * square root, from the fifth vertex)
+ * (tests/bench/README.md, "Russian roulette's start"). */
 #define RR_DEPTH 3
 
 /* Russian roulette: the path survives with probability

@@ -1,3 +1,6 @@
+/* quick.c -- FRANJA_MAX_SPP read from the environment as a cap on samples per
+ * pixel (see quick.h). */
+
 #include "quick.h"
 
 #include <stdlib.h>

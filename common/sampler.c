@@ -1,3 +1,6 @@
+/* sampler.c -- the pixel sample's random numbers: Owen-scrambled 2D Sobol
+ * pairs (see sampler.h). */
+
 #include "sampler.h"
 
 #include <stddef.h>

@@ -1,3 +1,6 @@
+/* scene_pages.c -- a loaded scene's BVH copied into memory of 2 MiB pages (see
+ * scene_pages.h). */
+
 #include "scene_pages.h"
 
 #include <stdint.h>

@@ -7,7 +7,8 @@
  * need a few dozen.  A mapped binary scene gets such pages only where the
  * page cache happens to hold large folios (which depends on the kernel and
  * on how the file was written and read), so the walk of the same tree ran
- * at 0.71 to 1.0 of its speed in large pages from one load to the next.
+ * slower in some loads than in others
+ * (tests/bench/README.md, "Large pages for the BVH").
  *
  * scn_bvh_large_pages copies the nodes and leaf blocks into private
  * anonymous memory, 2 MiB-aligned, that asks the kernel for large pages

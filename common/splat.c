@@ -1,3 +1,6 @@
+/* splat.c -- light-tracing splats as 64-bit fixed point, summed in any order
+ * (see splat.h). */
+
 #include "splat.h"
 
 uint64_t spl_fixed(float v)

@@ -1,3 +1,6 @@
+/* texture.c -- texture lookups, and textures, bump and normal maps applied at
+ * a hit (see texture.h). */
+
 #include "texture.h"
 
 #include "bsdf.h"

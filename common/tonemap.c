@@ -1,3 +1,6 @@
+/* tonemap.c -- exposure, the filmic curve and sRGB encoding of the final image
+ * (see tonemap.h). */
+
 #include "tonemap.h"
 
 #include <string.h>

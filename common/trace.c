@@ -1,3 +1,6 @@
+/* trace.c -- the closest hit and shadow-ray queries over the BVH and the
+ * planes (see trace.h). */
+
 #include "trace.h"
 
 #include <string.h>

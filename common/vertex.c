@@ -1,3 +1,6 @@
+/* vertex.c -- path vertices: the next vertex through media, light samples,
+ * scattering (see vertex.h). */
+
 #include "vertex.h"
 
 #include "fmath.h"

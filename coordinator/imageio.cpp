@@ -1,5 +1,5 @@
-// imageio.cpp -- OpenImageIO behind a C header (imageio.h).  Nothing else
-// in the coordinator is C++, and no C++ exception crosses into C.
+/* imageio.cpp -- OpenImageIO behind a C header (imageio.h).  Nothing else
+ * in the coordinator is C++, and no C++ exception crosses into C. */
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 

@@ -1,4 +1,6 @@
 #!/bin/sh
+# base-image.sh -- makes a missing debian:SUITE base image with debootstrap.
+#
 # base-image.sh SUITE... -- give the Docker engine the base image debian:SUITE
 # when it has none, built from Debian's repository with debootstrap (for
 # machines that reach Debian's mirror but no image registry).  An engine that

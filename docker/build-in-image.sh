@@ -1,4 +1,6 @@
 #!/bin/sh
+# build-in-image.sh -- builds the workers and franja inside a Dockerfile image.
+#
 # build-in-image.sh OUT -- run inside a docker/Dockerfile.* image, in a copy of
 # the source tree: builds franja-worker for amd64 (native) and arm64 (Debian's
 # cross compiler, against the image's libcjson-dev:arm64), and franja for

@@ -1,4 +1,6 @@
 #!/bin/sh
+# build.sh -- builds the Dockerfile.* images and copies out their binaries.
+#
 # build.sh [-o DIST] [-j N] [--bootstrap] [--own-engine] [TARGET...]
 #
 # Builds the docker/Dockerfile.TARGET images (TARGET: bullseye, bookworm,
@@ -27,7 +29,7 @@ while [ $# -gt 0 ]; do
     -j) jobs=$2; shift 2 ;;
     --bootstrap) bootstrap=1; shift ;;
     --own-engine) own=1; bootstrap=1; shift ;;
-    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '4,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "build.sh: unknown option '$1'" >&2; exit 2 ;;
     *) break ;;
     esac

@@ -1,4 +1,6 @@
 #!/bin/sh
+# private-dockerd.sh -- starts or stops a private Docker engine.
+#
 # private-dockerd.sh start STATE_DIR [DATA_DIR] | stop STATE_DIR
 #
 # Runs a Docker engine of its own, for machines where none is running (the

@@ -1,4 +1,6 @@
 #!/bin/sh
+# install-deps.sh -- installs the Debian packages to build, test and benchmark.
+#
 # Install the Debian 12 packages Franja needs to build, test and cross-build
 # (make deps); with the argument `bench`, also what the benchmarks and the
 # references compare against: Blender's Cycles, and numpy for Blender's

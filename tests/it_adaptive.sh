@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_adaptive.sh -- tests adaptive sampling through the band renderer.
+#
 # Adaptive sampling through the band renderer: `franja render
 # --noise-threshold E` stitches the same bytes from 1, 2, 3 and 7 slabs and
 # any number of workers (each pixel's decision reads only its own samples),

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_appear.sh -- tests the appearance scenes compile and render end to end.
+#
 # The appearance scenes end to end: each compiles (image textures through
 # OpenImageIO) and renders a slab; the worker alone refuses a JSON scene with
 # image textures and says to compile it; textures really reach the binary

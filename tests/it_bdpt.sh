@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_bdpt.sh -- tests bidirectional renders stitch alike for any split.
+#
 # Bidirectional renders through the band renderer.  Light tracing adds
 # light to rows outside the slab that traced it, yet the stitched image is
 # byte-identical for 1, 2, 3 and 7 slabs, any number of worker processes,

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_budget.sh -- tests the compile budget against crafted scenes.
+#
 # The compile budget: crafted glTF and JSON scenes that declare huge
 # accessors, name one file many times, hold a buffer past the per-file
 # limit, drive lookups quadratic or keep vertices no triangle uses are

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_cache.sh -- the scene cache of SSH hosts stays bounded: with cache=SIZE
+# it_cache.sh -- tests the SSH hosts' scene cache stays within its bound.
+#
+# The scene cache of SSH hosts stays bounded: with cache=SIZE
 # in the host table, staging a scene removes the least recently used ones
 # until the cache fits, keeping the scene just used, any scene a running
 # worker has mapped and any scene a live render holds a lease on (between

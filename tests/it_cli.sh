@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_cli.sh -- franja's command line: version, help, the outputs named after
+# it_cli.sh -- tests franja's version, help and default output names.
+#
+# franja's command line: version, help, the outputs named after
 # the scene when -o is omitted.
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh

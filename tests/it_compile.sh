@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_compile.sh -- tests franja compile end to end.
+#
 # franja compile end to end: a compiled scene renders the same bytes as the
 # JSON it came from, compiling is deterministic, meshes (OBJ/MTL, Assimp
 # formats, transforms, levels of detail) arrive, and bad input of every

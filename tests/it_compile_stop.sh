@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_compile_stop.sh -- tests an interrupted compile stops at once, leaving nothing.
+#
 # Ctrl-C (SIGINT) or SIGTERM during a long compile stops franja render and
 # franja compile at once (the compile runs in a child process that is
 # killed), leaves no partial scene.fbin, no private compile directory and

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_continue.sh -- franja-worker --sums and --continue FILE: a slab
+# it_continue.sh -- tests franja-worker --sums and --continue give exact bytes.
+#
+# franja-worker --sums and --continue FILE: a slab
 # rendered with fewer samples and continued gives the bytes of a render of
 # every sample at once; what cannot be continued exactly is refused.
 cd "$(dirname "$0")/.." || exit 1

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_conventions.sh -- what the docs say about Franja's conventions, and how
+# it_conventions.sh -- tests the documented conventions by measuring them.
+#
+# What the docs say about Franja's conventions, and how
 # they map to Cycles, measured.  Each check reads the statement from the docs
 # (so a wrong statement fails here) and measures it: against a closed form,
 # or against the small Cycles renders in tests/data (made by `make refs`).

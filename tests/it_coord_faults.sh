@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_faults.sh -- tests renders survive faults on fake SSH hosts.
+#
 # Faults on fake SSH hosts, each render still ending byte-identical to the
 # one-process render: a worker killed mid-slab, truncated and wrong-size
 # partial images, a host unreachable from the start, a whole host killed

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_hostile.sh -- tests renders survive hostile and broken workers.
+#
 # Hostile and broken workers on fake SSH hosts: each render still finishes
 # on the healthy host, in bounded time, byte-identical to the one-process
 # render.

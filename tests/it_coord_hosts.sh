@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_hosts.sh -- tests the host table parser through franja hosts list.
+#
 # The host table parser (franja-hosts(5)), through `franja hosts list`:
 # good tables parse with defaults filled in; every bad line is refused with
 # file:line and what was expected, and nothing crashes.

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_lifeline.sh -- tests workers end when the coordinator is gone.
+#
 # Workers end themselves when the coordinator or their channel is gone
 # (worker/lifeline.h): a worker whose --lifeline standard input ends, or
 # whose standard output's reader goes; a local render's workers and an SSH

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_local.sh -- tests the coordinator with local workers.
+#
 # The coordinator on this machine (no SSH): -j 1 and -j N give the same bytes
 # as a one-process render; every output format is written; faults of local
 # workers (bad output, a stuck process) are survived; Ctrl-C keeps the

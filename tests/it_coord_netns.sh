@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_netns.sh -- tests a host whose link goes silent is dropped.
+#
 # A link that goes silent: one fake host lives in its own network namespace
 # behind a veth pair; mid-render the veth is taken down, so packets vanish
 # without any reset.  The coordinator notices the silence (keepalive

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_odd.sh -- tests odd hosts are left out or tamed, with a message.
+#
 # Odd hosts on fake SSH hosts: each is left out or tamed, with a message,
 # and the render ends on the others, byte-identical to the one-process
 # render.  An absurd processor count (clamped), a worker of another version

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_slowhost.sh -- tests hosts slow to be ready hold nobody up.
+#
 # Hosts that are slow to be ready hold nobody up: slabs start on each host
 # as soon as it is ready.  A host that accepts TCP connections and never
 # answers (its sshd stopped: the kernel still completes the handshake, as

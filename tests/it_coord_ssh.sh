@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_coord_ssh.sh -- tests the coordinator over SSH with fake hosts.
+#
 # The coordinator over SSH with fake hosts (real sshd on loopback): the
 # stitched image equals the one-process render byte for byte, the scene
 # reaches each host's work directory by SFTP once, a damaged cached copy is

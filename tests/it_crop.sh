@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_crop.sh -- franja render --crop X0:Y0:X1:Y1: only the window's rows are
+# it_crop.sh -- tests franja render --crop renders only the window.
+#
+# franja render --crop X0:Y0:X1:Y1: only the window's rows are
 # rendered, split like any render; the window's pixels are byte for byte
 # those of a full render, the rest black; --crop-output writes the window
 # alone; bad windows are refused before rendering.

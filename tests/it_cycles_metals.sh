@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_cycles_metals.sh -- tests rough metals against Cycles.
+#
 # Rough metals against Cycles: tests/data/cycles-metals.json (the Cornell
 # box with three GGX conductor spheres of roughness 0.15, 0.35 and 0.6,
 # without Fresnel factor and with separable masking: Cycles' Glossy BSDF),

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_cycles_principled.sh -- tests the principled material against Cycles.
+#
 # The principled (glTF metallic-roughness) material against Cycles 3.4's
 # Principled BSDF: tests/data/cycles-principled.json (a red dielectric of
 # roughness 0.25, a blue one of roughness 0.7, a half-metallic gold, a

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_cycles_rough.sh -- tests rough metal and rough glass against Cycles.
+#
 # Rough metal and rough glass against Cycles: tests/data/cycles-rough.json
 # (a GGX metal sphere without Fresnel factor, a rough glass sphere and a
 # diffuse sphere on a diffuse plane, lit only by scenes/textures/sky.hdr, a

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_docs.sh -- the documentation's examples run, and show what they say.
+# it_docs.sh -- tests the documentation's examples run and show what they say.
+#
+# The documentation's examples run, and show what they say.
 #
 # Every fenced example (```lang ... ```) of the Markdown files of the
 # repository (README.md, scenes/README.md, coordinator/README.md ..., any

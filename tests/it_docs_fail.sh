@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_docs_fail.sh -- tests/it_docs.sh fails on documentation that does not
+# it_docs_fail.sh -- tests it_docs.sh fails on broken documentation.
+#
+# tests/it_docs.sh fails on documentation that does not
 # do what it says, naming the file and line: a document of broken examples
 # (written here, never into the repository) must give exactly the failures
 # listed below, and its one good example must pass.

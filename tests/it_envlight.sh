@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_envlight.sh -- tests the environment map against Cycles.
+#
 # The environment map against Cycles: scenes/textures/sky.hdr read through
 # the scene compiler (OpenImageIO) and rendered by Franja, view by view,
 # against Cycles' renders of the same views with the map as Blender's

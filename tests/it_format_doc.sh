@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_format_doc.sh -- FORMAT.md (the binary scene's specification) says the
+# it_format_doc.sh -- tests FORMAT.md against the format the code uses.
+#
+# FORMAT.md (the binary scene's specification) says the
 # format version and the sections that the code writes and reads.
 #
 # From FORMAT.md: the version of its title, of its opening paragraph, of

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_frames.sh -- franja render PATTERN --frames LIST: a three-frame
+# it_frames.sh -- tests franja render --frames gives each frame's bytes.
+#
+# franja render PATTERN --frames LIST: a three-frame
 # animation (a sphere moving) gives, frame for frame, the bytes of three
 # single renders; outputs that exist are skipped unless --overwrite; an
 # interrupt keeps the frame's finished slabs and --resume goes on from

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_frames_report.sh -- an animation's reporters with its frames rendered
+# it_frames_report.sh -- tests an animation's progress, preview and time limit.
+#
+# An animation's reporters with its frames rendered
 # together: --progress json is one stream in which every event of a frame
 # carries its number (frame 2 starts before frame 1 is done, on two
 # slots), the run's own events carry none; --preview writes each frame's

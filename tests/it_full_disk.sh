@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_full_disk.sh -- tests the final image on a full file system.
+#
 # The final image on a full file system: for every output format the render
 # fails with a message naming the file, the file already there is left as it
 # was (no truncated or empty image under the final name), no temporary file

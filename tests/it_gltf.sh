@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_gltf.sh -- tests glTF 2.0 scenes end to end.
+#
 # glTF 2.0 scenes end to end: files written by tests/gen/gengltf compile
 # and render; the same triangles as glTF and as JSON give the same binary
 # scene and image; node transforms, camera framing (yfov, aspectRatio) and

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_guide.sh -- make docs: the user guide (pandoc) and the API
+# it_guide.sh -- tests make docs builds the guide and API pages, links intact.
+#
+# make docs: the user guide (pandoc) and the API
 # documentation (Doxygen) are built; the guide has a page per README and
 # per manual page, each man page's page has every section of the page
 # (.SH), each README's page every heading, and every link of the guide

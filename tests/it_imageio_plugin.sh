@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_imageio_plugin.sh -- franja loads OpenImageIO through its plug-in
+# it_imageio_plugin.sh -- tests OpenImageIO is loaded through its plug-in only.
+#
+# franja loads OpenImageIO through its plug-in
 # franja-imageio.so only when it reads or writes an image other than PFM:
 # franja itself needs none of OpenImageIO's libraries; with the plug-in
 # beside it (or in ../lib/franja) a PNG is written; without it a PFM

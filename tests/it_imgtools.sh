@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_imgtools.sh -- the image tools the other tests measure with, on PFM
+# it_imgtools.sh -- tests the image tools the other tests measure with.
+#
+# The image tools the other tests measure with, on PFM
 # files whose values are known: pfmpix's orientation (y = 0 is the top row,
 # which a PFM stores last), imgstat's means, and imgcmp's RMSE with and
 # without --clamp-pct (a percentile of the reference's channels off the

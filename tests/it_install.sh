@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_install.sh -- make install / make uninstall into a staging DESTDIR: the
+# it_install.sh -- tests make install and make uninstall into a DESTDIR.
+#
+# make install / make uninstall into a staging DESTDIR: the
 # programs run from where they are installed (franja finds the installed
 # worker), man finds the pages, bash completion offers the commands, the
 # options and the scene files, and uninstall leaves no file behind.

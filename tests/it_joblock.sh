@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_joblock.sh -- tests one render per output through the job lock.
+#
 # One render per output: the job directory's lock keeps a second franja out
 # (status 2, naming the first), a killed render's lock is taken over at once
 # by --resume, --fresh is refused while another render holds the lock,

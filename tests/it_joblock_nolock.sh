@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_joblock_nolock.sh -- tests a job directory on a file system without locks.
+#
 # A job directory on a file system that refuses locks (franja(1), "Job
 # directory"): bin/tools/nolockfs mounts a directory through FUSE answering
 # every fcntl and flock lock with ENOLCK, as an NFS mount without a lock

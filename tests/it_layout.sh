@@ -16,7 +16,9 @@
 #     benchmark or fuzz target (an allow-list names the entry points);
 #   - no test compiles a project source into itself (#include "x.c");
 #   - every common/ header is documented in the comment style Doxygen reads
-#     (/** @file NAME ... */), and `make docs` shows the header contracts.
+#     (/** @file NAME ... */), and `make docs` shows the header contracts;
+#   - every source, header and script opens with a line saying what it is
+#     ("/* NAME -- ...", "/** @file NAME", "# NAME -- ..." after a shebang).
 cd "$(dirname "$0")/.." || exit 1
 . tests/lib.sh
 need nm tsort cc doxygen
@@ -187,7 +189,24 @@ fi
 grep -rn '^[[:space:]]*#[[:space:]]*include[[:space:]]*"[^"]*\.c"' tests --include='*.c' --include='*.h' >"$T/cinc"
 if [ -s "$T/cinc" ]; then bad "a test includes a source: $(head -3 "$T/cinc")"; else ok; fi
 
-# (6) Header comments Doxygen reads, and the documentation it makes.
+# (6) Every source, header and script opens with a line saying what it is.
+opening() { # FILE: succeeds when FILE opens as the rule says
+    b=$(basename "$1")
+    case "$1" in
+    *.h) head -n 1 "$1" | grep -qE "^/\*\*? (@file $b\$|$b --)" ;;
+    *.sh) sed -n '1,2p' "$1" | grep -q "^# $b -- " ;;
+    *) head -n 1 "$1" | grep -q "^/\* $b -- " ;;
+    esac
+}
+{ git ls-files 'common/*' 'coordinator/*' 'worker/*' 'tests/*' 'docker/*' 2>/dev/null ||
+    find common coordinator worker tests docker -type f; } | grep -E '\.(c|cpp|inc|h|sh)$' >"$T/all"
+check "sources and scripts found" test "$(wc -l <"$T/all")" -gt 150
+while read -r f; do opening "$f" || echo "$f"; done <"$T/all" >"$T/noopen"
+if [ -s "$T/noopen" ]; then bad "files without an opening line: $(head -5 "$T/noopen" | tr '\n' ' ')"; else ok; fi
+printf '#include <stdio.h>\n' >"$T/plant.c"
+if opening "$T/plant.c"; then bad "a planted file without an opening line goes unnoticed"; else ok; fi
+
+# (7) Header comments Doxygen reads, and the documentation it makes.
 for h in $(grep '^common/.*\.h$' "$T/files"); do
     head -n 1 "$h" | grep -qx "/\*\* @file $(basename "$h")" || bad "$h does not open with /** @file $(basename "$h")"
     grep -n '/\*[^*]' "$h" | grep -v '/\*\*' >"$T/plain" && bad "$h: plain /* comments: $(head -2 "$T/plain")"

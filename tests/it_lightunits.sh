@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_lightunits.sh -- Blender's light units, their glTF export and Franja's
+# it_lightunits.sh -- tests Blender's light units through glTF against Franja.
+#
+# Blender's light units, their glTF export and Franja's
 # import, measured (scenes/README.md, "Units, glTF and Blender").
 #
 # tests/refs/cycles_lights.py (make refs) built three Blender scenes -- a

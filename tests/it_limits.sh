@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_limits.sh -- tests unusable numbers and empty scene files are refused.
+#
 # Numbers a single-precision renderer cannot use, and empty scene files:
 # refused with the JSON path (or the file) and what was expected, never an
 # internal message, a vanished shape or a file misread as another kind.

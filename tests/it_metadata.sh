@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_metadata.sh -- a final image says what made it: Franja's version
+# it_metadata.sh -- tests the final image records what made it.
+#
+# A final image says what made it: Franja's version
 # (Software), the scene's hash, the samples per pixel, the integrator, the
 # render time and the hosts that rendered rows (ImageDescription, and as
 # franja:* attributes in OpenEXR), read back with oiiotool from .png

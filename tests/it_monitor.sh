@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_monitor.sh -- franja render --monitor PORT: a live page on 127.0.0.1,
+# it_monitor.sh -- tests the --monitor web page in a real browser.
+#
+# franja render --monitor PORT: a live page on 127.0.0.1,
 # at the address with its token that franja prints (it_monitor_guard.sh
 # checks the token and the limits), loaded in a real browser (headless chromium) during a render on two
 # hosts, one of which fails every slab; the page shows the image so far,

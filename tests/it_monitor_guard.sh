@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_monitor_guard.sh -- who may use franja render --monitor, and for how
+# it_monitor_guard.sh -- tests the monitor's token and request deadlines.
+#
+# Who may use franja render --monitor, and for how
 # long: without --monitor-open every request needs the token of the address
 # printed on stderr (none, or a wrong one, gets 403); with it, none is
 # needed.  Clients that trickle a header line a second hold no connection

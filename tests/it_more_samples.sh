@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_more_samples.sh -- tests --resume --spp adds samples to the exact bytes.
+#
 # More samples later: a render kept with --keep-job goes on with
 # --resume --spp N, rendering only the samples each pixel lacks, to the
 # bytes of a render of every sample at once: locally and on fake SSH hosts,

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_options.sh -- one list of options: `franja COMMAND --help`, `franja
+# it_options.sh -- tests help texts, man pages and README agree on options.
+#
+# One list of options: `franja COMMAND --help`, `franja
 # --help`, `franja-worker --help`, franja(1), franja-worker(1) and the
 # option tables of README.md name the same options with the same defaults.
 #

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_output_options.sh -- how the output is stored: --jpeg-quality for
+# it_output_options.sh -- tests the JPEG and OpenEXR output options.
+#
+# How the output is stored: --jpeg-quality for
 # .jpg (default 98, as the help says), --exr-half and --exr-compression for
 # .exr (default 32-bit floats, zip), each visible in the file; bad values
 # are refused with what is allowed.

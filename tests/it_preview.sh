@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_preview.sh -- franja render --preview FILE: the image so far, written
+# it_preview.sh -- tests --preview writes the image so far.
+#
+# franja render --preview FILE: the image so far, written
 # atomically every few seconds while the render runs (rows not yet done as
 # a grey checkerboard), and the whole image at the end; --progress json:
 # one JSON object a line on stdout.

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_reference.sh -- tests the Cornell box against the Cycles reference.
+#
 # Against a peer: scenes/cornell.json at 256x256 and 64 spp, rendered as two
 # worker slabs, against the Cycles reference (4096 spp) in tests/data:
 # each channel's mean within 1.5 %, RMSE off the light <= 0.010.

@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_size.sh -- the image size on render's command line: --scale 50% or
+# it_size.sh -- tests --scale and --size on render's command line.
+#
+# The image size on render's command line: --scale 50% or
 # 0.5 renders at that fraction of the scene's size, each side rounded to
 # the nearest pixel (halves up) and at least 1, and gives the same bytes as
 # --size with that size; bad scales and --scale with --size are refused

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_slurm.sh -- tests franja on a real Slurm cluster of three nodes.
+#
 # franja render --slurm and franja hosts check --slurm on a real Slurm
 # cluster of three nodes on this machine (tests/support/slurm_cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_slurm_cluster.sh -- tests the Slurm test cluster itself.
+#
 # The Slurm test cluster itself (tests/support/slurm_cluster.sh), before anything is
 # rendered on it: three nodes come up idle, a step spans them, a lost node
 # is noticed by the controller and comes back, and stop leaves no daemon and

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_special_files.sh -- tests inputs that are not plain files are refused in time.
+#
 # Inputs that are not plain files, or that promise more than they hold: a
 # FIFO as scene, mesh, MTL, texture or host table; /dev/zero (directly or
 # through a symbolic link) as scene or mtllib; a directory; an ASCII PLY

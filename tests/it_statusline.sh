@@ -1,5 +1,7 @@
 #!/bin/sh
-# it_statusline.sh -- the live progress line on a terminal (a pseudo-terminal
+# it_statusline.sh -- tests the live progress line fits the terminal.
+#
+# The live progress line on a terminal (a pseudo-terminal
 # made by script(1)) fits the terminal's width, from TIOCGWINSZ or, when the
 # terminal has no size, from $COLUMNS, and shows the elapsed time and the ETA.
 cd "$(dirname "$0")/.." || exit 1

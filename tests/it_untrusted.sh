@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_untrusted.sh -- tests that scene files read only their own folder.
+#
 # Untrusted scene files: every file a glTF, OBJ or JSON scene names must lie
 # in the scene's own folder (or one --allow-path gives), FIFOs and devices
 # are refused at once, and no message, output or .fbin repeats a byte of a

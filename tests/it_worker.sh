@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_worker.sh -- tests franja-worker end to end.
+#
 # franja-worker end to end: its command line, its errors on bad input,
 # split invariance through real processes, and the formats it writes.
 cd "$(dirname "$0")/.." || exit 1

@@ -1,4 +1,6 @@
-# lib.sh -- sourced by the shell tests (tests/it_*.sh, and through
+# lib.sh -- the check counters sourced by every shell test.
+#
+# Sourced by the shell tests (tests/it_*.sh, and through
 # tests/support/fakehosts.sh and tests/cross/lib.sh by the others): counts the
 # checks and prints the closing line that tests/run.sh reads.
 #

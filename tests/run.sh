@@ -1,4 +1,6 @@
 #!/bin/sh
+# run.sh -- runs the tests and prints the total passed and failed.
+#
 # Run the given tests (default: every test program bin/tests/test_* and
 # integration script tests/it_*.sh in name order, then a short fuzz pass:
 # tests/fuzz/run.sh, FUZZ_TEST_SECONDS (default 10) per libFuzzer target

@@ -1,4 +1,7 @@
-/* Adaptive sampling (settings.noise_threshold): any split of the rows
+/* test_adaptive.c -- adaptive sampling is split-invariant, keeps the mean and
+ * checks its range.
+ *
+ * Adaptive sampling (settings.noise_threshold): any split of the rows
  * (2, 3, 7 slabs) renders the same bits; a threshold no pixel can reach renders the
  * image of the full sample count (but for pixels black so far); a reachable one stops pixels early
  * and keeps the image's mean; the scene reader and the worker command

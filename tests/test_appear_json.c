@@ -1,4 +1,7 @@
-/* The appearance part of the scene format refuses bad input with the JSON
+/* test_appear_json.c -- the scene reader's errors on bad textures, maps, media
+ * and lens.
+ *
+ * The appearance part of the scene format refuses bad input with the JSON
  * path and what was expected: textures, textured colours, bump and normal
  * maps, media, interfaces, the f-number lens and tone mapping. */
 #include <stdlib.h>

@@ -1,4 +1,6 @@
-/* Bidirectional path tracing estimates the same images as path tracing.
+/* test_bdpt.c -- bidirectional path tracing agrees with path tracing.
+ *
+ * Bidirectional path tracing estimates the same images as path tracing.
  *
  * - On the Cornell box and the spheres scene (mirror, glass), block by
  *   block, BDPT's means agree with path tracing's within their noise.

@@ -1,4 +1,7 @@
-/* Depth of field: a thin lens of radius A focused at distance F (along the
+/* test_dof.c -- depth of field blurs a point into the thin lens's circle of
+ * confusion.
+ *
+ * Depth of field: a thin lens of radius A focused at distance F (along the
  * view axis) images a point at depth z as a uniform disk whose radius on
  * the focal plane is A |z - F| / z (the circle of confusion of the
  * thin-lens formula, seen through the lens' magnification).  Tiny emissive

@@ -1,4 +1,7 @@
-/* Energy: white furnaces (closed diffuse enclosures that emit) and a point
+/* test_energy.c -- white furnaces and a lit Lambert plane against analytic
+ * radiance.
+ *
+ * Energy: white furnaces (closed diffuse enclosures that emit) and a point
  * light over a Lambert plane, against their analytic radiance. */
 #include <math.h>
 

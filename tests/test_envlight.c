@@ -1,4 +1,7 @@
-/* The environment light: its sampling against its pdf (chi-square over the
+/* test_envlight.c -- the environment light's sampling, pdf, furnace and
+ * orientation.
+ *
+ * The environment light: its sampling against its pdf (chi-square over the
  * map's texels, binned with libm's own mapping of directions), the pdf
  * against the radiance it follows, a constant environment as a furnace,
  * light-only / BSDF-only / MIS agreement, and the documented orientation

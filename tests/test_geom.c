@@ -1,4 +1,7 @@
-/* Ray/primitive intersection: hits from outside and inside, misses, grazing
+/* test_geom.c -- ray/primitive intersection, watertight edges, no self-
+ * intersection.
+ *
+ * Ray/primitive intersection: hits from outside and inside, misses, grazing
  * and parallel rays, watertight shared edges, and self-intersection
  * avoidance at several scene scales. */
 #include <math.h>

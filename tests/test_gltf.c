@@ -1,4 +1,7 @@
-/* The glTF reader in memory (common/compile/gltf_doc.c, gltf_scene.c, gltf_mat.c):
+/* test_gltf.c -- the glTF reader in memory: accessors, nodes, camera and
+ * errors.
+ *
+ * The glTF reader in memory (common/compile/gltf_doc.c, gltf_scene.c, gltf_mat.c):
  * base64 data URIs, accessors of every component type (normalized,
  * strided, sparse), strips and fans, node transforms and the camera,
  * JSON-pointer errors, bounds on instancing, warnings once each. */

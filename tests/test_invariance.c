@@ -1,4 +1,7 @@
-/* An image must not depend on how its geometry is written down: the
+/* test_invariance.c -- images do not depend on quad diagonals or distance from
+ * the origin.
+ *
+ * An image must not depend on how its geometry is written down: the
  * Cornell box renders the same, within noise and region by region, when
  * the corners of a quad are listed from another corner (so the quad is
  * split into two triangles along the other diagonal) and when the whole

@@ -1,4 +1,7 @@
-/* Scene JSON is read strictly: a member named twice (two materials of one
+/* test_json_strict.c -- scene JSON with duplicate members or bad syntax is
+ * refused at its line.
+ *
+ * Scene JSON is read strictly: a member named twice (two materials of one
  * name, a radius given twice), text after the scene's closing brace and
  * every syntax error are refused with the file, line and column; what is
  * valid still reads. */

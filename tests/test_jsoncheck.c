@@ -1,4 +1,7 @@
-/* jsoncheck.h: strict JSON recognized, everything else refused at the
+/* test_jsoncheck.c -- the strict JSON check: what it accepts and where it
+ * refuses.
+ *
+ * jsoncheck.h: strict JSON recognized, everything else refused at the
  * right line and column; duplicate names found at any depth and among many
  * members; NUL bytes and every example scene handled. */
 #include <stdio.h>

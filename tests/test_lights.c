@@ -1,4 +1,6 @@
-/* Sun, spot and point lights against closed forms; rays leaving lights
+/* test_lights.c -- sun, spot, point and area lights against closed forms.
+ *
+ * Sun, spot and point lights against closed forms; rays leaving lights
  * (their densities and the power they carry); pick probabilities of many
  * area lights; the JSON errors of the lights. */
 #include <math.h>

@@ -1,4 +1,7 @@
-/* Participating media: transmittance e^(-sigma_t d) through slabs, the
+/* test_medium.c -- participating media against transmittance and scattering
+ * integrals.
+ *
+ * Participating media: transmittance e^(-sigma_t d) through slabs, the
  * sampling routines against their densities, single scattering from a
  * point light and from a rect or quad area light against the numerically
  * integrated analytic integral (with and without equiangular sampling, and

@@ -1,4 +1,7 @@
-/* Microfacet lobes (common/microfacet.h): closed forms of the distribution,
+/* test_microfacet.c -- GGX lobes: closed forms, sampling fit, furnaces, albedo
+ * tables.
+ *
+ * Microfacet lobes (common/microfacet.h): closed forms of the distribution,
  * masking and Fresnel factors; chi-square goodness of fit of every sampler
  * against its pdf, from normal to grazing incidence and roughness 0.05 to 1;
  * reciprocity; white furnaces with and without energy compensation; the

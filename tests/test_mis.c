@@ -1,4 +1,6 @@
-/* Multiple importance sampling is unbiased: light sampling only, BSDF
+/* test_mis.c -- light sampling, BSDF sampling and MIS estimate the same image.
+ *
+ * Multiple importance sampling is unbiased: light sampling only, BSDF
  * sampling only and their MIS combination estimate the same image, within
  * their noise.  The scene has a rectangle light, a small sphere light and
  * a glossy floor, so each strategy is weak somewhere. */

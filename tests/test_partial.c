@@ -1,4 +1,7 @@
-/* Partial images with and without light-tracing splats: what a worker
+/* test_partial.c -- partial images and their splat blocks: exact round trips,
+ * refusals.
+ *
+ * Partial images with and without light-tracing splats: what a worker
  * writes reads back exactly; a damaged, truncated or padded splat block,
  * a malformed splat field and splats in an sRGB image are refused; and
  * fixed-point splat sums round once, saturate, and do not depend on the

@@ -1,4 +1,7 @@
-/* FRANJA_MAX_SPP (common/quick.c): unset changes nothing; set, it caps the
+/* test_quick.c -- FRANJA_MAX_SPP caps the samples per pixel, or changes
+ * nothing.
+ *
+ * FRANJA_MAX_SPP (common/quick.c): unset changes nothing; set, it caps the
  * samples per pixel and says so; a bad value is an error naming it. */
 #include <stdlib.h>
 #include <string.h>

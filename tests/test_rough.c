@@ -1,4 +1,7 @@
-/* The microfacet materials in the renderer: the scene syntax (what is
+/* test_rough.c -- rough materials in the renderer: syntax, sampling, furnaces,
+ * MIS.
+ *
+ * The microfacet materials in the renderer: the scene syntax (what is
  * accepted, what is refused and where), textured roughness and metallic,
  * bsdf_sample against bsdf_eval in tilted shading frames (chi-square and
  * per-sample agreement, no light through the wrong side), rendered white

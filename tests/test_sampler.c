@@ -1,4 +1,7 @@
-/* The sampler (common/sampler.h): its numbers are a pure function of
+/* test_sampler.c -- the sampler is deterministic, stratified (0, m, 2)-nets,
+ * decorrelated.
+ *
+ * The sampler (common/sampler.h): its numbers are a pure function of
  * pixel, index, dimension and seed; every power-of-two prefix of a pixel's
  * samples in a dimension pair is a (0, m, 2)-net (one point in each of the
  * 2^m elementary intervals of every shape); pairs and pixels are

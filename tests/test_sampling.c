@@ -1,4 +1,7 @@
-/* BSDF sampling against its pdf (chi-square goodness of fit), exact
+/* test_sampling.c -- smooth and Phong BSDF sampling against pdf, Fresnel and
+ * reciprocity.
+ *
+ * BSDF sampling against its pdf (chi-square goodness of fit), exact
  * Fresnel values, reciprocity and energy of the smooth lobes. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,4 +1,6 @@
-/* Split invariance: the full image and its concatenation from uneven
+/* test_split.c -- any split of the rows into slabs renders the same bytes.
+ *
+ * Split invariance: the full image and its concatenation from uneven
  * slabs (2, 3 and 7 of them) are byte-identical, on a scene with every
  * material kind, point and area lights, and on one lit by an environment
  * map, a sun disk and a spot, with a medium inside a box.  Bidirectional

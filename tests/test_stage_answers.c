@@ -1,4 +1,7 @@
-/* What the coordinator reads from a host's answers to its cache commands
+/* test_stage_answers.c -- the coordinator's reading of hosts' answers to cache
+ * commands.
+ *
+ * What the coordinator reads from a host's answers to its cache commands
  * (stage.h): the scenes the cache trimming removed ("NAME BYTES" lines),
  * the cache listing (a size a line), what the cleaning did ("REMOVED
  * BYTES IN_USE TEMP") and the codename of os-release.  Each

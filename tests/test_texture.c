@@ -1,4 +1,7 @@
-/* Textures, UVs, bump and normal maps: lookups against hand-computed
+/* test_texture.c -- texture lookups, UVs, bump and normal maps against known
+ * values.
+ *
+ * Textures, UVs, bump and normal maps: lookups against hand-computed
  * values, UV round trips on every primitive, an emissive textured quad
  * seen head-on, a flat bump map that changes nothing, and shading normals
  * that never let light through a surface. */

@@ -1,4 +1,6 @@
-/* Tone mapping: exposure in stops, the filmic curve's shape, the sRGB
+/* test_tonemap.c -- exposure, the filmic curve and the sRGB transfer curve.
+ *
+ * Tone mapping: exposure in stops, the filmic curve's shape, the sRGB
  * transfer curve at the end. */
 #include <math.h>
 

@@ -1,4 +1,7 @@
-/* The path-vertex pieces the integrators share (vertex.h), one by one:
+/* test_vertex.c -- the shared path-vertex pieces one by one against closed
+ * forms.
+ *
+ * The path-vertex pieces the integrators share (vertex.h), one by one:
  * finding the next vertex with and without media (and how many sampler
  * dimensions that takes), next-event estimation at a surface against the
  * closed form of a point light over a Lambert plane, a blocked shadow ray,

@@ -1,5 +1,5 @@
-/* franja-worker -- render rows [y0, y1) of a scene and write them as a
- * partial image of the PPM family (see franja-worker(1)). */
+/* main.c -- franja-worker: render rows [y0, y1) of a scene and write them
+ * as a partial image of the PPM family (see franja-worker(1)). */
 #include <errno.h>
 #include <stdint.h>
 #include <stdio.h>

@@ -1,3 +1,6 @@
+/* builder.c -- a scene under construction: arrays of shapes, materials and the
+ * camera (see builder.h). */
+
 #include "compile/builder.h"
 
 #include <stdlib.h>

@@ -1,3 +1,6 @@
+/* builder_light.c -- point, spot and sun lights and the environment added to a
+ * builder (see builder_light.h). */
+
 #include "compile/builder_light.h"
 
 #include <math.h>

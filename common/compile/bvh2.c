@@ -1,3 +1,6 @@
+/* bvh2.c -- the cost model of collapsing the binary build tree to 8-wide nodes
+ * (see bvh2.h). */
+
 #include "compile/bvh2.h"
 
 /* The costs of binary node v from those of its children. */

@@ -1,3 +1,6 @@
+/* bvh_build.c -- the BVH build: binned SAH binary tree collapsed to the 8-wide
+ * layout (see bvh_build.h). */
+
 #include "compile/bvh_build.h"
 
 #include <math.h>
@@ -186,9 +189,9 @@ static bvh2_box ref_slab(const build *B, uint32_t i, int a, float lo, float hi)
 }
 
 /* The cheapest spatial split of s across its longest axis (trying the
- * other two costs twice the build time for about 1 % fewer leaf blocks per
- * ray on the meshes of tests/bench): *axis and *plane, its cost (INFINITY
- * if none).  Bins are slabs of equal width of the span's box; a reference
+ * other two costs much build time for hardly fewer leaf blocks per ray on
+ * the meshes of tests/bench; tests/bench/README.md, "Spatial splits on one axis"):
+ * *axis and *plane, its cost (INFINITY if none).  Bins are slabs of equal width of the span's box; a reference
  * enters the bin of its lower bound, leaves from that of its upper bound,
  * and adds the bounds of its part in each bin it crosses. */
 static float spatial_best(const build *B, const span *s, int nb, int *axis, float *plane)

@@ -1,3 +1,6 @@
+/* bvh_reinsert.c -- subtree reinsertion that lowers the binary build tree's
+ * cost (see bvh_reinsert.h). */
+
 #include "compile/bvh_reinsert.h"
 
 #include <stdlib.h>

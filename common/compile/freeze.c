@@ -1,3 +1,6 @@
+/* freeze.c -- a builder frozen into a ready scene: camera, BVH, lights, bytes
+ * (see freeze.h). */
+
 #include "compile/freeze.h"
 
 #include <stdlib.h>

@@ -1,3 +1,6 @@
+/* freeze_light.c -- the light table of a scene being frozen, with pick
+ * probabilities (see freeze_light.h). */
+
 #include "compile/freeze_light.h"
 
 #include <float.h>

@@ -1,3 +1,6 @@
+/* json_appear.c -- the JSON scene's textures, bump and normal maps, media and
+ * lens (see json_appear.h). */
+
 #include "compile/json_appear.h"
 
 #include <ctype.h>

@@ -1,3 +1,6 @@
+/* json_light.c -- the JSON scene's "lights" array and "environment" object
+ * (see json_light.h). */
+
 #include "compile/json_light.h"
 
 #include <stdio.h>

@@ -1,3 +1,6 @@
+/* json_microfacet.c -- the JSON scene's conductor, principled and rough glass
+ * materials (see json_microfacet.h). */
+
 #include "compile/json_microfacet.h"
 
 #include <stdio.h>

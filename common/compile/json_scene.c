@@ -1,3 +1,6 @@
+/* json_scene.c -- the JSON scene reader: every field checked, shapes into a
+ * builder (see json_scene.h). */
+
 #include "compile/json_scene.h"
 
 #include <math.h>

@@ -1,3 +1,6 @@
+/* jsonval.c -- typed values read out of cJSON, with the JSON path in errors
+ * (see jsonval.h). */
+
 #include "compile/jsonval.h"
 
 #include <math.h>

@@ -1,3 +1,6 @@
+/* mesh.c -- the JSON scene's `mesh` shape: files read, placed, levels of
+ * detail (see mesh.h). */
+
 #include "compile/mesh.h"
 
 #include <math.h>

@@ -1,3 +1,6 @@
+/* obj.c -- the Wavefront OBJ and MTL reader, with file:line errors (see
+ * obj.h). */
+
 #include "compile/obj.h"
 
 #include <errno.h>

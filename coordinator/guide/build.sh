@@ -1,6 +1,8 @@
 #!/bin/sh
-# build.sh OUTDIR APIDIR -- the user guide: the project's Markdown documents
-# and its manual pages as HTML pages in OUTDIR, each with a bar linking them
+# build.sh -- the user guide as HTML.
+#
+# build.sh OUTDIR APIDIR: the project's Markdown documents and its manual
+# pages as HTML pages in OUTDIR, each with a bar linking them
 # all, links between them pointing at their pages (links.lua).  APIDIR is
 # where the API documentation's index.html is (Doxygen; make docs).  Run
 # from the repository's root (make docs, make guide).  Needs pandoc.

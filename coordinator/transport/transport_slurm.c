@@ -9,18 +9,18 @@
  * retries, straggler copies and kills of single copies work unchanged;
  * each worker is a step that Slurm places on its own CPU (--exclusive),
  * accounts and lists (squeue -s); a node that fails fails only its own
- * steps.  The cost is one srun per slab (tens of milliseconds against
- * slabs of seconds; tests/bench/coord_slurm.sh) and one srun process per
- * running worker on this machine (about 8 MB), which is fine for hundreds
- * of slots.  `--mem=0` lets a step use the job's memory on its node without
- * taking it from the other steps; --cpus-per-task=1 overrides one the job
- * was given.
+ * steps.  The cost is one srun per slab (a launch is short against slabs
+ * of seconds; tests/bench/coord_slurm.sh) and one srun process per
+ * running worker on this machine (a few megabytes each), which is fine
+ * for hundreds of slots (tests/bench/README.md, "srun's cost").
+ * `--mem=0` lets a step use the job's memory on its node without taking it
+ * from the other steps; --cpus-per-task=1 overrides one the job was given.
  *
  * Stopping: an srun that gets SIGTERM cancels its step (the task is gone
- * within ~40 ms) and exits; after SIGKILL only srun's helper process
- * cancels the step, seconds later, so SIGKILL is sent only to an srun
- * still there long after its SIGTERM, at close.  An srun whose node died
- * may take Slurm's KillWait to exit: such sruns are kept and reaped later
+ * almost at once, as measured in the same section) and exits; after
+ * SIGKILL only srun's helper process cancels the step, seconds later, so
+ * SIGKILL is sent only to an srun still there long after its SIGTERM, at
+ * close.  An srun whose node died may take Slurm's KillWait to exit: such sruns are kept and reaped later
  * instead of blocking the event loop.  Every srun gets SIGTERM from the
  * kernel when franja dies (tr_pipe_spawn_tied): a franja killed by
  * SIGKILL leaves no step running.  Steps are started by the thread that

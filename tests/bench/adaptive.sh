@@ -1,4 +1,6 @@
 #!/bin/sh
+# adaptive.sh -- measures adaptive against uniform sampling at equal CPU time.
+#
 # Adaptive sampling at equal time: scenes/spheres.json at 128x128, uniform
 # sampling against --noise-threshold E (at most MAX_SPP samples a pixel),
 # each at the sample count its CPU time allows, against a converged image

@@ -1,4 +1,6 @@
 #!/bin/sh
+# bdpt.sh -- measures bidirectional against path tracing at equal CPU time.
+#
 # Bidirectional against unidirectional path tracing at equal CPU time on
 # the spheres scene (a mirror ball, a glass ball and a Phong ball in the
 # Cornell box) under a small lamp: tests/bench/scenes/spheres-lamp.json,

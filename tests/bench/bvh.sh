@@ -1,4 +1,6 @@
 #!/bin/sh
+# bvh.sh -- measures the BVH and binary scene against Embree 3.
+#
 # BVH and binary scene against Embree 3 on the same triangles and rays:
 # build time (one thread each; Embree at its default and at its high,
 # spatial-split build quality), closest-hit and any-hit Mrays/s for primary

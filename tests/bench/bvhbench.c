@@ -1,4 +1,4 @@
-/* bvhbench -- Franja's BVH against Embree 3 on the same triangles and rays.
+/* bvhbench.c -- Franja's BVH against Embree 3 on the same triangles and rays.
  *
  *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages map|2m|4k]
  *

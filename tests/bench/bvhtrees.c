@@ -1,4 +1,4 @@
-/* bvhtrees -- trees of the same triangles walked by the same walk: is a
+/* bvhtrees.c -- trees of the same triangles walked by the same walk: is a
  * gap to Embree the tree's or the walk's?
  *
  *   bvhtrees SCENE.fbin [--size WxH] [--passes N] [--chunk N] [--leaf N]

@@ -1,4 +1,6 @@
 #!/bin/sh
+# coord_local.sh -- measures local mode's parallel efficiency.
+#
 # Parallel efficiency of local mode: the same render with -j 1 and with one
 # worker per core.  efficiency = T(1) / (N * T(N)); 1.0 is perfect.
 #

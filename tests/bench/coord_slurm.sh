@@ -1,4 +1,6 @@
 #!/bin/sh
+# coord_slurm.sh -- measures the cost of Slurm job steps against local workers.
+#
 # The cost of Slurm: the same render as job steps in an allocation of a
 # real Slurm cluster on this machine (tests/support/slurm_cluster.sh: one node per
 # core, one CPU each) against local worker processes with the same number

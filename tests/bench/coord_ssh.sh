@@ -1,4 +1,6 @@
 #!/bin/sh
+# coord_ssh.sh -- measures the cost of fake SSH hosts against local workers.
+#
 # The cost of distribution: the same render on fake SSH hosts (sshd on
 # loopback, one worker slot each) against local worker processes with the
 # same total number of slots.  ratio = T(ssh) / T(local); the goal is a

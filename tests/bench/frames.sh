@@ -1,4 +1,6 @@
 #!/bin/sh
+# frames.sh -- times an animation's --frames render against a reference build.
+#
 # An animation rendered with --frames: five frames of the Cornell box with
 # a sphere moving, 128x128 at 16 spp, -j 2 (FRAMES, SIZE, SPP, JOBS change
 # them; OPTS adds options to both, e.g. OPTS='--progress json').  B is this build's --frames, which runs the frames together over

@@ -1,4 +1,4 @@
-/* media -- what equiangular sampling brings: one scene with a point light
+/* media.c -- what equiangular sampling brings: one scene with a point light
  * in fog rendered at the same samples per pixel with distance sampling
  * alone and with equiangular + distance sampling combined by MIS; each
  * against a reference of many more samples (other seed).  Prints RMSE,

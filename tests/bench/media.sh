@@ -1,4 +1,6 @@
 #!/bin/sh
+# media.sh -- measures equiangular + MIS against distance sampling in fog.
+#
 # Participating media: equiangular + MIS against distance sampling alone on
 # the foggy room (point light in fog), at equal samples per pixel, each
 # against a high-sample reference; one thread.

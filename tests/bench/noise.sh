@@ -1,4 +1,6 @@
 #!/bin/sh
+# noise.sh -- measures noise per sample, Franja against Cycles.
+#
 # Noise per sample, Franja against Cycles: the Cornell box with a mirror
 # and a glass sphere, and the Cornell box filled with fog lit by its area
 # light (tests/bench/scenes/), 128x128 at SPP samples per pixel.  Each

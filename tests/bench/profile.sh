@@ -1,4 +1,6 @@
 #!/bin/sh
+# profile.sh -- counts a Cornell box sample's instructions by part (callgrind).
+#
 # Where a Cornell box sample's time goes, in instructions (callgrind counts
 # them exactly, whatever else loads the machine): scenes/cornell.json at
 # 64x64 and 16 spp in one worker process, the cost of each function (with

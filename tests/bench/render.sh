@@ -1,4 +1,6 @@
 #!/bin/sh
+# render.sh -- measures render speed and quality on the Cornell box.
+#
 # Render speed and quality: scenes/cornell.json at 512x512 and 64 spp, one
 # worker process per core over row slabs (16 slabs handed out as cores free
 # up), against the Cycles reference (256x256, 4096 spp) after a 2x2 box

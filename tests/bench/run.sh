@@ -1,4 +1,6 @@
 #!/bin/sh
+# run.sh -- runs every benchmark script of tests/bench in turn.
+#
 # Runs every benchmark script tests/bench/*.sh (except this one) in turn.
 # Each prints its own figures: ratios against a reference measured in the
 # same run, medians, and the machine.

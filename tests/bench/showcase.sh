@@ -1,4 +1,6 @@
 #!/bin/sh
+# showcase.sh -- measures the showcase scene's noise against Cycles 3.4.
+#
 # The showcase against Cycles 3.4 on this machine: tests/bench/scenes/
 # showcase.json (scenes/sky-spheres.json in a form both renderers read:
 # rough gold, rough glass, plastic and diffuse spheres lit only by an HDR

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_10_static.sh -- tests the static amd64 and arm64 workers render alike.
+#
 # The fully static workers (make static): they need no shared library, the
 # arm64 one runs under qemu-aarch64-static, and both render the test slab
 # byte-identical to this machine's bin/franja-worker, and a bidirectional

@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_20_docker.sh -- tests each Dockerfile builds and its binaries render alike.
+#
 # Every docker/Dockerfile.* is built by a real Docker engine (a private
 # dockerd started here and stopped after; base images made by debootstrap when
 # the engine lacks them), and what each build produces renders the test slab

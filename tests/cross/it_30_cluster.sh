@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_30_cluster.sh -- tests a mixed-architecture fake cluster renders alike.
+#
 # A mixed cluster of fake SSH hosts (tests/support/fakehosts.sh): host "arm"
 # runs the static arm64 worker under qemu, "old" the Debian 11 amd64 build and
 # "armdeb" the Debian 12 arm64 build under qemu against that release's own

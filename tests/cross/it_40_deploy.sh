@@ -1,4 +1,6 @@
 #!/bin/sh
+# it_40_deploy.sh -- tests franja deploy puts the matching build on each host.
+#
 # franja deploy over fake SSH hosts (tests/support/fakehosts.sh): each host gets
 # the build that matches the os= and arch= of its table line, or what it
 # reports, falling back to the static build; the installed worker is checked

@@ -1,4 +1,6 @@
-# lib.sh -- sourced by the cross-build tests (tests/cross/it_*.sh).
+# lib.sh -- helpers sourced by the cross-build tests.
+#
+# Sourced by the cross-build tests (tests/cross/it_*.sh).
 #
 #   cross_refs DIR       compiles the test scene into DIR/scene.fbin and renders
 #                        the reference slabs DIR/ref-json.pf and DIR/ref-fbin.pf

@@ -1,4 +1,6 @@
 #!/bin/sh
+# run.sh -- runs each libFuzzer target for a while and reports findings.
+#
 # make fuzz, and the short pass of make test: run each libFuzzer target
 # (bin/fuzz/fuzz_*, built with clang, ASan and UBSan) for SECONDS seconds
 # (default 60) from its seeds, and print per target the executions, the

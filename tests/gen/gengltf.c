@@ -1,4 +1,4 @@
-/* gengltf -- small glTF 2.0 scenes for the tests and the example scene
+/* gengltf.c -- small glTF 2.0 scenes for the tests and the example scene
  * (nothing can be downloaded, so the project writes its own):
  *
  *   gengltf scene   DIR       scene.gltf (buffer in a data: URI), scene.glb,

@@ -1,4 +1,4 @@
-/* genmesh -- procedural triangle meshes as Wavefront OBJ files, for tests,
+/* genmesh.c -- procedural triangle meshes as Wavefront OBJ files, for tests,
  * benchmarks and example scenes (nothing can be downloaded, so the project
  * makes its own detailed meshes).
  *

@@ -1,4 +1,4 @@
-/* genmftab -- integrates the albedo tables of microfacet energy compensation
+/* genmftab.c -- integrates the albedo tables of microfacet energy compensation
  * and prints them as C source:
  *
  *   bin/gen/genmftab > common/microfacet_table.c

@@ -1,4 +1,4 @@
-/* gensky -- writes a procedural sky for environment lighting as a Radiance
+/* gensky.c -- writes a procedural sky for environment lighting as a Radiance
  * HDR file (RGBE, run-length encoded scanlines), in Franja's
  * equirectangular layout (scenes/README.md, "environment"): nothing can be
  * downloaded, so the example skies are made here.

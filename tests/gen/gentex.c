@@ -1,4 +1,4 @@
-/* gentex -- writes the example scenes' textures (nothing can be
+/* gentex.c -- writes the example scenes' textures (nothing can be
  * downloaded, so they are made here) as binary PPM/PGM files:
  *
  *   bin/gen/gentex DIR

@@ -1,4 +1,6 @@
-# bench_common.sh -- sourced by the coordinator benchmarks (tests/bench/coord_*.sh).
+# bench_common.sh -- helpers sourced by the coordinator benchmarks.
+#
+# Sourced by the coordinator benchmarks (tests/bench/coord_*.sh).
 #
 # compare "A-CMD" "B-CMD": runs the two commands alternately $RUNS times
 # (alternating spreads a changing machine load over both), prints every

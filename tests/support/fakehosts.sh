@@ -1,4 +1,6 @@
-# fakehosts.sh -- sourced by the coordinator's integration tests (it_coord_*.sh).
+# fakehosts.sh -- fake SSH hosts (sshd on loopback), sourced by tests.
+#
+# Sourced by the coordinator's integration tests (it_coord_*.sh).
 #
 # Fake cluster hosts: real OpenSSH servers on loopback addresses 127.0.0.N,
 # each with its own throwaway host key, port and work directory; one

@@ -1,5 +1,7 @@
 #!/bin/sh
-# slurm_cluster.sh -- a real Slurm cluster on this one machine, for tests and
+# slurm_cluster.sh -- starts or stops a real Slurm cluster on this machine.
+#
+# A real Slurm cluster on this one machine, for tests and
 # benchmarks: a private munged, one slurmctld and N slurmd, each slurmd a
 # node of its own (n1 .. nN) with its own port on 127.0.0.1.  Everything
 # (configuration, keys, sockets, state, logs, PIDs) lives under DIR; the

@@ -1,4 +1,6 @@
-# slurm_lib.sh -- sourced by the Slurm tests (tests/it_slurm*.sh) and benchmark:
+# slurm_lib.sh -- helpers sourced by the Slurm tests and benchmark.
+#
+# Sourced by the Slurm tests (tests/it_slurm*.sh) and benchmark:
 # a private cluster from tests/support/slurm_cluster.sh, stopped on exit whatever
 # happens, and Slurm clients that can neither hang nor read the test's stdin.
 #

@@ -1,4 +1,4 @@
-/* docjson -- the JSON side of the documentation examples' test
+/* docjson.c -- the JSON side of the documentation examples' test
  * (tests/it_docs.sh): reads a scene fragment as the docs show it and builds
  * the scenes that test it.
  *

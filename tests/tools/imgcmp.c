@@ -1,4 +1,4 @@
-/* imgcmp -- compare a rendered PFM against a reference PFM.
+/* imgcmp.c -- compare a rendered PFM against a reference PFM.
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
  *          [--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]]

@@ -1,4 +1,4 @@
-/* imgstat -- statistics of a PFM image, for tests that look at pictures.
+/* imgstat.c -- statistics of a PFM image, for tests that look at pictures.
  *
  *   imgstat IMAGE.pfm [--rect X0 Y0 X1 Y1] [--diff OTHER.pfm | --ratio OTHER.pfm] [--rows | --cols]
  *

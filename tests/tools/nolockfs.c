@@ -1,4 +1,4 @@
-/* nolockfs -- a FUSE file system that refuses locks, for tests/it_joblock.sh.
+/* nolockfs.c -- a FUSE file system that refuses locks, for tests/it_joblock.sh.
  *
  *   nolockfs BACKING_DIR MOUNTPOINT      (as root; unmount with umount)
  *

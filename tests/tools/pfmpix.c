@@ -1,4 +1,4 @@
-/* pfmpix -- print pixels of a PFM image (as franja-worker and franja write
+/* pfmpix.c -- print pixels of a PFM image (as franja-worker and franja write
  * them), for tests that check known pixels:
  *
  *   pfmpix IMAGE.pfm X Y [X Y ...]
