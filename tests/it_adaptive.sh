@@ -8,7 +8,7 @@
 # directory (a resume with another threshold is refused), and refuses
 # thresholds outside (0, 1] and adaptive bidirectional renders.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 F=bin/franja
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -7,7 +7,7 @@
 # scene (a flat-coloured texture renders like the plain colour); tone
 # mapping options reach the output; bad textures are refused with the path.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 F=bin/franja W=bin/franja-worker
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -7,7 +7,7 @@
 # refused with the limit and its option named (or compiled, when they are
 # legitimate) within 2 s and 200 MB, and --limit raises or lowers a limit.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need python3
 F=bin/franja
 T=$(mktemp -d)

@@ -4,7 +4,7 @@
 # franja's command line: version, help, the outputs named after
 # the scene when -o is omitted.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need cmp oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

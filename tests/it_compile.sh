@@ -6,7 +6,7 @@
 # formats, transforms, levels of detail) arrive, and bad input of every
 # kind is refused with a message that says where.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 F=bin/franja W=bin/franja-worker G=bin/gen/genmesh
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

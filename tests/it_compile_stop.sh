@@ -9,7 +9,7 @@
 # lock is free for the next render.
 # A scene that fails to compile leaves no job directory.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 F=$PWD/bin/franja
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

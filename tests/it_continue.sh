@@ -5,7 +5,7 @@
 # rendered with fewer samples and continued gives the bytes of a render of
 # every sample at once; what cannot be continued exactly is refused.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 W="$(pwd)/bin/franja-worker"

@@ -28,7 +28,7 @@
 #   sh tests/it_conventions.sh [DOC]    (default scenes/README.md: the
 #                                        statements may be read from a copy)
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need awk oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -5,7 +5,7 @@
 # good tables parse with defaults filled in; every bad line is refused with
 # file:line and what was expected, and nothing crashes.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-. "$ROOT/tests/lib.sh"
+. "$ROOT/tests/support/lib.sh"
 FRANJA="$ROOT/bin/franja"
 T=$(mktemp -d /tmp/franja-hosts.XXXXXX)
 trap 'rm -rf "$T"' EXIT

@@ -6,7 +6,7 @@
 # those of a full render, the rest black; --crop-output writes the window
 # alone; bad windows are refused before rendering.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

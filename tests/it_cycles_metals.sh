@@ -19,7 +19,7 @@
 # roughnesses of the outer spheres swapped (0.6 on the left, 0.15 on the
 # right) do not pass.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 . tests/support/cycles.sh
 need oiiotool
 T=$(mktemp -d)

@@ -20,7 +20,7 @@
 # specular layer, "coupling": "albedo") does not pass, nor does the
 # metallic copper made a dielectric.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 . tests/support/cycles.sh
 need oiiotool
 T=$(mktemp -d)

@@ -20,7 +20,7 @@
 # plane).  The comparison can fail: the sky turned by 180 degrees (shadows
 # and highlights elsewhere) does not pass.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 . tests/support/cycles.sh
 need oiiotool
 T=$(mktemp -d)

@@ -68,7 +68,7 @@
 #
 #   sh tests/it_docs.sh [DOC...]     (default: the files above)
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need awk oiiotool timeout cmp
 ROOT=$(pwd)
 T=$(mktemp -d)

@@ -18,7 +18,7 @@
 #   - an option that franja does not have, in an example that is skipped;
 #   - an unknown check, an annotation before text instead of an example.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 

@@ -11,7 +11,7 @@
 # pixel the ratio Franja / Cycles must average 1 and barely vary, so the sky
 # must be where Cycles has it, the right way round, as bright.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need awk
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -15,7 +15,7 @@
 # statement must be there and agree; a version or a section added to one
 # side only fails here.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need awk od
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -10,7 +10,7 @@
 # output) is refused before anything is rendered.  Needs root (it mounts
 # small tmpfs file systems); without it the test fails.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool
 F=$PWD/bin/franja
 T=$(mktemp -d)

@@ -9,7 +9,7 @@
 # compile and render; malformed files are refused with a message naming the
 # file and the JSON pointer or byte offset.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool cmp
 F=bin/franja W=bin/franja-worker G=bin/gen/gengltf P=bin/tools/pfmpix
 T=$(mktemp -d)

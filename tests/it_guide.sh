@@ -9,7 +9,7 @@
 # repository, or the API documentation.  The link checker itself must see
 # a planted broken link and a planted missing anchor.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need make pandoc doxygen awk
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -10,7 +10,7 @@
 # for; a file of that name that is no plug-in is refused with the loader's
 # message.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool ldd
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

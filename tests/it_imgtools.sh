@@ -8,7 +8,7 @@
 # light, pixels of the reference at 10 or more being the light); broken
 # files and bad values are refused with status 2 (imgcmp, imgstat) or 1.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 B=bin/tools

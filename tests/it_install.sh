@@ -6,7 +6,7 @@
 # worker), man finds the pages, bash completion offers the commands, the
 # options and the scene files, and uninstall leaves no file behind.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need make man bash
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -11,7 +11,7 @@
 # Needs root and /dev/fuse (it mounts a FUSE file system); without them the
 # test fails.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need cmp umount
 F=$PWD/bin/franja W=$PWD/bin/franja-worker
 T=$(mktemp -d)

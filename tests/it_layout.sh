@@ -20,7 +20,7 @@
 #   - every source, header and script opens with a line saying what it is
 #     ("/* NAME -- ...", "/** @file NAME", "# NAME -- ..." after a shebang).
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need nm tsort cc doxygen
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -24,7 +24,7 @@
 #     cos 30; the point light's brightest pixel is near 0.8 / pi x P /
 #     (4 pi) / 1 m^2 (directly below it).
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need awk jq oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

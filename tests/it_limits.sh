@@ -5,7 +5,7 @@
 # refused with the JSON path (or the file) and what was expected, never an
 # internal message, a vanished shape or a file misread as another kind.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 F=bin/franja W=bin/franja-worker
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -8,7 +8,7 @@
 # (text chunks), .tif (tags), .exr and .jpg; franja stitch says the same
 # but for the time and the hosts, which it does not know.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

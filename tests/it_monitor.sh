@@ -10,7 +10,7 @@
 # with its frames together, the page shows which frames are written and
 # which are rendering, with their rows, and the newest frame's image.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need chromium curl jq ss
 T=$(mktemp -d)
 pid=""

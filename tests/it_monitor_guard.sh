@@ -8,7 +8,7 @@
 # longer than the 5 s a request header is given, and neither 32 of them nor
 # 100 keep a prompt request out: it is answered within 2 s.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need curl jq python3
 T=$(mktemp -d)
 pid=""

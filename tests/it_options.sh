@@ -16,7 +16,7 @@
 # and in the SYNOPSIS sections must exist as well, and franja --help and
 # the SYNOPSIS of franja(1) and franja-worker(1) list every option.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need awk
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

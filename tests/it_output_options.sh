@@ -6,7 +6,7 @@
 # .exr (default 32-bit floats, zip), each visible in the file; bad values
 # are refused with what is allowed.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

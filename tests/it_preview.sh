@@ -6,7 +6,7 @@
 # a grey checkerboard), and the whole image at the end; --progress json:
 # one JSON object a line on stdout.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need cmp jq oiiotool
 T=$(mktemp -d)
 trap 'kill $pid 2>/dev/null; rm -rf "$T"' EXIT

@@ -8,7 +8,7 @@
 # with what is allowed; a --size of another aspect ratio than the scene's
 # is warned about once, naming both ratios, and one of the same ratio is not.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need oiiotool cmp
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

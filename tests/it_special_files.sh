@@ -10,7 +10,7 @@
 # address-space limit, so that a failure of this test cannot take the
 # machine down with it.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need mkfifo timeout
 F=$PWD/bin/franja W=$PWD/bin/franja-worker
 T=$(mktemp -d)

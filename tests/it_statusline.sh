@@ -5,7 +5,7 @@
 # made by script(1)) fits the terminal's width, from TIOCGWINSZ or, when the
 # terminal has no size, from $COLUMNS, and shows the elapsed time and the ETA.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need script stty
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -6,7 +6,7 @@
 # are refused at once, and no message, output or .fbin repeats a byte of a
 # file outside the folder or of a referenced file that fails to parse.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 need mkfifo timeout grep base64
 F=$PWD/bin/franja
 T=$(mktemp -d)

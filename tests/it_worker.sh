@@ -4,13 +4,13 @@
 # franja-worker end to end: its command line, its errors on bad input,
 # split invariance through real processes, and the formats it writes.
 cd "$(dirname "$0")/.." || exit 1
-. tests/lib.sh
+. tests/support/lib.sh
 W=bin/franja-worker
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
 # worker_error "what it tests" "fragment of stderr" command...: expect_error
-# (tests/lib.sh), and the failing worker wrote nothing on stdout.
+# (tests/support/lib.sh), and the failing worker wrote nothing on stdout.
 worker_error() {
     expect_error "$@" || return
     [ ! -s "$T/out" ] && ok || bad "$1: wrote to stdout"

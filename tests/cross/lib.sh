@@ -9,7 +9,7 @@
 #                        (tests/support/fakehosts.sh: fh_start, fr ...) in $FH
 #                        and makes it the current directory
 #
-# The checks and the closing line are tests/lib.sh's (check, need, summary).
+# The checks and the closing line are tests/support/lib.sh's (check, need, summary).
 #
 # Variables: ROOT (the repository), SLAB (worker arguments of the test slab),
 # CROSS (state shared by the tests in one run: the Docker builds' dist/),
@@ -17,7 +17,7 @@
 # QEMU (qemu-aarch64-static).
 
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
-. "$ROOT/tests/lib.sh"
+. "$ROOT/tests/support/lib.sh"
 # A small slab keeps qemu quick: 20 rows of a 64x64 image at 4 samples.
 SLAB="--rows 10:30 --spp 4 --size 64x64"
 CROSS=${FRANJA_CROSS_DIR:-$ROOT/build/cross}

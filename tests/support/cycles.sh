@@ -1,7 +1,7 @@
 # cycles.sh -- helpers sourced by the comparisons with Cycles.
 #
 # Sourced by the comparisons with Cycles (tests/it_cycles_*.sh,
-# after tests/lib.sh, with the scratch directory $T): renders one of the
+# after tests/support/lib.sh, with the scratch directory $T): renders one of the
 # scenes of tests/data/cycles-*.json with Franja and compares it with
 # Cycles' render of it (tests/data/cycles-NAME.exr and its RGB pixels as
 # .pfm, made by `make refs` with tests/refs/cycles_scene.py).

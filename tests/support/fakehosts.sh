@@ -29,10 +29,10 @@
 #                             franja with the fake hosts' SSH settings; in the
 #                             background; waiting for that one (status in $rc)
 #
-# The checks and the closing line are tests/lib.sh's (check, summary ...).
+# The checks and the closing line are tests/support/lib.sh's (check, summary ...).
 
 ROOT=${ROOT:-$(cd "$(dirname "$0")/.." && pwd)}
-. "$ROOT/tests/lib.sh"
+. "$ROOT/tests/support/lib.sh"
 FRANJA="$ROOT/bin/franja"
 WORKER="$ROOT/bin/franja-worker"
 

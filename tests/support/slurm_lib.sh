@@ -24,10 +24,10 @@
 #   sl_stop                 stops the cluster now (the exit trap does it too)
 #   sl_until SECS CMD...    runs CMD every 0.1 s until it succeeds
 #
-# The checks and the closing line are tests/lib.sh's (check, summary ...).
+# The checks and the closing line are tests/support/lib.sh's (check, summary ...).
 
 ROOT=${ROOT:-$(cd "$(dirname "$0")/.." && pwd)}
-. "$ROOT/tests/lib.sh"
+. "$ROOT/tests/support/lib.sh"
 CLUSTER="$ROOT/tests/support/slurm_cluster.sh"
 FRANJA="$ROOT/bin/franja"
 WORKER="$ROOT/bin/franja-worker"
