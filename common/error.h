@@ -8,7 +8,7 @@
  *
  * Messages may carry names and words from input files, so every message
  * is made safe for a terminal: control characters (C0, DEL and the C1
- * range in its UTF-8 form) are written as \xHH, never raw.
+ * range in its UTF-8 form) are written as \\xHH, never raw.
  */
 #ifndef FRANJA_ERROR_H
 #define FRANJA_ERROR_H
@@ -23,7 +23,7 @@ typedef struct { char msg[512]; } fr_error;
 int fr_fail(fr_error *e, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /** Rewrites the NUL-terminated string s (in a buffer of cap bytes) with
- * each control character as the four characters \xHH: bytes 0x01-0x1f,
+ * each control character as the four characters \\xHH: bytes 0x01-0x1f,
  * 0x7f, and the UTF-8 forms of U+0080-U+009F.  An escape that no longer
  * fits ends the string (the text is cut, never left raw).  Every other
  * byte, backslashes included, stays as it is, so escaping twice changes

@@ -52,8 +52,8 @@ enum {
 
 /** Handles option c (a CLI_COMMON_LONGOPTS value, as opt_next returned it,
  * with its value v) for command cmd: sets o, or *hosts (pointing at v) for
- * --hosts; for --help prints usage, then the transport options' help.  Returns a
- * CLI_* value. */
+ * --hosts; for --help prints usage, then the transport options' help.  Returns
+ * one of the values above. */
 int cli_common_opt(const char *cmd, int c, const char *v, const char *usage, tr_options *o, const char **hosts);
 
 /** Where the hosts come from when they are a Slurm allocation (--slurm). */

@@ -220,6 +220,7 @@ if { cat coordinator/Doxyfile; echo "OUTPUT_DIRECTORY = $T/docs"; echo "WARN_LOG
     check "docs: pt_render_rows with its contract" grep -rqs "caller-owned, width" "$T/docs/html"
     check "docs: fr_camera's fields" grep -rqs "lens radius, scene units" "$T/docs/html"
     check "docs: compile/builder.h" grep -rqs "bld_push" "$T/docs/html"
+    if [ -s "$T/docs/warnings.log" ]; then bad "doxygen warns: $(head -3 "$T/docs/warnings.log")"; else ok; fi
 else
     bad "doxygen failed: $(tail -3 "$T/doxygen.log")"
 fi

@@ -6,7 +6,7 @@
  * nothing but white space after it; no object may name a member twice
  * (names compared after unescaping, so "a" and "\u0061" are the same),
  * since a reader that takes the first and ignores the second would
- * silently drop what the author wrote last; no string may hold \u0000; and
+ * silently drop what the author wrote last; no string may hold \\u0000; and
  * values nest at most JC_MAX_DEPTH deep.  Errors name the file, the line
  * and the column (both from 1, columns counted in characters) and what was
  * expected, e.g. `scene.json:12:5: duplicate member "white" in materials
