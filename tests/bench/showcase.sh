@@ -47,7 +47,7 @@ crmse() { bin/tools/imgcmp "$1" "$2" --clamp-pct "$PCT" | sed -n 's/^clamped rms
 # franja SPP SEED OUT: N row slabs at once, stitched; "wall cpu" in $T/time.
 franja() {
     sed "s/\"seed\": [0-9]*/\"seed\": $2/; s|\"\.\./\.\./\.\./scenes/|\"$(pwd)/scenes/|" $SCENE >"$T/seeded.json"
-    bin/franja compile "$T/seeded.json" -o "$T/s.fbin" >/dev/null || exit 1
+    bin/franja compile "$T/seeded.json" --allow-path scenes -o "$T/s.fbin" >/dev/null || exit 1
     /usr/bin/time -f '%e %U %S' -o "$T/rt" sh -c '
         i=0
         while [ $i -lt '"$N"' ]; do
