@@ -10,6 +10,7 @@
 
 #include "fbin.h"
 #include "scene.h"
+#include "trace.h"
 
 static const char *const format_names[] = {"pf", "ppm16", "ppm8"};
 static const char *const integrator_names[] = {"path", "bdpt"};
@@ -204,6 +205,16 @@ void proto_version_line(const char *program, char *out, size_t cap)
     snprintf(out, cap, "%s %s scene-format %d", program, FRANJA_VERSION, FBIN_VERSION);
 }
 
+void proto_walk_line(char *out, size_t cap)
+{
+    int n = snprintf(out, cap, "walk %s (this processor runs:", trace_walk_name(trace_walk()));
+    for (int k = 0; k < TRACE_WALKS && n >= 0 && (size_t)n < cap; k++)
+        if (trace_walks() >> k & 1)
+            n += snprintf(out + n, cap - (size_t)n, " %s", trace_walk_name(k));
+    if (n >= 0 && (size_t)n < cap)
+        snprintf(out + n, cap - (size_t)n, ")");
+}
+
 int proto_parse_version(const char *line, proto_version *v, fr_error *err)
 {
     memset(v, 0, sizeof *v);
@@ -271,6 +282,17 @@ int proto_parse_probe(const char *out, size_t len, proto_host *h, fr_error *err)
         next_line(out, len, &pos, cores, sizeof cores) ||
         next_line(out, len, &pos, h->version, sizeof h->version) || parse_u32(cores, &n) || n == 0)
         return fr_fail(err, "unexpected answer to uname/nproc/--version");
+    /* The walk line, where the worker prints one (a worker before it did
+     * not): its first word after "walk". */
+    char walk[128];
+    if (next_line(out, len, &pos, walk, sizeof walk) == 0 && !strncmp(walk, "walk ", 5)) {
+        size_t w = strcspn(walk + 5, " ");
+        if (w >= sizeof h->walk)
+            w = sizeof h->walk - 1;
+        memcpy(h->walk, walk + 5, w);
+        h->walk[w] = 0;
+        proto_printable(h->walk);
+    }
     h->cores_reported = n;
     h->cores = n > PROTO_MAX_CORES ? PROTO_MAX_CORES : (int)n;
     proto_printable(h->arch);

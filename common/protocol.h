@@ -95,6 +95,11 @@ int proto_parse_size(const char *s, uint32_t *w, uint32_t *h);
  * binary scene format) into out[cap]. */
 void proto_version_line(const char *program, char *out, size_t cap);
 
+/** Writes the second line of a worker's `--version`: "walk NAME", the BVH
+ * walk this process runs (trace.h: portable, avx2 or avx512), then the
+ * walks the processor can run in brackets. */
+void proto_walk_line(char *out, size_t cap);
+
 /** A parsed `--version` line. */
 typedef struct {
     char program[32];          /**< "franja-worker" */
@@ -116,7 +121,8 @@ int proto_parse_check(const char *out, size_t len, uint64_t *hash, fr_error *err
 
 /** The probe, as a command for a POSIX shell run as
  * `sh -c PROTO_PROBE_SCRIPT WORKER`: four lines, uname -m, uname -s, the
- * number of online processors and the worker's `--version` line.  The
+ * number of online processors and the worker's `--version` line, then the
+ * rest of `--version` (its walk line, from workers that print one).  The
  * worker path travels as $0, never inside the script. */
 extern const char PROTO_PROBE_SCRIPT[];
 
@@ -133,6 +139,7 @@ typedef struct {
     int cores;                 /**< online processors, at most PROTO_MAX_CORES */
     uint32_t cores_reported;   /**< the number the host gave (may exceed PROTO_MAX_CORES) */
     char version[128];         /**< the worker's --version line */
+    char walk[16];             /**< the BVH walk its --version names; "" from a worker that names none */
 } proto_host;
 
 /** Parses the probe's output (len bytes).  Fails if a line is missing, too

@@ -9,9 +9,10 @@
 #include "lanes.h"
 #include "simd4.h"
 
-/* x86-64 with GCC: a second copy of the traversal for AVX2 processors. */
+/* x86-64 with GCC: copies of the traversal for AVX2 and AVX-512 processors. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define TRACE_WIDE 1
+#include <cpuid.h>
 #include <immintrin.h>
 #else
 #define TRACE_WIDE 0
@@ -161,31 +162,115 @@ static __attribute__((noinline)) int occluded_wide(const fr_scene *s, const fr_r
 }
 #pragma GCC pop_options
 
-static int wide_ok, wide_on;
+/* And once more for AVX-512 (x86-64-v4: F, VL, BW and DQ): the same
+ * eight-lane tests with comparisons into mask registers, 32 vector
+ * registers, and a node's children ordered by a sorting network and
+ * stacked by vector stores. */
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512vl,avx512bw,avx512dq")
+#define W(name) name##_v4
+#define WALK_WIDE 2
+#include "trace_walk.inc"
+#undef W
+#undef WALK_WIDE
+
+static __attribute__((noinline)) int closest_v4(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
+{
+    return walk_v4(s, r, tmax, hit, 0, FR_NONE);
+}
+
+static __attribute__((noinline)) int occluded_v4(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
+{
+    fr_hit h = {0};
+    return walk_v4(s, r, tmax, &h, 1, skip);
+}
+#pragma GCC pop_options
+
+/* What the processor has and its OS saves on a context switch: CPUID for
+ * the instructions, XGETBV for the registers' state (SSE and AVX: XCR0
+ * bits 1-2; AVX-512's mask registers and upper halves of zmm0-31: bits
+ * 5-7).  An OS that does not save a state makes its instructions fault. */
+static unsigned cpu_walks(void)
+{
+    unsigned a, b, c, d, walks = 1u << TRACE_WALK_PORTABLE;
+    if (!__get_cpuid(1, &a, &b, &c, &d) || !(c & bit_OSXSAVE) || !(c & bit_AVX))
+        return walks;
+    unsigned lo, hi;
+    __asm__("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0));
+    if ((lo & 0x6) != 0x6 || !__get_cpuid_count(7, 0, &a, &b, &c, &d))
+        return walks;
+    if (b & bit_AVX2)
+        walks |= 1u << TRACE_WALK_AVX2;
+    unsigned v4 = bit_AVX512F | bit_AVX512VL | bit_AVX512BW | bit_AVX512DQ;
+    if ((b & bit_AVX2) && (b & v4) == v4 && (lo & 0xe6) == 0xe6)
+        walks |= 1u << TRACE_WALK_AVX512;
+    return walks;
+}
+
+static unsigned walks_ok;
+static int walk_on;
 
 __attribute__((constructor)) static void trace_init(void)
 {
-    __builtin_cpu_init();
-    wide_ok = wide_on = __builtin_cpu_supports("avx2") != 0;
-}
-
-int trace_set_wide(int on)
-{
-    wide_on = on && wide_ok;
-    return wide_on;
+    walks_ok = cpu_walks();
+    walk_on = walks_ok >> TRACE_WALK_AVX512 & 1 ? TRACE_WALK_AVX512
+              : walks_ok >> TRACE_WALK_AVX2 & 1 ? TRACE_WALK_AVX2
+                                                : TRACE_WALK_PORTABLE;
 }
 #else
-int trace_set_wide(int on)
-{
-    (void)on;
-    return 0;
-}
+static const unsigned walks_ok = 1u << TRACE_WALK_PORTABLE;
+static const int walk_on = TRACE_WALK_PORTABLE;
 #endif
+
+unsigned trace_walks(void)
+{
+    return walks_ok;
+}
+
+int trace_walk(void)
+{
+    return walk_on;
+}
+
+int trace_set_walk(int k)
+{
+#if TRACE_WIDE
+    if (k >= 0 && k < TRACE_WALKS && (walks_ok >> k & 1))
+        walk_on = k;
+#else
+    (void)k;
+#endif
+    return walk_on;
+}
+
+static const char *const walk_names[TRACE_WALKS] = {"portable", "avx2", "avx512"};
+
+const char *trace_walk_name(int k)
+{
+    return k >= 0 && k < TRACE_WALKS ? walk_names[k] : NULL;
+}
+
+int trace_walk_choose(const char *name, fr_error *err)
+{
+    if (!name || !name[0])
+        return 0;
+    for (int k = 0; k < TRACE_WALKS; k++) {
+        if (strcmp(name, walk_names[k]))
+            continue;
+        if (!(walks_ok >> k & 1))
+            return fr_fail(err, "FRANJA_WALK=%s: this processor (or its OS) cannot run the %s walk", name, name);
+        trace_set_walk(k);
+        return 0;
+    }
+    return fr_fail(err, "FRANJA_WALK=%.40s: expected portable, avx2 or avx512", name);
+}
 
 int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 {
 #if TRACE_WIDE
-    if (wide_on)
+    if (walk_on == TRACE_WALK_AVX512)
+        return closest_v4(s, r, tmax, hit);
+    if (walk_on == TRACE_WALK_AVX2)
         return closest_wide(s, r, tmax, hit);
 #endif
     return closest_base(s, r, tmax, hit);
@@ -194,7 +279,9 @@ int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
 #if TRACE_WIDE
-    if (wide_on)
+    if (walk_on == TRACE_WALK_AVX512)
+        return occluded_v4(s, r, tmax, skip);
+    if (walk_on == TRACE_WALK_AVX2)
         return occluded_wide(s, r, tmax, skip);
 #endif
     return occluded_base(s, r, tmax, skip);

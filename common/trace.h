@@ -8,6 +8,7 @@
 #ifndef FRANJA_TRACE_H
 #define FRANJA_TRACE_H
 
+#include "error.h"
 #include "geom.h"
 
 /** Where a ray hit, before shading: which primitive and its local
@@ -42,12 +43,26 @@ int trace_closest(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit);
  * cannot hide its own sampled point, and near its silhouette rounding would
  * make it seem to. */
 int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip);
-/** Which of the two equivalent traversals runs: on x86-64 processors with
- * AVX2 one that tests a node's eight boxes at once (the default there),
- * elsewhere, or with `on` 0, the portable one.  Both give the same bits;
- * tests and benchmarks use this to compare them.  Returns 1 if the wide one
- * is now in use.  Not thread-safe: call it before tracing starts. */
-int trace_set_wide(int on);
+/** The BVH walks, each the same traversal compiled for an instruction set:
+ * the portable one (SSE2, NEON or plain C) everywhere, and on x86-64 one
+ * for AVX2 and one for AVX-512 (x86-64-v4: F, VL, BW, DQ).  All give the
+ * same bits; the fastest one the processor and its OS can run is used
+ * unless another is chosen. */
+enum { TRACE_WALK_PORTABLE, TRACE_WALK_AVX2, TRACE_WALK_AVX512, TRACE_WALKS };
+/** The walks this processor and its OS can run: bit k set for walk k. */
+unsigned trace_walks(void);
+/** The walk in use. */
+int trace_walk(void);
+/** Use walk k from now on, if trace_walks() has it (otherwise nothing
+ * changes).  Returns the walk now in use.  Not thread-safe: call it
+ * before tracing starts; tests and benchmarks use it to compare walks. */
+int trace_set_walk(int k);
+/** "portable", "avx2" or "avx512" for walk k; NULL for another k. */
+const char *trace_walk_name(int k);
+/** Use the walk `name` names (the value of FRANJA_WALK; NULL or empty
+ * keeps the default).  Returns 0, or -1 with *err set when the name is
+ * unknown or the processor cannot run that walk. */
+int trace_walk_choose(const char *name, fr_error *err);
 /** Nearest hit on one primitive, for tests and the BVH: t or 0. */
 float trace_prim(const fr_scene *s, uint32_t prim, const fr_ray *r, float tmax, float *a, float *b);
 /** Rebuild the surface at a hit. */

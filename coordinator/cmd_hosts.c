@@ -56,7 +56,8 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
     if (slurm)
         cluster_drop_other_versions(cl, t->n);
     int bad = 0;
-    printf("%-16s %-6s %-8s %-9s %5s  %-36s %s\n", "host", "state", "arch", "os", "cores", "worker", "scene cache");
+    printf("%-16s %-6s %-8s %-9s %5s  %-36s %-8s %s\n", "host", "state", "arch", "os", "cores", "worker", "walk",
+           "scene cache");
     for (int i = 0; i < t->n; i++) {
         cluster_host *h = &cl[i];
         if (!h->tr) {
@@ -96,8 +97,8 @@ static int check(const hosts_table *t, const tr_options *o, int slurm)
             bad++;
         }
         int cores = h->entry->cores ? h->entry->cores : h->info.cores;
-        printf("%-16s %-6s %-8s %-9s %5d  %-36s %s%s\n", h->entry->name, "ok", h->info.arch, os, cores,
-               h->info.version, cache, warn);
+        printf("%-16s %-6s %-8s %-9s %5d  %-36s %-8s %s%s\n", h->entry->name, "ok", h->info.arch, os, cores,
+               h->info.version, h->info.walk[0] ? h->info.walk : "-", cache, warn);
     }
     fr_error err;
     if (cluster_check_versions(cl, t->n, &err)) {

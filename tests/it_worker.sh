@@ -18,6 +18,29 @@ worker_error() {
 
 $W --help | grep -q -- '--rows Y0:Y1' && ok || bad "--help"
 $W --version | grep -Eq '^franja-worker [0-9]+\.[0-9]+\.[0-9]+ scene-format [0-9]+$' && ok || bad "--version"
+# Its second line names the BVH walk in use and those the processor runs.
+$W --version | sed -n 2p | grep -Eq '^walk (portable|avx2|avx512) \(this processor runs: portable( avx2)?( avx512)?\)$' &&
+    ok || bad "--version's walk line: $($W --version | sed -n 2p)"
+FRANJA_WALK=portable $W --version | grep -q '^walk portable ' && ok || bad "FRANJA_WALK=portable not taken"
+worker_error "FRANJA_WALK unknown" "FRANJA_WALK=fast: expected portable, avx2 or avx512" env FRANJA_WALK=fast $W --version
+[ "$(env FRANJA_WALK=fast $W --version 2>/dev/null; echo $?)" = 2 ] && ok || bad "FRANJA_WALK unknown: not exit status 2"
+
+# Every walk the processor runs renders the same bytes: a mesh (BVH of
+# triangles), spheres and rectangles in mixed leaves, a textured box, a
+# glTF courtyard.
+walks=$($W --version | sed -n 's/.*this processor runs: \(.*\))$/\1/p')
+for s in knot spheres cornell-textured courtyard; do
+    f=scenes/$s.json
+    [ -e "$f" ] || f=scenes/$s.glb
+    bin/franja compile "$f" -o "$T/walk.fbin" >/dev/null || bad "$s: franja compile failed"
+    for w in $walks; do
+        FRANJA_WALK=$w $W --scene "$T/walk.fbin" --size 48x36 --spp 2 --rows 0:36 -o "$T/walk-$w.pfm" ||
+            bad "$s: the $w walk failed"
+    done
+    for w in $walks; do
+        cmp -s "$T/walk-portable.pfm" "$T/walk-$w.pfm" && ok || bad "$s: the $w walk's image differs from the portable walk's"
+    done
+done
 
 S=scenes/cornell.json
 worker_error "rows past the end" "need 0 <= Y0 < Y1 <= 32" $W --scene $S --size 32x32 --rows 10:33 -o "$T/x"

@@ -555,13 +555,15 @@ static void signed_zeros(void)
  * turns it away, and its neighbours' hits are close.  The walk must
  * return brute force's nearest hit, bit for bit, and any-hit queries must
  * agree with it, with and without the ray's own triangle skipped, through
- * both traversals where there are two. */
+ * every walk this processor runs. */
 static void from_surfaces(void)
 {
-    int wide = trace_set_wide(1);
-    for (int pass = 0; pass < (wide ? 2 : 1); pass++) {
-        trace_set_wide(wide && pass == 0);
-        const char *name = wide && pass == 0 ? "eight-lane" : "portable";
+    int def = trace_walk();
+    for (int k = 0; k < TRACE_WALKS; k++) {
+        if (!(trace_walks() >> k & 1))
+            continue;
+        trace_set_walk(k);
+        const char *name = trace_walk_name(k);
         fr_builder b;
         start(&b);
         grid(&b, 40);
@@ -615,7 +617,7 @@ static void from_surfaces(void)
         scn_free(&s);
         bld_free(&b);
     }
-    trace_set_wide(wide);
+    trace_set_walk(def);
 }
 
 int main(void)
@@ -635,17 +637,31 @@ int main(void)
         {"copies", 200, 1000},       {"mixed", 800, 3000},    {"mixed soup", 1500, 3000},
         {"slivers", 2000, 4000},     {"slivers and sheets", 600, 4000}, {"nested", 120, 2000},
     };
-    /* Every case through both traversals where there are two (the eight-lane
-     * one on x86-64 with AVX2, the portable one everywhere). */
-    int wide = trace_set_wide(1);
+    /* Every case through every walk this processor runs (the portable one
+     * everywhere; on x86-64 the AVX2 one and the AVX-512 one where the
+     * processor and its OS have them). */
+    unsigned walks = trace_walks();
+    CHECK(walks & (1u << TRACE_WALK_PORTABLE), "the portable walk is not available");
+    CHECK((walks >> trace_walk()) & 1, "the walk in use (%s) is not available", trace_walk_name(trace_walk()));
+    CHECK(trace_walk() == 31 - __builtin_clz(walks), "the default walk is %s, not the fastest available",
+          trace_walk_name(trace_walk()));
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-    CHECK(wide == (__builtin_cpu_supports("avx2") != 0), "the eight-lane traversal is %s on a processor %s AVX2",
-          wide ? "used" : "not used", __builtin_cpu_supports("avx2") ? "with" : "without");
+    __builtin_cpu_init();
+    CHECK(!(walks >> TRACE_WALK_AVX2 & 1) == !__builtin_cpu_supports("avx2"), "the AVX2 walk is %s on a processor %s AVX2",
+          walks >> TRACE_WALK_AVX2 & 1 ? "available" : "not available", __builtin_cpu_supports("avx2") ? "with" : "without");
+    int v4 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+    CHECK(!(walks >> TRACE_WALK_AVX512 & 1) == !v4, "the AVX-512 walk is %s on a processor %s AVX-512 F/VL/BW/DQ",
+          walks >> TRACE_WALK_AVX512 & 1 ? "available" : "not available", v4 ? "with" : "without");
 #endif
-    for (size_t c = 0; c < (wide ? 2 : 1) * (sizeof cases / sizeof cases[0]); c++) {
-        size_t cs = c % (sizeof cases / sizeof cases[0]);
-        if (wide)
-            trace_set_wide(c == cs);
+    int def = trace_walk();
+    size_t ncases = sizeof cases / sizeof cases[0];
+    for (size_t c = 0; c < TRACE_WALKS * ncases; c++) {
+        size_t cs = c % ncases;
+        int k = (int)(c / ncases);
+        if (!(walks >> k & 1))
+            continue;
+        trace_set_walk(k);
         fr_builder b[2];
         uint64_t seed = rng_state;
         for (int k = 0; k < 2; k++) {
@@ -667,11 +683,12 @@ int main(void)
             }
         }
         char name[96];
-        snprintf(name, sizeof name, "%s (%s traversal)", cases[cs].name, wide && c == cs ? "eight-lane" : "portable");
+        snprintf(name, sizeof name, "%s (%s walk)", cases[cs].name, trace_walk_name(k));
         compare(name, &b[0], &b[1], cases[cs].rays, cs == 9);
         bld_free(&b[0]);
         bld_free(&b[1]);
     }
+    trace_set_walk(def);
     from_surfaces();
     return check_done();
 }

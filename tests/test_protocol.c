@@ -9,6 +9,7 @@
 #include "fbin.h"
 #include "protocol.h"
 #include "scene.h"
+#include "trace.h"
 
 /* argv as a worker gets it: the program, then the built arguments. */
 static int reparse(const proto_argv *a, proto_request *r, fr_error *err)
@@ -177,6 +178,16 @@ static void test_probe_answer(void)
     CHECK(!strcmp(ph.arch, "x86_64") && !strcmp(ph.os, "Linux") && ph.cores == 16 &&
               !strcmp(ph.version, "franja-worker 0.1.0 scene-format 4"),
           "probe read as %s %s %d '%s'", ph.arch, ph.os, ph.cores, ph.version);
+    CHECK(ph.walk[0] == 0, "a walk read from an answer without one: '%s'", ph.walk);
+    /* The walk line that follows the version line in a worker's --version. */
+    char withwalk[256] = "x86_64\nLinux\n16\nfranja-worker 0.1.0 scene-format 4\n", line[128];
+    proto_walk_line(line, sizeof line);
+    snprintf(withwalk + strlen(withwalk), sizeof withwalk - strlen(withwalk), "%s\n", line);
+    CHECK(proto_parse_probe(withwalk, strlen(withwalk), &ph, &err) == 0, "probe answer with '%s' refused: %s", line,
+          err.msg);
+    CHECK(!strcmp(ph.walk, trace_walk_name(trace_walk())) && !strcmp(ph.version, "franja-worker 0.1.0 scene-format 4"),
+          "'%s' read as walk '%s', version '%s'", line, ph.walk, ph.version);
+    CHECK(strstr(line, "portable") != NULL, "the walk line '%s' does not list the portable walk", line);
     const char *bad[] = {"x86_64\nLinux\n16\n", "x86_64\nLinux\n0\nv\n", "x86_64\nLinux\nmany\nv\n",
                          "a-very-long-architecture-name-beyond-32\nLinux\n2\nv\n"};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++)

@@ -18,6 +18,7 @@
 #include "protocol.h"
 #include "quick.h"
 #include "splat.h"
+#include "trace.h"
 #ifndef FRANJA_NO_JSON
 #include "compile/json_scene.h"
 #endif
@@ -88,9 +89,17 @@ int main(int argc, char **argv)
         fputs(usage, stdout);
         return 0;
     }
+    /* The BVH walk: the fastest this processor runs, or the one FRANJA_WALK
+     * names (all give the same bits; trace.h). */
+    if (trace_walk_choose(getenv("FRANJA_WALK"), &err) < 0) {
+        fprintf(stderr, "franja-worker: %s\n", err.msg);
+        return 2;
+    }
     if (req.mode == PROTO_VERSION) {
         char line[128];
         proto_version_line("franja-worker", line, sizeof line);
+        printf("%s\n", line);
+        proto_walk_line(line, sizeof line);
         printf("%s\n", line);
         return 0;
     }

@@ -12,7 +12,10 @@
 # pixel of the scene's camera; the bounce rays start where they hit, so a
 # bounce pass holds 0.3-0.5 M rays and lasts 0.07-1.2 s on a 2-core AMD EPYC
 # VM, long enough for two runs' ratios to agree within about 0.01 there
-# (512x512 gave passes of 20-350 ms whose ratios moved by 0.1).  Ratios of rays/s are Franja / Embree (higher is better for
+# (512x512 gave passes of 20-350 ms whose ratios moved by 0.1).  Each
+# `walks` line times every BVH walk the processor runs (portable, AVX2,
+# AVX-512) in the same rounds, with the AVX-512 walk's rate over the AVX2
+# walk's.  Ratios of rays/s are Franja / Embree (higher is better for
 # Franja), of build times Franja / Embree (lower is better).
 cd "$(dirname "$0")/../.." || exit 1
 T=$(mktemp -d)

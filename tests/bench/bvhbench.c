@@ -1,6 +1,7 @@
 /* bvhbench.c -- Franja's BVH against Embree 3 on the same triangles and rays.
  *
  *   bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages map|2m|4k]
+ *            [--default-walk]
  *
  * Loads a compiled scene, takes its triangles, and measures single-threaded:
  *   - BVH build time: bvh_build versus rtcCommitScene (Embree device with
@@ -10,7 +11,10 @@
  *     (trace_occluded / rtcOccluded1) throughput for primary rays (one per
  *     pixel through the scene camera) and diffuse bounce rays (cosine
  *     directions from the primary hits, incoherent), against both Embree
- *     trees;
+ *     trees; Franja's figure is its default walk's (the fastest this
+ *     processor runs: trace.h), and unless --default-walk is given each
+ *     walk the processor runs (portable, AVX2, AVX-512) is timed too, in
+ *     the same rounds, with the ratio of the AVX-512 walk to the AVX2 one;
  *   - with --worker: worker start-up, from process start to its first pixel
  *     written (a 1x1-pixel, 1-sample render of the scene);
  *   - the binary scene's bytes per triangle.
@@ -139,7 +143,10 @@ static void to_embree(const fr_ray *r, struct RTCRayHit *rh)
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
 }
 
-typedef struct { double franja, embree, high; } trio;
+typedef struct {
+    double franja, embree, high;
+    double walk[TRACE_WALKS];  /* Mrays/s of each walk this processor runs (0: not run) */
+} trio;
 
 /* Seconds of CPU time for Embree scene es to answer rays[0..n). */
 static double embree_pass(RTCScene es, const fr_ray *rays, uint32_t n, int any, volatile uint32_t *sink)
@@ -164,31 +171,53 @@ static double embree_pass(RTCScene es, const fr_ray *rays, uint32_t n, int any, 
     return t;
 }
 
-/* Mrays/s of closest-hit (any = 0) or any-hit queries on rays[0..n):
- * Franja, Embree default (es) and Embree high quality (eh), interleaved. */
-static trio throughput(const fr_scene *s, RTCScene es, RTCScene eh, const fr_ray *rays, uint32_t n, int any, int reps,
-                       volatile uint32_t *sink)
+/* CPU seconds of Franja's walk (the one in use) for rays[0..n). */
+static double franja_pass(const fr_scene *s, const fr_ray *rays, uint32_t n, int any, volatile uint32_t *sink)
 {
-    double tf[64], te[64], th[64];
-    for (int k = 0; k < reps; k++) {
-        uint32_t acc = 0;
-        double t0 = now();
-        if (any) {
-            for (uint32_t i = 0; i < n; i++)
-                acc += (uint32_t)trace_occluded(s, &rays[i], INFINITY, FR_NONE);
-        } else {
-            for (uint32_t i = 0; i < n; i++) {
-                fr_hit h;
-                if (trace_closest(s, &rays[i], INFINITY, &h))
-                    acc += h.prim;
-            }
+    uint32_t acc = 0;
+    double t0 = now();
+    if (any) {
+        for (uint32_t i = 0; i < n; i++)
+            acc += (uint32_t)trace_occluded(s, &rays[i], INFINITY, FR_NONE);
+    } else {
+        for (uint32_t i = 0; i < n; i++) {
+            fr_hit h;
+            if (trace_closest(s, &rays[i], INFINITY, &h))
+                acc += h.prim;
         }
-        tf[k] = now() - t0;
-        *sink += acc;
+    }
+    double t = now() - t0;
+    *sink += acc;
+    return t;
+}
+
+/* Mrays/s of closest-hit (any = 0) or any-hit queries on rays[0..n):
+ * Franja, Embree default (es) and Embree high quality (eh), interleaved;
+ * with `walks`, also each of Franja's walks that this processor runs, in
+ * the same rounds (Franja's figure is the default walk's). */
+static trio throughput(const fr_scene *s, RTCScene es, RTCScene eh, const fr_ray *rays, uint32_t n, int any, int reps,
+                       int walks, volatile uint32_t *sink)
+{
+    double tf[TRACE_WALKS][64], te[64], th[64];
+    int def = trace_walk();
+    for (int k = 0; k < reps; k++) {
+        /* The walks in turn, their order reversed every other round. */
+        for (int j = 0; j < TRACE_WALKS; j++) {
+            int w = k & 1 ? TRACE_WALKS - 1 - j : j;
+            if (w != def && (!walks || !(trace_walks() >> w & 1)))
+                continue;
+            trace_set_walk(w);
+            tf[w][k] = franja_pass(s, rays, n, any, sink);
+        }
+        trace_set_walk(def);
         te[k] = embree_pass(es, rays, n, any, sink);
         th[k] = embree_pass(eh, rays, n, any, sink);
     }
-    return (trio){n / median(tf, reps) / 1e6, n / median(te, reps) / 1e6, n / median(th, reps) / 1e6};
+    trio r = {n / median(tf[def], reps) / 1e6, n / median(te, reps) / 1e6, n / median(th, reps) / 1e6, {0}};
+    for (int w = 0; w < TRACE_WALKS; w++)
+        if (w == def || (walks && (trace_walks() >> w & 1)))
+            r.walk[w] = n / median(tf[w], reps) / 1e6;
+    return r;
 }
 
 /* Rays where Embree and Franja disagree (hit/miss, triangle, or t). */
@@ -236,20 +265,22 @@ static double startup_ms(const char *worker, const char *scene, int reps)
 int main(int argc, char **argv)
 {
     const char *path = NULL, *worker = NULL, *pages = NULL;
-    int reps = 5;
+    int reps = 5, walks = 1;
     uint32_t w = 512, h = 512;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) reps = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) sscanf(argv[++i], "%ux%u", &w, &h);
         else if (!strcmp(argv[i], "--worker") && i + 1 < argc) worker = argv[++i];
         else if (!strcmp(argv[i], "--pages") && i + 1 < argc) pages = argv[++i];
+        else if (!strcmp(argv[i], "--default-walk")) walks = 0;
         else if (argv[i][0] != '-') path = argv[i];
         else { fprintf(stderr, "bvhbench: unknown argument %s\n", argv[i]); return 2; }
     }
     if (pages && strcmp(pages, "map") && strcmp(pages, "2m") && strcmp(pages, "4k"))
         path = NULL;
     if (!path || reps < 1 || reps > 64 || w == 0 || h == 0) {
-        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages map|2m|4k]\n");
+        fprintf(stderr, "usage: bvhbench SCENE.fbin [--reps N] [--size WxH] [--worker PATH] [--pages map|2m|4k] "
+                        "[--default-walk]\n");
         return 2;
     }
     fr_scene s;
@@ -340,9 +371,18 @@ int main(int argc, char **argv)
         uint32_t n = q < 2 ? np : nb;
         if (n == 0)
             continue;
-        trio p = throughput(&s, es, eh, r, n, q & 1, reps, &sink);
+        trio p = throughput(&s, es, eh, r, n, q & 1, reps, walks, &sink);
         printf("%s franja %6.2f Mrays/s   embree %6.2f   embree-high %6.2f   ratio %.2f   ratio-high %.2f\n", names[q],
                p.franja, p.embree, p.high, p.franja / p.embree, p.franja / p.high);
+        if (walks) {
+            printf("  walks   ");
+            for (int k = 0; k < TRACE_WALKS; k++)
+                if (p.walk[k] > 0.0)
+                    printf(" %s %6.2f", trace_walk_name(k), p.walk[k]);
+            if (p.walk[TRACE_WALK_AVX512] > 0.0 && p.walk[TRACE_WALK_AVX2] > 0.0)
+                printf("   avx512/avx2 %.3f", p.walk[TRACE_WALK_AVX512] / p.walk[TRACE_WALK_AVX2]);
+            printf("\n");
+        }
     }
     if (worker) {
         double ms = startup_ms(worker, path, reps);
