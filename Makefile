@@ -29,6 +29,7 @@ OIIO_CFLAGS  := $(shell $(PKG) --cflags OpenImageIO 2>/dev/null)
 OIIO_LIBS    := $(shell $(PKG) --libs OpenImageIO 2>/dev/null)
 ASSIMP_LIBS  := $(shell $(PKG) --libs assimp 2>/dev/null || echo -lassimp)
 MHD_LIBS     := $(shell $(PKG) --libs libmicrohttpd 2>/dev/null || echo -lmicrohttpd)
+ZSTD_LIBS    := $(shell $(PKG) --libs libzstd 2>/dev/null || echo -lzstd)
 
 B = build
 COMMON_SRC  = $(wildcard common/*.c common/compile/*.c)
@@ -61,8 +62,8 @@ BENCH_SRC   = $(wildcard tests/bench/*.c)
 BENCH_BIN   = $(BENCH_SRC:tests/bench/%.c=bin/bench/%)
 LIB         = $(B)/libfranja.a
 
-WORKER_LIBS = $(CJSON_LIBS) -lm
-COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) -ldl -lm -pthread
+WORKER_LIBS = $(CJSON_LIBS) $(ZSTD_LIBS) -lm
+COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) $(ZSTD_LIBS) -ldl -lm -pthread
 
 .PHONY: all deps bench-deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
 all: bin/franja-worker bin/franja $(IIO_PLUGIN)
@@ -277,19 +278,24 @@ guide:
 
 # Fully static workers, bin/static/<arch>/franja-worker: they run on any Linux
 # of their architecture.  Debian ships no static cJSON, so they are built with
-# -DFRANJA_NO_JSON and read binary scenes only.  Each arch has its own objects.
+# -DFRANJA_NO_JSON and read binary scenes only.  libzstd.a is linked where the
+# arch's compiler finds one (libzstd-dev, libzstd-dev:arm64); without it the
+# worker is built with -DFRANJA_NO_ZSTD, cannot unpack, and is sent scenes
+# uncompressed.  Each arch has its own objects.
 STATIC_ARCHS = amd64 arm64
 STATIC_CC_amd64 = x86_64-linux-gnu-gcc
 STATIC_CC_arm64 = aarch64-linux-gnu-gcc
 static: $(STATIC_ARCHS:%=bin/static/%/franja-worker)
 
+static_zstd = $(filter /%,$(shell $(STATIC_CC_$(1)) -print-file-name=libzstd.a 2>/dev/null))
 bin/static/%/franja-worker: $(COMMON_SRC) $(WORKER_SRC) $(wildcard common/*.h common/compile/*.h worker/*.h)
 	$(MAKE) --no-print-directory B=$(B)/static-$* CC=$(STATIC_CC_$*) \
-	    AR=$(STATIC_CC_$*:-gcc=-ar) CJSON_CFLAGS= CFLAGS='$(CFLAGS) -DFRANJA_NO_JSON' \
+	    AR=$(STATIC_CC_$*:-gcc=-ar) CJSON_CFLAGS= \
+	    CFLAGS='$(CFLAGS) -DFRANJA_NO_JSON $(if $(call static_zstd,$*),,-DFRANJA_NO_ZSTD)' \
 	    $(B)/static-$*/libfranja.a $(WORKER_SRC:%.c=$(B)/static-$*/%.o)
 	@mkdir -p $(dir $@)
 	$(STATIC_CC_$*) $(CFLAGS) $(LTO_LINK) -static -o $@ $(WORKER_SRC:%.c=$(B)/static-$*/%.o) \
-	    $(B)/static-$*/libfranja.a -lm
+	    $(B)/static-$*/libfranja.a $(call static_zstd,$*) -lm
 
 # dist/<os>-<arch>/ from the docker/Dockerfile.* images (docker/build.sh; see
 # docker/README.md), plus dist/static-<arch>/.  DIST_TARGETS: bullseye bookworm

@@ -142,13 +142,17 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             return 0;
         } else if (!strcmp(a, "--check")) {
             check = 1;
+        } else if (!strcmp(a, "--features")) {
+            r->mode = PROTO_FEATURES;
+            return 0;
         } else if (!strcmp(a, "--lifeline")) {
             r->slab.lifeline = 1;
         } else if (!strcmp(a, "--sums")) {
             r->slab.sums = 1;
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
                                 !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "--integrator") ||
-                                !strcmp(a, "--noise-threshold") || !strcmp(a, "--continue") || !strcmp(a, "-o"))) {
+                                !strcmp(a, "--noise-threshold") || !strcmp(a, "--continue") || !strcmp(a, "-o") ||
+                                !strcmp(a, "--unpack"))) {
             return fr_fail(err, "%s needs a value", a);
         } else if (!strcmp(a, "--scene")) {
             r->slab.scene = argv[++i];
@@ -177,10 +181,13 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             r->slab.out = argv[++i];
         } else if (!strcmp(a, "--continue")) {
             r->slab.continue_from = argv[++i];
+        } else if (!strcmp(a, "--unpack")) {
+            r->unpack = argv[++i];
         } else {
             static const char *const known[] = {"help",       "version",         "check",    "lifeline", "sums",
                                                 "scene",      "rows",            "spp",      "size",     "format",
-                                                "integrator", "noise-threshold", "continue", "o",        "h"};
+                                                "integrator", "noise-threshold", "continue", "o",        "h",
+                                                "features",   "unpack"};
             char near[64];
             if (a[0] == '-' && sug_option(a, known, sizeof known / sizeof *known, near, sizeof near) == 0)
                 return fr_fail(err, "unknown argument '%s' (did you mean %s? see --help)", a, near);
@@ -191,6 +198,12 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         return fr_fail(err, "--format: expected pf, ppm16 or ppm8, got '%s'", fmt_name);
     if (!r->slab.scene)
         return fr_fail(err, "--scene is required (see --help)");
+    if (r->unpack) {
+        if (rows || check)
+            return fr_fail(err, "--unpack takes --scene OUT only (see --help)");
+        r->mode = PROTO_UNPACK;
+        return 0;
+    }
     if (!rows && !check)
         return fr_fail(err, "--rows is required (see --help)");
     if (rows && parse_pair(rows, ':', &r->slab.y0, &r->slab.y1) < 0)
@@ -233,6 +246,32 @@ void proto_check_argv(const char *path, const char *argv[4])
     argv[1] = path;
     argv[2] = "--check";
     argv[3] = NULL;
+}
+
+void proto_unpack_argv(const char *in, const char *out, const char *argv[6])
+{
+    argv[0] = "--unpack";
+    argv[1] = in;
+    argv[2] = "--scene";
+    argv[3] = out;
+    argv[4] = NULL;
+    argv[5] = NULL;
+}
+
+int proto_has_feature(const char *out, size_t len, const char *feature)
+{
+    size_t n = strlen(feature);
+    for (size_t i = 0; i < len;) {
+        while (i < len && (out[i] == ' ' || out[i] == '\t' || out[i] == '\n' || out[i] == '\r'))
+            i++;
+        size_t j = i;
+        while (j < len && !(out[j] == ' ' || out[j] == '\t' || out[j] == '\n' || out[j] == '\r'))
+            j++;
+        if (j - i == n && !memcmp(out + i, feature, n))
+            return 1;
+        i = j;
+    }
+    return 0;
 }
 
 int proto_parse_check(const char *out, size_t len, uint64_t *hash, fr_error *err)

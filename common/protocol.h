@@ -64,7 +64,9 @@ typedef enum {
     PROTO_RENDER = 0,          /**< render the slab */
     PROTO_CHECK,               /**< --check: validate the scene, print its hash */
     PROTO_VERSION,             /**< --version */
-    PROTO_HELP                 /**< --help / -h */
+    PROTO_HELP,                /**< --help / -h */
+    PROTO_FEATURES,            /**< --features: print what this build can do besides rendering */
+    PROTO_UNPACK               /**< --unpack IN --scene OUT: a compressed scene into the cache */
 } proto_mode;
 
 /** A parsed worker command line. */
@@ -72,6 +74,7 @@ typedef struct {
     proto_mode mode;
     proto_slab slab;           /**< scene, rows, size, spp, format, out */
     int have_rows;             /**< --rows was given */
+    const char *unpack;        /**< --unpack: the compressed scene (the output is slab.scene) */
 } proto_request;
 
 /** Reads a worker command line (argv[0] is the program).  Checks the syntax
@@ -114,6 +117,21 @@ int proto_parse_version(const char *line, proto_version *v, fr_error *err);
 /** The arguments (no program name) that make a worker check the scene at
  * path and print its content hash: write them to argv[4]. */
 void proto_check_argv(const char *path, const char *argv[4]);
+
+/** The word `--features` prints when the worker can unpack a scene sent
+ * compressed with zstd (`--unpack`). */
+#define PROTO_FEATURE_UNPACK "unpack-zstd"
+
+/** Fills argv (NULL-terminated) with the worker arguments (after the program) that
+ * unpack the compressed scene `in` into `out`: the scene is written under
+ * a temporary name beside `out`, checked (its content hash, as --check)
+ * and renamed to `out`; `in` is removed whatever happens.  Prints the
+ * hash as --check does. */
+void proto_unpack_argv(const char *in, const char *out, const char *argv[6]);
+
+/** Whether a `--features` answer (len bytes: words separated by blanks)
+ * has the word `feature`. */
+int proto_has_feature(const char *out, size_t len, const char *feature);
 
 /** Reads the output of `--check` (len bytes): one line of 16 hex digits.
  * Fails if it is anything else. */

@@ -185,14 +185,16 @@ static int rf_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene
     frame_slot *fs = fx->fr[frame];
     const hosts_entry *e = &fx->table->v[host_i];
     double t0 = clock_now();
-    int uploaded = 0;
+    uint64_t sent = 0;
     fr_error e2;
-    if (cluster_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, scene, scene_cap, lease, lease_cap, &uploaded, &e2))
+    if (cluster_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, scene, scene_cap, lease, lease_cap, &sent, &e2))
         return fr_fail(err, "%s: %s", fs->label, e2.msg);
+    h->sent += sent;
     if (fx->table->path[0] != '(' || !isatty(2)) {
         render_run_clear_line();
-        fprintf(stderr, "franja: host %s: %s: scene %s (%.2f s)\n", h->name, fs->label,
-                hosts_is_local(e) ? "local" : uploaded ? "uploaded" : "already there", clock_now() - t0);
+        char how[64];
+        render_run_scene_state(e, sent, how);
+        fprintf(stderr, "franja: host %s: %s: scene %s (%.2f s)\n", h->name, fs->label, how, clock_now() - t0);
     }
     return 0;
 }

@@ -82,14 +82,16 @@ static void summary(const sched_host *hs, int n, const job_spec *spec, const sch
     fputc('\n', stderr);
     if (n == 0)
         return;
-    fprintf(stderr, "  %-16s %5s %6s %6s %8s %6s %8s  %s\n", "host", "slots", "slabs", "rows", "failures", "copies",
-            "busy s", "state");
+    fprintf(stderr, "  %-16s %5s %6s %6s %8s %6s %8s %10s  %s\n", "host", "slots", "slabs", "rows", "failures",
+            "copies", "busy s", "sent", "state");
     for (int i = 0; i < n; i++) {
         const sched_host *h = &hs[i];
         if (!h->tr)
             continue; /* never ready: said when it was given up */
-        fprintf(stderr, "  %-16s %5d %6d %6d %8d %6d %8.2f  %s%s\n", h->name, h->slots, h->slabs, h->rows,
-                h->failures, h->duplicates, h->busy_s, h->dropped ? "dropped: " : "ok",
+        char sent[32];
+        hosts_format_size(h->sent, sent);
+        fprintf(stderr, "  %-16s %5d %6d %6d %8d %6d %8.2f %10s  %s%s\n", h->name, h->slots, h->slabs, h->rows,
+                h->failures, h->duplicates, h->busy_s, sent, h->dropped ? "dropped: " : "ok",
                 h->dropped ? h->drop_reason : "");
     }
 }
@@ -128,6 +130,18 @@ static void host_event(reporter *r, long frame, const char *what, const char *ho
 }
 
 static int line_drawn;          /* a live status line is on the terminal */
+
+void render_run_scene_state(const hosts_entry *e, uint64_t sent, char *out)
+{
+    char size[32];
+    hosts_format_size(sent, size);
+    if (hosts_is_local(e))
+        snprintf(out, 64, "local");
+    else if (sent)
+        snprintf(out, 64, "uploaded (%s)", size);
+    else
+        snprintf(out, 64, "already there");
+}
 
 void render_run_clear_line(void)
 {
@@ -256,10 +270,13 @@ static void join_hosts(joiner *j, sched_host *sh, int ms)
         if ((table || !isatty(2)) && j->rep && j->rep->fx) /* each frame's scene is said as it is staged */
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s (%.2f s)\n", s->name, h.info.os, h.info.arch,
                     s->slots, h.info.version, h.ready_s);
-        else if (table || !isatty(2))
+        else if (table || !isatty(2)) {
+            char how[64];
+            render_run_scene_state(h.entry, h.sent, how);
             fprintf(stderr, "franja: host %s: %s %s, %d slots, %s, scene %s (%.2f s)\n", s->name, h.info.os,
-                    h.info.arch, s->slots, h.info.version,
-                    hosts_is_local(h.entry) ? "local" : h.uploaded ? "uploaded" : "already there", h.ready_s);
+                    h.info.arch, s->slots, h.info.version, how, h.ready_s);
+        }
+        s->sent += h.sent;
         if (j->rep) {
             char line[600];
             snprintf(line, sizeof line, "host %s ready: %s %s, %d slots (%.2f s)", s->name, h.info.os, h.info.arch,

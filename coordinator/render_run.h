@@ -76,4 +76,8 @@ int render_run(const frame_settings *a, const hosts_table *table, const char *fb
  * log line can follow. */
 void render_run_clear_line(void);
 
+/** How a host got its scene, for the log: "local", "already there" (in its
+ * cache) or "uploaded (SIZE)" with the bytes sent, into out[64]. */
+void render_run_scene_state(const hosts_entry *e, uint64_t sent, char *out);
+
 #endif

@@ -81,6 +81,7 @@ typedef struct {
     double retry_at;           /**< no new process before this time (after a refused start) */
     char drop_reason[300];
     double busy_s;             /**< sum of the run time of accepted slabs */
+    uint64_t sent;             /**< bytes of scenes sent to the host (set by the caller, for the summary) */
 } sched_host;
 
 /** One frame of a run: the image to render and where its slabs go.  The

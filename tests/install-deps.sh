@@ -11,7 +11,7 @@ export DEBIAN_FRONTEND=noninteractive
 apt-get update
 apt-get install -y --no-install-recommends \
     build-essential pkg-config \
-    libcjson-dev libxxhash-dev libassimp-dev libembree-dev clang libclang-rt-14-dev \
+    libcjson-dev libxxhash-dev libzstd-dev zstd libassimp-dev libembree-dev clang libclang-rt-14-dev \
     libssh-dev libmicrohttpd-dev libopenimageio-dev openimageio-tools assimp-testmodels \
     openssh-server openssh-client iproute2 procps doxygen pandoc man-db groff-base jq chromium curl \
     libfuse3-dev fuse3 time python3 \

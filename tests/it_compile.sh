@@ -142,7 +142,10 @@ scene "$T/m/j.json" '{"type": "mesh", "file": "quad.obj", "scale": [1, 0, 1]}'
 expect_error "singular transform" "shapes[0]: the transform is singular" $F compile "$T/m/j.json" -o "$T/x.fbin"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl ghost\nf 1 2 3\n' >"$T/m/ghost.obj"
 scene "$T/m/k.json" '{"type": "mesh", "file": "ghost.obj"}'
-expect_error "undefined usemtl" "ghost.obj:4: usemtl: no such material" $F compile "$T/m/k.json" -o "$T/x.fbin"
+# A name no MTL file defines: the default material, with a warning (as in Blender).
+$F compile "$T/m/k.json" -o "$T/x.fbin" >/dev/null 2>"$T/err" &&
+    grep -q "warning: .*ghost.obj:4: usemtl: 1 material name defined in no mtllib file" "$T/err" && ok ||
+    bad "undefined usemtl: $(cat "$T/err")"
 scene "$T/m/n.json" '{"type": "mesh", "file": "quad.obj", "lod": ["quad.obj"]}'
 expect_error "file and lod" "give exactly one of file" $F compile "$T/m/n.json" -o "$T/x.fbin"
 printf 'not a mesh\n' >"$T/m/junk.ply"

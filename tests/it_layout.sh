@@ -166,13 +166,14 @@ if cc -c -o "$T/p.o" "$T/p.c" && nm -g --defined-only "$T/p.o" | awk 'NF == 3 { 
 
 # (3) The worker links from the render-side objects alone (a worker built
 # for binary scenes only, as the static ones are) and renders the same
-# bytes as bin/franja-worker.
+# bytes as bin/franja-worker.  libzstd is the one library besides libm: the
+# worker unpacks scenes sent compressed (common/unpack.h).
 render_objs=""
 for c in $(grep '^common/.*\.c$' "$T/files"); do
     is_compile_time "${c#common/}" || render_objs="$render_objs $B/${c%.c}.o"
 done
 if cc -std=c17 -D_GNU_SOURCE -DFRANJA_NO_JSON -ffp-contract=off -fno-math-errno -Icommon \
-    -o "$T/worker" worker/*.c $render_objs -lm 2>"$T/link"; then
+    -o "$T/worker" worker/*.c $render_objs -lzstd -lm 2>"$T/link"; then
     ok
     if bin/franja compile scenes/spheres.json -o "$T/s.fbin" >/dev/null 2>"$T/log" &&
         bin/franja-worker --scene "$T/s.fbin" --rows 2:6 --size 24x8 --spp 4 -o "$T/a.pf" 2>"$T/log" &&

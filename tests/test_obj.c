@@ -14,7 +14,7 @@
 
 static int parse(const char *text, mesh_data *m, fr_error *err)
 {
-    return obj_parse(text, strlen(text), "t.obj", NULL, NULL, m, err);
+    return obj_parse(text, strlen(text), "t.obj", NULL, NULL, NULL, m, err);
 }
 
 /* Parsing must fail with a message containing `want`. */
@@ -28,6 +28,19 @@ static void bad(const char *text, const char *want)
         mesh_data_free(&m);
     else
         CHECK(strstr(err.msg, want) != NULL, "message \"%s\" lacks \"%s\"", err.msg, want);
+}
+
+/* Warnings received through an obj_warn sink. */
+typedef struct {
+    int n;
+    char last[512];
+} warnings;
+
+static void note_warning(void *user, const char *msg)
+{
+    warnings *w = user;
+    w->n++;
+    snprintf(w->last, sizeof w->last, "%s", msg);
 }
 
 static double tri_area2(const mesh_data *m, uint32_t t, vec3 n)
@@ -154,7 +167,7 @@ static void test_groups_materials(void)
              "usemtl lamp\nf 1 2 4\ns 1\nusemtl glass\nf 1 3 4\nusemtl mirror\nf 3 2 1\nusemtl red\nf 4 3 2\n");
     mesh_data m;
     fr_error err;
-    CHECK(obj_read(path, NULL, NULL, &m, &err) == 0, "%s", err.msg);
+    CHECK(obj_read(path, NULL, NULL, NULL, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 7, "faces in every group: %u", m.n_tri);
     const char *names[] = {"(default)", "red", "shiny", "lamp", "glass", "mirror", "red"};
     for (uint32_t t = 0; t < m.n_tri && t < 7; t++)
@@ -178,22 +191,28 @@ static void test_groups_materials(void)
 
     /* A usemtl without a definition is kept, marked undefined, with its line. */
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf 1 2 3\n");
-    CHECK(obj_read(path, NULL, NULL, &m, &err) == 0, "%s", err.msg);
+    CHECK(obj_read(path, NULL, NULL, NULL, &m, &err) == 0, "%s", err.msg);
     CHECK(m.n_tri == 1 && !m.mats[m.tri_mat[0]].defined && m.mats[m.tri_mat[0]].line == 5, "undefined material");
     mesh_data_free(&m);
-    /* Missing MTL file, and MTL errors, name their file and line. */
-    put_file(path, sizeof path, dir, "m.obj", "v 0 0 0\nmtllib missing.mtl\n");
-    CHECK(obj_read(path, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "m.obj:2:") && strstr(err.msg, "missing.mtl"),
+    /* A missing MTL file is a warning naming its file and line; its names
+     * stay undefined.  MTL errors name their file and line. */
+    put_file(path, sizeof path, dir, "m.obj", "v 0 0 0\nmtllib missing.mtl\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n");
+    warnings w = {0, ""};
+    obj_warn sink = {note_warning, &w};
+    CHECK(obj_read(path, NULL, NULL, &sink, &m, &err) == 0 && m.n_tri == 1 && !m.mats[m.tri_mat[0]].defined,
           "missing mtllib: %s", err.msg);
+    CHECK(w.n == 1 && strstr(w.last, "m.obj:2: mtllib: ") && strstr(w.last, "missing.mtl does not exist"),
+          "missing mtllib warned once: %d \"%s\"", w.n, w.last);
+    mesh_data_free(&m);
     put_file(path, sizeof path, dir, "a.mtl", "newmtl x\nKd 1 1\n");
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl\n");
-    CHECK(obj_read(path, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "a.mtl:2:") && strstr(err.msg, "Kd"), "MTL error: %s",
+    CHECK(obj_read(path, NULL, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "a.mtl:2:") && strstr(err.msg, "Kd"), "MTL error: %s",
           err.msg);
     /* Two MTL files of one OBJ defining one name: which was meant? */
     put_file(path, sizeof path, dir, "a.mtl", "newmtl red\nKd 0.8 0.1 0.1\n");
     put_file(path, sizeof path, dir, "b.mtl", "newmtl blue\nKd 0.1 0.1 0.8\nnewmtl red\nKd 0.9 0 0\n");
     put_file(path, sizeof path, dir, "m.obj", "mtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
-    CHECK(obj_read(path, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "b.mtl:3:") && strstr(err.msg, "newmtl: the material is defined twice"),
+    CHECK(obj_read(path, NULL, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "b.mtl:3:") && strstr(err.msg, "newmtl: the material is defined twice"),
           "one material name in two MTL files: %s", err.msg);
     const char *files[] = {"a.mtl", "b.mtl", "m.obj"};
     for (int i = 0; i < 3; i++) {
@@ -245,18 +264,64 @@ static void test_errors(void)
     bad("v 0 0 0 junk\n", "t.obj:1: expected a finite number for v");
     bad("# nothing\nv 0 0 0\n", "t.obj: no faces");
     bad("v 0 0 0\nfoo 1 2\n", "t.obj:2: unknown OBJ statement (expected");
-    bad("usemtl\n", "t.obj:1: usemtl: expected a material name");
+    char longname[200] = "usemtl ";
+    memset(longname + 7, 'a', 150);
+    strcpy(longname + 157, "\n");
+    bad(longname, "t.obj:1: usemtl: a material name longer than 127 bytes");
     bad("mtllib\n", "t.obj:1: mtllib: expected a file name");
     mesh_data m;
     fr_error err;
     const char nul[] = "v 0 0 0\nv 1 0 0\n\0v 0 1 0\nf 1 2 3\n";
-    CHECK(obj_parse(nul, sizeof nul - 1, "t.obj", NULL, NULL, &m, &err) < 0 && strstr(err.msg, "t.obj:3: NUL byte"),
+    CHECK(obj_parse(nul, sizeof nul - 1, "t.obj", NULL, NULL, NULL, &m, &err) < 0 && strstr(err.msg, "t.obj:3: NUL byte"),
           "NUL byte: %s", err.msg);
+    const char utf16[] = "\xfe\xff\0v\0 \0001\0\n";
+    CHECK(obj_parse(utf16, sizeof utf16 - 1, "t.obj", NULL, NULL, NULL, &m, &err) < 0 &&
+              strstr(err.msg, "t.obj: UTF-16 text"),
+          "UTF-16: %s", err.msg);
     /* Ignored statements of the format are accepted. */
     CHECK(parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvp 0.5\nl 1 2\np 1\ns off\ncstype bezier\nf 1 2 3\n", &m, &err) == 0 &&
               m.n_tri == 1,
           "ignored statements: %s", err.msg);
     mesh_data_free(&m);
+}
+
+/* Material names are the rest of the line, blanks inside kept and those
+ * around dropped, as Assimp and Blender read them (assimp-testmodels'
+ * space_in_material_name.obj, box_mat_with_spaces.obj); an empty name is
+ * a name too (Blender writes `newmtl ` for a nameless material). */
+static void test_material_names(void)
+{
+    char dir[] = "/tmp/franja-test-obj-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL, "mkdtemp");
+    char path[256];
+    put_file(path, sizeof path, dir, "s.mtl",
+             "\xef\xbb\xbfnewmtl Hard Shiny Plastic White\r\nKd 0.1 0.2 0.4\r\n"
+             "newmtl   Material #25  \nKd 0.5 0.5 0.5\nnewmtl Hard Shiny\nKd 1 0 0\nnewmtl \nKd 0 1 0\n");
+    put_file(path, sizeof path, dir, "s.obj",
+             "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+             "usemtl  Hard Shiny Plastic White \r\nf 1 2 3\nusemtl Material #25\nf 1 2 3\n"
+             "usemtl Hard Shiny\nf 1 2 3\nusemtl\nf 1 2 3\n");
+    mesh_data m;
+    fr_error err;
+    warnings w = {0, ""};
+    obj_warn sink = {note_warning, &w};
+    CHECK(obj_read(path, NULL, NULL, &sink, &m, &err) == 0, "%s", err.msg);
+    const char *names[] = {"Hard Shiny Plastic White", "Material #25", "Hard Shiny", ""};
+    const float kd[] = {0.1f, 0.5f, 1.0f, 0.0f};
+    for (uint32_t t = 0; t < m.n_tri && t < 4; t++) {
+        const mesh_material *mt = &m.mats[m.tri_mat[t]];
+        CHECK(!strcmp(mt->name, names[t]) && mt->defined && mt->kd.x == kd[t], "face %u: material \"%s\" (%s)", t,
+              mt->name, mt->defined ? "defined" : "undefined");
+    }
+    CHECK(m.n_tri == 4 && m.n_mats == 5 && w.n == 0, "four faces, four materials and the default: %u %u, %d warnings",
+          m.n_tri, m.n_mats, w.n);
+    mesh_data_free(&m);
+    const char *files[] = {"s.mtl", "s.obj"};
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        unlink(path);
+    }
+    rmdir(dir);
 }
 
 int main(void)
@@ -267,5 +332,6 @@ int main(void)
     test_groups_materials();
     test_mtl_errors();
     test_errors();
+    test_material_names();
     return check_done();
 }

@@ -19,6 +19,7 @@
 #include "quick.h"
 #include "splat.h"
 #include "trace.h"
+#include "unpack.h"
 #ifndef FRANJA_NO_JSON
 #include "compile/json_scene.h"
 #endif
@@ -28,6 +29,8 @@ static const char usage[] =
     "                     [--integrator path|bdpt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
     "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE]\n"
     "       franja-worker --scene FILE --check\n"
+    "       franja-worker --unpack FILE.zst --scene FILE\n"
+    "       franja-worker --features\n"
     "       franja-worker --help | --version\n"
     "\n"
     "Renders rows Y0 (inclusive) to Y1 (exclusive) of a scene and writes them as a\n"
@@ -43,6 +46,10 @@ static const char usage[] =
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
+    "  --unpack F     decompress the zstd file F into the --scene file, check it\n"
+    "                 as --check does (printing its hash) and remove F\n"
+    "  --features     print what this build can do besides rendering\n"
+    "                 (" PROTO_FEATURE_UNPACK ": --unpack)\n"
     "  --lifeline     end when standard input (a pipe) reaches its end\n"
     "  --sums         append each pixel's sample sums to the PF image, so that a\n"
     "                 later render can add samples exactly (path integrator, no\n"
@@ -101,6 +108,21 @@ int main(int argc, char **argv)
         printf("%s\n", line);
         proto_walk_line(line, sizeof line);
         printf("%s\n", line);
+        return 0;
+    }
+    if (req.mode == PROTO_FEATURES) {
+        printf("%s\n", unpack_available() ? PROTO_FEATURE_UNPACK : "");
+        return 0;
+    }
+    if (req.mode == PROTO_UNPACK) {
+        uint64_t hash;
+        if (unpack_file(req.unpack, req.slab.scene, &hash, &err) < 0) {
+            fprintf(stderr, "franja-worker: %s\n", err.msg);
+            return 1;
+        }
+        char hx[17];
+        fbin_hash_hex(hash, hx);
+        printf("%s\n", hx);
         return 0;
     }
     const proto_slab *sl = &req.slab;

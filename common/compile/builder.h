@@ -39,6 +39,9 @@ typedef struct {
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
     fr_array distrib;          /**< float: filled by frz_scene */
     fr_budget *budget;         /**< the compile's limits (budget.h), not owned; NULL: none */
+    void (*warn)(void *user, const char *msg); /**< where readers of the scene's files report warnings
+                                                    (scene_hooks.h); NULL: nowhere */
+    void *warn_user;           /**< passed back to warn */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero, no

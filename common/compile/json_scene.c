@@ -441,6 +441,8 @@ int json_scene_load(const char *path, const scene_hooks *hooks, fr_scene *out, f
     fr_builder b;
     bld_init(&b);
     b.budget = hooks ? hooks->budget : NULL;
+    b.warn = hooks ? hooks->warn : NULL;
+    b.warn_user = hooks ? hooks->user : NULL;
     if (budget_take(b.budget, BUDGET_READ, len, path, err) < 0) {
         free(text);
         return -1;

@@ -22,13 +22,14 @@ enum { LOD_MAX = 16 };
  * folder): OBJ by obj_read, others by mesh_import into the same structure
  * (free with mesh_data_free).  The file's size, and each MTL file an OBJ
  * names, count against budget's read limit first (NULL: no limit). */
-static int mesh_read(const char *path, const confine *scope, fr_budget *budget, mesh_data *m, fr_error *err)
+static int mesh_read(const fr_builder *b, const char *path, const confine *scope, mesh_data *m, fr_error *err)
 {
     const char *dot = strrchr(path, '.');
-    if (budget_take_file(budget, path, path, err) < 0)
+    if (budget_take_file(b->budget, path, path, err) < 0)
         return -1;
+    obj_warn w = {b->warn, b->warn_user};
     if (dot && !strcasecmp(dot, ".obj"))
-        return obj_read(path, scope, budget, m, err);
+        return obj_read(path, scope, b->budget, &w, m, err);
     return mesh_import(path, scope, m, err);
 }
 
@@ -227,13 +228,13 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
      * triangles for the mesh's size on screen; the finest if none is. */
     mesh_data m;
     int level = levels - 1;
-    if (mesh_read(paths[level], scope, b->budget, &m, err) < 0)
+    if (mesh_read(b, paths[level], scope, &m, err) < 0)
         return -1;
     float need = density * projected_pixels(b, &m, &x);
     while (level > 0 && (float)m.n_tri < need) {
         mesh_data_free(&m);
         --level;
-        if (mesh_read(paths[level], scope, b->budget, &m, err) < 0)
+        if (mesh_read(b, paths[level], scope, &m, err) < 0)
             return -1;
     }
     if (budget_take(b->budget, BUDGET_VERTICES, m.n_vert, paths[level], err) < 0 ||
@@ -253,19 +254,37 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
     for (uint32_t i = 0; i < m.n_mats; i++)
         mat_of[i] = material;
     if (material == FR_NONE) {
+        /* A name no MTL file defines gets the default material (0), as in
+         * Blender; one warning names the first use and the count. */
+        uint32_t undefined = 0, first = 0;
         for (uint32_t t = 0; t < m.n_tri && rc == 0; t++) {
             uint32_t k = m.tri_mat[t];
             if (mat_of[k] != FR_NONE)
                 continue;
             if (!m.mats[k].defined) {
-                rc = fr_fail(err, "%s:%d: usemtl: no such material in the mtllib files (or give the shape a "
-                             "material)", paths[level], m.mats[k].line);
-                break;
+                if (undefined++ == 0 || m.mats[k].line < m.mats[first].line)
+                    first = k;
+                if (mat_of[0] == FR_NONE) {
+                    fr_material fm;
+                    mesh_data_material(&m.mats[0], &fm);
+                    if ((mat_of[0] = bld_push(&b->materials, &fm)) == FR_NONE)
+                        rc = fr_fail(err, "%s: out of memory", where);
+                }
+                mat_of[k] = mat_of[0];
+                continue;
             }
             fr_material fm;
             mesh_data_material(&m.mats[k], &fm);
             if ((mat_of[k] = bld_push(&b->materials, &fm)) == FR_NONE)
                 rc = fr_fail(err, "%s: out of memory", where);
+        }
+        if (rc == 0 && undefined > 0 && b->warn) {
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s:%d: usemtl: %u material name%s defined in no mtllib file (the first used "
+                     "here): %s the default material", paths[level], m.mats[first].line, undefined,
+                     undefined == 1 ? "" : "s", undefined == 1 ? "it gets" : "they get");
+            fr_escape_controls(msg, sizeof msg);
+            b->warn(b->warn_user, msg);
         }
     }
 

@@ -7,7 +7,9 @@
  * other extension (ply, stl, gltf, glb, dae, fbx, 3ds ...) through Assimp,
  * in a child process with limits (mesh_import.h).
  * MTL (or Assimp) materials become Franja materials as scenes/README.md
- * describes, unless the shape names a material that overrides them all.
+ * describes, unless the shape names a material that overrides them all; a
+ * usemtl name that no MTL file defines gets the default material, with a
+ * warning through the builder's warn hook.
  */
 #ifndef FRANJA_MESH_H
 #define FRANJA_MESH_H

@@ -5,9 +5,11 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "bsdf.h"
 #include "compile/builder.h"
@@ -61,6 +63,48 @@ static int number(cursor *c, float *out, const char *what)
     c->p = end;
     *out = v;
     return 1;
+}
+
+/* A material name (newmtl, usemtl): the rest of the line without the
+ * blanks around it; blanks and '#' inside belong to it ("Material #25").
+ * May be empty; -1 (error set) when longer than cap - 1 bytes. */
+static int name_rest(cursor *c, char *buf, size_t cap, const char *what)
+{
+    skip_space(c);
+    const char *s = c->p, *e = s;
+    while (*e && *e != '\n')
+        e++;
+    c->p = e;
+    while (e > s && is_space(e[-1]))
+        e--;
+    size_t n = (size_t)(e - s);
+    if (n >= cap)
+        return fr_fail(c->err, "%s:%d: %s: a material name longer than %zu bytes", c->name, c->line, what, cap - 1);
+    memcpy(buf, s, n);
+    buf[n] = 0;
+    return 0;
+}
+
+/* Text that is not 8-bit: a UTF-16 byte-order mark or a NUL byte gets an
+ * error naming the file (and the line of the NUL); -1 then, else 0. */
+static int not_text(const char *text, size_t len, const char *name, fr_error *err)
+{
+    const unsigned char *u = (const unsigned char *)text;
+    if (len >= 2 && ((u[0] == 0xfe && u[1] == 0xff) || (u[0] == 0xff && u[1] == 0xfe)))
+        return fr_fail(err, "%s: UTF-16 text (it starts with a byte-order mark): save it as UTF-8 or ASCII", name);
+    const char *nul = memchr(text, 0, len);
+    if (!nul)
+        return 0;
+    int line = 1;
+    for (const char *q = text; q < nul; q++)
+        line += *q == '\n';
+    return fr_fail(err, "%s:%d: NUL byte in a text file", name, line);
+}
+
+/* Where the text starts: after a UTF-8 byte-order mark, if any. */
+static const char *skip_bom(const char *text)
+{
+    return !strncmp(text, "\xef\xbb\xbf", 3) ? text + 3 : text;
 }
 
 static int end_of_line(cursor *c, const char *what)
@@ -176,17 +220,15 @@ static int mtl_ignored(const char *kw)
 
 static int parse_mtl(const char *text, const char *name, mesh_data *m, uint32_t *cap, fr_error *err)
 {
-    cursor c = {text, name, 0, err};
+    cursor c = {skip_bom(text), name, 0, err};
     mesh_material *cur = NULL;
-    char kw[64], arg[128];
+    char kw[64], arg[sizeof cur->name];
     while (*c.p) {
         c.line++;
         const char *next = strchr(c.p, '\n');
         if (word(&c, kw, sizeof kw)) {
             if (!strcmp(kw, "newmtl")) {
-                if (!word(&c, arg, sizeof arg))
-                    return fr_fail(err, "%s:%d: newmtl: expected a name", name, c.line);
-                if (end_of_line(&c, "newmtl name") < 0)
+                if (name_rest(&c, arg, sizeof arg, "newmtl") < 0)
                     return -1;
                 uint32_t i;
                 if (mat_find(m, cap, arg, c.line, &i, &c) < 0)
@@ -245,6 +287,7 @@ typedef struct {
     cursor c;
     const char *dir;
     const confine *scope;       /* where mtllib files may be read */
+    const obj_warn *warn;       /* where warnings go (NULL: nowhere) */
     fr_budget *budget;         /* counts the MTL files read (NULL: no limit) */
     /* raw attribute lists of the file */
     vec3 *v; uint32_t n_v, cap_v;
@@ -518,6 +561,20 @@ static int obj_ignored(const char *kw)
     return 0;
 }
 
+static void warn(parser *P, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void warn(parser *P, const char *fmt, ...)
+{
+    if (!P->warn || !P->warn->fn)
+        return;
+    char msg[sizeof ((fr_error *)0)->msg];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    fr_escape_controls(msg, sizeof msg);
+    P->warn->fn(P->warn->user, msg);
+}
+
 static int load_mtllib(parser *P, const char *file)
 {
     char path[4096];
@@ -528,12 +585,19 @@ static int load_mtllib(parser *P, const char *file)
     size_t len;
     fr_error e;
     snprintf(where, sizeof where, "%s:%d: mtllib", P->c.name, P->c.line);
+    /* A missing library is what Blender and Assimp shrug off (a file sent
+     * without its .mtl): its names get the default material. */
+    struct stat st;
+    if (stat(path, &st) < 0 && (errno == ENOENT || errno == ENOTDIR)) {
+        warn(P, "%s:%d: mtllib: %s does not exist: the materials it would define get the default material",
+             P->c.name, P->c.line, path);
+        return 0;
+    }
     if (budget_take_file(P->budget, path, where, P->c.err) < 0)
         return -1;
     if (confine_read(P->scope, path, FILE_READ_MAX, &text, &len, &e) < 0)
         return fr_fail(P->c.err, "%s:%d: mtllib: %s", P->c.name, P->c.line, e.msg);
-    int rc = memchr(text, 0, len) ? fr_fail(P->c.err, "%s: NUL byte in a text file", path)
-                                   : parse_mtl(text, path, P->m, &P->cap_mats, P->c.err);
+    int rc = not_text(text, len, path, P->c.err) < 0 ? -1 : parse_mtl(text, path, P->m, &P->cap_mats, P->c.err);
     free(text);
     return rc;
 }
@@ -588,9 +652,9 @@ static int parse_line(parser *P, const char *kw)
     } else if (!strcmp(kw, "g") || !strcmp(kw, "o")) {
         /* Groups and objects only name faces; all of them are loaded. */
     } else if (!strcmp(kw, "usemtl")) {
-        char name[128];
-        if (!word(c, name, sizeof name))
-            return fr_fail(c->err, "%s:%d: usemtl: expected a material name", c->name, c->line);
+        char name[sizeof m->mats->name];
+        if (name_rest(c, name, sizeof name, "usemtl") < 0)
+            return -1;
         return mat_find(m, &P->cap_mats, name, c->line, &P->material, c);
     } else if (!strcmp(kw, "mtllib")) {
         char file[1024];
@@ -610,7 +674,7 @@ static int parse_line(parser *P, const char *kw)
 }
 
 static int parse_obj(const char *text, size_t len, const char *name, const char *dir, const confine *scope,
-                     fr_budget *budget, mesh_data *m, fr_error *err)
+                     fr_budget *budget, const obj_warn *wn, mesh_data *m, fr_error *err)
 {
     memset(m, 0, sizeof *m);
     confine own;
@@ -635,14 +699,8 @@ static int parse_obj(const char *text, size_t len, const char *name, const char 
     P.dir = dir;
     P.scope = scope;
     P.budget = budget;
-    int rc = 0;
-    const char *nul = memchr(text, 0, len);
-    if (nul) {
-        int line = 1;
-        for (const char *q = text; q < nul; q++)
-            line += *q == '\n';
-        rc = fr_fail(err, "%s:%d: NUL byte in a text file", name, line);
-    }
+    P.warn = wn;
+    int rc = not_text(text, len, name, err);
     if (rc == 0 && grow(&m->mats, &P.cap_mats, 1, sizeof *m->mats) < 0)
         rc = fr_fail(err, "%s: out of memory", name);
     if (rc == 0) {
@@ -651,7 +709,7 @@ static int parse_obj(const char *text, size_t len, const char *name, const char 
         m->mats[0].defined = 1;
         m->n_mats = 1;
     }
-    const char *p = buf;
+    const char *p = skip_bom(buf);
     char kw[64];
     while (rc == 0 && *p) {
         P.c.line++;
@@ -677,10 +735,10 @@ static int parse_obj(const char *text, size_t len, const char *name, const char 
     return 0;
 }
 
-int obj_parse(const char *text, size_t len, const char *name, const char *dir, const confine *scope, mesh_data *m,
-              fr_error *err)
+int obj_parse(const char *text, size_t len, const char *name, const char *dir, const confine *scope,
+              const obj_warn *warn, mesh_data *m, fr_error *err)
 {
-    return parse_obj(text, len, name, dir, scope, NULL, m, err);
+    return parse_obj(text, len, name, dir, scope, NULL, warn, m, err);
 }
 
 int obj_parse_mtl(const char *text, size_t len, const char *name, mesh_data *m, fr_error *err)
@@ -703,12 +761,13 @@ int obj_parse_mtl(const char *text, size_t len, const char *name, mesh_data *m, 
         m->mats[0].defined = 1;
         m->n_mats = 1;
     }
-    rc = memchr(text, 0, len) ? fr_fail(err, "%s: NUL byte in a text file", name) : parse_mtl(buf, name, m, &cap, err);
+    rc = not_text(text, len, name, err) < 0 ? -1 : parse_mtl(buf, name, m, &cap, err);
     free(buf);
     return rc;
 }
 
-int obj_read(const char *path, const confine *scope, fr_budget *budget, mesh_data *m, fr_error *err)
+int obj_read(const char *path, const confine *scope, fr_budget *budget, const obj_warn *warn, mesh_data *m,
+             fr_error *err)
 {
     char *text;
     size_t len;
@@ -716,7 +775,7 @@ int obj_read(const char *path, const confine *scope, fr_budget *budget, mesh_dat
         return -1;
     char dir[4096];
     file_dir(path, dir, sizeof dir);
-    int rc = parse_obj(text, len, path, dir, scope, budget, m, err);
+    int rc = parse_obj(text, len, path, dir, scope, budget, warn, m, err);
     free(text);
     return rc;
 }

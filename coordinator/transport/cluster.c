@@ -79,9 +79,9 @@ typedef struct {
 } open_ctx;
 
 int cluster_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, char *remote, size_t cap,
-             char *lease, size_t lease_cap, int *uploaded, fr_error *err)
+             char *lease, size_t lease_cap, uint64_t *sent, fr_error *err)
 {
-    if (stage_scene(tr, scene, hash, remote, cap, lease, lease_cap, uploaded, err))
+    if (stage_scene(tr, scene, hash, remote, cap, lease, lease_cap, sent, err))
         return -1;
     /* The cache stays bounded; a failure to trim it does not stop the render. */
     uint64_t limit = entry->cache ? entry->cache : HOSTS_CACHE_DEFAULT, bytes;
@@ -108,7 +108,7 @@ static int probe_and_stage(cluster_host *h, int i, void *vctx, fr_error *err)
     if (!c->scene)
         return 0;
     return cluster_stage(h->tr, h->entry, c->scene, c->hash, h->scene, sizeof h->scene, h->lease, sizeof h->lease,
-                    &h->uploaded, err);
+                    &h->sent, err);
 }
 
 void cluster_open(cluster_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash)

@@ -19,7 +19,7 @@ typedef struct {
     proto_host info;           /**< what the host reported (cluster_open; valid when tr) */
     char scene[1024];          /**< path of the scene on the host (when staged) */
     char lease[1200];          /**< the render's lease on it (stage_scene), "" if none; remove it at the end */
-    int uploaded;              /**< the scene was sent during this run */
+    uint64_t sent;             /**< bytes of the scene sent during this run (0: it was cached) */
     double ready_s;            /**< seconds it took */
     fr_error err;              /**< why the host is not usable (tr == NULL) */
     char notes[2048];          /**< private: remarks collected while the threads run */
@@ -41,12 +41,12 @@ void cluster_each(cluster_host *hosts, int n, const tr_options *o, cluster_step 
 void cluster_open(cluster_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash);
 
 /** The render's step after the probe, for one more scene on a ready host
- * (the frames of an animation): stage_scene (remote, lease, *uploaded as
+ * (the frames of an animation): stage_scene (remote, lease, *sent as
  * it says), then the host's scene cache trimmed to its limit (stage_evict;
  * what went, or why it could not, is a remark of the host).  -1 with err
  * when the scene cannot be staged. */
 int cluster_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, char *remote, size_t cap,
-             char *lease, size_t lease_cap, int *uploaded, fr_error *err);
+             char *lease, size_t lease_cap, uint64_t *sent, fr_error *err);
 
 /** Hosts being made ready in the background (cluster_start). */
 typedef struct cluster_group cluster_group;

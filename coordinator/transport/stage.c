@@ -8,22 +8,28 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "fbin.h"
+#include "transport/pack.h"
 
 /* The exit status of the cache check when there is no cached copy (the
  * worker's own statuses are 0, 1 and 2). */
 enum { ABSENT = 97 };
 
 /* `sh -c CHECK_SCRIPT WORKER --scene PATH --check`: the worker checks the
- * copy if there is one. */
-static const char CHECK_SCRIPT[] = "[ -e \"$2\" ] || exit 97; exec \"$0\" \"$@\"";
+ * copy if there is one; if there is none, says what it can do besides
+ * rendering (`--features`: whether a scene may be sent compressed; a
+ * worker too old to know prints nothing), in the same round trip. */
+static const char CHECK_SCRIPT[] =
+    "[ -e \"$2\" ] || { \"$0\" --features 2>/dev/null; exit 97; }; exec \"$0\" \"$@\"";
 
 /* `sh -c LEASE_CHECK_SCRIPT LEASE WORKER --scene PATH --check`: takes (or
  * renews) the render's lease on the scene first, then checks the copy. */
 static const char LEASE_CHECK_SCRIPT[] =
-    "(set -C; : >\"$0\") 2>/dev/null || touch -c -- \"$0\"; [ -e \"$3\" ] || exit 97; exec \"$@\"";
+    "(set -C; : >\"$0\") 2>/dev/null || touch -c -- \"$0\"; "
+    "[ -e \"$3\" ] || { \"$1\" --features 2>/dev/null; exit 97; }; exec \"$@\"";
 
 /* A lease younger than this many minutes keeps its scene (stage.h). */
 #define LEASE_MIN "10"
@@ -58,7 +64,8 @@ static const char CLEAN_SCRIPT[] =
     "n=0; b=0; k=0; p=0; for f in *.fbin; do [ -f \"$f\" ] || continue; "
     "case $u in *\" $f \"*) k=$((k + 1)); continue ;; esac; if leased \"$f\"; then k=$((k + 1)); continue; fi; "
     "s=$(wc -c <\"$f\") && rm -f -- \"$f\" && n=$((n + 1)) && b=$((b + s)); done; "
-    "for f in $(find . -maxdepth 1 -type f \\( -name '*.part-*' -o -name '.check-*' -o -name '*.fbin.lease-*' \\) "
+    "for f in $(find . -maxdepth 1 -type f \\( -name '*.part-*' -o -name '.check-*' -o -name '*.fbin.lease-*' "
+    "-o -name '*.fbin.zst-*' \\) "
     "-mmin +" LEASE_MIN "); do "
     "rm -f -- \"$f\" && p=$((p + 1)); done; echo \"$n $b $k $p\"";
 
@@ -105,9 +112,12 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err)
 }
 
 /* 1 when the cached copy at path checks out, 0 when there is none, 2 when
- * it is damaged (or unreadable for this worker), -1 on error. */
-static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash, fr_error *err)
+ * it is damaged (or unreadable for this worker), -1 on error.  When there
+ * is none, *unpack says whether the worker can unpack a compressed scene
+ * (else it is 0). */
+static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash, int *unpack, fr_error *err)
 {
+    *unpack = 0;
     const char *check[4];
     proto_check_argv(path, check);
     const char *plain[] = {"sh", "-c", CHECK_SCRIPT, tr_host_worker(h), check[0], check[1], check[2], NULL};
@@ -124,8 +134,10 @@ static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash
     fr_error e;
     if (tr_proc_state(p) == TR_FAILED)
         rc = failed(h, p, "scene check", err);
-    else if (tr_proc_status(p) == ABSENT)
+    else if (tr_proc_status(p) == ABSENT) {
         rc = 0;
+        *unpack = proto_has_feature(out, len, PROTO_FEATURE_UNPACK);
+    }
     else
         rc = tr_proc_status(p) == 0 && proto_parse_check(out, len, &got, &e) == 0 && got == hash ? 1 : 2;
     tr_proc_free(p);
@@ -147,10 +159,66 @@ static int lease_name(const char *remote, char *lease, size_t cap)
                     ts.tv_nsec / 1000000) >= (int)cap;
 }
 
-int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
-                size_t lease_cap, int *uploaded, fr_error *err)
+/* Sends the scene compressed (pack.h) under a name of its own beside
+ * `remote` and has the host's worker unpack it into `remote` (unpack.h),
+ * adding the bytes sent to *sent.  0 when the unpacked scene has the
+ * expected hash; 1 when the unpacking failed (a damaged transfer: worth
+ * sending again); -1 on error (the upload failed). */
+static int send_packed(tr_host *h, const char *local_path, uint64_t hash, const char *remote, uint64_t *sent,
+                       fr_error *err)
 {
-    *uploaded = 0;
+    char packed[4200], name[1400];
+    uint64_t size;
+    if (pack_acquire(local_path, hash, packed, sizeof packed, &size, err))
+        return -1;
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    char host[64] = "";
+    gethostname(host, sizeof host - 1);
+    for (char *c = host; *c; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '-'))
+            *c = '_';
+    snprintf(name, sizeof name, "%s.zst-%s-%ld-%ld", remote, host, (long)getpid(), (long)ts.tv_nsec);
+    int rc = tr_upload(h, packed, name, 0600, err);
+    pack_release(hash);
+    if (rc)
+        return -1;
+    *sent += size;
+    const char *un[6];
+    proto_unpack_argv(name, remote, un);
+    const char *argv[] = {tr_host_worker(h), un[0], un[1], un[2], un[3], NULL};
+    tr_proc *p;
+    if (run(h, argv, &p, err))
+        return -1;
+    size_t len;
+    const char *out = (const char *)tr_proc_output(p, &len);
+    uint64_t got;
+    fr_error e;
+    if (tr_proc_state(p) == TR_EXITED && tr_proc_status(p) == 0 && proto_parse_check(out, len, &got, &e) == 0 &&
+        got == hash) {
+        rc = 0;
+    } else {
+        char why[300];
+        snprintf(why, sizeof why, "%s", tr_proc_state(p) == TR_EXITED && tr_proc_status(p) == 0
+                                            ? "a scene of another hash" : tr_proc_reason(p));
+        tr_note(h, "the compressed scene did not unpack (%s); sending it again", why);
+        if (tr_proc_state(p) != TR_EXITED) {
+            fr_error ignored;
+            tr_remove(h, name, &ignored); /* the worker removes it itself when it runs */
+        }
+        rc = 1;
+    }
+    tr_proc_free(p);
+    return rc;
+}
+
+/* Attempts at a compressed transfer before the scene is sent as it is. */
+enum { PACKED_TRIES = 2 };
+
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
+                size_t lease_cap, uint64_t *sent, fr_error *err)
+{
+    *sent = 0;
     if (lease_cap)
         lease[0] = 0;
     const char *wd = tr_host_workdir(h);
@@ -172,15 +240,28 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
     if (lease_cap && !strcmp(tr_host_backend(h), "ssh") && lease_name(remote, lease, lease_cap))
         return fr_fail(err, "%s: work directory path too long", tr_host_label(h));
     const char *mine = lease_cap ? lease : "";
-    int ok = cached(h, remote, mine, hash, err);
+    int unpack;
+    int ok = cached(h, remote, mine, hash, &unpack, err);
     if (ok < 0 || ok == 1)
         return ok < 0 ? -1 : 0;
     if (ok == 2)
         tr_note(h, "cached scene %s is damaged; uploading it again", remote);
-    if (tr_upload(h, local_path, remote, 0644, err))
-        return -1;
-    *uploaded = 1;
-    ok = cached(h, remote, mine, hash, err); /* takes the lease if the directory was new */
+    /* Over a link, compressed when the worker there can unpack (a worker
+     * built without libzstd cannot); a transfer that does not unpack to
+     * the scene is sent again, then sent as it is. */
+    int packed = -1;
+    for (int i = 0; i < PACKED_TRIES && tr_host_link_upload(h) && unpack && packed != 0; i++)
+        if ((packed = send_packed(h, local_path, hash, remote, sent, err)) < 0)
+            return -1;
+    if (packed != 0) {
+        if (packed == 1)
+            tr_note(h, "sending the scene uncompressed");
+        if (tr_upload(h, local_path, remote, 0644, err))
+            return -1;
+        struct stat st;
+        *sent += stat(local_path, &st) == 0 ? (uint64_t)st.st_size : 0;
+    }
+    ok = cached(h, remote, mine, hash, &unpack, err); /* takes the lease if the directory was new */
     if (ok < 0)
         return -1;
     if (ok != 1)

@@ -30,8 +30,15 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
 
 /** Makes the binary scene at local_path (content hash `hash`) available on
  * the host and writes the path its worker must be given into remote[cap].
- * *uploaded says whether the file was sent.  A damaged cached copy is
- * noted (tr_options.notes) and replaced.
+ * *sent gets the bytes sent (0: the cached copy was used).  A damaged
+ * cached copy is noted (tr_options.notes) and replaced.
+ *
+ * Over a network link (tr_host_link_upload) to a worker that can unpack
+ * (`--features`, asked in the round trip that finds no cached copy), the
+ * scene travels compressed (pack.h) under a name of its own and the
+ * worker unpacks it into the cache, checking its hash before it takes the
+ * cache's name; a transfer that does not unpack (damaged on the way) is
+ * noted and sent again, and after two such it is sent uncompressed.
  *
  * The lease: on an SSH host with a scene cache, and when lease_cap is not
  * 0, the render takes a lease on the scene before looking for it: an empty
@@ -44,7 +51,7 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
  * a render that died goes stale in ten minutes and is then removed by the
  * next eviction or clean. */
 int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
-                size_t lease_cap, int *uploaded, fr_error *err);
+                size_t lease_cap, uint64_t *sent, fr_error *err);
 
 /** Checks that files reach the host's scene cache the way a render's scene
  * does (tr_upload: SFTP for an SSH host): a small file is uploaded into

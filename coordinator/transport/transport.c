@@ -143,6 +143,8 @@ const char *tr_host_backend(const tr_host *h) { return h->be->name; }
 
 int tr_host_busy_upload(const tr_host *h) { return h->place.busy_upload; }
 
+int tr_host_link_upload(const tr_host *h) { return h->place.link_upload; }
+
 void tr_note(tr_host *h, const char *fmt, ...)
 {
     char msg[900];

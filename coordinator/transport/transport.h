@@ -130,6 +130,11 @@ const char *tr_host_backend(const tr_host *h);
  * of its own). */
 int tr_host_busy_upload(const tr_host *h);
 
+/** Whether tr_upload sends the file over a network link (SFTP; sbcast to
+ * a Slurm node's own disk), where a compressed scene saves time; not a
+ * Slurm shared work directory (a copy on this machine). */
+int tr_host_link_upload(const tr_host *h);
+
 /** Hands a remark about host h to the person (tr_options.notes), prefixed
  * with the host's label once connect has set it. */
 void tr_note(tr_host *h, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -39,6 +39,9 @@ typedef struct {
                                     machine's files (nothing is uploaded) */
     int busy_upload;           /**< an upload works while every slot of the host runs a worker (it
                                     starts no process that needs a slot of its own) */
+    int link_upload;           /**< an upload crosses a network link (SFTP, sbcast), so that a
+                                    scene is worth compressing for it; 0 for a copy on this
+                                    machine's files */
 } tr_place;
 
 /** The operations of one backend.  `impl` is the backend's state for one

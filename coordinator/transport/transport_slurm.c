@@ -101,6 +101,7 @@ static int slurm_connect(tr_host *h, void **impl, tr_place *place, fr_error *err
     snprintf(place->worker, sizeof place->worker, "%s", e->worker[0] ? e->worker : a->worker);
     snprintf(place->workdir, sizeof place->workdir, "%s", e->workdir[0] ? e->workdir : a->workdir);
     place->busy_upload = a->shared; /* a copy here; sbcast would need a step of its own */
+    place->link_upload = !a->shared;
     snprintf(s->label, sizeof s->label, "%s", place->label);
     *impl = s;
     return 0;

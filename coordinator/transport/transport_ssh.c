@@ -162,6 +162,7 @@ static int ssh_connect_host(tr_host *th, void **impl, tr_place *place, fr_error 
     snprintf(place->label, sizeof place->label, "%s", e->name);
     snprintf(place->workdir, sizeof place->workdir, "%s", home_relative(hosts_workdir(e)));
     place->busy_upload = 1; /* SFTP, on the session's own channel */
+    place->link_upload = 1;
     if (e->worker[0])
         snprintf(place->worker, sizeof place->worker, "%s", home_relative(e->worker));
     else

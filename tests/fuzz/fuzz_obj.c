@@ -74,7 +74,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         mesh_data_free(&m);
         return 0;
     }
-    if (obj_parse((const char *)data, size, "fuzz.obj", NULL, NULL, &m, &err) == 0)
+    if (obj_parse((const char *)data, size, "fuzz.obj", NULL, NULL, NULL, &m, &err) == 0)
         mesh_data_free(&m);
     FILE *f = fopen(obj_path, "wb");
     if (!f)
