@@ -38,6 +38,8 @@ typedef struct {
     fr_tonemap tonemap;
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
     fr_array distrib;          /**< float: filled by frz_scene */
+    fr_array meshes;           /**< bld_mesh: meshes that instances place (builder_instance.h) */
+    fr_array instances;        /**< fr_instance: meshes placed (builder_instance.h) */
     fr_budget *budget;         /**< the compile's limits (budget.h), not owned; NULL: none */
 } fr_builder;
 
