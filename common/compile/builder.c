@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "compile/builder_instance.h"
 #include "fmath.h"
 #include "geom.h"
 

@@ -24,6 +24,13 @@ typedef struct {
     uint32_t elem;             /**< bytes per element */
 } fr_array;
 
+/** A mesh under construction (builder_instance.h): prims [first, first +
+ * count) of the builder, triangles only, placed by instances only. */
+typedef struct {
+    uint32_t first, count;
+    vec3 lo, hi;               /**< bounds of its vertices (set by bld_mesh_end) */
+} bld_mesh;
+
 /** A scene under construction: the sections of fr_scene as growable
  * arrays, in the same element types. */
 typedef struct {

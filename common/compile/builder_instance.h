@@ -15,13 +15,6 @@
 
 #include "compile/builder.h"
 
-/** A mesh under construction: prims [first, first + count) of the
- * builder, triangles only, placed by instances only. */
-typedef struct {
-    uint32_t first, count;
-    vec3 lo, hi;               /**< bounds of its vertices (set by bld_mesh_end) */
-} bld_mesh;
-
 /** Start a mesh: the prims added until bld_mesh_end() are its triangles.
  * Returns its index in b->meshes, or FR_NONE when memory runs out. */
 uint32_t bld_mesh_begin(fr_builder *b);
