@@ -29,7 +29,8 @@ enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
-    SEC_COUNT = SEC_DISTRIB
+    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES,
+    SEC_COUNT = SEC_MESH_LEAVES
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -64,6 +65,10 @@ static const section_desc sections[SEC_COUNT + 1] = {
     [SEC_TONEMAP] = {"tonemap", sizeof(fr_tonemap), offsetof(fr_scene, tonemap), 0},
     [SEC_WORLD] = {"world", sizeof(fr_world), offsetof(fr_scene, world), 0},
     ARR(SEC_DISTRIB, "distrib", distrib, float),
+    ARR(SEC_MESHES, "meshes", meshes, fr_mesh),
+    ARR(SEC_INSTANCES, "instances", instances, fr_instance),
+    ARR(SEC_MESH_NODES, "mesh_nodes", mesh_nodes, fr_bvh_node),
+    ARR(SEC_MESH_LEAVES, "mesh_leaves", mesh_leaves, fr_bvh_leaf),
 };
 #undef ARR
 
@@ -280,6 +285,54 @@ static int validate_lights(const fr_scene *s, const void *base, const uint64_t *
     return 0;
 }
 
+/* The instanced meshes and their instances: each mesh's ranges follow the
+ * last one's, its prims fill the end of prims, and each instance names a
+ * mesh through finite transforms that are each other's inverse (to a
+ * tolerance: a wrong pair would only draw wrong, never read out of
+ * bounds).  bvh_validate checks each mesh's tree. */
+static int validate_instances(const fr_scene *s, const void *base, fr_error *err)
+{
+    uint64_t node = 0, leaf = 0, prim = s->n_meshes ? s->meshes[0].prim_first : s->n_prims;
+    for (uint32_t k = 0; k < s->n_meshes; k++) {
+        const fr_mesh *m = &s->meshes[k];
+        if (m->node_first != node || m->leaf_first != leaf || m->prim_first != prim || m->n_nodes == 0 ||
+            m->n_leaves == 0 || m->n_prims == 0 || m->pad[0] || m->pad[1])
+            return fr_fail(err, "section meshes, byte %zu: mesh %u: its ranges do not follow the last mesh's, or "
+                           "one is empty", AT(m), k);
+        node += m->n_nodes;
+        leaf += m->n_leaves;
+        prim += m->n_prims;
+    }
+    if (node != s->n_mesh_nodes || leaf != s->n_mesh_leaves || prim != s->n_prims)
+        return fr_fail(err, "section meshes: the meshes cover %llu nodes, %llu leaf blocks and prims up to %llu, "
+                       "the scene has %u, %u and %u", (unsigned long long)node, (unsigned long long)leaf,
+                       (unsigned long long)prim, s->n_mesh_nodes, s->n_mesh_leaves, s->n_prims);
+    for (uint32_t i = 0; i < s->n_instances; i++) {
+        const fr_instance *in = &s->instances[i];
+        if (in->mesh >= s->n_meshes || in->pad[0] || in->pad[1] || in->pad[2])
+            return fr_fail(err, "section instances, byte %zu: instance %u: mesh %u of %u", AT(&in->mesh), i,
+                           in->mesh, s->n_meshes);
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 4; c++)
+                if (!isfinite(in->xf[r][c]) || !isfinite(in->inv[r][c]) || fabsf(in->xf[r][c]) > 1e30f ||
+                    fabsf(in->inv[r][c]) > 1e30f)
+                    return fr_fail(err, "section instances, byte %zu: instance %u: transform not finite",
+                                   AT(&in->xf[r][c]), i);
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++) {
+                double sum = 0.0, mag = 0.0;
+                for (int k = 0; k < 3; k++) {
+                    sum += (double)in->xf[r][k] * in->inv[k][c];
+                    mag += fabs((double)in->xf[r][k] * in->inv[k][c]);
+                }
+                if (!(fabs(sum - (r == c)) <= 1e-3 * (mag + 1.0)))
+                    return fr_fail(err, "section instances, byte %zu: instance %u: the inverse is not the "
+                                   "transform's inverse", AT(in->inv), i);
+            }
+    }
+    return 0;
+}
+
 /* Check every cross-reference so that rendering can index without checks. */
 static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
@@ -316,7 +369,10 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     }
     if (s->n_prims > 0 && s->n_materials == 0)
         return fr_fail(err, "section materials: primitives but no material");
-    uint32_t kind_count[FR_PRIM_KINDS] = {s->n_triangles, s->n_spheres, s->n_rects};
+    if (validate_instances(s, base, err) < 0)
+        return -1;
+    uint32_t top = s->n_meshes ? s->meshes[0].prim_first : s->n_prims;
+    uint32_t kind_count[FR_PRIM_KINDS] = {s->n_triangles, s->n_spheres, s->n_rects, s->n_instances};
     for (uint32_t i = 0; i < s->n_prims; i++) {
         const fr_prim *p = &s->prims[i];
         if (p->kind >= FR_PRIM_KINDS || p->index >= kind_count[p->kind])
@@ -326,6 +382,11 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
         if (p->material >= s->n_materials)
             return fr_fail(err, "section prims, byte %zu: primitive %u: material %u out of range", AT(&p->material), i,
                            p->material);
+        if (i >= top && (p->kind != FR_PRIM_TRIANGLE || p->light != FR_NONE))
+            return fr_fail(err, "section prims, byte %zu: primitive %u: a mesh's primitive must be a triangle and "
+                           "not a light", AT(p), i);
+        if (p->kind == FR_PRIM_INSTANCE && p->light != FR_NONE)
+            return fr_fail(err, "section prims, byte %zu: primitive %u: an instance is not a light", AT(&p->light), i);
         if (p->light != FR_NONE && (p->light >= s->n_lights || s->lights[p->light].kind != FR_LIGHT_PRIM ||
                                     s->lights[p->light].prim != i))
             return fr_fail(err, "section prims, byte %zu: primitive %u: light %u does not point back", AT(&p->light), i,

@@ -177,13 +177,16 @@ typedef struct {
     uint32_t pad[2];
 } fr_tonemap;
 
-enum { FR_PRIM_TRIANGLE = 0, FR_PRIM_SPHERE = 1, FR_PRIM_RECT = 2, FR_PRIM_KINDS };
+enum { FR_PRIM_TRIANGLE = 0, FR_PRIM_SPHERE = 1, FR_PRIM_RECT = 2, FR_PRIM_INSTANCE = 3, FR_PRIM_KINDS };
 
 /** One entry per bounded primitive; the BVH's leaves hold ranges of this
- * array.  `index` points into the array of the primitive's kind. */
+ * array.  `index` points into the array of the primitive's kind.  An
+ * FR_PRIM_INSTANCE (only in the top-level BVH) places a mesh: its triangles
+ * are the prims of that fr_mesh, at the end of the array, and its material
+ * and light are unused (0 and FR_NONE). */
 typedef struct {
     uint32_t kind;             /**< FR_PRIM_* */
-    uint32_t index;            /**< into spheres, rects or triangles */
+    uint32_t index;            /**< into spheres, rects, triangles or instances */
     uint32_t material;
     uint32_t light;            /**< index into lights if emissive, else FR_NONE */
 } fr_prim;
@@ -303,6 +306,33 @@ typedef struct {
     uint32_t prim[4];
 } fr_bvh_leaf;
 
+/** An instanced mesh: a BVH of its own (a bottom-level BVH, in object
+ * space) over triangles that only instances place.  Its nodes and leaf
+ * blocks are mesh_nodes[node_first ..] and mesh_leaves[leaf_first ..],
+ * with child indices relative to those starts (node 0 of the range is its
+ * root), its leaf lanes name prims[prim_first .. prim_first + n_prims),
+ * all triangles and none of them a light.  Meshes follow one another in
+ * every array: mesh 0 starts at node 0 and leaf 0, and its prims start
+ * right after the prims of the top-level BVH. */
+typedef struct {
+    uint32_t node_first, n_nodes;
+    uint32_t leaf_first, n_leaves;
+    uint32_t prim_first, n_prims;
+    uint32_t pad[2];
+} fr_mesh;
+
+/** A mesh placed in the world by an affine transform: a world point is
+ * xf * (p, 1) for an object-space point p (xf row-major, 3 rows of 4),
+ * and inv is the inverse transform.  A ray is taken into object space by
+ * inv without renormalising its direction, so distances along it are the
+ * world's; normals go out by the transpose of inv's linear part. */
+typedef struct {
+    float xf[3][4];
+    float inv[3][4];
+    uint32_t mesh;             /**< index into meshes */
+    uint32_t pad[3];
+} fr_instance;
+
 /** A whole scene: its settings and camera, and each section as an array
  * and its length (pointing into `blob`). */
 typedef struct {
@@ -328,6 +358,10 @@ typedef struct {
     const fr_bvh_leaf *leaves;    uint32_t n_leaves;
     fr_world world;
     const float *distrib;         uint32_t n_distrib;
+    const fr_mesh *meshes;        uint32_t n_meshes;
+    const fr_instance *instances; uint32_t n_instances;
+    const fr_bvh_node *mesh_nodes; uint32_t n_mesh_nodes;
+    const fr_bvh_leaf *mesh_leaves; uint32_t n_mesh_leaves;
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

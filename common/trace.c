@@ -22,9 +22,13 @@
  * tree no deeper than FR_BVH_MAX_DEPTH (the loader refuses deeper ones). */
 #define BVH_STACK ((FR_BVH_WIDTH - 1) * FR_BVH_MAX_DEPTH + 1)
 
+static float instance_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, float *a, float *b);
+
 float trace_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, float *a, float *b)
 {
     const fr_prim *p = &s->prims[i];
+    if (p->kind == FR_PRIM_INSTANCE)
+        return instance_prim(s, i, r, tmax, a, b);
     if (p->kind == FR_PRIM_TRIANGLE) {
         const fr_triangle *t = &s->triangles[p->index];
         return geo_triangle(s->positions[t->v[0]], s->positions[t->v[1]], s->positions[t->v[2]], r, tmax, a, b);
@@ -112,7 +116,21 @@ static inline void record(hit_state *H, float t, uint32_t prim, float a, float b
     H->far = t * FAR_SCALE;
     H->key = prim;
     H->found = 1;
-    H->hit->t = t; H->hit->prim = prim; H->hit->plane = FR_NONE; H->hit->a = a; H->hit->b = b;
+    H->hit->t = t; H->hit->prim = prim; H->hit->plane = FR_NONE; H->hit->a = a; H->hit->b = b; H->hit->inst = 0;
+}
+
+/* A world-space ray in an instance's object space: origin and direction by
+ * the inverse transform, the direction not renormalised, so a point at t
+ * along one is the point at t along the other. */
+static inline void instance_ray(const fr_instance *in, const fr_ray *r, fr_ray *o)
+{
+    const float (*m)[4] = in->inv;
+    vec3 p = r->o, d = r->d;
+    o->o = v3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
+              m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
+              m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]);
+    o->d = v3(m[0][0] * d.x + m[0][1] * d.y + m[0][2] * d.z, m[1][0] * d.x + m[1][1] * d.y + m[1][2] * d.z,
+              m[2][0] * d.x + m[2][1] * d.y + m[2][2] * d.z);
 }
 
 typedef struct { uint32_t child, leaf; float t; } stack_entry;
@@ -130,13 +148,13 @@ typedef struct { uint32_t child, leaf; float t; } stack_entry;
  * aligned frame) before reaching the other copy. */
 static __attribute__((noinline)) int closest_base(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 {
-    return walk_base(s, r, tmax, hit, 0, FR_NONE);
+    return walk_base(s, NULL, r, tmax, hit, 0, FR_NONE);
 }
 
 static __attribute__((noinline)) int occluded_base(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
     fr_hit h = {0};
-    return walk_base(s, r, tmax, &h, 1, skip);
+    return walk_base(s, NULL, r, tmax, &h, 1, skip);
 }
 
 #if TRACE_WIDE
@@ -152,13 +170,13 @@ static __attribute__((noinline)) int occluded_base(const fr_scene *s, const fr_r
 
 static __attribute__((noinline)) int closest_wide(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 {
-    return walk_wide(s, r, tmax, hit, 0, FR_NONE);
+    return walk_wide(s, NULL, r, tmax, hit, 0, FR_NONE);
 }
 
 static __attribute__((noinline)) int occluded_wide(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
     fr_hit h = {0};
-    return walk_wide(s, r, tmax, &h, 1, skip);
+    return walk_wide(s, NULL, r, tmax, &h, 1, skip);
 }
 #pragma GCC pop_options
 
@@ -176,13 +194,13 @@ static __attribute__((noinline)) int occluded_wide(const fr_scene *s, const fr_r
 
 static __attribute__((noinline)) int closest_v4(const fr_scene *s, const fr_ray *r, float tmax, fr_hit *hit)
 {
-    return walk_v4(s, r, tmax, hit, 0, FR_NONE);
+    return walk_v4(s, NULL, r, tmax, hit, 0, FR_NONE);
 }
 
 static __attribute__((noinline)) int occluded_v4(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
     fr_hit h = {0};
-    return walk_v4(s, r, tmax, &h, 1, skip);
+    return walk_v4(s, NULL, r, tmax, &h, 1, skip);
 }
 #pragma GCC pop_options
 
@@ -287,16 +305,41 @@ int trace_occluded(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip
     return occluded_base(s, r, tmax, skip);
 }
 
+/* Nearest hit on instance prim i (trace_prim): its mesh's nearest
+ * triangle, barycentrics in object space. */
+static float instance_prim(const fr_scene *s, uint32_t i, const fr_ray *r, float tmax, float *a, float *b)
+{
+    fr_hit best = {0};
+    hit_state H = {tmax, tmax * FAR_SCALE, 0, &best, 0};
+#if TRACE_WIDE
+    if (walk_on == TRACE_WALK_AVX512)
+        instance_test_v4(s, i, r, &H, 0);
+    else if (walk_on == TRACE_WALK_AVX2)
+        instance_test_wide(s, i, r, &H, 0);
+    else
+#endif
+        instance_test_base(s, i, r, &H, 0);
+    *a = best.a;
+    *b = best.b;
+    return H.found ? best.t : 0.0f;
+}
+
 static inline void no_uv(fr_surface *out)
 {
     out->uv = (vec2){0.0f, 0.0f};
     out->dpdu = out->dpdv = v3s(0.0f);
 }
 
+static void instance_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out, int uv);
+
 /* The surface at a hit, uv, dpdu and dpdv only when `uv` is not 0. */
 static inline __attribute__((always_inline)) void surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit,
                                                           fr_surface *out, int uv)
 {
+    if (__builtin_expect(hit->inst != 0, 0)) {
+        instance_surface(s, r, hit, out, uv);
+        return;
+    }
     if (hit->prim == FR_NONE) {
         const fr_plane *pl = &s->planes[hit->plane];
         out->p = geo_plane_point(pl, r, hit->t, &out->perr);
@@ -390,6 +433,56 @@ static inline __attribute__((always_inline)) void surface(const fr_scene *s, con
             out->dpdu = ln_vec(e1);
             out->dpdv = ln_vec(e2);
         }
+    }
+}
+
+/* The linear part of a 3x4 transform applied to v (rows of m), or its
+ * transpose (columns). */
+static inline vec3 lin(const float (*m)[4], vec3 v)
+{
+    return v3(m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+              m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z);
+}
+
+static inline vec3 lin_t(const float (*m)[4], vec3 v)
+{
+    return v3(m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z, m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
+              m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z);
+}
+
+static inline vec3 v3_absv(vec3 v) { return v3(fabsf(v.x), fabsf(v.y), fabsf(v.z)); }
+
+/* The surface of an instanced triangle: found in object space, then taken
+ * to the world: the point by the transform, normals by the inverse
+ * transpose (the transpose of inv), tangents by the linear part.  The
+ * point's error bound covers the object-space bound carried through the
+ * transform, the transform's own rounding and, four times over, the
+ * rounding of taking a ray leaving the point back into object space. */
+static __attribute__((noinline)) void instance_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit,
+                                                       fr_surface *out, int uv)
+{
+    const fr_instance *in = &s->instances[hit->inst - 1];
+    fr_hit h = *hit;
+    h.inst = 0;
+    fr_surface o;
+    surface(s, r, &h, &o, uv);
+    const float (*m)[4] = in->xf;
+    vec3 t = v3(m[0][3], m[1][3], m[2][3]);
+    *out = o;
+    out->p = v3_add(lin(m, o.p), t);
+    float g = GEO_GAMMA(4);
+    vec3 am[3] = {v3_absv(v3(m[0][0], m[0][1], m[0][2])), v3_absv(v3(m[1][0], m[1][1], m[1][2])),
+                  v3_absv(v3(m[2][0], m[2][1], m[2][2]))};
+    vec3 e = v3_add(o.perr, v3_scale(v3_absv(o.p), g));
+    vec3 slack = v3_scale(v3_add(v3_absv(t), v3_absv(out->p)), 4.0f * g);
+    out->perr = v3_add(v3(v3_dot(am[0], e), v3_dot(am[1], e), v3_dot(am[2], e)), slack);
+    out->ng = v3_norm(lin_t(in->inv, o.ng));
+    vec3 ns = lin_t(in->inv, o.ns);
+    ns = v3_len2(ns) > 0.0f ? v3_norm(ns) : out->ng;
+    out->ns = v3_dot(ns, out->ng) < 0.0f ? v3_neg(ns) : ns;
+    if (uv) {
+        out->dpdu = lin(m, o.dpdu);
+        out->dpdv = lin(m, o.dpdv);
     }
 }
 

@@ -18,6 +18,8 @@ typedef struct {
     uint32_t prim;             /**< index into prims, or FR_NONE for a plane */
     uint32_t plane;            /**< index into planes when prim == FR_NONE */
     float a, b;                /**< barycentrics (triangle) or edge coords (rect) */
+    uint32_t inst;             /**< 1 + index into instances when prim is a triangle of an instanced mesh
+                                    (a, b then in object space), else 0 */
 } fr_hit;
 
 /** The local geometry at a hit, for shading. */

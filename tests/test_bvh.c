@@ -249,7 +249,7 @@ static int brute(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip, 
         float t = trace_prim(s, p, r, best, &a, &b);
         if (t > 0.0f) {
             best = t;
-            *h = (fr_hit){t, p, FR_NONE, a, b};
+            *h = (fr_hit){t, p, FR_NONE, a, b, 0};
             found = 1;
         }
     }

@@ -24,6 +24,13 @@ typedef struct {
     uint32_t elem;             /**< bytes per element */
 } fr_array;
 
+/** A mesh under construction (builder_instance.h): prims [first, first +
+ * count) of the builder, triangles only, placed by instances only. */
+typedef struct {
+    uint32_t first, count;
+    vec3 lo, hi;               /**< bounds of its vertices (set by bld_mesh_end) */
+} bld_mesh;
+
 /** A scene under construction: the sections of fr_scene as growable
  * arrays, in the same element types. */
 typedef struct {
@@ -38,6 +45,8 @@ typedef struct {
     fr_tonemap tonemap;
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
     fr_array distrib;          /**< float: filled by frz_scene */
+    fr_array meshes;           /**< bld_mesh: meshes that instances place (builder_instance.h) */
+    fr_array instances;        /**< fr_instance: meshes placed (builder_instance.h) */
     fr_budget *budget;         /**< the compile's limits (budget.h), not owned; NULL: none */
     void (*warn)(void *user, const char *msg); /**< where readers of the scene's files report warnings
                                                     (scene_hooks.h); NULL: nowhere */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compile/builder_instance.h"
 #include "compile/bvh2.h"
 #include "compile/bvh_reinsert.h"
 #include "simd4.h"
@@ -49,7 +50,9 @@ typedef struct {
 static void bvh_prim_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi)
 {
     const fr_prim *p = (const fr_prim *)b->prims.data + i;
-    if (p->kind == FR_PRIM_SPHERE) {
+    if (p->kind == FR_PRIM_INSTANCE) {
+        bld_instance_bounds(b, p->index, lo, hi);
+    } else if (p->kind == FR_PRIM_SPHERE) {
         const fr_sphere *s = (const fr_sphere *)b->spheres.data + p->index;
         *lo = v3_sub(s->center, v3s(s->radius));
         *hi = v3_add(s->center, v3s(s->radius));

@@ -6,25 +6,101 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compile/builder_instance.h"
 #include "compile/bvh_build.h"
 #include "fbin.h"
 #include "compile/freeze_light.h"
 
+/* The meshes' prims taken out of b->prims into `mp` (mesh by mesh, each
+ * mesh's in order) and each mesh's BVH built over them, in object space:
+ * nodes and blocks appended to mnodes and mleaves, lanes naming the prims
+ * where they will be once appended after the `top` prims of the scene's
+ * tree.  b->meshes becomes the fr_mesh table. */
+static int build_meshes(fr_builder *b, fr_array *mp, fr_array *mnodes, fr_array *mleaves, fr_array *table,
+                        fr_error *err)
+{
+    uint32_t nm = b->meshes.count, n = b->prims.count;
+    const bld_mesh *meshes = b->meshes.data;
+    unsigned char *in_mesh = calloc(n ? n : 1, 1);
+    fr_array world = {NULL, 0, 0, sizeof(fr_prim)};
+    if (!in_mesh)
+        return fr_fail(err, "out of memory for the meshes");
+    uint32_t top = n;
+    for (uint32_t k = 0; k < nm; k++) {
+        memset(in_mesh + meshes[k].first, 1, meshes[k].count);
+        top -= meshes[k].count;
+    }
+    int rc = 0;
+    const fr_prim *prims = b->prims.data;
+    for (uint32_t i = 0; i < n && rc == 0; i++)
+        if (!in_mesh[i] && bld_push(&world, &prims[i]) == FR_NONE)
+            rc = fr_fail(err, "out of memory for the meshes");
+    free(in_mesh);
+    uint32_t first = top;
+    for (uint32_t k = 0; k < nm && rc == 0; k++) {
+        fr_builder mb = *b;
+        mb.prims = (fr_array){NULL, 0, 0, sizeof(fr_prim)};
+        for (uint32_t i = 0; i < meshes[k].count && rc == 0; i++)
+            if (bld_push(&mb.prims, &prims[meshes[k].first + i]) == FR_NONE)
+                rc = fr_fail(err, "out of memory for the meshes");
+        fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
+        if (rc == 0)
+            rc = bvh_build(&mb, &nodes, &leaves, NULL, err);
+        fr_mesh m = {mnodes->count, nodes.count, mleaves->count, leaves.count, first, mb.prims.count, {0, 0}};
+        fr_bvh_leaf *L = leaves.data;
+        for (uint32_t j = 0; j < leaves.count; j++)
+            for (int lane = 0; lane < 4; lane++)
+                if (L[j].prim[lane] != FR_NONE)
+                    L[j].prim[lane] += first;
+        for (uint32_t j = 0; j < nodes.count && rc == 0; j++)
+            if (bld_push(mnodes, (fr_bvh_node *)nodes.data + j) == FR_NONE)
+                rc = fr_fail(err, "out of memory for the meshes");
+        for (uint32_t j = 0; j < leaves.count && rc == 0; j++)
+            if (bld_push(mleaves, L + j) == FR_NONE)
+                rc = fr_fail(err, "out of memory for the meshes");
+        for (uint32_t i = 0; i < mb.prims.count && rc == 0; i++)
+            if (bld_push(mp, (fr_prim *)mb.prims.data + i) == FR_NONE)
+                rc = fr_fail(err, "out of memory for the meshes");
+        if (rc == 0 && bld_push(table, &m) == FR_NONE)
+            rc = fr_fail(err, "out of memory for the meshes");
+        first += mb.prims.count;
+        free(mb.prims.data);
+        free(nodes.data);
+        free(leaves.data);
+    }
+    if (rc < 0) {
+        free(world.data);
+        return -1;
+    }
+    free(b->prims.data);
+    b->prims = world;
+    return 0;
+}
+
 int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (bld_camera_finish(&b->camera, err) < 0 || bld_drop_unused_vertices(b, err) < 0)
+    if (bld_camera_finish(&b->camera, err) < 0 || bld_drop_unused_vertices(b, err) < 0 || bld_flatten(b, 0, err) < 0)
         return -1;
     fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
+    fr_array mprims = {NULL, 0, 0, sizeof(fr_prim)}, mnodes = {NULL, 0, 0, sizeof(fr_bvh_node)};
+    fr_array mleaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)}, table = {NULL, 0, 0, sizeof(fr_mesh)};
+    /* With instances, two levels: a tree per mesh, then the scene's over
+     * the other prims and the instances (bld_flatten has dropped meshes
+     * without instances, so a scene without any takes the one-level path
+     * unchanged). */
+    int rc = b->meshes.count ? build_meshes(b, &mprims, &mnodes, &mleaves, &table, err) : 0;
     /* The BVH reorders prims, so lights (which point at prims) come after. */
     uint32_t *placed = NULL;
-    if (bvh_build(b, &nodes, &leaves, &placed, err) < 0) {
-        free(nodes.data);
-        free(leaves.data);
-        return -1;
-    }
-    int rc = frz_lights(b, placed, err);
+    if (rc == 0)
+        rc = bvh_build(b, &nodes, &leaves, &placed, err);
+    if (rc == 0)
+        rc = frz_lights(b, placed, err);
     free(placed);
+    for (uint32_t i = 0; i < mprims.count && rc == 0; i++)
+        if (bld_push(&b->prims, (fr_prim *)mprims.data + i) == FR_NONE)
+            rc = fr_fail(err, "out of memory for the meshes");
+    free(mprims.data);
 
     fr_scene view;
     memset(&view, 0, sizeof view);
@@ -40,6 +116,8 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
     view.tonemap = b->tonemap;
     view.world = b->world;
     VIEW(distrib, b->distrib);
+    VIEW(meshes, table); VIEW(instances, b->instances);
+    VIEW(mesh_nodes, mnodes); VIEW(mesh_leaves, mleaves);
 #undef VIEW
     void *blob = NULL;
     size_t size = 0;
@@ -47,6 +125,9 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
         rc = fbin_serialize(&view, &blob, &size, err);
     free(nodes.data);
     free(leaves.data);
+    free(mnodes.data);
+    free(mleaves.data);
+    free(table.data);
     if (rc == 0)
         rc = fbin_open_mem(blob, size, 0, out, err);
     if (rc < 0)

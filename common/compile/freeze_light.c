@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "compile/builder_instance.h"
 #include "texture.h"
 
 /* |a x b| in double: edges of coordinates up to 1e18 (jsonval.h) have
@@ -42,7 +43,12 @@ static void bounds(fr_builder *b)
     const fr_prim *prims = b->prims.data;
     for (uint32_t i = 0; i < b->prims.count; i++) {
         const fr_prim *p = &prims[i];
-        if (p->kind == FR_PRIM_SPHERE) {
+        if (p->kind == FR_PRIM_INSTANCE) {
+            vec3 l, h;
+            bld_instance_bounds(b, p->index, &l, &h);
+            lo = v3_vmin(lo, l);
+            hi = v3_vmax(hi, h);
+        } else if (p->kind == FR_PRIM_SPHERE) {
             const fr_sphere *s = (const fr_sphere *)b->spheres.data + p->index;
             lo = v3_vmin(lo, v3_sub(s->center, v3s(s->radius)));
             hi = v3_vmax(hi, v3_add(s->center, v3s(s->radius)));
@@ -275,7 +281,7 @@ int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
         prims[i].light = FR_NONE;
     for (uint32_t k = 0; k < b->prims.count; k++) {
         uint32_t i = placed ? placed[k] : k;
-        if (v3_is_zero(mats[prims[i].material].emission))
+        if (prims[i].kind == FR_PRIM_INSTANCE || v3_is_zero(mats[prims[i].material].emission))
             continue;
         fr_light l;
         memset(&l, 0, sizeof l);

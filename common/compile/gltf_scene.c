@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "compile/builder_instance.h"
 #include "compile/builder_light.h"
 #include "compile/freeze.h"
 #include "compile/gltf_doc.h"
@@ -77,6 +78,9 @@ typedef struct {
     gmat_ctx mat;
     uint32_t max_tri, vertices;
     int cam_node;              /* node whose camera was taken, or -1 */
+    int counting;              /* the first pass over the nodes: only count the uses of each mesh */
+    uint32_t *uses;            /* per glTF mesh: nodes that draw it */
+    uint32_t *mesh_of;         /* per glTF mesh drawn more than once: its builder mesh, or FR_NONE */
 } imp;
 
 /* ---- nodes ------------------------------------------------------------ */
@@ -287,7 +291,7 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
     return 0;
 }
 
-static int mesh(imp *c, uint32_t m, const affine *w, fr_error *err)
+static int mesh_prims(imp *c, uint32_t m, const affine *w, fr_error *err)
 {
     gltf_doc *d = c->d;
     char ptr[48];
@@ -299,6 +303,39 @@ static int mesh(imp *c, uint32_t m, const affine *w, fr_error *err)
     for (const cJSON *p = prims->child; p; p = p->next, i++)
         if (primitive(c, m, i, p, w, err) < 0)
             return -1;
+    return 0;
+}
+
+/* A mesh drawn by one node is placed into the world's triangles; one drawn
+ * by several is read once in its own space and placed by an instance per
+ * node (builder_instance.h). */
+static int mesh(imp *c, uint32_t m, const affine *w, fr_error *err)
+{
+    if (c->uses[m] < 2)
+        return mesh_prims(c, m, w, err);
+    if (c->mesh_of[m] == FR_NONE) {
+        affine id;
+        af_identity(&id);
+        uint32_t k = bld_mesh_begin(c->b);
+        if (k == FR_NONE)
+            return gdoc_fail(c->d, err, NULL, "out of memory");
+        if (mesh_prims(c, m, &id, err) < 0)
+            return -1;
+        fr_error e;
+        if (bld_mesh_end(c->b, k, &e) < 0)
+            return gdoc_fail(c->d, err, NULL, "%s", e.msg);
+        c->mesh_of[m] = k;
+    }
+    float xf[3][4];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            xf[i][j] = (float)w->m[i][j];
+    fr_error e;
+    if (bld_instance(c->b, c->mesh_of[m], (const float(*)[4])xf, &e) < 0) {
+        char ptr[48];
+        snprintf(ptr, sizeof ptr, "/meshes/%u", m);
+        return gdoc_fail(c->d, err, ptr, "%s", e.msg);
+    }
     return 0;
 }
 
@@ -444,6 +481,11 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
         gdoc_index(d, o, ptr, "camera", 0, d->cameras.n, "cameras", &cam, err) < 0 ||
         gdoc_object(d, o, ptr, "extensions", &ext, err) < 0)
         return -1;
+    if (c->counting) {
+        if (m != UINT32_MAX)
+            c->uses[m]++;
+        return 0;
+    }
     if (ext)
         lp = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
     if (cJSON_GetObjectItemCaseSensitive(o, "skin"))
@@ -532,7 +574,34 @@ static int scene_roots(imp *c, const uint32_t *parent, uint32_t *roots, uint32_t
 
 /* Depth first from the roots, in the file's order, with an explicit stack
  * (each node is on it at most once: the nodes form trees). */
+static int walk_nodes(imp *c, fr_error *err);
+
+/* Every node of the scene, twice: the uses of each mesh counted, then
+ * each node read. */
 static int traverse(imp *c, fr_error *err)
+{
+    uint32_t n = c->d->meshes.n ? c->d->meshes.n : 1;
+    c->uses = calloc(n, sizeof *c->uses);
+    c->mesh_of = malloc(n * sizeof *c->mesh_of);
+    int rc = -1;
+    if (!c->uses || !c->mesh_of) {
+        gdoc_fail(c->d, err, NULL, "out of memory");
+    } else {
+        for (uint32_t i = 0; i < n; i++)
+            c->mesh_of[i] = FR_NONE;
+        c->counting = 1;
+        rc = walk_nodes(c, err);
+        c->counting = 0;
+        if (rc == 0)
+            rc = walk_nodes(c, err);
+    }
+    free(c->uses);
+    free(c->mesh_of);
+    c->uses = c->mesh_of = NULL;
+    return rc;
+}
+
+static int walk_nodes(imp *c, fr_error *err)
 {
     gltf_doc *d = c->d;
     uint32_t nn = d->nodes.n ? d->nodes.n : 1;
@@ -636,7 +705,7 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
                       fr_error *err)
 {
     memset(r, 0, sizeof *r);
-    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1};
+    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0, NULL, NULL};
     gdoc_warn_extensions(d, known_extensions);
     const cJSON *an = cJSON_GetObjectItemCaseSensitive(d->root, "animations");
     if (cJSON_GetArraySize(an) > 0)
@@ -743,7 +812,9 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scen
     st->max_depth = 8;
     vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
     const vec3 *p = b->positions.data;
-    for (uint32_t i = 0; i < b->positions.count; i++) {
+    if (b->instances.count)
+        bld_bounds(b, &lo, &hi);
+    for (uint32_t i = 0; i < b->positions.count && !b->instances.count; i++) {
         lo = v3_vmin(lo, p[i]);
         hi = v3_vmax(hi, p[i]);
     }

@@ -10,6 +10,7 @@
 #include <strings.h>
 
 #include "fmath.h"
+#include "compile/builder_instance.h"
 #include "compile/jsonval.h"
 #include "compile/mesh_import.h"
 
@@ -159,14 +160,48 @@ static float projected_pixels(const fr_builder *b, const mesh_data *m, const xfo
 static int only_fields(const cJSON *o, const char *where, fr_error *err)
 {
     static const char *const ok[] = {"type", "material", "file", "lod", "lod_density", "scale", "rotate",
-                                     "translate", "matrix", "normals", NULL};
+                                     "translate", "matrix", "normals", "instances", NULL};
     for (const cJSON *c = o->child; c; c = c->next) {
         int found = 0;
         for (int i = 0; ok[i] && !found; i++)
             found = !strcmp(c->string, ok[i]);
         if (!found)
             return fr_fail(err, "%s.%s: unknown field (mesh fields: file, lod, lod_density, material, scale, "
-                           "rotate, translate, matrix, normals)", where, c->string);
+                           "rotate, translate, matrix, normals, instances)", where, c->string);
+    }
+    return 0;
+}
+
+/* The `instances` of a mesh shape: each a transform (scale, rotate,
+ * translate or matrix) placing mesh `mesh` once more. */
+static int place_instances(fr_builder *b, const cJSON *list, const char *where, uint32_t mesh, fr_error *err)
+{
+    int i = 0;
+    for (const cJSON *e = list->child; e; e = e->next, i++) {
+        char at[512];
+        snprintf(at, sizeof at, "%s.instances[%d]", where, i);
+        if (!cJSON_IsObject(e))
+            return fr_fail(err, "%s: expected an object with scale, rotate, translate or matrix", at);
+        for (const cJSON *c = e->child; c; c = c->next)
+            if (strcmp(c->string, "scale") && strcmp(c->string, "rotate") && strcmp(c->string, "translate") &&
+                strcmp(c->string, "matrix"))
+                return fr_fail(err, "%s.%s: unknown field (an instance has scale, rotate, translate or matrix)", at,
+                               c->string);
+        xform x;
+        float det;
+        if (read_xform(e, at, &x, &det, err) < 0)
+            return -1;
+        float xf[3][4];
+        for (int r = 0; r < 3; r++) {
+            for (int c = 0; c < 3; c++)
+                xf[r][c] = x.m[r][c];
+        }
+        xf[0][3] = x.t.x;
+        xf[1][3] = x.t.y;
+        xf[2][3] = x.t.z;
+        fr_error e2;
+        if (bld_instance(b, mesh, (const float(*)[4])xf, &e2) < 0)
+            return fr_fail(err, "%s: %s", at, e2.msg);
     }
     return 0;
 }
@@ -224,13 +259,18 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
         flat = !strcmp(nm->valuestring, "flat");
     }
 
+    const cJSON *insts = cJSON_GetObjectItemCaseSensitive(o, "instances");
+    if (insts && (!cJSON_IsArray(insts) || cJSON_GetArraySize(insts) == 0))
+        return fr_fail(err, "%s.instances: expected a non-empty array of transforms", where);
+
     /* Level of detail: from the coarsest level up, the first with enough
-     * triangles for the mesh's size on screen; the finest if none is. */
+     * triangles for the mesh's size on screen; the finest if none is (and
+     * for a mesh placed by instances, which share one level). */
     mesh_data m;
-    int level = levels - 1;
+    int level = insts ? 0 : levels - 1;
     if (mesh_read(b, paths[level], scope, &m, err) < 0)
         return -1;
-    float need = density * projected_pixels(b, &m, &x);
+    float need = insts ? 0.0f : density * projected_pixels(b, &m, &x);
     while (level > 0 && (float)m.n_tri < need) {
         mesh_data_free(&m);
         --level;
@@ -288,6 +328,11 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
         }
     }
 
+    /* With instances, what follows is the mesh in its own space. */
+    uint32_t mesh_id = FR_NONE;
+    if (rc == 0 && insts && (mesh_id = bld_mesh_begin(b)) == FR_NONE)
+        rc = fr_fail(err, "%s: out of memory", where);
+
     /* Vertices, placed; normals by the inverse transpose. */
     uint32_t base = b->positions.count;
     int use_n = m.nrm && !flat, use_uv = m.uv != NULL;
@@ -333,6 +378,8 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
         if (ti == FR_NONE || bld_push(&b->prims, &p) == FR_NONE)
             rc = fr_fail(err, "%s: out of memory", where);
     }
+    if (rc == 0 && insts)
+        rc = bld_mesh_end(b, mesh_id, err) < 0 ? -1 : place_instances(b, insts, where, mesh_id, err);
     free(mat_of);
     mesh_data_free(&m);
     return rc;

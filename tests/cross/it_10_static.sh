@@ -4,7 +4,9 @@
 # The fully static workers (make static): they need no shared library, the
 # arm64 one runs under qemu-aarch64-static, and both render the test slab
 # byte-identical to this machine's bin/franja-worker, and a bidirectional
-# slab too (its rows and its light-tracing splats over the whole image).
+# slab too (its rows and its light-tracing splats over the whole image),
+# and a slab of instanced meshes (the fuzz seed tests/fuzz/corpus/fbin/
+# instances.json: a rotation, a mirror, a non-uniform scale).
 . "$(dirname "$0")/lib.sh"
 need readelf cmp "$QEMU"
 T=$(mktemp -d /tmp/franja-static.XXXXXX)
@@ -46,6 +48,16 @@ check "reference bidirectional slab carries splats" grep -q "splat=" "$T/bd-ref.
 check "amd64 static bidirectional slab is byte-identical" cmp "$T/bd-s64.pf" "$T/bd-ref.pf"
 "$QEMU" "$SA64" --scene "$T/spheres.fbin" $BD -o "$T/bd-sa64.pf"
 check "arm64 static bidirectional slab under qemu is byte-identical" cmp "$T/bd-sa64.pf" "$T/bd-ref.pf"
+
+# Instances: the mesh walked in object space, normals back by the inverse.
+"$ROOT/bin/franja" compile "$ROOT/tests/fuzz/corpus/fbin/instances.json" -o "$T/inst.fbin" >/dev/null 2>&1
+IN="--rows 0:12 --spp 8 --size 32x24"
+"$ROOT/bin/franja-worker" --scene "$T/inst.fbin" $IN -o "$T/in-ref.pf"
+check "instanced scene renders" test -s "$T/in-ref.pf"
+"$S64" --scene "$T/inst.fbin" $IN -o "$T/in-s64.pf"
+check "amd64 static instanced slab is byte-identical" cmp "$T/in-s64.pf" "$T/in-ref.pf"
+"$QEMU" "$SA64" --scene "$T/inst.fbin" $IN -o "$T/in-sa64.pf"
+check "arm64 static instanced slab under qemu is byte-identical" cmp "$T/in-sa64.pf" "$T/in-ref.pf"
 
 # Built without cJSON, the static worker refuses a JSON scene with a message
 # instead of misreading it.
