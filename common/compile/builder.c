@@ -25,6 +25,7 @@ void bld_init(fr_builder *b)
     array_init(&b->texels, sizeof(float));
     array_init(&b->media, sizeof(fr_medium));
     array_init(&b->distrib, sizeof(float));
+    array_init(&b->light_nodes, sizeof(fr_light_node));
     b->world.env_light = b->world.env_texture = FR_NONE;
     b->world.rot_cos = 1.0f;
 }
@@ -33,7 +34,7 @@ void bld_free(fr_builder *b)
 {
     fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
                        &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
-                       &b->textures, &b->texels, &b->media, &b->distrib};
+                       &b->textures, &b->texels, &b->media, &b->distrib, &b->light_nodes};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->data);
     memset(b, 0, sizeof *b);

@@ -37,6 +37,8 @@ typedef struct {
     fr_tonemap tonemap;
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */
     fr_array distrib;          /**< float: filled by frz_scene */
+    fr_array light_nodes;      /**< fr_light_node: the light tree, built by frz_scene */
+    int no_light_tree;         /**< 1: no light tree, next-event estimation picks by the power table alone */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero. */

@@ -37,6 +37,7 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
     view.tonemap = b->tonemap;
     view.world = b->world;
     VIEW(distrib, b->distrib);
+    VIEW(light_nodes, b->light_nodes);
 #undef VIEW
     void *blob = NULL;
     size_t size = 0;
