@@ -68,39 +68,37 @@ static inline float sin_sub_clamped(float sa, float ca, float sb, float cb) { re
  * times a bound on the cosine at p (|cos|: both sides of a surface may
  * take light), over the squared distance to the node's centre (at least a
  * sixteenth of its bounding sphere's squared radius); 0 where no light of
- * the node can send light to p.
+ * the node can send light to p (Conty Estevez and Kulla 2018).
  *
- * The smallest angle between the cone's axis w and a direction from a
- * point q of the node to p is bounded twice: by the angle between w and the
- * direction from the centre less the angle the bounding sphere subtends
- * (Conty Estevez and Kulla 2018, pbrt-v4's LightBounds), and through the
- * box, max w.(p - q) / min |p - q| over the box (tight for flat clusters,
- * such as lamps at one height); the tighter of the two, less the cone's
- * spread, bounds the angle at the lights, and the same two bounds with nrm
- * the angle at p.  Cosines of differences come from cos_sub_clamped: + - *
- * / and sqrt only. */
+ * The smallest angle between the cone's axis w and a direction p - q from
+ * a point q of the node's box to p has cosine at most
+ * max w.(p - q) / min |p - q| over the box, when that maximum is positive
+ * (else at most max w.(p - q) / max |p - q|): w.(p - c) + sum |w_k| e_k
+ * over the distance from p to the box (c its centre, e its half extent).
+ * Unlike the bounding sphere's angle (pbrt-v4), this bound stays tight
+ * for flat clusters, such as lamps at one height seen from the ground.
+ * That angle less the cone's spread bounds the angle at the lights; the
+ * same bound with nrm, the angle at p.  Cosines of differences come from
+ * cos_sub_clamped: + - * / and sqrt only. */
 static inline float node_importance(const fr_light_node *n, vec3 p, vec3 nrm)
 {
     vec3 e = v3_scale(v3_sub(n->hi, n->lo), 0.5f), d = v3_sub(p, v3_add(n->lo, e));
     float d2 = v3_len2(d), r2 = v3_len2(e), cos_p = 1.0f, cos_i = 1.0f;
-    if (d2 > r2) {
-        /* Outside the bounding sphere, so outside the box: db > 0. */
-        vec3 out = v3_vmax(v3_sub(v3_abs(d), e), v3s(0.0f));
-        float inv = 1.0f / sqrtf(d2), db = sqrtf(v3_len2(out));
-        float sin2b = r2 / d2, cb = sqrtf(fmaxf(0.0f, 1.0f - sin2b)), sb = sqrtf(sin2b);
+    vec3 out = v3_vmax(v3_sub(v3_abs(d), e), v3s(0.0f));
+    float db2 = v3_len2(out);
+    if (db2 > 0.0f) {
+        float inv = 1.0f / sqrtf(db2);
         float wd = v3_dot(n->axis, d), we = v3_dot(v3_abs(n->axis), e);
         if (n->flags & FR_LNODE_TWO_SIDED)
             wd = fabsf(wd);
-        float cw = wd * inv, sw = sqrtf(fmaxf(0.0f, 1.0f - cw * cw));
-        float cm = fminf(cos_sub_clamped(sw, cw, sb, cb), wd + we > 0.0f ? fminf(1.0f, (wd + we) / db) : 0.0f);
+        /* Behind every point of the box: over the farthest distance. */
+        float cm = wd + we > 0.0f ? fminf(1.0f, (wd + we) * inv) : (wd + we) / (sqrtf(d2) + sqrtf(r2));
         float sm = sqrtf(fmaxf(0.0f, 1.0f - cm * cm)), so = sqrtf(fmaxf(0.0f, 1.0f - n->cos_o * n->cos_o));
         cos_p = cos_sub_clamped(sm, cm, so, n->cos_o);
         if (cos_p < n->cos_e)
             return 0.0f;
-        if (!v3_is_zero(nrm)) {
-            float nd = fabsf(v3_dot(nrm, d)), ci = nd * inv, si = sqrtf(fmaxf(0.0f, 1.0f - ci * ci));
-            cos_i = fminf(cos_sub_clamped(si, ci, sb, cb), fminf(1.0f, (nd + v3_dot(v3_abs(nrm), e)) / db));
-        }
+        if (!v3_is_zero(nrm))
+            cos_i = fminf(1.0f, (fabsf(v3_dot(nrm, d)) + v3_dot(v3_abs(nrm), e)) * inv);
     }
     /* Floors on the cosines: a spot whose light spreads past 90 degrees
      * reaches p at a negative cos_p too, and rounding must not make a

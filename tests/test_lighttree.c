@@ -213,8 +213,8 @@ static void lamp_sums(void)
 
 /* The foreground (the lower half of the image) of the lamp-lit ground:
  * with 64 lamps, where the power table converges too, the same mean with
- * the tree as with it; with 900, at least 4 times less noise (16 times
- * less variance) with the tree at equal samples. */
+ * the tree as with it; with 900, at least 10 times less noise (100 times
+ * less variance) with the tree at equal samples (measured: 37 times). */
 static void lamp_ground(void)
 {
     fr_scene tree, power;
@@ -236,8 +236,8 @@ static void lamp_ground(void)
            ep.se);
     d = fabs(et.mean - ep.mean), sd = sqrt(et.se * et.se + ep.se * ep.se);
     CHECK(d < 4 * sd, "900 lamps: tree and power table differ by %.5f (%.1f sigma)", d, d / sd);
-    CHECK(et.se * 4 < ep.se, "900 lamps: standard error with the tree %.5f, with the power table %.5f: not 4 times "
-          "less", et.se, ep.se);
+    CHECK(et.se * 10 < ep.se, "900 lamps: standard error with the tree %.5f, with the power table %.5f: not 10 "
+          "times less", et.se, ep.se);
     scn_free(&tree);
     scn_free(&power);
 }
