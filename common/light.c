@@ -80,6 +80,9 @@ static inline float sin_sub_clamped(float sa, float ca, float sb, float cb) { re
  * That angle less the cone's spread bounds the angle at the lights; the
  * same bound with nrm, the angle at p.  Cosines of differences come from
  * cos_sub_clamped: + - * / and sqrt only. */
+static inline float min2(float a, float b) { return a < b ? a : b; }
+static inline float max2(float a, float b) { return a > b ? a : b; }
+
 static inline float node_importance(const fr_light_node *n, vec3 p, vec3 nrm)
 {
     vec3 e = v3_scale(v3_sub(n->hi, n->lo), 0.5f), d = v3_sub(p, v3_add(n->lo, e));
@@ -92,18 +95,24 @@ static inline float node_importance(const fr_light_node *n, vec3 p, vec3 nrm)
         if (n->flags & FR_LNODE_TWO_SIDED)
             wd = fabsf(wd);
         /* Behind every point of the box: over the farthest distance. */
-        float cm = wd + we > 0.0f ? fminf(1.0f, (wd + we) * inv) : (wd + we) / (sqrtf(d2) + sqrtf(r2));
-        float sm = sqrtf(fmaxf(0.0f, 1.0f - cm * cm)), so = sqrtf(fmaxf(0.0f, 1.0f - n->cos_o * n->cos_o));
-        cos_p = cos_sub_clamped(sm, cm, so, n->cos_o);
+        float cm = wd + we > 0.0f ? min2(1.0f, (wd + we) * inv) : (wd + we) / (sqrtf(d2) + sqrtf(r2));
+        /* cos(max(0, angle - spread)); a single direction (cos_o = 1)
+         * and every direction (cos_o = -1) need no sines. */
+        if (n->cos_o >= 1.0f) {
+            cos_p = cm;
+        } else if (n->cos_o > -1.0f) {
+            float sm = sqrtf(max2(0.0f, 1.0f - cm * cm)), so = sqrtf(max2(0.0f, 1.0f - n->cos_o * n->cos_o));
+            cos_p = cos_sub_clamped(sm, cm, so, n->cos_o);
+        }
         if (cos_p < n->cos_e)
             return 0.0f;
         if (!v3_is_zero(nrm))
-            cos_i = fminf(1.0f, (fabsf(v3_dot(nrm, d)) + v3_dot(v3_abs(nrm), e)) * inv);
+            cos_i = min2(1.0f, (fabsf(v3_dot(nrm, d)) + v3_dot(v3_abs(nrm), e)) * inv);
     }
     /* Floors on the cosines: a spot whose light spreads past 90 degrees
      * reaches p at a negative cos_p too, and rounding must not make a
      * light that reaches p impossible to pick. */
-    float imp = n->power * fmaxf(cos_p, 1e-3f) * fmaxf(cos_i, 1e-3f) / fmaxf(fmaxf(d2, 0.0625f * r2), 1e-30f);
+    float imp = n->power * max2(cos_p, 1e-3f) * max2(cos_i, 1e-3f) / max2(max2(d2, 0.0625f * r2), 1e-30f);
     return imp < 1e30f ? imp : n->power > 0.0f ? 1e30f : 0.0f;
 }
 
