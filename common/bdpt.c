@@ -610,7 +610,9 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         return zero;
     if (s_ == 1) {
         fr_light_sample ls;
-        if (!lgt_sample(s, pt->p, pt->u[0], pt->u[1], pt->u[2], &ls))
+        /* The power table's pick, as the light subpaths start by: the
+         * strategies' densities of this vertex (emit_pdf_origin) are its. */
+        if (!lgt_sample_table(s, pt->p, pt->u[0], pt->u[1], pt->u[2], &ls))
             return zero;
         vec3 L = v3_mul(v3_mul(pt->beta, vert_f(pt, ls.wi, 0)), ls.radiance);
         L = v3_scale(L, fabsf(v3_dot(ls.wi, pt->ns)) / ls.pdf);

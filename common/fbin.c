@@ -29,8 +29,8 @@ enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
-    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES,
-    SEC_COUNT = SEC_MESH_LEAVES
+    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE,
+    SEC_COUNT = SEC_LIGHTTREE
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -69,6 +69,7 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_INSTANCES, "instances", instances, fr_instance),
     ARR(SEC_MESH_NODES, "mesh_nodes", mesh_nodes, fr_bvh_node),
     ARR(SEC_MESH_LEAVES, "mesh_leaves", mesh_leaves, fr_bvh_leaf),
+    ARR(SEC_LIGHTTREE, "lighttree", light_nodes, fr_light_node),
 };
 #undef ARR
 
@@ -333,6 +334,52 @@ static int validate_instances(const fr_scene *s, const void *base, fr_error *err
     return 0;
 }
 
+/* The light tree: none (next-event estimation picks by the power table),
+ * or one leaf per local light (light nd + j is node j),
+ * inner nodes after the leaves, each after its children, the root last;
+ * parents and children agree, so the nodes form one tree; no leaf deeper
+ * than FR_BVH_MAX_DEPTH levels (light.c walks a leaf's path on a fixed
+ * stack); finite bounds and cones, power >= 0. */
+static int validate_light_tree(const fr_scene *s, const void *base, fr_error *err)
+{
+    uint32_t nd = 0;
+    while (nd < s->n_lights && (s->lights[nd].kind == FR_LIGHT_SUN || s->lights[nd].kind == FR_LIGHT_ENV))
+        nd++;
+    uint32_t nl = s->n_lights - nd, n = s->n_light_nodes;
+    if (n != 0 && n != 2 * nl - 1)
+        return fr_fail(err, "section lighttree: %u nodes for %u local lights, expected 0 or %u", n, nl,
+                       nl ? 2 * nl - 1 : 0);
+    if (n == 0)
+        return 0;
+    for (uint32_t i = 0; i < n; i++) {
+        const fr_light_node *t = &s->light_nodes[i];
+        if (!finite3(t->lo) || !finite3(t->hi) || !(t->lo.x <= t->hi.x && t->lo.y <= t->hi.y && t->lo.z <= t->hi.z) ||
+            !finite3(t->axis) || fabsf(v3_len2(t->axis) - 1.0f) > 1e-3f || !(t->cos_o >= -1.0f && t->cos_o <= 1.0f) ||
+            !(t->cos_e >= -1.0f && t->cos_e <= 1.0f) || !(t->power >= 0.0f) || !isfinite(t->power) ||
+            (t->flags & ~(uint32_t)FR_LNODE_TWO_SIDED))
+            return fr_fail(err, "section lighttree, byte %zu: node %u: bad bounds, cone, power or flags", AT(t), i);
+        int leaf = i < nl;
+        if (leaf != (t->child[0] == FR_NONE) || leaf != (t->child[1] == FR_NONE) ||
+            (!leaf && !(t->child[0] < i && t->child[1] < i && t->child[0] != t->child[1] &&
+                        s->light_nodes[t->child[0]].parent == i && s->light_nodes[t->child[1]].parent == i)))
+            return fr_fail(err, "section lighttree, byte %zu: node %u: children missing, out of order or not "
+                           "pointing back", AT(t->child), i);
+        uint32_t p = t->parent;
+        if ((i + 1 == n) != (p == FR_NONE) ||
+            (p != FR_NONE && !(p > i && p < n && (s->light_nodes[p].child[0] == i || s->light_nodes[p].child[1] == i))))
+            return fr_fail(err, "section lighttree, byte %zu: node %u: parent %u out of order or not its parent",
+                           AT(&t->parent), i, p);
+    }
+    for (uint32_t j = 0; j < nl; j++) {
+        uint32_t depth = 1;
+        for (uint32_t k = j; s->light_nodes[k].parent != FR_NONE; k = s->light_nodes[k].parent)
+            if (++depth > FR_BVH_MAX_DEPTH)
+                return fr_fail(err, "section lighttree, byte %zu: leaf %u deeper than %d levels",
+                               AT(s->light_nodes + j), j, FR_BVH_MAX_DEPTH);
+    }
+    return 0;
+}
+
 /* Check every cross-reference so that rendering can index without checks. */
 static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
@@ -417,7 +464,7 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
             !finite3(s->planes[i].point))
             return fr_fail(err, "section planes, byte %zu: plane %u: material out of range or non-finite geometry",
                            AT(s->planes + i), i);
-    if (validate_lights(s, base, off, err) < 0)
+    if (validate_lights(s, base, off, err) < 0 || validate_light_tree(s, base, err) < 0)
         return -1;
     return bvh_validate(s, base, err);
 }

@@ -47,23 +47,6 @@ uint32_t lgt_pick(const fr_scene *s, float u)
     return base + !(u < s->lights[base].cdf);
 }
 
-int lgt_pick_reuse(const fr_scene *s, float *u)
-{
-    if (s->n_lights == 0)
-        return 1;
-    uint32_t li = lgt_pick(s, *u);
-    /* The cdf below light li, 0 below the first (an arithmetic select: li
-     * is random; cdfs are finite and at least 0). */
-    uint32_t above_first = li != 0;
-    float lo = s->lights[li - above_first].cdf * (float)above_first, hi = s->lights[li].cdf, w = hi - lo;
-    if (!(w >= 0x1p-8f))
-        return 0;
-    float r = (*u - lo) / w;
-    /* Rounding can reach 1 (or, past the last cdf, above it). */
-    *u = r < 0.0f ? 0.0f : r < 1.0f ? r : 0x1.fffffep-1f;
-    return 1;
-}
-
 static int is_distant(const fr_light *l) { return l->kind == FR_LIGHT_SUN || l->kind == FR_LIGHT_ENV; }
 
 uint32_t lgt_n_distant(const fr_scene *s)
@@ -72,6 +55,147 @@ uint32_t lgt_n_distant(const fr_scene *s)
     while (n < s->n_lights && is_distant(&s->lights[n]))
         n++;
     return n;
+}
+
+/* ---- the light tree (scene.h, fr_light_node) ------------------------------ */
+
+/* cos(max(0, a - b)) and sin(max(0, a - b)) of angles a, b in [0, pi]
+ * given by their sines and cosines: no inverse trigonometry (pbrt-v4's
+ * bounds of the importance). */
+static inline float cos_sub_clamped(float sa, float ca, float sb, float cb) { return ca > cb ? 1.0f : ca * cb + sa * sb; }
+static inline float sin_sub_clamped(float sa, float ca, float sb, float cb) { return ca > cb ? 0.0f : sa * cb - ca * sb; }
+
+/* The importance node n gives point p with unit normal nrm (zero: a point
+ * in a medium, which takes light from every direction): its power times a
+ * bound on the cosine between the lights' emission and the direction to p,
+ * times a bound on the cosine at p (|cos|: both sides of a surface may
+ * take light), over the squared distance to the node's centre (at least a
+ * sixteenth of its bounding sphere's squared radius); 0 where no light of
+ * the node can send light to p (Conty Estevez and Kulla 2018).
+ *
+ * The smallest angle between the cone's axis w and a direction p - q from
+ * a point q of the node's box to p has cosine at most
+ * max w.(p - q) / min |p - q| over the box, when that maximum is positive
+ * (else at most max w.(p - q) / max |p - q|): w.(p - c) + sum |w_k| e_k
+ * over the distance from p to the box (c its centre, e its half extent).
+ * Unlike the bounding sphere's angle (pbrt-v4), this bound stays tight
+ * for flat clusters, such as lamps at one height seen from the ground.
+ * That angle less the cone's spread bounds the angle at the lights; the
+ * same bound with nrm, the angle at p.  Cosines of differences come from
+ * cos_sub_clamped: + - * / and sqrt only. */
+static inline float min2(float a, float b) { return a < b ? a : b; }
+static inline float max2(float a, float b) { return a > b ? a : b; }
+
+static inline float node_importance(const fr_light_node *n, vec3 p, vec3 nrm)
+{
+    vec3 e = v3_scale(v3_sub(n->hi, n->lo), 0.5f), d = v3_sub(p, v3_add(n->lo, e));
+    float d2 = v3_len2(d), r2 = v3_len2(e), cos_p = 1.0f, cos_i = 1.0f;
+    vec3 out = v3_vmax(v3_sub(v3_abs(d), e), v3s(0.0f));
+    float db2 = v3_len2(out);
+    if (db2 > 0.0f) {
+        float inv = 1.0f / sqrtf(db2);
+        float wd = v3_dot(n->axis, d), we = v3_dot(v3_abs(n->axis), e);
+        if (n->flags & FR_LNODE_TWO_SIDED)
+            wd = fabsf(wd);
+        /* Behind every point of the box: over the farthest distance. */
+        float cm = wd + we > 0.0f ? min2(1.0f, (wd + we) * inv) : (wd + we) / (sqrtf(d2) + sqrtf(r2));
+        /* cos(max(0, angle - spread)); a single direction (cos_o = 1)
+         * and every direction (cos_o = -1) need no sines. */
+        if (n->cos_o >= 1.0f) {
+            cos_p = cm;
+        } else if (n->cos_o > -1.0f) {
+            float sm = sqrtf(max2(0.0f, 1.0f - cm * cm)), so = sqrtf(max2(0.0f, 1.0f - n->cos_o * n->cos_o));
+            cos_p = cos_sub_clamped(sm, cm, so, n->cos_o);
+        }
+        if (cos_p < n->cos_e)
+            return 0.0f;
+        if (!v3_is_zero(nrm))
+            cos_i = min2(1.0f, (fabsf(v3_dot(nrm, d)) + v3_dot(v3_abs(nrm), e)) * inv);
+    }
+    /* Floors on the cosines: a spot whose light spreads past 90 degrees
+     * reaches p at a negative cos_p too, and rounding must not make a
+     * light that reaches p impossible to pick. */
+    float imp = n->power * max2(cos_p, 1e-3f) * max2(cos_i, 1e-3f) / max2(max2(d2, 0.0625f * r2), 1e-30f);
+    return imp < 1e30f ? imp : n->power > 0.0f ? 1e30f : 0.0f;
+}
+
+/* The probabilities of the children of inner node n from p: each one's
+ * importance over their sum; both 0 when neither reaches p.  lgt_choose
+ * and lgt_pick_pdf both take them from here, so a light's pdf is the
+ * product of the same numbers in the same order either way. */
+static inline void branch(const fr_scene *s, const fr_light_node *n, vec3 p, vec3 nrm, float *p0, float *p1)
+{
+    float i0 = node_importance(&s->light_nodes[n->child[0]], p, nrm);
+    float i1 = node_importance(&s->light_nodes[n->child[1]], p, nrm);
+    float sum = i0 + i1;
+    *p0 = sum > 0.0f ? i0 / sum : 0.0f;
+    *p1 = sum > 0.0f ? i1 / sum : 0.0f;
+}
+
+/* x clamped to [0, 1): rescaled numbers can round to 1. */
+static inline float unit(float x) { return x < 0.0f ? 0.0f : x < 1.0f ? x : 0x1.fffffep-1f; }
+
+/* The share of the local lights (the tree): all but the distant lights'
+ * picks in the power table. */
+static inline float tree_share(const fr_scene *s, uint32_t nd) { return nd ? 1.0f - s->lights[nd - 1].cdf : 1.0f; }
+
+uint32_t lgt_choose(const fr_scene *s, vec3 from, vec3 nrm, float *u, float *pick)
+{
+    if (s->n_lights == 0)
+        return FR_NONE;
+    uint32_t nd = lgt_n_distant(s);
+    float x = *u;
+    if ((nd && x < s->lights[nd - 1].cdf) || s->n_light_nodes == 0) {
+        uint32_t li = lgt_pick(s, x);
+        float lo = li ? s->lights[li - 1].cdf : 0.0f;
+        *pick = s->lights[li].pick;
+        *u = unit((x - lo) / (s->lights[li].cdf - lo));
+        return li;
+    }
+    float share = tree_share(s, nd), pk = share;
+    x = unit((x - (nd ? s->lights[nd - 1].cdf : 0.0f)) / share);
+    uint32_t nl = s->n_lights - nd, n = s->n_light_nodes - 1;
+    while (n >= nl) {
+        const fr_light_node *t = &s->light_nodes[n];
+        float p0, p1;
+        branch(s, t, from, nrm, &p0, &p1);
+        if (x < p0) {
+            x = unit(x / p0);
+            pk *= p0;
+            n = t->child[0];
+        } else if (p1 > 0.0f) {
+            x = unit((x - p0) / p1);
+            pk *= p1;
+            n = t->child[1];
+        } else {
+            return FR_NONE;
+        }
+    }
+    *pick = pk;
+    *u = x;
+    return nd + n;
+}
+
+float lgt_pick_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 nrm)
+{
+    uint32_t nd = lgt_n_distant(s);
+    if (light < nd || s->n_light_nodes == 0)
+        return s->lights[light].pick;
+    /* The path from the root to the light's leaf, walked down as
+     * lgt_choose walks it. */
+    uint32_t path[FR_BVH_MAX_DEPTH], k = 0;
+    for (uint32_t n = light - nd; s->light_nodes[n].parent != FR_NONE; n = s->light_nodes[n].parent)
+        path[k++] = n;
+    float pk = tree_share(s, nd);
+    uint32_t n = s->n_light_nodes - 1;
+    while (k > 0) {
+        uint32_t c = path[--k];
+        float p0, p1;
+        branch(s, &s->light_nodes[n], from, nrm, &p0, &p1);
+        pk *= c == s->light_nodes[n].child[0] ? p0 : p1;
+        n = c;
+    }
+    return pk;
 }
 
 float lgt_spot_falloff(const fr_light *l, float c)
@@ -121,7 +245,9 @@ static vec3 sun_radiance(const fr_light *l)
     return v3_scale(l->intensity, 1.0f / (FM_PI * sin2));
 }
 
-float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
+/* Solid-angle pdf of point p (normal n) of area light `light`, picked
+ * with probability pick, from `from`. */
+static float pdf_picked(const fr_scene *s, uint32_t light, float pick, vec3 from, vec3 p, vec3 n)
 {
     const fr_light *l = &s->lights[light];
     const fr_prim *pr = &s->prims[l->prim];
@@ -129,14 +255,24 @@ float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
         const fr_sphere *sp = &s->spheres[pr->index];
         float d2 = v3_len2(v3_sub(sp->center, from)), r2 = sp->radius * sp->radius;
         if (d2 > r2 * 1.0001f)
-            return l->pick / (2.0f * FM_PI * cone_one_minus_cos(r2, d2));
+            return pick / (2.0f * FM_PI * cone_one_minus_cos(r2, d2));
     }
     vec3 d = v3_sub(p, from);
     float dist2 = v3_len2(d);
     float cosl = fabsf(v3_dot(n, d)) / sqrtf(dist2);
     if (cosl <= 0.0f)
         return 0.0f;
-    return l->pick * dist2 / (cosl * l->area);
+    return pick * dist2 / (cosl * l->area);
+}
+
+float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 nrm, vec3 p, vec3 n)
+{
+    return pdf_picked(s, light, lgt_pick_pdf(s, light, from, nrm), from, p, n);
+}
+
+float lgt_pdf_table(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
+{
+    return pdf_picked(s, light, s->lights[light].pick, from, p, n);
 }
 
 vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf)
@@ -167,7 +303,8 @@ static float aim(fr_light_sample *out, vec3 from)
 }
 
 /* Light samples of the lights that are not primitives. */
-static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u1, float u2, fr_light_sample *out)
+static int sample_other(const fr_scene *s, const fr_light *l, float pick, vec3 from, float u1, float u2,
+                        fr_light_sample *out)
 {
     out->prim = FR_NONE;
     if (l->kind == FR_LIGHT_POINT || l->kind == FR_LIGHT_SPOT) {
@@ -176,7 +313,7 @@ static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u
         if (!(d2 > 0.0f))
             return 0;
         out->radiance = v3_scale(lgt_intensity(l, v3_neg(out->wi)), 1.0f / d2);
-        out->pdf = l->pick;
+        out->pdf = pick;
         out->n = v3_neg(out->wi);
         out->delta = 1;
         out->distant = 0;
@@ -190,17 +327,17 @@ static int sample_other(const fr_scene *s, const fr_light *l, vec3 from, float u
         if (out->delta) {
             out->wi = l->axis;
             out->radiance = l->intensity;
-            out->pdf = l->pick;
+            out->pdf = pick;
         } else {
             out->wi = cone_sample(l->axis, l->cone_aux, u1, u2);
             out->radiance = sun_radiance(l);
-            out->pdf = l->pick / (2.0f * FM_PI * l->cone_aux);
+            out->pdf = pick / (2.0f * FM_PI * l->cone_aux);
         }
     } else {
         float pdf;
         out->delta = 0;
         out->wi = env_sample(s, u1, u2, &pdf, &out->radiance);
-        out->pdf = l->pick * pdf;
+        out->pdf = pick * pdf;
         if (!(out->pdf > 0.0f))
             return 0;
     }
@@ -274,16 +411,14 @@ int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 
 /* Inlined where it is called, with prim_point and textured
  * (always_inline): the light sample's vectors stay in registers instead of
  * going through the stack at each call. */
-__attribute__((always_inline)) inline int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2,
-                                                     fr_light_sample *out)
+__attribute__((always_inline)) inline int lgt_sample_chosen(const fr_scene *s, uint32_t li, float pick, vec3 from,
+                                                            float u1, float u2, fr_light_sample *out)
 {
-    if (s->n_lights == 0)
-        return 0;
-    uint32_t li = lgt_pick(s, upick);
     const fr_light *l = &s->lights[li];
     out->light = li;
+    out->pick = pick;
     if (l->kind != FR_LIGHT_PRIM)
-        return sample_other(s, l, from, u1, u2, out);
+        return sample_other(s, l, pick, from, u1, u2, out);
     const fr_prim *pr = &s->prims[l->prim];
     const fr_material *m = &s->materials[pr->material];
     out->delta = 0;
@@ -304,7 +439,7 @@ __attribute__((always_inline)) inline int lgt_sample(const fr_scene *s, vec3 fro
             out->dist = proj - sqrtf(h2);
             out->p = v3_madd(from, out->wi, out->dist);
             out->n = v3_norm(v3_sub(out->p, sp->center));
-            out->pdf = l->pick / (2.0f * FM_PI * omc);
+            out->pdf = pick / (2.0f * FM_PI * omc);
             out->radiance = textured(s, m, l->prim, out->p, 0.0f, 0.0f, lgt_emitted(m, out->n, v3_neg(out->wi)));
             return out->pdf > 0.0f && !v3_is_zero(out->radiance);
         }
@@ -318,9 +453,24 @@ __attribute__((always_inline)) inline int lgt_sample(const fr_scene *s, vec3 fro
     float cosl = fabsf(v3_dot(out->n, out->wi));
     if (cosl <= 0.0f)
         return 0;
-    out->pdf = l->pick * d2 / (cosl * l->area);
+    out->pdf = pick * d2 / (cosl * l->area);
     out->radiance = textured(s, m, l->prim, out->p, ua, ub, lgt_emitted(m, out->n, v3_neg(out->wi)));
     return !v3_is_zero(out->radiance);
+}
+
+int lgt_sample(const fr_scene *s, vec3 from, vec3 nrm, float upick, float u1, float u2, fr_light_sample *out)
+{
+    float pick;
+    uint32_t li = lgt_choose(s, from, nrm, &upick, &pick);
+    return li != FR_NONE && lgt_sample_chosen(s, li, pick, from, u1, u2, out);
+}
+
+int lgt_sample_table(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out)
+{
+    if (s->n_lights == 0)
+        return 0;
+    uint32_t li = lgt_pick(s, upick);
+    return lgt_sample_chosen(s, li, s->lights[li].pick, from, u1, u2, out);
 }
 
 /* ---- rays leaving lights ------------------------------------------------ */

@@ -1,11 +1,19 @@
 /** @file light.h
  * Lights seen from the scene and lights as the start of paths.
  *
- * For next-event estimation: lgt_sample picks a light with probability
- * `pick` (proportional to its power, binary search over the running sums)
- * and a point or direction on it, and gives the solid-angle pdf of having
- * done so; lgt_pdf and lgt_distant give the same pdf for a point or
- * direction that a BSDF sample found, for multiple importance sampling.
+ * For next-event estimation from a point: lgt_choose picks a light by the
+ * light tree (scene.h, fr_light_node), a walk from the root that goes to
+ * each child with probability its importance from that point over the sum
+ * of both (distance, the cone of the lights' emission, the node's bounds
+ * and power); the distant lights (sun, environment) keep the share the
+ * power table gives them, split among them in proportion to power.
+ * lgt_sample picks a light so and a point or direction on it and gives the
+ * solid-angle pdf of having done so; lgt_pdf and lgt_distant give the same
+ * pdf (lgt_pick_pdf the same pick, bit for bit) for a point or direction
+ * that a BSDF sample found, for multiple importance sampling.  Where no
+ * point is known when the light is picked (paths that start on a light,
+ * equiangular sampling in media) the pick is the power table's: lgt_pick,
+ * lgt_sample_table, lgt_pdf_table.
  * Points are chosen uniformly by area on rectangles and triangles,
  * uniformly in the visible cone on spheres seen from outside and on a sun's
  * disk, in proportion to the map (times sin theta) on an environment.
@@ -32,6 +40,7 @@ typedef struct {
     vec3 radiance;             /**< incident radiance (area, sun disk, environment), intensity/dist^2 (point, spot)
                                     or irradiance (sun without a disk) */
     float pdf;                 /**< solid-angle pdf including the pick; for a delta light the pick alone */
+    float pick;                /**< the probability with which the light was picked */
     vec3 p, n;                 /**< sampled point and its light's normal (local lights only) */
     uint32_t light;            /**< index into lights */
     uint32_t prim;             /**< the emitting prim, FR_NONE for other lights */
@@ -39,25 +48,43 @@ typedef struct {
     int distant;               /**< 1 for sun and environment: the shadow ray is unbounded */
 } fr_light_sample;
 
-/** The light that lgt_sample picks with number u (the scene has lights). */
+/** The light that the power table picks with number u (the scene has
+ * lights): the first whose cdf exceeds u. */
 uint32_t lgt_pick(const fr_scene *s, float u);
 
-/** Reuse the number u that picked a light (lgt_pick) as the first number
- * of the point on it: on success *u becomes (u - the light's lower cdf) /
- * its pick probability, uniform in [0, 1) again and as well stratified
- * as u was, and the function returns 1.  It returns 0 (u unchanged) when
- * the picked light's probability is below 2^-8, where the rescaled number
- * would keep fewer than 16 significant bits; the caller then draws a fresh
- * number for the point.  A scene without lights returns 1, u unchanged. */
-int lgt_pick_reuse(const fr_scene *s, float *u);
+/** The light that next-event estimation from point `from` (unit normal
+ * nrm there, the shading normal; zero in a medium) picks with number *u: a distant light by the power table, or a local one by the
+ * light tree; *pick receives the probability of that pick, and *u the
+ * number rescaled within the pick (uniform in [0, 1) again, with about
+ * log2(1 / *pick) fewer significant bits).  FR_NONE when the scene has no
+ * lights or no light of the tree can reach `from` (every importance 0). */
+uint32_t lgt_choose(const fr_scene *s, vec3 from, vec3 nrm, float *u, float *pick);
+
+/** The probability that lgt_choose picks light `light` from `from` (normal
+ * nrm): the
+ * product of its path's branch probabilities, the same float as *pick
+ * there; 0 where lgt_choose never picks it. */
+float lgt_pick_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 nrm);
 
 /** Number of distant lights: lights[0 .. n) are the sun and environment lights. */
 uint32_t lgt_n_distant(const fr_scene *s);
 
-/** Sample a light as seen from point `from`.  Returns 0 if the scene has no
- * lights or the sample carries no light (back side of a one-sided emitter,
- * outside a spot's cone, a black part of a map). */
-int lgt_sample(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out);
+/** Sample a light as seen from point `from` (normal nrm, as lgt_choose
+ * takes it): lgt_choose with upick, then
+ * lgt_sample_chosen.  Returns 0 if no light is picked or the sample
+ * carries no light (back side of a one-sided emitter, outside a spot's
+ * cone, a black part of a map). */
+int lgt_sample(const fr_scene *s, vec3 from, vec3 nrm, float upick, float u1, float u2, fr_light_sample *out);
+
+/** A point or direction on light li, picked with probability `pick`, seen
+ * from `from`, with (u1, u2); returns as lgt_sample. */
+int lgt_sample_chosen(const fr_scene *s, uint32_t li, float pick, vec3 from, float u1, float u2,
+                      fr_light_sample *out);
+
+/** lgt_sample with the power table's pick (lgt_pick) instead of the tree's:
+ * for strategies whose other densities count the table's pick (the
+ * connections of bidirectional path tracing, equiangular sampling). */
+int lgt_sample_table(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out);
 
 /** The point lgt_sample picks on light `light` with (u1, u2) wherever it is
  * seen from, into *p: a point or spot light's position, or the point
@@ -72,13 +99,16 @@ int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 
 int lgt_has_fixed_point(const fr_scene *s, uint32_t light);
 
 /** Solid-angle pdf that lgt_sample would have produced the point `p` (normal
- * `n`) of area light `light` from `from`. */
-float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n);
+ * `n`) of area light `light` from `from` (normal nrm there). */
+float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 nrm, vec3 p, vec3 n);
+
+/** The same for lgt_sample_table (the power table's pick; no normal). */
+float lgt_pdf_table(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n);
 
 /** Radiance that distant light `light` sends along -dir toward the scene
  * (dir: unit, from the scene toward the sky), and in *pdf the solid-angle
  * pdf, including the pick, with which lgt_sample picks that direction of
- * that light.  Both 0 for a sun without a disk, and outside the disk. */
+ * that light (the tree and the table pick distant lights alike).  Both 0 for a sun without a disk, and outside the disk. */
 vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf);
 
 /** Radiance an emissive material sends toward direction `w` from a surface
@@ -111,7 +141,7 @@ typedef struct {
     int distant;               /**< sun, environment */
 } fr_light_emit;
 
-/** Start a ray on a light: the light picked by upick as lgt_sample does,
+/** Start a ray on a light: the light picked by upick as lgt_pick does,
  * the origin from (u1, u2), the direction from (u3, u4): cosine-weighted
  * about the normal for area lights (two-sided ones pick a side with u3),
  * uniform over the sphere (point) or the outer cone (spot), from the disk

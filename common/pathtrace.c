@@ -37,15 +37,27 @@ static int roulette(fr_sampler *smp, uint32_t depth, vec3 *beta)
     return 1;
 }
 
-/* The numbers of a light sample: one stratified pair whose first number
- * picks the light and, rescaled, places the point on it too
- * (lgt_pick_reuse); a second pair for the point only where the picked
- * light is too unlikely for that. */
-static void light_numbers(const fr_scene *s, fr_sampler *smp, float *upick, float *u1, float *u2)
+/* The light of a light sample from point `from` (normal nrm, zero in a
+ * medium) and the numbers of its
+ * point: one stratified pair whose first number picks the light
+ * (lgt_choose, when `choose`; else no light, *light FR_NONE) and,
+ * rescaled, places the point on it too; a second pair for the point only
+ * where the picked light is too unlikely for that (below 2^-8, where the
+ * rescaled number would keep fewer than 16 significant bits). */
+static void light_numbers(const fr_scene *s, vec3 from, vec3 nrm, int choose, fr_sampler *smp, uint32_t *light,
+                          float *pick, float *u1, float *u2)
 {
     smp_2d(smp, u1, u2);
-    *upick = *u1;
-    if (!lgt_pick_reuse(s, u1))
+    *light = FR_NONE;
+    if (!choose)
+        return;
+    float u = *u1;
+    *light = lgt_choose(s, from, nrm, &u, pick);
+    if (*light == FR_NONE)
+        return;
+    if (*pick >= 0x1p-8f)
+        *u1 = u;
+    else
         smp_2d(smp, u1, u2);
 }
 
@@ -70,13 +82,15 @@ fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float 
 
 /* Light reached by a BSDF or phase sample (or seen directly) at surface
  * vertex sf of material m, seen along wo: its emission times beta, weighted
- * against light sampling from the previous vertex prev_p, whose scattering
+ * against light sampling from the previous vertex prev_p (its normal
+ * prev_n, zero in a medium), whose scattering
  * sampled this direction with solid-angle density prev_pdf (or a delta
  * event: weight 1); when that vertex was medium vertex prev_v (in medium
  * prev_medium, not 0), against the equiangular sampling of its segment
  * too. */
 static vec3 emission(const fr_scene *s, pt_strategy strategy, vtx_mis mis, const fr_material *m, const fr_surface *sf,
-                     vec3 wo, vec3 beta, float prev_pdf, int prev_delta, vec3 prev_p, const vtx_vertex *prev_v,
+                     vec3 wo, vec3 beta, float prev_pdf, int prev_delta, vec3 prev_p, vec3 prev_n,
+                     const vtx_vertex *prev_v,
                      uint32_t prev_medium)
 {
     vec3 le = lgt_emitted(m, sf->ng, wo);
@@ -87,8 +101,9 @@ static vec3 emission(const fr_scene *s, pt_strategy strategy, vtx_mis mis, const
         if (strategy == PT_LIGHT_ONLY)
             w = 0.0f;
         else if (strategy != PT_BSDF_ONLY) {
-            float pl = lgt_pdf(s, sf->light, prev_p, sf->p, sf->ng);
-            w = prev_medium ? vtx_medium_hit_weight(s, prev_v, prev_medium, mis, sf->light, sf->p, prev_pdf, pl)
+            float pl = lgt_pdf(s, sf->light, prev_p, prev_n, sf->p, sf->ng);
+            w = prev_medium ? vtx_medium_hit_weight(s, prev_v, prev_medium, mis, sf->light, sf->p, prev_pdf, pl,
+                                                    lgt_pdf_table(s, sf->light, prev_p, sf->p, sf->ng))
                             : vtx_power_heuristic(prev_pdf, pl);
         }
     }
@@ -140,7 +155,7 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
     vec3 L = v3s(0.0f), beta = v3s(1.0f);
     float prev_pdf = 0.0f;     /* solid-angle pdf of the last BSDF or phase sample */
     int prev_delta = 1;        /* the camera ray counts as a delta event */
-    vec3 prev_p = ray.o;
+    vec3 prev_p = ray.o, prev_n = v3s(0.0f);
     vtx_vertex prev_v;         /* the last vertex, when it was in a medium */
     uint32_t prev_medium = 0;  /* its medium (1 + index); 0: the last vertex was not in a medium */
     uint32_t medium = s->volume.camera_medium;   /* the ray's medium: 1 + index, 0 = vacuum */
@@ -158,18 +173,20 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
         /* Each vertex draws a pair for the light (light_numbers), one for
          * the scattered direction, and before them one for the lobe
          * choice where the material has lobes to choose from. */
-        float upick, ulobe = 0.5f, u1, u2, v1, v2;
+        float pick = 0.0f, ulobe = 0.5f, u1, u2, v1, v2;
+        uint32_t light;
         vtx_direct d;
         if (kind == VTX_MEDIUM) {
             if (depth >= max_depth)
                 break;
-            light_numbers(s, &smp, &upick, &u1, &u2);
+            light_numbers(s, v.p, v3s(0.0f), light_sampling, &smp, &light, &pick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
-            if (light_sampling && vtx_direct_medium(s, &v, medium, beta, mis, upick, u1, u2, &d))
+            if (vtx_direct_medium(s, &v, medium, beta, mis, light, pick, u1, u2, &d))
                 L = v3_add(L, d.L);
             vtx_scatter_medium(s, &v, medium, v1, v2, &ray, &prev_pdf);
             prev_delta = 0;
             prev_p = v.p;
+            prev_n = v3s(0.0f);
             prev_v = v;
             prev_medium = medium;
         } else {
@@ -177,7 +194,7 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             const fr_material *m = tex_material(s, &s->materials[v.sf.material], &v.sf, &textured);
             vec3 wo = v3_neg(ray.d);
             if (v.sf.light != FR_NONE)
-                L = v3_add(L, emission(s, strategy, mis, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p, &prev_v,
+                L = v3_add(L, emission(s, strategy, mis, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p, prev_n, &prev_v,
                                        prev_medium));
             if (depth >= max_depth)
                 break;
@@ -185,10 +202,10 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
                 float unused;
                 smp_2d(&smp, &ulobe, &unused);
             }
-            light_numbers(s, &smp, &upick, &u1, &u2);
+            light_numbers(s, v.sf.p, v.sf.ns, light_sampling && bsdf_has_smooth(m), &smp, &light, &pick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
             vtx_origin org = vtx_origin_at(&v.sf, wo);
-            if (light_sampling && vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, upick, u1, u2, &org, &d))
+            if (vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, light, pick, u1, u2, &org, &d))
                 L = v3_add(L, d.L);
             fr_bsdf_sample bs;
             if (!vtx_scatter_surface(s, m, &v.sf, wo, ulobe, v1, v2, &org, &bs, &ray, &medium))
@@ -197,6 +214,7 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             prev_pdf = bs.pdf;
             prev_delta = bs.delta;
             prev_p = v.sf.p;
+            prev_n = v.sf.ns;
             prev_medium = 0;
         }
         if (!roulette(&smp, depth, &beta))

@@ -225,7 +225,11 @@ typedef struct { vec3 point, normal; uint32_t material; uint32_t pad; } fr_plane
  *    (kept exact for small angles); both 1 and 0 for a delta sun;
  *  - FR_LIGHT_ENV: the environment; its parameters are in fr_world.
  * Distant lights (sun, environment) come first in the table, so escaping
- * rays test only them.  The pick probabilities follow the lights' power. */
+ * rays test only them.  The pick probabilities follow the lights' power:
+ * the table that paths starting on a light (bidirectional methods) and
+ * equiangular sampling in media use, where no point of the scene is known;
+ * next-event estimation from a point uses the light tree (fr_light_node)
+ * for the local lights and these picks for the distant ones. */
 enum { FR_LIGHT_POINT = 0, FR_LIGHT_PRIM = 1, FR_LIGHT_SPOT = 2, FR_LIGHT_SUN = 3, FR_LIGHT_ENV = 4, FR_LIGHT_KINDS };
 typedef struct {
     uint32_t kind;             /**< FR_LIGHT_* */
@@ -236,9 +240,31 @@ typedef struct {
     float area;                /**< FR_LIGHT_PRIM: surface area */
     float cone_cos;            /**< SPOT: cosine of the outer cone angle; SUN: cosine of the disk's half-angle */
     float cone_aux;            /**< SPOT: cosine of the inner cone angle; SUN: 1 - cone_cos */
-    float pick;                /**< probability of picking this light (sums to 1) */
+    float pick;                /**< power table: probability of picking this light (sums to 1) */
     float cdf;                 /**< sum of pick over lights[0..this], for binary search */
 } fr_light;
+
+/** A node of the light tree (Conty Estevez & Kulla 2018): a binary tree
+ * over the local lights (every light but the sun and the environment) that
+ * bounds, for the lights under it, their points (box lo..hi), the normals
+ * they emit around (the cone of unit `axis` with cosine of its half-angle
+ * `cos_o`; -1: every direction), how far beyond those normals they emit
+ * (`cos_e`: the cosine of that spread, 0 for a hemisphere) and their total
+ * power.  Light nd + j (nd: the number of distant lights) is leaf node j;
+ * inner nodes follow the leaves, each after its two children, and the
+ * root is the last node.  light.c walks it to pick a light by an importance
+ * that each point of the scene gives each node. */
+enum { FR_LNODE_TWO_SIDED = 1 };
+typedef struct {
+    vec3 lo, hi;               /**< bounds of the lights' points */
+    vec3 axis;                 /**< unit axis of the normals' cone */
+    float cos_o;               /**< cosine of the normals' cone half-angle, in [-1, 1] */
+    float cos_e;               /**< cosine of the emission's spread about any of those normals, in [-1, 1] */
+    float power;               /**< the lights' power (the power table's estimate), >= 0 */
+    uint32_t child[2];         /**< inner node: its children (below its own index); leaf: FR_NONE */
+    uint32_t parent;           /**< FR_NONE for the root, else above its own index */
+    uint32_t flags;            /**< FR_LNODE_TWO_SIDED: the lights emit about -axis too */
+} fr_light_node;
 
 /** What surrounds the scene: its bounding sphere (distant lights enter
  * through it) and the environment light.  The environment is a constant
@@ -362,6 +388,7 @@ typedef struct {
     const fr_instance *instances; uint32_t n_instances;
     const fr_bvh_node *mesh_nodes; uint32_t n_mesh_nodes;
     const fr_bvh_leaf *mesh_leaves; uint32_t n_mesh_leaves;
+    const fr_light_node *light_nodes; uint32_t n_light_nodes;
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

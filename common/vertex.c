@@ -59,9 +59,10 @@ static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, f
         !med_equiangular(ray->o, ray->d, tmax, c, u, &t, &pe))
         return v3s(0.0f);
     /* The same light and point, now seen from the scattering point: its
-     * direction, distance, radiance and solid-angle pdf there. */
+     * direction, distance, radiance and solid-angle pdf there, with the
+     * power table's pick (the light was picked before the point was known). */
     x = v3_madd(ray->o, ray->d, t);
-    if (!lgt_sample(s, x, upick, ul1, ul2, &ls))
+    if (!lgt_sample_table(s, x, upick, ul1, ul2, &ls))
         return v3s(0.0f);
     fr_ray shadow = {x, ls.wi};
     vec3 tr = med_shadow(s, medium, &shadow, ls.dist, ls.prim);
@@ -69,16 +70,18 @@ static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, f
         return v3s(0.0f);
     float pd = med_distance_pdf(md, beta, t), ph = med_phase(md->g, v3_dot(ray->d, ls.wi));
     /* Densities of the (distance, light point) pair, each technique's
-     * pdf of the point in solid angle at x: equiangular pe * pl, the
-     * vertex's light sample pd * pl, its phase sample pd * ph. */
-    float w = ls.delta ? vtx_power_heuristic(pe, pd)
-                       : vtx_power_heuristic3(pe * ls.pdf, pd * ls.pdf, mis.area ? pd * ph : 0.0f);
+     * pdf of the point in solid angle at x: equiangular pe * pl (the
+     * table's pick), the vertex's light sample pd * pl' (the tree's pick
+     * from x), its phase sample pd * ph. */
+    float pl_tree = ls.pdf / ls.pick * lgt_pick_pdf(s, ls.light, x, v3s(0.0f));
+    float w = ls.delta ? vtx_power_heuristic(pe * ls.pdf, pd * pl_tree)
+                       : vtx_power_heuristic3(pe * ls.pdf, pd * pl_tree, mis.area ? pd * ph : 0.0f);
     vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, ls.radiance));
     return v3_scale(v3_mul(beta, f), w * ph / (pe * ls.pdf));
 }
 
 float vtx_medium_hit_weight(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vtx_mis mis, uint32_t light,
-                            vec3 p, float phase_pdf, float light_pdf)
+                            vec3 p, float phase_pdf, float light_pdf, float light_pdf_table)
 {
     float pe = 0.0f;
     if (mis.equiangular && lgt_has_fixed_point(s, light))
@@ -86,7 +89,7 @@ float vtx_medium_hit_weight(const fr_scene *s, const vtx_vertex *v, uint32_t med
     if (pe == 0.0f)
         return vtx_power_heuristic(phase_pdf, light_pdf);
     float pd = med_distance_pdf(&s->media[medium - 1], v->seg_beta, v->t);
-    return vtx_power_heuristic3(pd * phase_pdf, pd * light_pdf, pe * light_pdf);
+    return vtx_power_heuristic3(pd * phase_pdf, pd * light_pdf, pe * light_pdf_table);
 }
 
 int vtx_next(const fr_scene *s, fr_sampler *smp, fr_ray *ray, uint32_t *medium, vec3 *beta, vtx_mis mis,
@@ -157,10 +160,11 @@ static inline vec3 origin(const vtx_origin *org, const fr_surface *sf, vec3 dir)
 }
 
 int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, uint32_t medium,
-                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, const vtx_origin *org, vtx_direct *out)
+                       vec3 beta, vtx_mis mis, uint32_t light, float pick, float u1, float u2, const vtx_origin *org,
+                       vtx_direct *out)
 {
     fr_light_sample *ls = &out->ls;
-    if (!bsdf_has_smooth(m) || !lgt_sample(s, sf->p, upick, u1, u2, ls))
+    if (light == FR_NONE || !bsdf_has_smooth(m) || !lgt_sample_chosen(s, light, pick, sf->p, u1, u2, ls))
         return 0;
     vec3 f = bsdf_eval(m, sf, wo, ls->wi, &out->scatter_pdf);
     if (v3_is_zero(f))
@@ -178,11 +182,11 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
     return 1;
 }
 
-int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, float upick,
-                      float u1, float u2, vtx_direct *out)
+int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, uint32_t light,
+                      float pick, float u1, float u2, vtx_direct *out)
 {
     fr_light_sample *ls = &out->ls;
-    if (!lgt_sample(s, v->p, upick, u1, u2, ls))
+    if (light == FR_NONE || !lgt_sample_chosen(s, light, pick, v->p, u1, u2, ls))
         return 0;
     const fr_medium *md = &s->media[medium - 1];
     fr_ray shadow = {v->p, ls->wi};
@@ -193,11 +197,13 @@ int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, v
     float pe = 0.0f;
     if (mis.equiangular && lgt_has_fixed_point(s, ls->light))
         pe = med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, ls->p, v->t);
+    /* Equiangular sampling picks its light by the power table. */
+    float pl_table = pe > 0.0f ? ls->pdf / ls->pick * s->lights[ls->light].pick : 0.0f;
     if (ls->delta && pe > 0.0f)
-        out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t), pe);
+        out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t) * ls->pdf, pe * pl_table);
     else if (!ls->delta && pe > 0.0f) {
         float pd = med_distance_pdf(md, v->seg_beta, v->t);
-        out->weight = vtx_power_heuristic3(pd * ls->pdf, mis.area ? pd * ph : 0.0f, pe * ls->pdf);
+        out->weight = vtx_power_heuristic3(pd * ls->pdf, mis.area ? pd * ph : 0.0f, pe * pl_table);
     } else if (!ls->delta && mis.area)
         out->weight = vtx_power_heuristic(ls->pdf, ph);
     out->L = v3_scale(v3_mul(beta, v3_mul(tr, ls->radiance)), out->weight * ph / ls->pdf);

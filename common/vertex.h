@@ -95,14 +95,16 @@ typedef struct {
 } vtx_direct;
 
 /** Next-event estimation at surface vertex sf, of material m (as textured
- * there), seen along wo, reached through `medium`: samples a light with
- * (upick, u1, u2), evaluates the BSDF and traces the shadow ray (through
+ * there), seen along wo, reached through `medium`: samples a point on
+ * light `light` (picked from sf->p by lgt_choose with probability pick;
+ * FR_NONE: none) with (u1, u2), evaluates the BSDF and traces the shadow ray (through
  * media and their interfaces when the scene has media), leaving from *org
  * (vtx_origin_at) when it is on that side.  Returns 1 with *out filled when the sample brings light,
  * 0 when it brings none (no smooth lobe, no light sample, a zero BSDF, a
  * blocked shadow ray). */
 int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface *sf, vec3 wo, uint32_t medium,
-                       vec3 beta, vtx_mis mis, float upick, float u1, float u2, const vtx_origin *org, vtx_direct *out);
+                       vec3 beta, vtx_mis mis, uint32_t light, float pick, float u1, float u2, const vtx_origin *org,
+                       vtx_direct *out);
 
 /** Next-event estimation at medium vertex v (in `medium`), as
  * vtx_direct_surface with the phase function for the BSDF.  When
@@ -110,17 +112,18 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
  * weighted against the equiangular sampling of v's segment as well (and
  * an area light against the phase sample when mis.area).  Returns 1 when a light was sampled (out->L may still
  * be 0: blocked), 0 when none was. */
-int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, float upick,
-                      float u1, float u2, vtx_direct *out);
+int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vec3 beta, vtx_mis mis, uint32_t light,
+                      float pick, float u1, float u2, vtx_direct *out);
 
 /** The MIS weight of light from area light `light`, at its point p, that
  * a path found by sampling the phase function at medium vertex v (in
  * `medium`) with solid-angle pdf phase_pdf, where light sampling from v
- * has pdf light_pdf: against light sampling alone, or with
+ * has pdf light_pdf (lgt_pdf) and light_pdf_table with the power table's
+ * pick (lgt_pdf_table, which equiangular sampling picks by): against light sampling alone, or with
  * mis.equiangular and a light that equiangular sampling covers, against
  * both light sampling and equiangular sampling of v's segment toward p. */
 float vtx_medium_hit_weight(const fr_scene *s, const vtx_vertex *v, uint32_t medium, vtx_mis mis, uint32_t light,
-                            vec3 p, float phase_pdf, float light_pdf);
+                            vec3 p, float phase_pdf, float light_pdf, float light_pdf_table);
 
 /** Scatter onward from medium vertex v (in `medium`): *next leaves v->p in
  * a direction sampled from the phase function with (u1, u2); *pdf is its

@@ -593,6 +593,29 @@ static void test_texture_sizes(void)
     scn_free(&ts);
 }
 
+/* The light tree (section 22): each rule of FORMAT.md refuses a file that
+ * breaks it, at the field at fault. */
+static void test_light_tree(void)
+{
+    const unsigned char *g = good.blob;
+    size_t t = section(g, 22);
+    uint32_t n = good.n_light_nodes, root = n - 1;
+    CHECK(n >= 1, "test scene: %u light tree nodes", n);
+    if (n < 1)
+        return;
+    float two = 2.0f, neg = -1.0f;
+    uint32_t u;
+    memcpy(&u, &two, 4);
+    poke_at("light node cone cosine above 1", t + 36, u, "section lighttree", t);
+    memcpy(&u, &neg, 4);
+    poke_at("light node negative power", t + 44, u, "section lighttree", t);
+    poke_at("light node unknown flag", t + 60, 2, "section lighttree", t);
+    poke_at("leaf with a child", t + 48, 0, "section lighttree", t + 48);
+    poke_at("root with a parent", t + 64 * root + 56, 0, "section lighttree", t + 64 * root + 56);
+    if (n >= 3)
+        poke_at("leaf's parent a leaf", t + 56, 1, "section lighttree", t + 56);
+}
+
 int main(void)
 {
     test_scene(scene_json, &good);
@@ -604,6 +627,7 @@ int main(void)
     test_shapes();
     test_texture_sizes();
     test_lights();
+    test_light_tree();
     scn_free(&good);
     return check_done();
 }

@@ -83,13 +83,14 @@ static void point_light(void)
           (double)v.sf.p.y);
     CHECK(smp.dim == 0, "no media: no sampler dimension drawn (%u)", smp.dim);
 
-    /* L = beta * (albedo / pi) * I cos / d^2, pdf 1 (the only light). */
+    /* L = beta * (albedo / pi) * I cos / d^2, pdf 1 (the only light: light
+     * 0, picked with probability 1, as lgt_choose picks it). */
     vtx_direct d;
     vtx_mis mis = {1, 1};
     vec3 beta = v3(1.0f, 0.5f, 0.25f);
     const fr_material *m = &s.materials[v.sf.material];
     vtx_origin org = vtx_origin_at(&v.sf, v3(0, 1, 0));
-    int got = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &org, &d);
+    int got = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0, 1.0f, 0.6f, 0.2f, &org, &d);
     float d2 = 0.25f + 4.0f, cosv = 2.0f / sqrtf(d2), want = 0.5f / FM_PI * 4.0f / d2 * cosv;
     CHECK(got == 1, "point light sampled");
     CHECK(d.ls.delta && d.weight == 1.0f, "a point light sample is not weighted (%g)", (double)d.weight);
@@ -99,7 +100,7 @@ static void point_light(void)
           (double)d.scatter_pdf, (double)(cosv / FM_PI));
     /* Seen from below the floor the Lambert lobe faces away: no light. */
     org = vtx_origin_at(&v.sf, v3(0, -1, 0));
-    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, -1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &org, &d) == 0,
+    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, -1, 0), 0, beta, mis, 0, 1.0f, 0.6f, 0.2f, &org, &d) == 0,
           "no light through the back of the floor");
     scn_free(&s);
 
@@ -108,7 +109,7 @@ static void point_light(void)
     CHECK(kind == VTX_SURFACE, "blocked scene: floor below");
     m = &s.materials[v.sf.material];
     org = vtx_origin_at(&v.sf, v3(0, 1, 0));
-    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.3f, 0.6f, 0.2f, &org, &d) == 0,
+    CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0, 1.0f, 0.6f, 0.2f, &org, &d) == 0,
           "a ball between the floor and the light blocks it");
     fr_ray up = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, 1.0f, 0.0f)};
     uint32_t medium = 0;
@@ -128,8 +129,8 @@ static void area_light(void)
     vtx_mis mis = {1, 1}, off = {0, 1};
     vec3 beta = v3s(1.0f);
     vtx_origin org = vtx_origin_at(&v.sf, v3(0, 1, 0));
-    int ga = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0.5f, 0.3f, 0.7f, &org, &a);
-    int gb = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, off, 0.5f, 0.3f, 0.7f, &org, &b);
+    int ga = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0, 1.0f, 0.3f, 0.7f, &org, &a);
+    int gb = vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, off, 0, 1.0f, 0.3f, 0.7f, &org, &b);
     CHECK(ga && gb && !a.ls.delta, "panel sampled");
     CHECK(b.weight == 1.0f, "not weighed: weight %g", (double)b.weight);
     CHECK(a.weight == vtx_power_heuristic(a.ls.pdf, a.scatter_pdf) && a.weight > 0.0f && a.weight < 1.0f,
@@ -204,7 +205,7 @@ static void media(void)
               "sample %u: phase sample from the vertex, pdf %g", i, (double)pdf);
         vtx_direct d;
         vtx_mis mis = {1, 1};
-        if (vtx_direct_medium(&s, &v1, m1, b1, mis, 0.5f, 0.5f, 0.5f, &d)) {
+        if (vtx_direct_medium(&s, &v1, m1, b1, mis, 0, 1.0f, 0.5f, 0.5f, &d)) {
             float want = vtx_power_heuristic(med_distance_pdf(&s.media[0], v1.seg_beta, v1.t),
                                              med_equiangular_pdf(v1.seg.o, v1.seg.d, v1.seg_tmax, d.ls.p, v1.t));
             CHECK(d.ls.delta && d.weight == want, "sample %u: point light weighed against equiangular (%g, %g)", i,

@@ -30,6 +30,7 @@ void bld_init(fr_builder *b)
     array_init(&b->distrib, sizeof(float));
     array_init(&b->meshes, sizeof(bld_mesh));
     array_init(&b->instances, sizeof(fr_instance));
+    array_init(&b->light_nodes, sizeof(fr_light_node));
     b->world.env_light = b->world.env_texture = FR_NONE;
     b->world.rot_cos = 1.0f;
 }
@@ -38,7 +39,8 @@ void bld_free(fr_builder *b)
 {
     fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
                        &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
-                       &b->textures, &b->texels, &b->media, &b->distrib, &b->meshes, &b->instances};
+                       &b->textures, &b->texels, &b->media, &b->distrib, &b->meshes, &b->instances,
+                       &b->light_nodes};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->data);
     memset(b, 0, sizeof *b);

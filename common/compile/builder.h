@@ -51,6 +51,8 @@ typedef struct {
     void (*warn)(void *user, const char *msg); /**< where readers of the scene's files report warnings
                                                     (scene_hooks.h); NULL: nowhere */
     void *warn_user;           /**< passed back to warn */
+    fr_array light_nodes;      /**< fr_light_node: the light tree, built by frz_scene */
+    int no_light_tree;         /**< 1: no light tree, next-event estimation picks by the power table alone */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero, no

@@ -118,6 +118,7 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
     VIEW(distrib, b->distrib);
     VIEW(meshes, table); VIEW(instances, b->instances);
     VIEW(mesh_nodes, mnodes); VIEW(mesh_leaves, mleaves);
+    VIEW(light_nodes, b->light_nodes);
 #undef VIEW
     void *blob = NULL;
     size_t size = 0;

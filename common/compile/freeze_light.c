@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compile/freeze_lighttree.h"
 #include "fmath.h"
 #include "compile/builder_instance.h"
 #include "texture.h"
@@ -322,6 +323,8 @@ int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
         lights[i].pick = (float)p > 0.0f ? (float)p : 1e-30f;
         lights[i].cdf = i + 1 == b->lights.count ? 1.0f : (float)acc;
     }
+    b->light_nodes.count = 0;
+    int rc2 = b->no_light_tree ? 0 : frz_light_tree(b, power, err);
     free(power);
-    return 0;
+    return rc2;
 }

@@ -41,10 +41,11 @@ static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
 static int parse_image(ctx *c, const cJSON *o)
 {
     static const char *const fields[] = {"width", "height", "spp", "max_depth", "seed", "integrator",
-                                         "noise_threshold", NULL};
+                                         "noise_threshold", "light_sampling", NULL};
     static const char *const integrators[] = {"path", "bdpt", NULL};
+    static const char *const light_samplings[] = {"tree", "power", NULL};
     fr_settings *s = &c->b->settings;
-    int integrator;
+    int integrator, light_sampling;
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "image: missing or not an object");
     if (jv_only_fields(o, "image", fields, c->err) < 0 ||
@@ -54,9 +55,11 @@ static int parse_image(ctx *c, const cJSON *o)
         jv_uint(o, "max_depth", "image", 0, 8, 0, PROTO_MAX_DEPTH, &s->max_depth, c->err) < 0 ||
         jv_uint(o, "seed", "image", 0, 0, 0, 0xffffffffu, &s->seed, c->err) < 0 ||
         jv_choice(o, "integrator", "image", integrators, FR_INTEGRATOR_PATH, &integrator, c->err) < 0 ||
-        jv_number(o, "noise_threshold", "image", 0, 0.0f, &s->noise_threshold, c->err) < 0)
+        jv_number(o, "noise_threshold", "image", 0, 0.0f, &s->noise_threshold, c->err) < 0 ||
+        jv_choice(o, "light_sampling", "image", light_samplings, 0, &light_sampling, c->err) < 0)
         return -1;
     s->integrator = (uint32_t)integrator;
+    c->b->no_light_tree = light_sampling == 1;
     if (!(s->noise_threshold >= 0.0f && s->noise_threshold <= 1.0f))
         return fr_fail(c->err, "image.noise_threshold: expected a number in [0, 1] (0: off), got %g",
                        (double)s->noise_threshold);
