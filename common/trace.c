@@ -207,6 +207,7 @@ static inline void no_uv(fr_surface *out)
 static inline __attribute__((always_inline)) void surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit,
                                                           fr_surface *out, int uv)
 {
+    out->footprint = 0.0f;
     if (hit->prim == FR_NONE) {
         const fr_plane *pl = &s->planes[hit->plane];
         out->p = geo_plane_point(pl, r, hit->t, &out->perr);

@@ -22,7 +22,7 @@ void bld_init(fr_builder *b)
     array_init(&b->planes, sizeof(fr_plane));
     array_init(&b->lights, sizeof(fr_light));
     array_init(&b->textures, sizeof(fr_texture));
-    array_init(&b->texels, sizeof(float));
+    array_init(&b->texels, sizeof(uint32_t));
     array_init(&b->media, sizeof(fr_medium));
     array_init(&b->distrib, sizeof(float));
     b->world.env_light = b->world.env_texture = FR_NONE;
