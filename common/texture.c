@@ -62,7 +62,7 @@ float tex_half_to_float(uint16_t h)
     return v;
 }
 
-uint32_t tex_format_bytes(uint32_t format)
+static inline uint32_t format_bytes(uint32_t format)
 {
     switch (format) {
     case FR_TEXEL_U8_SRGB: case FR_TEXEL_U8: return 1;
@@ -70,6 +70,8 @@ uint32_t tex_format_bytes(uint32_t format)
     default: return 4;
     }
 }
+
+uint32_t tex_format_bytes(uint32_t format) { return format_bytes(format); }
 
 void tex_level_size(const fr_texture *t, uint32_t level, uint32_t *w, uint32_t *h)
 {
@@ -103,40 +105,59 @@ static inline float decode(uint32_t format, const unsigned char *p, uint32_t c)
     }
 }
 
+/* Texel i (row-major) of a level starting at byte lv: channels into out. */
+static inline __attribute__((always_inline)) void fetch(const unsigned char *lv, uint32_t format, uint32_t n,
+                                                        size_t i, float out[3])
+{
+    const unsigned char *p = lv + i * n * format_bytes(format);
+    switch (format) {
+    case FR_TEXEL_U8_SRGB:
+        for (uint32_t c = 0; c < n; c++)
+            out[c] = srgb8[p[c]];
+        break;
+    case FR_TEXEL_U8:
+        for (uint32_t c = 0; c < n; c++)
+            out[c] = (float)p[c] / 255.0f;
+        break;
+    default:
+        for (uint32_t c = 0; c < n; c++)
+            out[c] = decode(format, p, c);
+    }
+}
+
 void tex_texel(const uint32_t *texels, const fr_texture *t, uint32_t level, uint32_t x, uint32_t y, float out[3])
 {
-    uint32_t w, h, n = t->channels, bytes = tex_format_bytes(t->format);
+    uint32_t w, h;
     tex_level_size(t, level, &w, &h);
-    const unsigned char *p = (const unsigned char *)(texels + t->first[level]) + ((size_t)y * w + x) * n * bytes;
-    for (uint32_t c = 0; c < n; c++)
-        out[c] = decode(t->format, p, c);
+    fetch((const unsigned char *)(texels + t->first[level]), t->format, t->channels, (size_t)y * w + x, out);
 }
 
 /* Image lookup of level `level` at texture-space (u, v), channels into
  * out[0..channels). */
 static void level_eval(const fr_scene *s, const fr_texture *t, uint32_t level, float u, float v, float out[3])
 {
-    uint32_t n = t->channels, w, h;
+    uint32_t n = t->channels, w, h, f = t->format;
     tex_level_size(t, level, &w, &h);
+    const unsigned char *lv = (const unsigned char *)(s->texels + t->first[level]);
     /* Pixel space: x right, y down from the top row; texel centres at +0.5. */
     float x = wrap_coord(u, t->wrap) * (float)w;
     float y = (1.0f - wrap_coord(v, t->wrap)) * (float)h;
     if (t->filter == FR_FILTER_NEAREST) {
-        tex_texel(s->texels, t, level, wrap_index((long)floorf(x), w, FR_WRAP_CLAMP),
-                  wrap_index((long)floorf(y), h, FR_WRAP_CLAMP), out);
+        fetch(lv, f, n, (size_t)wrap_index((long)floorf(y), h, FR_WRAP_CLAMP) * w +
+                            wrap_index((long)floorf(x), w, FR_WRAP_CLAMP), out);
         return;
     }
     x -= 0.5f;
     y -= 0.5f;
     float x0f = floorf(x), y0f = floorf(y), fx = x - x0f, fy = y - y0f;
     long x0 = (long)x0f, y0 = (long)y0f;
-    uint32_t xa = wrap_index(x0, w, t->wrap), xb = wrap_index(x0 + 1, w, t->wrap);
-    uint32_t ya = wrap_index(y0, h, t->wrap), yb = wrap_index(y0 + 1, h, t->wrap);
+    size_t xa = wrap_index(x0, w, t->wrap), xb = wrap_index(x0 + 1, w, t->wrap);
+    size_t ya = (size_t)wrap_index(y0, h, t->wrap) * w, yb = (size_t)wrap_index(y0 + 1, h, t->wrap) * w;
     float p00[3], p10[3], p01[3], p11[3];
-    tex_texel(s->texels, t, level, xa, ya, p00);
-    tex_texel(s->texels, t, level, xb, ya, p10);
-    tex_texel(s->texels, t, level, xa, yb, p01);
-    tex_texel(s->texels, t, level, xb, yb, p11);
+    fetch(lv, f, n, ya + xa, p00);
+    fetch(lv, f, n, ya + xb, p10);
+    fetch(lv, f, n, yb + xa, p01);
+    fetch(lv, f, n, yb + xb, p11);
     for (uint32_t c = 0; c < n; c++)
         out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
 }
