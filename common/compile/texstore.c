@@ -1,6 +1,7 @@
 #include "compile/texstore.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -65,11 +66,37 @@ static uint32_t srgb_nearest(double v, uint32_t maxcode)
     return (uint32_t)best;
 }
 
+/* Midpoints between the decoded values of consecutive 8-bit sRGB codes:
+ * the nearest code to v is the number of midpoints below v (a tie, v on a
+ * midpoint, goes to the lower code). */
+static double srgb8_mid[255];
+static pthread_once_t srgb8_once = PTHREAD_ONCE_INIT;
+
+static void srgb8_init(void)
+{
+    for (uint32_t k = 0; k < 255; k++)
+        srgb8_mid[k] = 0.5 * (srgb_decoded(k, 255) + srgb_decoded(k + 1, 255));
+}
+
+static uint32_t srgb8_nearest(double v)
+{
+    pthread_once(&srgb8_once, srgb8_init);
+    uint32_t lo = 0, hi = 255;          /* the answer is in [lo, hi] */
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;   /* is srgb8_mid[mid] (between mid and mid + 1) below v? */
+        if (srgb8_mid[mid] < v)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 uint32_t texstore_encode(uint32_t format, double v)
 {
     switch (format) {
     case FR_TEXEL_U8_SRGB:
-        return srgb_nearest(v, 255);
+        return v != v ? 0 : srgb8_nearest(v);
     case FR_TEXEL_U16_SRGB:
         return srgb_nearest(v, 65535);
     case FR_TEXEL_U8:
