@@ -28,7 +28,8 @@ float cam_lens_area(const fr_camera *c)
 
 float cam_pixel_spread(const fr_scene *s)
 {
-    return 2.0f * s->camera.tan_half / (float)s->settings.height;
+    float share = 1.0f / sqrtf((float)s->settings.spp);
+    return 2.0f * s->camera.tan_half / (float)s->settings.height * (share > 0.125f ? share : 0.125f);
 }
 
 float cam_footprint(float width, vec3 ng, vec3 d)

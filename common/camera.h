@@ -45,10 +45,13 @@ float cam_importance(const fr_scene *s, vec3 o, vec3 w, float *pdf_dir, float *r
 
 /** The ray cone of a camera ray (Akenine-Moller et al. 2019, "Texture
  * Level of Detail Strategies for Real-Time Ray Tracing"): the angle one
- * pixel spans at the image's centre, 2 tan(vfov / 2) / height, radians.
- * A ray's cone is this angle times the distance it travelled (through
- * perfect mirrors and glass, whose flat-surface approximation keeps the
- * angle); a thin lens's aperture is not counted. */
+ * pixel spans at the image's centre, 2 tan(vfov / 2) / height, radians,
+ * times max(1/8, 1/sqrt(spp)) as pbrt-v4 scales its ray differentials:
+ * the pixel is already averaged over its spp samples, so each sample
+ * need only filter its share of it.  A ray's cone is this angle times the
+ * distance it travelled (through perfect mirrors and glass, whose
+ * flat-surface approximation keeps the angle); a thin lens's aperture is
+ * not counted. */
 float cam_pixel_spread(const fr_scene *s);
 
 /** The footprint on a surface (fr_surface.footprint) of a cone `width`

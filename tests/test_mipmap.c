@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "camera.h"
 #include "check.h"
 #include "pathtrace.h"
 #include "texture.h"
@@ -322,6 +323,22 @@ static void lod(void)
     ((fr_texture *)b.textures.data)[t].scale = (vec2){2, 2};
     sf.footprint = 2.0f * 4.0f / 256.0f;
     CHECK(fabsf(tex_lod(&s, t, &sf) - 3.0f) < 1e-5f, "scale 2: level %g, expected 3", tex_lod(&s, t, &sf));
+    /* The camera's cone: a pixel's angle times max(1/8, 1/sqrt(spp)). */
+    fr_scene cs;
+    memset(&cs, 0, sizeof cs);
+    cs.camera.tan_half = 0.5f;
+    cs.settings.height = 100;
+    cs.settings.spp = 1;
+    CHECK(cam_pixel_spread(&cs) == 0.01f, "1 spp: the pixel's angle, %g", cam_pixel_spread(&cs));
+    cs.settings.spp = 16;
+    CHECK(cam_pixel_spread(&cs) == 0.0025f, "16 spp: a quarter of it, %g", cam_pixel_spread(&cs));
+    cs.settings.spp = 4096;
+    CHECK(cam_pixel_spread(&cs) == 0.00125f, "4096 spp: an eighth, %g", cam_pixel_spread(&cs));
+    /* Head-on, a cone 2 units wide; at 60 degrees, as wide as a disk of
+     * its elliptical section's area. */
+    CHECK(cam_footprint(2.0f, v3(0, 0, 1), v3(0, 0, -1)) == 2.0f, "head-on footprint");
+    CHECK(fabsf(cam_footprint(2.0f, v3(0, 0, 1), v3(0, 0.8660254f, -0.5f)) - 2.0f / sqrtf(0.5f)) < 1e-6f,
+          "footprint at 60 degrees");
     bld_free(&b);
 }
 
