@@ -184,6 +184,24 @@ static uint32_t nearest_srgb8(double v)
     return best;
 }
 
+/* The nearest code of the 16-bit sRGB format to v, by trying a window of
+ * codes around the curve's inverse (wide enough for any rounding). */
+static uint32_t nearest_srgb16(double v)
+{
+    double e = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+    long g = lround(e * 65535.0);
+    uint32_t best = 0;
+    double bd = INFINITY;
+    for (long k = g - 8; k <= g + 8; k++) {
+        if (k < 0 || k > 65535)
+            continue;
+        double d = fabs((double)tex_srgb_to_linear((float)k / 65535.0f) - v);
+        if (d < bd)
+            best = (uint32_t)k, bd = d;
+    }
+    return best;
+}
+
 /* Checks every level of texture t against the rule, recomputed here. */
 static void check_levels(const fr_scene *s, uint32_t t, const char *what)
 {
@@ -231,6 +249,12 @@ static void check_levels(const fr_scene *s, uint32_t t, const char *what)
                     case FR_TEXEL_U8_SRGB:
                         want = tex_srgb_to_linear((float)nearest_srgb8(mean) / 255.0f);
                         break;
+                    case FR_TEXEL_U16_SRGB:
+                        want = tex_srgb_to_linear((float)nearest_srgb16(mean) / 65535.0f);
+                        break;
+                    case FR_TEXEL_F32:
+                        want = (float)mean;
+                        break;
                     default: {
                         /* Halves: the stored one, and no neighbour nearer the mean. */
                         uint16_t hb = (uint16_t)texstore_encode(FR_TEXEL_F16, mean);
@@ -265,7 +289,12 @@ static void mip_levels(void)
     uint32_t c = store(&b, u8, SCENE_PIX_U8, 64, 64, 1, 0);
     uint32_t d = store(&b, u16, SCENE_PIX_U16, 37, 20, 3, 0);
     uint32_t e = store(&b, f16, SCENE_PIX_F16, 31, 1, 3, 0);
-    if (a == FR_NONE || c == FR_NONE || d == FR_NONE || e == FR_NONE) {
+    uint32_t g = store(&b, u16, SCENE_PIX_U16, 9, 6, 3, 1);
+    static float fl[11 * 5];
+    for (int i = 0; i < 11 * 5; i++)
+        fl[i] = (float)(mix((uint32_t)i + 3u) % 1000u) * 100.0f;   /* up to 99900: floats */
+    uint32_t h = store(&b, fl, SCENE_PIX_F32, 11, 5, 1, 0);
+    if (a == FR_NONE || c == FR_NONE || d == FR_NONE || e == FR_NONE || g == FR_NONE || h == FR_NONE) {
         bld_free(&b);
         return;
     }
@@ -274,6 +303,10 @@ static void mip_levels(void)
     check_levels(&s, c, "64x64 grey bytes");
     check_levels(&s, d, "37x20 RGB 16-bit");
     check_levels(&s, e, "31x1 RGB halves");
+    CHECK(s.textures[g].format == FR_TEXEL_U16_SRGB && s.textures[h].format == FR_TEXEL_F32,
+          "16-bit sRGB and float formats: %u %u", s.textures[g].format, s.textures[h].format);
+    check_levels(&s, g, "9x6 RGB 16-bit sRGB");
+    check_levels(&s, h, "11x5 grey floats");
     /* A constant image stays exactly constant all the way down. */
     static uint8_t flat[40 * 24];
     memset(flat, 200, sizeof flat);
