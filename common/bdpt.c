@@ -316,6 +316,9 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
      * of the direction it left by (the comment on vert). */
     int anchor = 0;
     float anchor_pdf = pdf_dir;
+    /* A camera subpath's ray cone for textures' mip levels, as the path
+     * tracer's (pathtrace.c): its angle until a non-delta bounce, its width. */
+    float spread = importance ? 0.0f : cam_pixel_spread(s), cone = 0.0f;
     for (uint32_t depth = 0; n < maxv; depth++) {
         fr_hit hit;
         vert *v = &path[n], *prev = &path[n - 1];
@@ -336,6 +339,10 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
             break;
         }
         trace_surface(s, &ray, &hit, &v->sf);
+        if (spread > 0.0f) {
+            cone += spread * hit.t;
+            v->sf.footprint = cam_footprint(cone, v->sf.ng, ray.d);
+        }
         v->m = *tex_material(s, &s->materials[v->sf.material], &v->sf, &v->m);
         v->type = BD_SURFACE;
         v->delta = v->delta_light = v->distant = 0;
@@ -391,6 +398,8 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
         beta = v3_mul(beta, weight);
         v->delta = delta_in = bs.delta;
         pdf_dir = bs.pdf;
+        if (!bs.delta)
+            spread = 0.0f;
         if (bs.delta) {
             prev->pdf_rev = 1.0f;
         } else {

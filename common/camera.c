@@ -29,6 +29,18 @@ float cam_lens_area(const fr_camera *c)
     return c->aperture > 0.0f ? FM_PI * c->aperture * c->aperture : 1.0f;
 }
 
+float cam_pixel_spread(const fr_scene *s)
+{
+    float share = 1.0f / sqrtf((float)s->settings.spp);
+    return 2.0f * s->camera.tan_half / (float)s->settings.height * (share > 0.125f ? share : 0.125f);
+}
+
+float cam_footprint(float width, vec3 ng, vec3 d)
+{
+    float c = fabsf(v3_dot(ng, d));
+    return c > 0.0f ? width / sqrtf(c) : 0.0f;
+}
+
 int cam_raster(const fr_scene *s, vec3 o, vec3 w, float *rx, float *ry)
 {
     const fr_camera *c = &s->camera;

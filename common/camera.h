@@ -43,4 +43,22 @@ int cam_raster(const fr_scene *s, vec3 o, vec3 w, float *rx, float *ry);
  * NULL and the ray lands inside, its raster position as cam_raster gives. */
 float cam_importance(const fr_scene *s, vec3 o, vec3 w, float *pdf_dir, float *rx, float *ry);
 
+/** The ray cone of a camera ray (Akenine-Moller et al. 2019, "Texture
+ * Level of Detail Strategies for Real-Time Ray Tracing"): the angle one
+ * pixel spans at the image's centre, 2 tan(vfov / 2) / height, radians,
+ * times max(1/8, 1/sqrt(spp)) as pbrt-v4 scales its ray differentials:
+ * the pixel is already averaged over its spp samples, so each sample
+ * need only filter its share of it.  A ray's cone is this angle times the
+ * distance it travelled (through perfect mirrors and glass, whose
+ * flat-surface approximation keeps the angle); a thin lens's aperture is
+ * not counted. */
+float cam_pixel_spread(const fr_scene *s);
+
+/** The footprint on a surface (fr_surface.footprint) of a cone `width`
+ * wide arriving along unit direction d at a surface of unit normal ng:
+ * width / sqrt|cos|, the width of the disk whose area is that of the
+ * cone's elliptical section (width across, width / |cos| along); 0 when
+ * the ray grazes the surface (cos = 0). */
+float cam_footprint(float width, vec3 ng, vec3 d);
+
 #endif

@@ -4,6 +4,7 @@
 #include "envmap.h"
 
 #include "fmath.h"
+#include "texture.h"
 
 /* 2 pi^2: the area of the unit square of (u, v) maps to the sphere with
  * density 2 pi^2 sin(theta). */
@@ -32,7 +33,8 @@ static vec3 texel(const fr_scene *s, const fr_texture *t, int64_t i, int64_t j)
     if (i < 0)
         i += w;
     j = j < 0 ? 0 : j >= h ? h - 1 : j;
-    const float *p = s->texels + t->first + (size_t)(j * w + i) * t->channels;
+    float p[3];
+    tex_texel(s->texels, t, 0, (uint32_t)i, (uint32_t)j, p);
     return t->channels == 3 ? v3(p[0], p[1], p[2]) : v3s(p[0]);
 }
 

@@ -7,6 +7,7 @@
 #include "file.h"
 #include "proto_limits.h"
 #include "scene_pages.h"
+#include "texture.h"
 
 #include <errno.h>
 #include <stdint.h>
@@ -59,7 +60,7 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_NODES, "nodes", nodes, fr_bvh_node),
     ARR(SEC_LEAVES, "leaves", leaves, fr_bvh_leaf),
     ARR(SEC_TEXTURES, "textures", textures, fr_texture),
-    ARR(SEC_TEXELS, "texels", texels, float),
+    ARR(SEC_TEXELS, "texels", texels, uint32_t),
     ARR(SEC_MEDIA, "media", media, fr_medium),
     [SEC_VOLUME] = {"volume", sizeof(fr_volume), offsetof(fr_scene, volume), 0},
     [SEC_TONEMAP] = {"tonemap", sizeof(fr_tonemap), offsetof(fr_scene, tonemap), 0},
@@ -155,21 +156,51 @@ static int validate_appearance(const fr_scene *s, const void *base, const uint64
         if (t->kind != FR_TEX_IMAGE)
             continue;
         if (t->width == 0 || t->height == 0 || t->width > FR_TEX_MAX_SIDE || t->height > FR_TEX_MAX_SIDE ||
-            (t->channels != 1 && t->channels != 3))
-            return fr_fail(err, "section textures, byte %zu: texture %u: image %ux%u with %u channels (at most "
-                           "%ux%u, 1 or 3 channels)", AT(t), i, t->width, t->height, t->channels, FR_TEX_MAX_SIDE,
-                           FR_TEX_MAX_SIDE);
-        /* width * height * channels <= the texels from `first` on, by
-         * division: no product that could wrap. */
-        uint32_t avail = t->first <= s->n_texels ? s->n_texels - t->first : 0;
-        if (t->first > s->n_texels || t->width > avail / t->channels / t->height)
-            return fr_fail(err, "section textures, byte %zu: texture %u: %ux%u image with %u channels does not fit "
-                           "in the %u texels from texel %u", AT(t), i, t->width, t->height, t->channels, avail,
-                           t->first);
+            (t->channels != 1 && t->channels != 3) || t->format >= FR_TEXEL_FORMATS)
+            return fr_fail(err, "section textures, byte %zu: texture %u: image %ux%u with %u channels of format %u "
+                           "(at most %ux%u, 1 or 3 channels, formats 0 to %u)", AT(t), i, t->width, t->height,
+                           t->channels, t->format, FR_TEX_MAX_SIDE, FR_TEX_MAX_SIDE, FR_TEXEL_FORMATS - 1);
+        uint32_t side = t->width > t->height ? t->width : t->height, chain = 1;
+        while (side >> chain)
+            chain++;
+        if (t->levels == 0 || t->levels > chain)
+            return fr_fail(err, "section textures, byte %zu: texture %u: %u mip levels (a %ux%u image has 1 to %u)",
+                           AT(t), i, t->levels, t->width, t->height, chain);
+        uint32_t bytes = tex_format_bytes(t->format);
+        for (uint32_t k = 0; k < FR_TEX_MAX_LEVELS; k++) {
+            if (k >= t->levels) {
+                if (t->first[k] != 0)
+                    return fr_fail(err, "section textures, byte %zu: texture %u: level %u is not stored but has "
+                                   "an offset", AT(t), i, k);
+                continue;
+            }
+            /* The level's words inside texels (64-bit sums: no wrap). */
+            uint32_t w, h;
+            tex_level_size(t, k, &w, &h);
+            uint64_t words = ((uint64_t)w * h * t->channels * bytes + 3) / 4;
+            if ((uint64_t)t->first[k] + words > s->n_texels)
+                return fr_fail(err, "section textures, byte %zu: texture %u: level %u (%ux%u, %u channels, format "
+                               "%u) does not fit in the %u words of texels from word %u", AT(t), i, k, w,
+                               h, t->channels, t->format, s->n_texels, t->first[k]);
+            /* Floating-point formats: every value finite. */
+            const unsigned char *p = (const unsigned char *)(s->texels + t->first[k]);
+            size_t nv = (size_t)w * h * t->channels;
+            if (t->format == FR_TEXEL_F32) {
+                for (size_t j = 0; j < nv; j++) {
+                    float f;
+                    memcpy(&f, p + 4 * j, 4);
+                    if (!isfinite(f))
+                        return fr_fail(err, "section texels, byte %zu: texture %u, level %u: value %zu is not a "
+                                       "finite number", AT(p + 4 * j), i, k, j);
+                }
+            } else if (t->format == FR_TEXEL_F16) {
+                for (size_t j = 0; j < nv; j++)
+                    if ((p[2 * j + 1] & 0x7c) == 0x7c)
+                        return fr_fail(err, "section texels, byte %zu: texture %u, level %u: value %zu is not a "
+                                       "finite number", AT(p + 2 * j), i, k, j);
+            }
+        }
     }
-    for (uint32_t i = 0; i < s->n_texels; i++)
-        if (!isfinite(s->texels[i]))
-            return fr_fail(err, "section texels, byte %zu: texel %u: not a finite number", AT(s->texels + i), i);
     for (uint32_t i = 0; i < s->n_media; i++) {
         const fr_medium *m = &s->media[i];
         if (!finite3(m->sigma_a) || !finite3(m->sigma_s) || v3_min(m->sigma_a) < 0.0f || v3_min(m->sigma_s) < 0.0f ||

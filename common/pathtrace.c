@@ -162,6 +162,10 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
     const uint32_t max_depth = s->settings.max_depth;
     vtx_mis mis = {strategy != PT_LIGHT_ONLY, strategy == PT_MIS || strategy == PT_LIGHT_ONLY};
     int light_sampling = strategy != PT_BSDF_ONLY;
+    /* The ray cone (camera.h) for textures' mip levels: its angle, until
+     * the path leaves a surface other than by a delta lobe (from then on,
+     * 0: textures at their finest level), and its width at prev_p. */
+    float spread = cam_pixel_spread(s), cone = 0.0f;
     for (uint32_t depth = 0;; depth++) {
         vtx_vertex v;
         int equi = mis.equiangular && depth < max_depth && s->n_lights;
@@ -177,6 +181,7 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
         uint32_t light;
         vtx_direct d;
         if (kind == VTX_MEDIUM) {
+            spread = 0.0f;
             if (depth >= max_depth)
                 break;
             light_numbers(s, v.p, v3s(0.0f), light_sampling, &smp, &light, &pick, &u1, &u2);
@@ -191,6 +196,10 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             prev_medium = medium;
         } else {
             fr_material textured;
+            if (spread > 0.0f) {
+                cone += spread * v3_len(v3_sub(v.sf.p, prev_p));
+                v.sf.footprint = cam_footprint(cone, v.sf.ng, ray.d);
+            }
             const fr_material *m = tex_material(s, &s->materials[v.sf.material], &v.sf, &textured);
             vec3 wo = v3_neg(ray.d);
             if (v.sf.light != FR_NONE)
@@ -213,6 +222,8 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             beta = v3_mul(beta, bs.weight);
             prev_pdf = bs.pdf;
             prev_delta = bs.delta;
+            if (!bs.delta)
+                spread = 0.0f;
             prev_p = v.sf.p;
             prev_n = v.sf.ns;
             prev_medium = 0;

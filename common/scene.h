@@ -127,25 +127,47 @@ typedef struct {
     uint32_t tex_transmission; /**< times transmission: a grey texture, or the R channel of an RGB one (glTF) */
 } fr_material;
 
-/** A texture: an image of decoded linear texels stored in the scene, or a
- * procedural checkerboard.  Lookups map the surface's UV through
- * uv * scale + offset; v grows upward, so v = 0 is the image's bottom row
- * (the OBJ convention). */
+/** A texture: an image stored in the scene at its own precision, with its
+ * mip-maps, or a procedural checkerboard.  Lookups map the surface's UV
+ * through uv * scale + offset; v grows upward, so v = 0 is the image's
+ * bottom row (the OBJ convention).
+ *
+ * An image's texels live in `texels` (32-bit words): mip level k has
+ * max(1, width >> k) x max(1, height >> k) texels, rows from the top, each
+ * texel `channels` values in `format`, the level starting at word
+ * first[k] (so every level is 4-byte aligned; its last word is padded with
+ * zero bytes).  Level k's texel (x, y) is the mean, in linear values, of
+ * the texels (2x..2x+1, 2y..2y+1) of level k - 1, the last column (row)
+ * also taking the odd one left over, rounded to the nearest value of the
+ * format (compile/texstore.h: texstore_encode). */
 enum { FR_TEX_IMAGE = 0, FR_TEX_CHECKER = 1 };
 /** The largest image width or height a texture may have, in pixels. */
 #define FR_TEX_MAX_SIDE 65536u
+/** Mip levels of an image of FR_TEX_MAX_SIDE: log2(65536) + 1. */
+#define FR_TEX_MAX_LEVELS 17u
 enum { FR_WRAP_REPEAT = 0, FR_WRAP_CLAMP = 1 };
 enum { FR_FILTER_BILINEAR = 0, FR_FILTER_NEAREST = 1 };
+/** How an image's values are stored (each value of each channel):
+ * F32 a linear binary32; U8_SRGB a byte holding the sRGB-encoded value
+ * k / 255 (decoded through a 256-entry table); U8 a byte k meaning k / 255;
+ * U16 a 16-bit k meaning k / 65535; U16_SRGB a 16-bit sRGB-encoded
+ * k / 65535; F16 an IEEE 754 binary16 (half), linear. */
+enum {
+    FR_TEXEL_F32 = 0, FR_TEXEL_U8_SRGB = 1, FR_TEXEL_U8 = 2, FR_TEXEL_U16 = 3, FR_TEXEL_U16_SRGB = 4,
+    FR_TEXEL_F16 = 5, FR_TEXEL_FORMATS = 6
+};
 typedef struct {
     uint32_t kind;             /**< FR_TEX_* */
-    uint32_t width, height;    /**< image: pixels */
-    uint32_t channels;         /**< image: 1 (grey) or 3 (RGB) floats per texel */
-    uint32_t first;            /**< image: index of its first float in texels */
+    uint32_t width, height;    /**< image: pixels of level 0 */
+    uint32_t channels;         /**< image: 1 (grey) or 3 (RGB) values per texel */
+    uint32_t format;           /**< image: FR_TEXEL_* */
+    uint32_t levels;           /**< image: mip levels stored, 1 .. the full chain down to 1 x 1 */
     uint32_t wrap;             /**< FR_WRAP_* */
     uint32_t filter;           /**< FR_FILTER_* */
-    uint32_t pad;
     vec2 scale, offset;        /**< UV transform */
     vec3 color0, color1;       /**< checker: the square at the UV origin, the other one */
+    uint32_t first[FR_TEX_MAX_LEVELS]; /**< image: word index into texels of each level; 0 past `levels` */
+    uint32_t pad;
 } fr_texture;
 
 /** A homogeneous participating medium: coefficients per colour channel in
@@ -374,7 +396,7 @@ typedef struct {
     const vec3 *normals;          uint32_t n_normals;
     const vec2 *uvs;              uint32_t n_uvs;
     const fr_texture *textures;   uint32_t n_textures;
-    const float *texels;          uint32_t n_texels;
+    const uint32_t *texels;       uint32_t n_texels;   /**< 32-bit words (fr_texture) */
     const fr_medium *media;       uint32_t n_media;
     fr_volume volume;
     fr_tonemap tonemap;

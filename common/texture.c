@@ -6,6 +6,8 @@
 #include "bsdf.h"
 #include "fmath.h"
 
+#include <string.h>
+
 float tex_srgb_to_linear(float v)
 {
     if (!(v > 0.0f))
@@ -40,35 +42,154 @@ static float wrap_coord(float x, uint32_t wrap)
     return f < 1.0f ? f : 0.0f;   /* x = -tiny rounds to 1.0 */
 }
 
-static const float *texel(const fr_scene *s, const fr_texture *t, uint32_t x, uint32_t y)
+/* sRGB-encoded bytes decoded: srgb8[k] = tex_srgb_to_linear(k / 255.0f),
+ * bit for bit (test_texture checks every entry). */
+static const float srgb8[256] = {
+#include "texture_srgb8.inc"
+};
+
+float tex_half_to_float(uint16_t h)
 {
-    return s->texels + t->first + ((size_t)y * t->width + x) * t->channels;
+    uint32_t sign = (uint32_t)(h >> 15) << 31, e = (h >> 10) & 31u, m = h & 1023u;
+    float v;
+    if (e == 0) {
+        v = (float)m * 0x1p-24f;                 /* subnormal (or zero): exact */
+    } else {
+        uint32_t bits = e == 31 ? 0x7f800000u | m << 13 : (e + 112u) << 23 | m << 13;
+        memcpy(&v, &bits, sizeof v);
+    }
+    uint32_t b;
+    memcpy(&b, &v, sizeof b);
+    b |= sign;
+    memcpy(&v, &b, sizeof v);
+    return v;
 }
 
-/* Image lookup at texture-space (u, v), channels into out[0..channels). */
-static void image_eval(const fr_scene *s, const fr_texture *t, float u, float v, float out[3])
+static inline uint32_t format_bytes(uint32_t format)
 {
-    uint32_t n = t->channels;
-    /* Pixel space: x right, y down from the top row; texel centres at +0.5. */
-    float x = wrap_coord(u, t->wrap) * (float)t->width;
-    float y = (1.0f - wrap_coord(v, t->wrap)) * (float)t->height;
-    if (t->filter == FR_FILTER_NEAREST) {
-        const float *p = texel(s, t, wrap_index((long)floorf(x), t->width, FR_WRAP_CLAMP),
-                               wrap_index((long)floorf(y), t->height, FR_WRAP_CLAMP));
+    switch (format) {
+    case FR_TEXEL_U8_SRGB: case FR_TEXEL_U8: return 1;
+    case FR_TEXEL_U16: case FR_TEXEL_U16_SRGB: case FR_TEXEL_F16: return 2;
+    default: return 4;
+    }
+}
+
+uint32_t tex_format_bytes(uint32_t format) { return format_bytes(format); }
+
+void tex_level_size(const fr_texture *t, uint32_t level, uint32_t *w, uint32_t *h)
+{
+    uint32_t a = level < 32 ? t->width >> level : 0, b = level < 32 ? t->height >> level : 0;
+    *w = a ? a : 1;
+    *h = b ? b : 1;
+}
+
+/* Value c of the texel starting at byte p. */
+static inline float decode(uint32_t format, const unsigned char *p, uint32_t c)
+{
+    uint16_t h;
+    float f;
+    switch (format) {
+    case FR_TEXEL_U8_SRGB:
+        return srgb8[p[c]];
+    case FR_TEXEL_U8:
+        return (float)p[c] / 255.0f;
+    case FR_TEXEL_U16:
+        memcpy(&h, p + 2 * c, 2);
+        return (float)h / 65535.0f;
+    case FR_TEXEL_U16_SRGB:
+        memcpy(&h, p + 2 * c, 2);
+        return tex_srgb_to_linear((float)h / 65535.0f);
+    case FR_TEXEL_F16:
+        memcpy(&h, p + 2 * c, 2);
+        return tex_half_to_float(h);
+    default:
+        memcpy(&f, p + 4 * c, 4);
+        return f;
+    }
+}
+
+/* Texel i (row-major) of a level starting at byte lv: channels into out. */
+static inline __attribute__((always_inline)) void fetch(const unsigned char *lv, uint32_t format, uint32_t n,
+                                                        size_t i, float out[3])
+{
+    const unsigned char *p = lv + i * n * format_bytes(format);
+    switch (format) {
+    case FR_TEXEL_U8_SRGB:
         for (uint32_t c = 0; c < n; c++)
-            out[c] = p[c];
+            out[c] = srgb8[p[c]];
+        break;
+    case FR_TEXEL_U8:
+        for (uint32_t c = 0; c < n; c++)
+            out[c] = (float)p[c] / 255.0f;
+        break;
+    default:
+        for (uint32_t c = 0; c < n; c++)
+            out[c] = decode(format, p, c);
+    }
+}
+
+void tex_texel(const uint32_t *texels, const fr_texture *t, uint32_t level, uint32_t x, uint32_t y, float out[3])
+{
+    uint32_t w, h;
+    tex_level_size(t, level, &w, &h);
+    fetch((const unsigned char *)(texels + t->first[level]), t->format, t->channels, (size_t)y * w + x, out);
+}
+
+/* Image lookup of level `level` at texture-space (u, v), channels into
+ * out[0..channels). */
+static void level_eval(const fr_scene *s, const fr_texture *t, uint32_t level, float u, float v, float out[3])
+{
+    uint32_t n = t->channels, w, h, f = t->format;
+    tex_level_size(t, level, &w, &h);
+    const unsigned char *lv = (const unsigned char *)(s->texels + t->first[level]);
+    /* Pixel space: x right, y down from the top row; texel centres at +0.5. */
+    float x = wrap_coord(u, t->wrap) * (float)w;
+    float y = (1.0f - wrap_coord(v, t->wrap)) * (float)h;
+    if (t->filter == FR_FILTER_NEAREST) {
+        fetch(lv, f, n, (size_t)wrap_index((long)floorf(y), h, FR_WRAP_CLAMP) * w +
+                            wrap_index((long)floorf(x), w, FR_WRAP_CLAMP), out);
         return;
     }
     x -= 0.5f;
     y -= 0.5f;
     float x0f = floorf(x), y0f = floorf(y), fx = x - x0f, fy = y - y0f;
     long x0 = (long)x0f, y0 = (long)y0f;
-    uint32_t xa = wrap_index(x0, t->width, t->wrap), xb = wrap_index(x0 + 1, t->width, t->wrap);
-    uint32_t ya = wrap_index(y0, t->height, t->wrap), yb = wrap_index(y0 + 1, t->height, t->wrap);
-    const float *p00 = texel(s, t, xa, ya), *p10 = texel(s, t, xb, ya);
-    const float *p01 = texel(s, t, xa, yb), *p11 = texel(s, t, xb, yb);
+    size_t xa = wrap_index(x0, w, t->wrap), xb = wrap_index(x0 + 1, w, t->wrap);
+    size_t ya = (size_t)wrap_index(y0, h, t->wrap) * w, yb = (size_t)wrap_index(y0 + 1, h, t->wrap) * w;
+    float p00[3], p10[3], p01[3], p11[3];
+    fetch(lv, f, n, ya + xa, p00);
+    fetch(lv, f, n, ya + xb, p10);
+    fetch(lv, f, n, yb + xa, p01);
+    fetch(lv, f, n, yb + xb, p11);
     for (uint32_t c = 0; c < n; c++)
         out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
+}
+
+/* Image lookup at texture-space (u, v) and level of detail lod (0: level
+ * 0; between levels, trilinear), channels into out[0..channels). */
+static void image_eval(const fr_scene *s, const fr_texture *t, float u, float v, float lod, float out[3])
+{
+    if (!(lod > 0.0f) || t->levels < 2 || t->filter == FR_FILTER_NEAREST) {
+        level_eval(s, t, 0, u, v, out);
+        return;
+    }
+    float top = (float)(t->levels - 1);
+    if (lod >= top) {
+        level_eval(s, t, t->levels - 1, u, v, out);
+        return;
+    }
+    float lf = floorf(lod), frac = lod - lf;
+    uint32_t l = (uint32_t)lf;
+    float a[3], b[3];
+    level_eval(s, t, l, u, v, a);
+    if (frac == 0.0f) {
+        for (uint32_t c = 0; c < t->channels; c++)
+            out[c] = a[c];
+        return;
+    }
+    level_eval(s, t, l + 1, u, v, b);
+    for (uint32_t c = 0; c < t->channels; c++)
+        out[c] = lerp(a[c], b[c], frac);
 }
 
 /* 1 if floor(x) is odd.  f - 2 floor(f/2) is exact for every float; above
@@ -79,14 +200,14 @@ static int odd(float x)
     return f - 2.0f * floorf(0.5f * f) != 0.0f;
 }
 
-static vec3 eval_at(const fr_scene *s, const fr_texture *t, float u, float v, int *grey)
+static vec3 eval_at(const fr_scene *s, const fr_texture *t, float u, float v, float lod, int *grey)
 {
     if (t->kind == FR_TEX_CHECKER) {
         *grey = 0;
         return odd(u) != odd(v) ? t->color1 : t->color0;
     }
-    float c[3];
-    image_eval(s, t, u, v, c);
+    float c[3] = {0.0f, 0.0f, 0.0f};
+    image_eval(s, t, u, v, lod, c);
     *grey = t->channels == 1;
     return t->channels == 1 ? v3s(c[0]) : v3(c[0], c[1], c[2]);
 }
@@ -97,13 +218,35 @@ static void to_texture_space(const fr_texture *t, vec2 uv, float *u, float *v)
     *v = uv.v * t->scale.v + t->offset.v;
 }
 
-vec3 tex_eval(const fr_scene *s, uint32_t ti, vec2 uv)
+/* As tex_eval at level of detail lod (0: level 0; fractions blend two
+ * levels; past the last level, the last). */
+static vec3 tex_eval_lod(const fr_scene *s, uint32_t ti, vec2 uv, float lod)
 {
     const fr_texture *t = &s->textures[ti];
     float u, v;
     int grey;
     to_texture_space(t, uv, &u, &v);
-    return eval_at(s, t, u, v, &grey);
+    return eval_at(s, t, u, v, lod, &grey);
+}
+
+vec3 tex_eval(const fr_scene *s, uint32_t ti, vec2 uv)
+{
+    return tex_eval_lod(s, ti, uv, 0.0f);
+}
+
+float tex_lod(const fr_scene *s, uint32_t ti, const fr_surface *sf)
+{
+    const fr_texture *t = &s->textures[ti];
+    if (!(sf->footprint > 0.0f) || t->kind != FR_TEX_IMAGE || t->levels < 2)
+        return 0.0f;
+    /* Texels per unit of texture space, over scene area per unit of uv:
+     * the squared number of level-0 texels one scene unit spans. */
+    float area = v3_len(v3_cross(sf->dpdu, sf->dpdv));
+    float density = (float)t->width * (float)t->height * fabsf(t->scale.u * t->scale.v);
+    float f2 = sf->footprint * sf->footprint * density / area;
+    if (!(f2 > 1.0f) || !(f2 < 1e30f))
+        return 0.0f;                  /* under a texel (or a degenerate uv map): level 0 */
+    return 0.5f * fm_logf(f2) * 1.44269504088896341f;
 }
 
 int tex_material_textured(const fr_material *m)
@@ -149,8 +292,8 @@ static void bump(const fr_scene *s, const fr_material *m, fr_surface *sf)
     to_texture_space(t, sf->uv, &u, &v);
     float du = t->kind == FR_TEX_IMAGE ? 1.0f / (float)t->width : 1.0f / 1024.0f;
     float dv = t->kind == FR_TEX_IMAGE ? 1.0f / (float)t->height : 1.0f / 1024.0f;
-    float hu = eval_at(s, t, u + du, v, &grey).x - eval_at(s, t, u - du, v, &grey).x;
-    float hv = eval_at(s, t, u, v + dv, &grey).x - eval_at(s, t, u, v - dv, &grey).x;
+    float hu = eval_at(s, t, u + du, v, 0.0f, &grey).x - eval_at(s, t, u - du, v, 0.0f, &grey).x;
+    float hv = eval_at(s, t, u, v + dv, 0.0f, &grey).x - eval_at(s, t, u, v - dv, 0.0f, &grey).x;
     if (hu == 0.0f && hv == 0.0f)
         return;                       /* flat here: the surface as it is */
     /* dh/du on the surface = dH/du' * du'/du = slope * scale. */
@@ -195,25 +338,27 @@ const fr_material *tex_material(const fr_scene *s, const fr_material *m, fr_surf
         return m;
     *tmp = *m;
     int lobes = 0;
+#define LOOKUP(tex) tex_eval_lod(s, tex, sf->uv, tex_lod(s, tex, sf))
     if (m->tex_diffuse != FR_NONE)
-        tmp->diffuse = v3_mul(m->diffuse, clamp01(tex_eval(s, m->tex_diffuse, sf->uv))), lobes = 1;
+        tmp->diffuse = v3_mul(m->diffuse, clamp01(LOOKUP(m->tex_diffuse))), lobes = 1;
     if (m->tex_glossy != FR_NONE)
-        tmp->glossy = v3_mul(m->glossy, clamp01(tex_eval(s, m->tex_glossy, sf->uv))), lobes = 1;
+        tmp->glossy = v3_mul(m->glossy, clamp01(LOOKUP(m->tex_glossy))), lobes = 1;
     if (m->tex_specular != FR_NONE)
-        tmp->specular = v3_mul(m->specular, clamp01(tex_eval(s, m->tex_specular, sf->uv))), lobes = 1;
+        tmp->specular = v3_mul(m->specular, clamp01(LOOKUP(m->tex_specular))), lobes = 1;
     if (m->tex_transmit != FR_NONE)
-        tmp->transmit = v3_mul(m->transmit, clamp01(tex_eval(s, m->tex_transmit, sf->uv))), lobes = 1;
+        tmp->transmit = v3_mul(m->transmit, clamp01(LOOKUP(m->tex_transmit))), lobes = 1;
     if (m->tex_emission != FR_NONE)
-        tmp->emission = tex_emission(s, m, sf->uv);
+        tmp->emission = tex_emission(s, m, sf->uv);  /* level 0, as light sampling sees it */
     /* glTF's metallicRoughness texture: roughness in G, metallic in B (a
      * grey texture has the same value in every channel). */
     if (m->tex_roughness != FR_NONE)
-        tmp->roughness = m->roughness * clamp01(tex_eval(s, m->tex_roughness, sf->uv)).y;
+        tmp->roughness = m->roughness * clamp01(LOOKUP(m->tex_roughness)).y;
     if (m->tex_metallic != FR_NONE)
-        tmp->metallic = m->metallic * clamp01(tex_eval(s, m->tex_metallic, sf->uv)).z;
+        tmp->metallic = m->metallic * clamp01(LOOKUP(m->tex_metallic)).z;
     /* glTF's transmissionTexture: the share in R. */
     if (m->tex_transmission != FR_NONE)
-        tmp->transmission = m->transmission * clamp01(tex_eval(s, m->tex_transmission, sf->uv)).x;
+        tmp->transmission = m->transmission * clamp01(LOOKUP(m->tex_transmission)).x;
+#undef LOOKUP
     if (lobes)
         bsdf_lobe_probs(tmp);
     if (m->tex_bump != FR_NONE)

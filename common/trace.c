@@ -336,6 +336,7 @@ static void instance_surface(const fr_scene *s, const fr_ray *r, const fr_hit *h
 static inline __attribute__((always_inline)) void surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit,
                                                           fr_surface *out, int uv)
 {
+    out->footprint = 0.0f;
     if (__builtin_expect(hit->inst != 0, 0)) {
         instance_surface(s, r, hit, out, uv);
         return;

@@ -32,6 +32,10 @@ typedef struct {
     vec3 dpdu, dpdv;           /**< how p moves with u and v (tangents for bump and normal maps) */
     uint32_t material;
     uint32_t light;            /**< FR_NONE unless an area light */
+    /** Width (scene units) of the ray's footprint on the surface, from
+     * which image lookups pick a mip level (texture.h); 0 (as every
+     * trace_surface* leaves it): the finest level. */
+    float footprint;
 } fr_surface;
 
 /** Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0.  The result

@@ -38,6 +38,8 @@ extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type ty
     snprintf(mem, sizeof mem, "/proc/self/fd/%d", fd);
     int rc = 0;
     try {
+        if (type == IIO_F16)
+            return close(fd), fr_fail(err, "%s: half-float pixels cannot be encoded (give floats)", name);
         TypeDesc td = type == IIO_U8 ? TypeDesc::UINT8 : type == IIO_U16 ? TypeDesc::UINT16 : TypeDesc::FLOAT;
         std::unique_ptr<ImageOutput> out = ImageOutput::create(name);
         if (!out) {
@@ -94,20 +96,32 @@ extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type ty
 }
 
 // Reads the first image of an opened input into *pixels (see iio_read).
-static int read_open(ImageInput *in, const char *name, float **pixels, uint32_t *width, uint32_t *height,
-                     uint32_t *channels, fr_error *err)
+static int read_open(ImageInput *in, const char *name, void **pixels, iio_type *type, uint32_t *width,
+                     uint32_t *height, uint32_t *channels, fr_error *err)
 {
     const ImageSpec &spec = in->spec();
     uint64_t n = (uint64_t)spec.width * (uint64_t)spec.height * (uint64_t)spec.nchannels;
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1 || n > (1u << 29))
         return fr_fail(err, "%s: %d x %d x %d pixels, %d channels: not a 2D image of at most 2^29 values", name,
                        spec.width, spec.height, spec.depth, spec.nchannels);
-    float *px = (float *)malloc(n * sizeof(float));
+    // The file's own precision: 8-bit, 16-bit and half stay so, the rest
+    // (float, double, 32-bit integers) becomes float.
+    TypeDesc td = TypeDesc::FLOAT;
+    iio_type t = IIO_F32;
+    size_t size = 4;
+    if (spec.format.basetype == TypeDesc::UINT8) {
+        td = TypeDesc::UINT8, t = IIO_U8, size = 1;
+    } else if (spec.format.basetype == TypeDesc::UINT16) {
+        td = TypeDesc::UINT16, t = IIO_U16, size = 2;
+    } else if (spec.format.basetype == TypeDesc::HALF) {
+        td = TypeDesc::HALF, t = IIO_F16, size = 2;
+    }
+    void *px = malloc(n * size);
     if (!px)
         return fr_fail(err, "%s: out of memory for %llu values", name, (unsigned long long)n);
     bool ok;
     try {
-        ok = in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, px);
+        ok = in->read_image(0, 0, 0, spec.nchannels, td, px);
     } catch (...) {
         free(px);
         throw;
@@ -117,6 +131,7 @@ static int read_open(ImageInput *in, const char *name, float **pixels, uint32_t 
         return fr_fail(err, "%s: %s", name, in->geterror().c_str());
     }
     *pixels = px;
+    *type = t;
     *width = (uint32_t)spec.width;
     *height = (uint32_t)spec.height;
     *channels = (uint32_t)spec.nchannels;
@@ -128,8 +143,8 @@ static int read_open(ImageInput *in, const char *name, float **pixels, uint32_t 
 // reader is chosen by the extension of `name`; a reader without I/O proxy
 // support (older OpenImageIO) reads a private memory file through
 // /proc/self/fd instead.
-extern "C" int iio_read(const char *name, const void *data, size_t len, float **pixels, uint32_t *width,
-                        uint32_t *height, uint32_t *channels, fr_error *err)
+extern "C" int iio_read(const char *name, const void *data, size_t len, void **pixels, iio_type *type,
+                        uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     *pixels = nullptr;
     const char *dot = strrchr(name, '.'), *slash = strrchr(name, '/');
@@ -168,7 +183,7 @@ extern "C" int iio_read(const char *name, const void *data, size_t len, float **
         }
         if (!ok)
             (void)in->geterror(); // the reader's words may quote the bytes: cleared, not shown
-        int rc = ok ? read_open(in.get(), name, pixels, width, height, channels, err)
+        int rc = ok ? read_open(in.get(), name, pixels, type, width, height, channels, err)
                     : fr_fail(err, "%s: not a readable %s image", name, ext.c_str());
         in.reset();
         if (fd >= 0)
@@ -183,8 +198,8 @@ extern "C" int iio_read(const char *name, const void *data, size_t len, float **
     }
 }
 
-extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, float **pixels, uint32_t *width,
-                            uint32_t *height, uint32_t *channels, fr_error *err)
+extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, void **pixels, iio_type *type,
+                            uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     *pixels = nullptr;
     // The format by its signature first (a MIME type may be wrong), then
@@ -206,7 +221,7 @@ extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, floa
         std::unique_ptr<ImageInput> in = ImageInput::open(name, nullptr, &mem);
         if (!in)
             return fr_fail(err, "embedded %s image: %s", name + 9, OIIO::geterror().c_str());
-        return read_open(in.get(), "embedded image", pixels, width, height, channels, err);
+        return read_open(in.get(), "embedded image", pixels, type, width, height, channels, err);
     } catch (const std::exception &e) {
         free(*pixels);
         *pixels = nullptr;

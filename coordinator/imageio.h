@@ -17,8 +17,9 @@
 
 #include "error.h"
 
-/** Pixel types iio_encode_with accepts. */
-typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32 } iio_type;
+/** Pixel types: iio_encode_with accepts the first three, iio_read gives
+ * any (IIO_F16: IEEE 754 binary16 bits in uint16_t). */
+typedef enum { IIO_U8 = 0, IIO_U16, IIO_F32, IIO_F16 } iio_type;
 
 /** How iio_encode_with stores an image, where the format allows. */
 typedef struct {
@@ -46,19 +47,21 @@ int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_
 
 /** Decodes the first image of the file `name`, whose `len` bytes the
  * caller has read into `data` (OpenImageIO opens no file: the reader is
- * chosen by name's extension), as floats: *pixels (malloc'd, the caller
- * frees) holds width*height*channels values, top row first, as stored
- * (integer formats scaled to [0, 1], no colour conversion).  Fails for an
- * unknown extension, undecodable bytes (without quoting them) and images
- * over 2^29 values. */
-int iio_read(const char *name, const void *data, size_t len, float **pixels, uint32_t *width, uint32_t *height,
-             uint32_t *channels, fr_error *err);
+ * chosen by name's extension), at its own precision: *pixels (malloc'd,
+ * the caller frees) holds width*height*channels values of *type, top row
+ * first, as stored (no colour conversion): 8-bit files as IIO_U8, 16-bit
+ * ones as IIO_U16, half-float ones as IIO_F16, every other type (float,
+ * 32-bit integers ...) as IIO_F32 (integers scaled to [0, 1]).  Fails for
+ * an unknown extension, undecodable bytes (without quoting them) and
+ * images over 2^29 values. */
+int iio_read(const char *name, const void *data, size_t len, void **pixels, iio_type *type, uint32_t *width,
+             uint32_t *height, uint32_t *channels, fr_error *err);
 
 /** Reads an image held in memory (`len` bytes of a PNG or JPEG file, told
  * apart by their signatures, else by `mime`) as iio_read does a file.
  * Fails for other formats and for undecodable bytes. */
-int iio_read_mem(const void *data, size_t len, const char *mime, float **pixels, uint32_t *width, uint32_t *height,
-                 uint32_t *channels, fr_error *err);
+int iio_read_mem(const void *data, size_t len, const char *mime, void **pixels, iio_type *type, uint32_t *width,
+                 uint32_t *height, uint32_t *channels, fr_error *err);
 
 /** Returns 1 if OpenImageIO has a writer for the file name's extension. */
 int iio_can_write(const char *path);

@@ -499,8 +499,9 @@ static void test_shapes(void)
     free(blocks);
 }
 
-/* A scene whose one material is textured by a 2x2 RGB image (texels 0..11)
- * followed by 4 spare texels, so a texture may also start later. */
+/* A scene whose one material is textured by a 2x2 RGB float image (words
+ * 0..11, one mip level) followed by 4 spare words, so a texture may also
+ * start later. */
 static int textured_scene(fr_scene *out, fr_error *err)
 {
     static const char *json =
@@ -520,7 +521,9 @@ static int textured_scene(fr_scene *out, fr_error *err)
         t->kind = FR_TEX_IMAGE;
         t->width = t->height = 2;
         t->channels = 3;
-        t->first = 0;
+        t->format = FR_TEXEL_F32;
+        t->levels = 1;
+        memset(t->first, 0, sizeof t->first);
         for (int i = 0; i < 16 && rc == 0; i++) {
             float v = (float)i / 16.0f;
             if (bld_push(&b.texels, &v) == FR_NONE)
@@ -547,21 +550,32 @@ static void test_texture_sizes(void)
     CHECK(ts.n_textures == 1 && ts.n_texels == 16, "textured scene: %u textures, %u texels", ts.n_textures,
           ts.n_texels);
     size_t tex = section(ts.blob, 15);
-    static const struct { uint32_t w, h, ch, first; int ok; const char *what; } cases[] = {
-        {2, 2, 3, 0, 1, "the image as written"},
-        {4, 4, 1, 0, 1, "grey, all 16 texels"},
-        {2, 2, 3, 4, 1, "starting at texel 4, ending at the last"},
-        {2, 2, 3, 5, 0, "one texel past the end"},
-        {1, 1, 1, 16, 0, "starting at the end"},
-        {1, 1, 1, 17, 0, "starting past the end"},
-        {1, 1, 1, 0xffffffffu, 0, "starting at 2^32 - 1"},
-        {3384208571u, 3633886365u, 3, 0, 0, "w*h*3 wraps to 13 in 64 bits"},
-        {4294901763u, 1431677610u, 3, 0, 0, "w*h*3 wraps to 327674 in 64 bits"},
-        {0x80000000u, 0x80000000u, 1, 0, 0, "w*h = 2^62"},
-        {0xffffffffu, 0xffffffffu, 3, 0, 0, "the largest 32-bit sizes"},
-        {16, 0x10000001u, 1, 0, 0, "w*h wraps to 16 in 32 bits"},
-        {0, 2, 3, 0, 0, "width 0"},
-        {2, 2, 2, 0, 0, "2 channels"},
+    /* Fields: width, height, channels, format, levels, first[0], first[1]. */
+    static const struct { uint32_t w, h, ch, fmt, lv, first, first1; int ok; const char *what; } cases[] = {
+        {2, 2, 3, 0, 1, 0, 0, 1, "the image as written"},
+        {4, 4, 1, 0, 1, 0, 0, 1, "grey, all 16 texels"},
+        {2, 2, 3, 0, 1, 4, 0, 1, "starting at texel 4, ending at the last"},
+        {2, 2, 3, 0, 1, 5, 0, 0, "one texel past the end"},
+        {1, 1, 1, 0, 1, 16, 0, 0, "starting at the end"},
+        {1, 1, 1, 0, 1, 17, 0, 0, "starting past the end"},
+        {1, 1, 1, 0, 1, 0xffffffffu, 0, 0, "starting at 2^32 - 1"},
+        {3384208571u, 3633886365u, 3, 0, 1, 0, 0, 0, "w*h*3 wraps to 13 in 64 bits"},
+        {4294901763u, 1431677610u, 3, 0, 1, 0, 0, 0, "w*h*3 wraps to 327674 in 64 bits"},
+        {0x80000000u, 0x80000000u, 1, 0, 1, 0, 0, 0, "w*h = 2^62"},
+        {0xffffffffu, 0xffffffffu, 3, 0, 1, 0, 0, 0, "the largest 32-bit sizes"},
+        {16, 0x10000001u, 1, 0, 1, 0, 0, 0, "w*h wraps to 16 in 32 bits"},
+        {0, 2, 3, 0, 1, 0, 0, 0, "width 0"},
+        {2, 2, 2, 0, 1, 0, 0, 0, "2 channels"},
+        {2, 2, 3, FR_TEXEL_FORMATS, 1, 0, 0, 0, "an unknown texel format"},
+        {2, 2, 3, 0, 0, 0, 0, 0, "no mip level"},
+        {2, 2, 3, 0, 3, 0, 12, 0, "three levels for a 2x2 image"},
+        {2, 2, 3, 0, 2, 0, 12, 1, "two levels: 2x2 then 1x1 in the spare words"},
+        {2, 2, 3, 0, 2, 0, 14, 0, "a second level past the end"},
+        {2, 2, 3, 0, 1, 0, 12, 0, "an offset for a level not stored"},
+        {8, 1, 1, FR_TEXEL_U8_SRGB, 4, 0, 2, 1, "8 bytes, then 4, 2 and 1 (levels in words 0, 2, ...)"},
+        {68, 1, 1, FR_TEXEL_U8, 1, 0, 0, 0, "68 bytes are 17 words"},
+        {32, 1, 1, FR_TEXEL_F16, 1, 0, 0, 1, "32 halves in 16 words"},
+        {34, 1, 1, FR_TEXEL_U16, 1, 0, 0, 0, "34 16-bit values are 17 words"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         unsigned char *p = aligned_alloc(64, (ts.blob_size + 63) / 64 * 64);
@@ -569,7 +583,12 @@ static void test_texture_sizes(void)
         put32(p + tex + 4, cases[i].w);
         put32(p + tex + 8, cases[i].h);
         put32(p + tex + 12, cases[i].ch);
-        put32(p + tex + 16, cases[i].first);
+        put32(p + tex + 16, cases[i].fmt);
+        put32(p + tex + 20, cases[i].lv);
+        put32(p + tex + 72, cases[i].first);
+        put32(p + tex + 76, cases[i].first1);
+        if (cases[i].lv == 4)          /* the 8x1 bytes: levels 4x1, 2x1, 1x1 one word each */
+            put32(p + tex + 80, 3), put32(p + tex + 84, 4);
         rehash(p, ts.blob_size);
         if (cases[i].ok) {
             fr_scene s;

@@ -25,7 +25,7 @@ void bld_init(fr_builder *b)
     array_init(&b->planes, sizeof(fr_plane));
     array_init(&b->lights, sizeof(fr_light));
     array_init(&b->textures, sizeof(fr_texture));
-    array_init(&b->texels, sizeof(float));
+    array_init(&b->texels, sizeof(uint32_t));
     array_init(&b->media, sizeof(fr_medium));
     array_init(&b->distrib, sizeof(float));
     array_init(&b->meshes, sizeof(bld_mesh));

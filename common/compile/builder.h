@@ -40,7 +40,7 @@ typedef struct {
     fr_array positions, normals, uvs, planes;
     fr_array lights;           /**< point, spot, sun and environment lights (builder_light.h); frz_scene
                                     orders them and adds the area lights */
-    fr_array textures, texels, media;   /**< fr_texture, float, fr_medium */
+    fr_array textures, texels, media;   /**< fr_texture, uint32_t (words of texels), fr_medium */
     fr_volume volume;
     fr_tonemap tonemap;
     fr_world world;            /**< the environment (bld_environment); frz_scene sets the bounds and tables */

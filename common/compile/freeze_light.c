@@ -94,7 +94,8 @@ static double texel_luma(const fr_builder *b, const fr_texture *t, vec3 color, i
     if (i < 0)
         i += w;
     j = j < 0 ? 0 : j >= h ? h - 1 : j;
-    const float *p = (const float *)b->texels.data + t->first + (size_t)(j * w + i) * t->channels;
+    float p[3];
+    tex_texel(b->texels.data, t, 0, (uint32_t)i, (uint32_t)j, p);
     vec3 c = t->channels == 3 ? v3(p[0], p[1], p[2]) : v3s(p[0]);
     double y = v3_luma(v3_mul(color, c));
     return y > 0.0 ? y : 0.0;

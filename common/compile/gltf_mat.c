@@ -10,6 +10,7 @@
 #include "file.h"
 #include "fmath.h"
 #include "compile/json_appear.h"
+#include "compile/texstore.h"
 
 enum { WRAP_CLAMP = 33071, WRAP_MIRROR = 33648, WRAP_REPEAT = 10497, FILTER_NEAREST = 9728 };
 
@@ -114,7 +115,7 @@ static int image(gmat_ctx *c, uint32_t i, int srgb, fr_texture *t, fr_error *err
     }
     fr_texture tex;
     memset(&tex, 0, sizeof tex);
-    rc = json_store_image(c->b, &img, srgb, &tex, ptr, &e);
+    rc = texstore_image(c->b, &img, srgb, &tex, ptr, &e);
     free(img.pixels);
     if (rc < 0)
         return gdoc_fail(d, err, NULL, "%s", e.msg);
@@ -241,7 +242,9 @@ static int texture_info(gmat_ctx *c, const cJSON *o, const char *ptr, const char
     tex.width = img.width;
     tex.height = img.height;
     tex.channels = img.channels;
-    tex.first = img.first;
+    tex.format = img.format;
+    tex.levels = img.levels;
+    memcpy(tex.first, img.first, sizeof tex.first);
     if ((r->tex = bld_push(&c->b->textures, &tex)) == FR_NONE)
         return gdoc_fail(d, err, p, "out of memory");
     return 0;

@@ -13,6 +13,7 @@
 #include "file.h"
 #include "geom.h"
 #include "compile/jsonval.h"
+#include "compile/texstore.h"
 #include "texture.h"
 
 /* The largest image file a texture may come from (a 16k x 8k float RGBA
@@ -149,38 +150,6 @@ static int check_texture(const json_appear *a, const cJSON *t, const char *where
     return 0;
 }
 
-int json_store_image(fr_builder *b, const scene_image *img, int from_srgb, fr_texture *tex, const char *where,
-                       fr_error *err)
-{
-    if (img->width == 0 || img->height == 0 || img->channels == 0 || img->channels > 4)
-        return fr_fail(err, "%s: the image has %ux%u pixels and %u channels (expected 1 to 4)", where, img->width,
-                       img->height, img->channels);
-    if (img->width > FR_TEX_MAX_SIDE || img->height > FR_TEX_MAX_SIDE)
-        return fr_fail(err, "%s: the image has %ux%u pixels (at most %u per side)", where, img->width, img->height,
-                       FR_TEX_MAX_SIDE);
-    uint32_t keep = img->channels >= 3 ? 3 : 1;
-    uint64_t count = (uint64_t)img->width * img->height * keep;
-    if (count > (1u << 29) || b->texels.count > (1u << 29) - count)
-        return fr_fail(err, "%s: the scene's textures exceed 2^29 texel values", where);
-    tex->width = img->width;
-    tex->height = img->height;
-    tex->channels = keep;
-    tex->first = b->texels.count;
-    size_t n = (size_t)img->width * img->height;
-    for (size_t i = 0; i < n; i++) {
-        for (uint32_t c = 0; c < keep; c++) {
-            float v = img->pixels[i * img->channels + c];
-            if (!isfinite(v))
-                return fr_fail(err, "%s: pixel %zu is not a finite number", where, i);
-            if (from_srgb)
-                v = tex_srgb_to_linear(v);
-            if (bld_push(&b->texels, &v) == FR_NONE)
-                return fr_fail(err, "%s: out of memory for texels", where);
-        }
-    }
-    return 0;
-}
-
 /* Index of texture `name` decoded for colour (as_colour) or data use,
  * decoding it on first use.  `where` is the referring member's path. */
 static int texture_ref(json_appear *a, const char *name, int as_colour, const char *where, uint32_t *out,
@@ -227,7 +196,7 @@ static int texture_ref(json_appear *a, const char *name, int as_colour, const ch
         }
         char iw[PATHLEN + 4096];
         snprintf(iw, sizeof iw, "%s.file '%s'", tw, path);
-        int rc = json_store_image(a->b, &img, from_srgb, &tex, iw, err);
+        int rc = texstore_image(a->b, &img, from_srgb, &tex, iw, err);
         free(img.pixels);
         if (rc < 0)
             return -1;

@@ -50,14 +50,6 @@ void json_appear_free(json_appear *a);
 int json_colour(json_appear *a, const cJSON *obj, const char *key, const char *where, int required, vec3 def,
                vec3 *tint, uint32_t *tex, fr_error *err);
 
-/** Append a decoded image's texels to the builder and fill tex's image
- * fields (width, height, channels, first): 1 or 2 channels (grey; alpha
- * dropped) give 1, 3 or 4 give 3; `from_srgb` decodes the sRGB curve.
- * Fails (naming `where`) on an empty image, non-finite texels, or when the
- * scene's texels would pass 2^29 values. */
-int json_store_image(fr_builder *b, const scene_image *img, int from_srgb, fr_texture *tex, const char *where,
-                    fr_error *err);
-
 /** Read number member `key` of obj (at path `where`): a number, a texture
  * name, or {"texture": name, "factor": f} (a data texture: no sRGB
  * decoding).  *value receives the number or the factor (1 by default),

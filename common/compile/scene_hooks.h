@@ -13,12 +13,21 @@
 #include "compile/builder.h"
 #include "compile/confine.h"
 
-/** An image as a texture hook decodes it: width*height*channels floats,
- * top row first, the values as stored (8- and 16-bit images scaled to
- * [0, 1]; no colour conversion).  pixels is malloc'd; the reader frees it. */
+/** How a decoded image's values are held: the file's own precision. */
+enum { SCENE_PIX_F32 = 0, SCENE_PIX_U8 = 1, SCENE_PIX_U16 = 2, SCENE_PIX_F16 = 3 };
+
+/** An image as a texture hook decodes it: width*height*channels values of
+ * `type` (SCENE_PIX_*; 0, float, unless the hook says otherwise), top row
+ * first, as stored: no colour conversion (8- and 16-bit integers mean
+ * k / 255 and k / 65535, halves are IEEE 754 binary16 bits).  The pixels
+ * are malloc'd; the reader frees them. */
 typedef struct {
-    float *pixels;
+    union {
+        float *pixels;         /**< SCENE_PIX_F32 */
+        void *data;            /**< the other types: uint8_t, uint16_t, binary16 bits in uint16_t */
+    };
     uint32_t width, height, channels;
+    uint32_t type;             /**< SCENE_PIX_* */
 } scene_image;
 
 /** The asset loaders (any may be NULL) and the compile's budget. */

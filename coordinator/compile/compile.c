@@ -11,16 +11,29 @@
 #include "compile/mesh.h"
 #include "compile/json_scene.h"
 
-/* The texture hook: images are decoded by OpenImageIO (imageio.h). */
+/* The scene's pixel type of OpenImageIO's. */
+static uint32_t pix_type(iio_type t)
+{
+    return t == IIO_U8 ? SCENE_PIX_U8 : t == IIO_U16 ? SCENE_PIX_U16 : t == IIO_F16 ? SCENE_PIX_F16 : SCENE_PIX_F32;
+}
+
+/* The texture hook: images are decoded by OpenImageIO (imageio.h) at
+ * their own precision, from the bytes the reader read through its scope. */
 static int texture_load(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
-    return iio_read(path, data, len, &img->pixels, &img->width, &img->height, &img->channels, err);
+    iio_type t = IIO_F32;
+    int rc = iio_read(path, data, len, &img->data, &t, &img->width, &img->height, &img->channels, err);
+    img->type = pix_type(t);
+    return rc;
 }
 
 /* Images embedded in glTF files, likewise. */
 static int image_load(const void *data, size_t len, const char *mime, scene_image *img, fr_error *err)
 {
-    return iio_read_mem(data, len, mime, &img->pixels, &img->width, &img->height, &img->channels, err);
+    iio_type t = IIO_F32;
+    int rc = iio_read_mem(data, len, mime, &img->data, &t, &img->width, &img->height, &img->channels, err);
+    img->type = pix_type(t);
+    return rc;
 }
 
 int compile_is_gltf(const char *path)

@@ -1,0 +1,45 @@
+/** @file texstore.h
+ * Storing a decoded image as an image texture (compile time): the texel
+ * format that keeps the file's precision, and its mip levels.
+ *
+ * Formats (scene.h, FR_TEXEL_*): an 8-bit image is stored as bytes (sRGB-
+ * encoded when it is decoded as sRGB, so the lookup's table decodes it),
+ * a 16-bit one as 16-bit integers, a half-float one as halves; a float
+ * image as halves when every value lies within half's range (|v| <=
+ * 65504: rounded to nearest even, a relative error of at most 2^-11, or
+ * 2^-25 absolute below 2^-14), else as floats.  A float or half image
+ * that must be sRGB-decoded (rare: a "colorspace" asked for it) is
+ * decoded and stored as floats.  Three or
+ * four channels keep three (RGB; alpha is not used), one or two keep one.
+ *
+ * Mip levels: level k (max(1, w >> k) x max(1, h >> k)) down to 1 x 1;
+ * its texel (x, y) averages the texels 2x..2x+1 by 2y..2y+1 of level
+ * k - 1, the last column (row) also the odd one left over, so every texel
+ * of level k - 1 counts once.  The mean is taken of the linear values and
+ * stored as texstore_encode rounds it, except for linear 8- and 16-bit
+ * integers, whose mean is that of the integers rounded half up (the same
+ * value, as they are proportional to the linear ones).
+ */
+#ifndef FRANJA_TEXSTORE_H
+#define FRANJA_TEXSTORE_H
+
+#include "compile/builder.h"
+#include "compile/scene_hooks.h"
+
+/** Append image `img` with its mip levels to b->texels and fill tex's
+ * image fields (width, height, channels, format, levels, first);
+ * `from_srgb` decodes the sRGB curve (at lookup, for integer images).
+ * Fails (naming `where`) on an empty or oversized image, a non-finite
+ * value, or when the scene's texels would pass 2^31 words (8 GiB). */
+int texstore_image(fr_builder *b, const scene_image *img, int from_srgb, fr_texture *tex, const char *where,
+                   fr_error *err);
+
+/** The stored value (the bits of a byte, 16-bit integer, half or float)
+ * of texel format `format` nearest to linear value v: for the sRGB
+ * formats the code whose decoded value is nearest (ties to the lower
+ * code), for the linear integers round(v x 255) or round(v x 65535)
+ * clamped to their range, for half and float IEEE rounding to nearest
+ * even (half: infinity past 65519.99). */
+uint32_t texstore_encode(uint32_t format, double v);
+
+#endif
