@@ -196,7 +196,7 @@ bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	@mkdir -p bin/fuzz
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -iquote coordinator -fsanitize=fuzzer,address,undefined -MMD -MP -MT $@ -MF $(B)/fuzz/$(@F).d \
 	    -o $@ $< $(FUZZ_COORD_LIB) \
-	    $(FUZZ_OBJ) $(CJSON_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) $(SSH_LIBS) $(MHD_LIBS) -ldl -lm -pthread
+	    $(FUZZ_OBJ) $(CJSON_LIBS) $(ZSTD_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) $(SSH_LIBS) $(MHD_LIBS) -ldl -lm -pthread
 
 fuzz: all $(FUZZ_BIN)
 	sh tests/fuzz/run.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
