@@ -3,6 +3,8 @@
 
 #include "light.h"
 
+#include <float.h>
+
 #include "envmap.h"
 #include "fmath.h"
 #include "lanes.h"
@@ -128,6 +130,13 @@ static inline void branch(const fr_scene *s, const fr_light_node *n, vec3 p, vec
     float i0 = node_importance(&s->light_nodes[n->child[0]], p, nrm);
     float i1 = node_importance(&s->light_nodes[n->child[1]], p, nrm);
     float sum = i0 + i1;
+    if (!(sum <= FLT_MAX)) {
+        /* An importance past a float's range (lights of enormous power, a
+         * point at a light): the infinite ones share the branch. */
+        i0 = i0 > FLT_MAX ? 1.0f : 0.0f;
+        i1 = i1 > FLT_MAX ? 1.0f : 0.0f;
+        sum = i0 + i1;
+    }
     *p0 = sum > 0.0f ? i0 / sum : 0.0f;
     *p1 = sum > 0.0f ? i1 / sum : 0.0f;
 }

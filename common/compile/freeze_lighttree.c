@@ -2,6 +2,7 @@
  * freeze_lighttree.h). */
 #include "compile/freeze_lighttree.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -129,7 +130,7 @@ static void store(fr_light_node *n, const lbound *b)
     n->axis = b->axis;
     n->cos_o = b->cos_o;
     n->cos_e = b->cos_e;
-    n->power = (float)b->power;
+    n->power = b->power < FLT_MAX ? (float)b->power : FLT_MAX; /* finite, as the loader asks */
     n->flags = b->two_sided ? FR_LNODE_TWO_SIDED : 0;
 }
 
