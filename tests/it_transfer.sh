@@ -81,7 +81,9 @@ check "c: then sent uncompressed" grep -q "c .*sending the scene uncompressed" l
 s=$(sent log1 c)
 check "c: the bytes sent count every attempt ($s)" test -n "$s" -a "${s:-0}" -gt "$FBIN"
 # d: a worker that cannot unpack gets the .fbin as it is.
-MIB=$(awk -v n="$FBIN" 'BEGIN { printf "%.1f MiB", n / 1048576 }')
+# As franja writes sizes: KiB, MiB ... with one decimal.
+MIB=$(awk -v n="$FBIN" 'BEGIN { v = n / 1024; u = "KiB"; if (v >= 1024) { v /= 1024; u = "MiB" }
+    printf "%.1f %s", v, u }')
 check "d: the scene sent as it is ($MIB)" grep -q "host d: .*scene uploaded ($MIB)" log1
 # The summary has the bytes sent per host.
 check "the summary has a sent column" grep -q '^  host .* sent  state' log1
