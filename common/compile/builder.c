@@ -104,11 +104,17 @@ void bld_material_init(fr_material *m)
 
 int bld_pad(fr_array *a, uint32_t count)
 {
-    char zero[32] = {0};
-    while (a->count < count)
+    if (a->count >= count)
+        return 0;
+    /* A zeroed element of the array's own size (light-tree nodes are 64
+     * bytes, BVH nodes 256). */
+    void *zero = calloc(1, a->elem);
+    int rc = zero ? 0 : -1;
+    while (rc == 0 && a->count < count)
         if (bld_push(a, zero) == FR_NONE)
-            return -1;
-    return 0;
+            rc = -1;
+    free(zero);
+    return rc;
 }
 
 uint32_t bld_triangle_uv(fr_builder *b, const vec3 p[3], const vec2 uv[3], uint32_t material)
