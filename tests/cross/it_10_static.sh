@@ -13,7 +13,9 @@ T=$(mktemp -d /tmp/franja-static.XXXXXX)
 trap 'rm -rf "$T"' EXIT
 S64="$ROOT/bin/static/amd64/franja-worker"
 SA64="$ROOT/bin/static/arm64/franja-worker"
-VERSION=$("$ROOT/bin/franja-worker" --version)
+# The first line of --version is what hosts must agree on; the second
+# names the BVH walk the processor runs, which differs between them.
+VERSION=$("$ROOT/bin/franja-worker" --version | head -n 1)
 
 cross_refs "$T"
 
@@ -21,7 +23,7 @@ check "amd64 static worker built" test -x "$S64"
 check "amd64 static worker is x86-64" is_machine "$S64" "Advanced Micro Devices X86-64"
 check "amd64 static worker is static" is_static "$S64"
 check "amd64 static worker reports the same version" \
-    test "$("$S64" --version)" = "$VERSION"
+    test "$("$S64" --version | head -n 1)" = "$VERSION"
 "$S64" --scene "$T/scene.fbin" $SLAB -o "$T/s64.pf"
 check "amd64 static slab is byte-identical" cmp "$T/s64.pf" "$T/ref-fbin.pf"
 "$S64" --scene "$T/scene.fbin" $SLAB -o - >"$T/s64-stdout.pf"
@@ -32,7 +34,7 @@ check "arm64 static worker is AArch64" is_machine "$SA64" AArch64
 check "arm64 static worker is static" is_static "$SA64"
 # No -L: a static binary needs no arm64 libraries on this machine.
 check "arm64 static worker reports the same version under qemu" \
-    test "$("$QEMU" "$SA64" --version)" = "$VERSION"
+    test "$("$QEMU" "$SA64" --version | head -n 1)" = "$VERSION"
 "$QEMU" "$SA64" --scene "$T/scene.fbin" $SLAB -o "$T/sa64.pf"
 check "arm64 static slab under qemu is byte-identical" cmp "$T/sa64.pf" "$T/ref-fbin.pf"
 check "arm64 static worker validates the scene to the same hash" \
