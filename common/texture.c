@@ -234,6 +234,19 @@ vec3 tex_eval(const fr_scene *s, uint32_t ti, vec2 uv)
     return tex_eval_lod(s, ti, uv, 0.0f);
 }
 
+vec3 tex_eval_level(const fr_scene *s, uint32_t ti, vec2 uv, uint32_t level)
+{
+    const fr_texture *t = &s->textures[ti];
+    if (t->kind != FR_TEX_IMAGE || (level == 0 && t->filter == FR_FILTER_BILINEAR))
+        return tex_eval(s, ti, uv);
+    fr_texture b = *t;
+    b.filter = FR_FILTER_BILINEAR;
+    float u, v, c[3] = {0.0f, 0.0f, 0.0f};
+    to_texture_space(t, uv, &u, &v);
+    level_eval(s, &b, level < t->levels ? level : t->levels - 1, u, v, c);
+    return t->channels == 1 ? v3s(c[0]) : v3(c[0], c[1], c[2]);
+}
+
 float tex_lod(const fr_scene *s, uint32_t ti, const fr_surface *sf)
 {
     const fr_texture *t = &s->textures[ti];

@@ -28,6 +28,12 @@
  * level 0; a one-channel texture gives its value in all three. */
 vec3 tex_eval(const fr_scene *s, uint32_t t, vec2 uv);
 
+/** RGB value of texture `t` at uv read bilinearly from mip level `level`
+ * (the last level past it), whatever t's filter; a checker's colour.  For
+ * means over a region at compile time (freeze_light.c): a level whose
+ * texels are a fraction of the region's size smooths it no more than that. */
+vec3 tex_eval_level(const fr_scene *s, uint32_t t, vec2 uv, uint32_t level);
+
 /** The level of detail at which texture t is looked up at surface *sf:
  * log2 of the number of level-0 texels that its footprint spans, measured
  * isotropically (footprint times the square root of texels per unit of

@@ -4,14 +4,18 @@
  * for bit; a scene of one light renders the same bits with the tree and
  * with the power table; a lamp-lit ground converges to the same mean with
  * and without the tree, and with much less noise with it; a furnace of
- * emissive triangles gives its closed form. */
+ * emissive triangles gives its closed form; the triangles of a mostly
+ * black textured screen are picked by the light on them. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bsdf.h"
 #include "check.h"
+#include "compile/freeze.h"
+#include "compile/texstore.h"
 #include "estimate.h"
 #include "light.h"
 #include "pathtrace.h"
@@ -332,6 +336,137 @@ static void furnace(void)
     scn_free(&s);
 }
 
+/* A screen split into 16 x 16 squares of two triangles, facing down 1 above
+ * a Lambert floor, its emission texture (64 x 64, clamped) black but for
+ * the 4 x 4 texels of its corner u < 1/16, v > 15/16: the triangles of the
+ * screen's corner square (with those beside it, where the bilinear lookup
+ * spills half a texel) take nearly all the pick probability, black ones
+ * next to none but never 0; the floor's mean is the same with the tree, the
+ * power table, and the power table with picks in proportion to area (as
+ * if the screen were lit all over), with far less noise than the last.
+ * `sampling`: 0 tree, 1 power table, 2 picks by area. */
+static int textured_screen_scene(int sampling, fr_scene *s)
+{
+    fr_builder b;
+    bld_init(&b);
+    b.settings = (fr_settings){.width = 16, .height = 16, .spp = 1, .max_depth = 1};
+    b.no_light_tree = sampling != 0;
+    b.camera.position = v3(0, 0.6f, -4.5f);
+    b.camera.target = v3(0, 0, 0.5f);
+    b.camera.up = v3(0, 1, 0);
+    b.camera.vfov = 0.9f;
+    b.camera.focus = 5;
+    float *px = calloc(64 * 64, sizeof *px);
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++)
+            px[y * 64 + x] = 1.0f;     /* rows from the top: v > 15/16 */
+    scene_image img;
+    memset(&img, 0, sizeof img);
+    img.pixels = px;
+    img.width = img.height = 64;
+    img.channels = 1;
+    img.type = SCENE_PIX_F32;
+    fr_texture t;
+    memset(&t, 0, sizeof t);
+    t.kind = FR_TEX_IMAGE;
+    t.wrap = FR_WRAP_CLAMP;
+    t.scale = (vec2){1, 1};
+    fr_error err;
+    int rc = texstore_image(&b, &img, 0, &t, "screen", &err);
+    free(px);
+    if (rc == 0) {
+        bld_push(&b.textures, &t);
+        fr_material floor, screen;
+        bld_material_init(&floor);
+        floor.diffuse = v3s(0.5f);
+        bsdf_material_finish(&floor);
+        bld_material_init(&screen);
+        screen.emission = v3s(40.0f);
+        screen.tex_emission = 0;
+        bld_push(&b.materials, &floor);
+        bld_push(&b.materials, &screen);
+        bld_rect(&b, v3(-4, 0, -4), v3(0, 0, 8), v3(8, 0, 0), 0);
+        for (int j = 0; j < 16; j++)
+            for (int i = 0; i < 16; i++) {
+                float x0 = -2 + i * 0.25f, z0 = -2 + j * 0.25f, u0 = i / 16.0f, v0 = j / 16.0f, d = 1 / 16.0f;
+                /* Wound to face down: (x, z) -> (x + d, z) -> (x, z + d). */
+                const vec3 p1[3] = {{x0, 1, z0}, {x0 + 0.25f, 1, z0}, {x0, 1, z0 + 0.25f}};
+                const vec2 t1[3] = {{u0, v0}, {u0 + d, v0}, {u0, v0 + d}};
+                const vec3 p2[3] = {{x0 + 0.25f, 1, z0}, {x0 + 0.25f, 1, z0 + 0.25f}, {x0, 1, z0 + 0.25f}};
+                const vec2 t2[3] = {{u0 + d, v0}, {u0 + d, v0 + d}, {u0, v0 + d}};
+                bld_triangle_uv(&b, p1, t1, 1);
+                bld_triangle_uv(&b, p2, t2, 1);
+            }
+        rc = frz_scene(&b, s, &err);
+    }
+    bld_free(&b);
+    CHECK(rc == 0, "textured screen: %s", rc ? err.msg : "");
+    if (rc < 0)
+        return -1;
+    if (sampling == 2) {
+        /* The power table by area alone: the blob is the test's own memory. */
+        fr_light *l = (fr_light *)s->lights;
+        double total = 0, acc = 0;
+        for (uint32_t i = 0; i < s->n_lights; i++)
+            total += l[i].area;
+        for (uint32_t i = 0; i < s->n_lights; i++) {
+            acc += l[i].area / total;
+            l[i].pick = (float)(l[i].area / total);
+            l[i].cdf = i + 1 == s->n_lights ? 1.0f : (float)acc;
+        }
+    }
+    return 0;
+}
+
+static void textured_screen(void)
+{
+    fr_scene tree, power, area;
+    if (textured_screen_scene(0, &tree) < 0)
+        return;
+    if (textured_screen_scene(1, &power) < 0 || textured_screen_scene(2, &area) < 0) {
+        scn_free(&tree);
+        return;
+    }
+    /* Picks of the triangles of the corner square, of the three squares
+     * beside it, and the least and most of the rest. */
+    double corner = 0, beside = 0, least = 1, most = 0;
+    for (uint32_t i = 0; i < power.n_lights; i++) {
+        const fr_triangle *tr = &power.triangles[power.prims[power.lights[i].prim].index];
+        float u = 0, v = 0;
+        for (int q = 0; q < 3; q++)
+            u += power.uvs[tr->v[q]].u / 3, v += power.uvs[tr->v[q]].v / 3;
+        double pk = power.lights[i].pick;
+        if (u < 1 / 16.0f && v > 15 / 16.0f)
+            corner += pk;
+        else if (u < 2 / 16.0f && v > 14 / 16.0f)
+            beside += pk;
+        else
+            least = fmin(least, pk), most = fmax(most, pk);
+    }
+    printf("textured screen of %u triangles: picks of the lit corner's 2 %.5f, of the 6 beside it %.5f, of each "
+           "other %.3g to %.3g\n", power.n_lights, corner, beside, least, most);
+    CHECK(power.n_lights == 512 && corner > 0.9 && corner + beside > 0.99,
+          "textured screen: the lit corner's triangles have %.4f of the picks (with those beside it %.4f)", corner,
+          corner + beside);
+    CHECK(least > 0 && most < 1e-4, "textured screen: a black triangle's pick %g to %g, expected in (0, 1e-4)", least,
+          most);
+    /* The lower half of the image: the floor alone (the camera looks down). */
+    estimate et = est_region(&tree, PT_MIS, 256, 0, 16, 8, 16), ep = est_region(&power, PT_MIS, 256, 0, 16, 8, 16),
+             ea = est_region(&area, PT_MIS, 256, 0, 16, 8, 16);
+    printf("textured screen, floor's mean: tree %.5f +- %.5f, power table %.5f +- %.5f, picks by area %.5f +- %.5f\n",
+           et.mean, et.se, ep.mean, ep.se, ea.mean, ea.se);
+    double d1 = fabs(et.mean - ep.mean), s1 = hypot(et.se, ep.se), d2 = fabs(ep.mean - ea.mean), s2 = hypot(ep.se, ea.se);
+    CHECK(et.mean > 0 && d1 < 4 * s1 && d2 < 4 * s2,
+          "textured screen: tree %.5f, power table %.5f, by area %.5f (+- %.5f %.5f %.5f)", et.mean, ep.mean, ea.mean,
+          et.se, ep.se, ea.se);
+    CHECK(ep.se * 4 < ea.se && et.se * 4 < ea.se,
+          "textured screen: standard error %.5f (tree), %.5f (power table), %.5f by area: not 4 times less", et.se,
+          ep.se, ea.se);
+    scn_free(&tree);
+    scn_free(&power);
+    scn_free(&area);
+}
+
 int main(void)
 {
     pick_probabilities();
@@ -340,5 +475,6 @@ int main(void)
     lamp_sums();
     lamp_ground();
     furnace();
+    textured_screen();
     return check_done();
 }

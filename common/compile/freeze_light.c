@@ -170,60 +170,146 @@ static int env_tables(fr_builder *b, double *integral, fr_error *err)
     return rc;
 }
 
-/* Luminance of material m's emission at texture coordinates uv. */
-static double emission_at(const fr_scene *view, const fr_material *m, vec2 uv)
+/* What the weights of textured emitters share: a view of the builder's
+ * textures for lookups, and each texture's mean value (computed once). */
+typedef struct {
+    fr_scene view;
+    vec3 *mean;                /* per texture; x < 0 until computed */
+} emit_ctx;
+
+/* A textured emitter's weight is at least this fraction of its colour
+ * times its texture's mean over all its texels: never 0 where the texture
+ * is not black everywhere, whatever the estimate over the primitive says
+ * (its points may miss a lit texel), so next-event estimation stays
+ * unbiased; small enough that a black part of a screen takes next to
+ * nothing from the lit part. */
+#define EMIT_FLOOR 1e-3
+
+/* Texture ti's mean value, each channel clamped at 0 as tex_emission
+ * clamps it: over its level-0 texels, or a checker's two colours. */
+static vec3 texture_mean(emit_ctx *c, uint32_t ti)
 {
-    return v3_luma(tex_emission(view, m, uv));
+    if (c->mean[ti].x >= 0.0f)
+        return c->mean[ti];
+    const fr_texture *t = &c->view.textures[ti];
+    double sum[3] = {0.0, 0.0, 0.0};
+    if (t->kind == FR_TEX_CHECKER) {
+        vec3 a = v3_vmax(t->color0, v3s(0.0f)), b = v3_vmax(t->color1, v3s(0.0f));
+        sum[0] = 0.5 * ((double)a.x + b.x), sum[1] = 0.5 * ((double)a.y + b.y), sum[2] = 0.5 * ((double)a.z + b.z);
+    } else {
+        for (uint32_t y = 0; y < t->height; y++)
+            for (uint32_t x = 0; x < t->width; x++) {
+                float p[3];
+                tex_texel(c->view.texels, t, 0, x, y, p);
+                for (uint32_t k = 0; k < 3; k++) {
+                    float v = p[t->channels == 3 ? k : 0];
+                    sum[k] += v > 0.0f ? v : 0.0;
+                }
+            }
+        double n = (double)t->width * t->height;
+        for (int k = 0; k < 3; k++)
+            sum[k] /= n;
+    }
+    c->mean[ti] = v3((float)sum[0], (float)sum[1], (float)sum[2]);
+    return c->mean[ti];
 }
 
-/* Mean luminance of the emission of primitive p (material m) for its
- * power: the emission colour, times its texture's mean over a few points
- * of the primitive (the corners, edge midpoints and centre of a triangle,
- * a 3 x 3 grid on a rectangle), blended with a tenth of the texture's
- * mean over its whole square so that no textured light gets no power. */
-static double emission_luma(const fr_builder *b, const fr_prim *p, const fr_material *m)
+/* Length in level-0 texels of a step d in uv across texture t (a checker
+ * counts two texels a square). */
+static double texels_along(const fr_texture *t, vec2 d)
+{
+    double w = t->kind == FR_TEX_IMAGE ? t->width : 2.0, h = t->kind == FR_TEX_IMAGE ? t->height : 2.0;
+    double x = (double)d.u * t->scale.u * w, y = (double)d.v * t->scale.v * h;
+    return sqrt(x * x + y * y);
+}
+
+/* How a primitive whose longest uv edge spans e level-0 texels of t is
+ * integrated: from the first mip level on which that edge spans at most 16
+ * texels (the last level if none), on a k-by-k grid with about two points
+ * a texel of that level along the edge (k from 4 to 32). */
+static int grid_for(const fr_texture *t, double e, uint32_t *level)
+{
+    uint32_t l = 0, levels = t->kind == FR_TEX_IMAGE ? t->levels : 1;
+    while (e > 16.0 && l + 1 < levels) {
+        e *= 0.5;
+        l++;
+    }
+    *level = l;
+    double k = ceil(2.0 * e);
+    return !(k > 4.0) ? 4 : k > 32.0 ? 32 : (int)k;
+}
+
+/* Luminance of material m's emission at uv, read from mip level `level`. */
+static double emission_at(const emit_ctx *c, const fr_material *m, vec2 uv, uint32_t level)
+{
+    vec3 v = v3_vmax(tex_eval_level(&c->view, m->tex_emission, uv, level), v3s(0.0f));
+    return v3_luma(v3_mul(m->emission, v));
+}
+
+/* Mean luminance of the emission of primitive p (material m), for its
+ * power: the emission colour times its texture's mean over the primitive,
+ * integrated on a grid fine enough for the mip level read (grid_for): a
+ * triangle cut into k x k equal triangles, read at their centroids; a
+ * rectangle's k x k cells; a sphere's (u, v) square, 2k x k cells weighted
+ * by sin(pi v), its area there.  Never below EMIT_FLOOR of the texture's
+ * mean over all its texels. */
+static double emission_luma(emit_ctx *c, const fr_builder *b, const fr_prim *p, const fr_material *m)
 {
     if (m->tex_emission == FR_NONE)
         return v3_luma(m->emission);
-    fr_scene view;
-    memset(&view, 0, sizeof view);
-    view.textures = b->textures.data;
-    view.n_textures = b->textures.count;
-    view.texels = b->texels.data;
-    view.n_texels = b->texels.count;
-    double global = 0.0, local = 0.0;
-    for (int j = 0; j < 8; j++)
-        for (int i = 0; i < 8; i++)
-            global += emission_at(&view, m, (vec2){((float)i + 0.5f) / 8.0f, ((float)j + 0.5f) / 8.0f}) / 64.0;
+    const fr_texture *t = (const fr_texture *)b->textures.data + m->tex_emission;
+    double floor_ = EMIT_FLOOR * v3_luma(v3_mul(m->emission, texture_mean(c, m->tex_emission)));
+    double sum = 0.0, weight = 0.0;
+    uint32_t level;
     if (p->kind == FR_PRIM_TRIANGLE) {
-        /* Barycentric points (b1, b2); uv as trace_surface computes it. */
-        static const float pts[7][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5f, 0}, {0, 0.5f}, {0.5f, 0.5f}, {1.0f / 3, 1.0f / 3}};
-        const fr_triangle *t = (const fr_triangle *)b->triangles.data + p->index;
-        const vec2 *uvs = b->uvs.data;
-        for (int k = 0; k < 7; k++) {
-            float b1 = pts[k][0], b2 = pts[k][1], b0 = 1.0f - b1 - b2;
-            vec2 uv = {b1, b2};
-            if (t->flags & FR_TRI_UVS)
-                uv = (vec2){b0 * uvs[t->v[0]].u + b1 * uvs[t->v[1]].u + b2 * uvs[t->v[2]].u,
-                            b0 * uvs[t->v[0]].v + b1 * uvs[t->v[1]].v + b2 * uvs[t->v[2]].v};
-            local += emission_at(&view, m, uv) / 7.0;
+        const fr_triangle *tri = (const fr_triangle *)b->triangles.data + p->index;
+        vec2 uv[3] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}};   /* barycentrics when it has none */
+        if (tri->flags & FR_TRI_UVS)
+            for (int q = 0; q < 3; q++)
+                uv[q] = ((const vec2 *)b->uvs.data)[tri->v[q]];
+        double e = 0.0;
+        for (int q = 0; q < 3; q++) {
+            double l = texels_along(t, (vec2){uv[(q + 1) % 3].u - uv[q].u, uv[(q + 1) % 3].v - uv[q].v});
+            e = l > e ? l : e;
         }
-    } else if (p->kind == FR_PRIM_RECT) {
-        for (int j = 0; j < 3; j++)
-            for (int i = 0; i < 3; i++)
-                local += emission_at(&view, m, (vec2){((float)i + 0.5f) / 3.0f, ((float)j + 0.5f) / 3.0f}) / 9.0;
-    } else {
-        local = global;
+        int k = grid_for(t, e, &level);
+        /* Up triangles (i, j), (i + 1, j), (i, j + 1) of the lattice and
+         * down ones (i + 1, j), (i, j + 1), (i + 1, j + 1): centroids at
+         * (3i + 1, 3j + 1) / 3k and (3i + 2, 3j + 2) / 3k. */
+        for (int i = 0; i < k; i++)
+            for (int j = 0; i + j < k; j++)
+                for (int d = 1; d <= 2; d++) {
+                    if (d == 2 && i + j + 2 > k)
+                        continue;
+                    float b1 = (float)(3 * i + d) / (float)(3 * k), b2 = (float)(3 * j + d) / (float)(3 * k);
+                    float b0 = 1.0f - b1 - b2;
+                    vec2 at = {b0 * uv[0].u + b1 * uv[1].u + b2 * uv[2].u, b0 * uv[0].v + b1 * uv[1].v + b2 * uv[2].v};
+                    sum += emission_at(c, m, at, level);
+                    weight += 1.0;
+                }
+    } else if (p->kind == FR_PRIM_RECT || p->kind == FR_PRIM_SPHERE) {
+        int sphere = p->kind == FR_PRIM_SPHERE;
+        double eu = texels_along(t, (vec2){1.0f, 0.0f}), ev = texels_along(t, (vec2){0.0f, 1.0f});
+        int k = grid_for(t, eu > ev ? eu : ev, &level), ku = sphere ? 2 * k : k;
+        for (int j = 0; j < k; j++) {
+            float v = ((float)j + 0.5f) / (float)k;
+            double w = sphere ? fm_sinf(FM_PI * v) : 1.0;
+            for (int i = 0; i < ku; i++) {
+                sum += w * emission_at(c, m, (vec2){((float)i + 0.5f) / (float)ku, v}, level);
+                weight += w;
+            }
+        }
     }
-    return 0.9 * local + 0.1 * global;
+    double mean = weight > 0.0 ? sum / weight : 0.0;
+    return mean > floor_ ? mean : floor_;
 }
 
 /* Power (W, as the light's units make it) that frz_lights gives light l
  * for its pick probability, for lights other than the environment.  An
- * area light with an emission texture counts the texture's mean over a
- * few points of its primitive (nine tenths) and over the whole texture
- * (one tenth), so every emitter keeps some chance of being picked. */
-static double frz_light_power(const fr_builder *b, const fr_light *l)
+ * area light with an emission texture counts the texture's mean over its
+ * primitive (emission_luma), with a floor that keeps every emitter some
+ * chance of being picked. */
+static double frz_light_power(emit_ctx *c, const fr_builder *b, const fr_light *l)
 {
     double r2 = (double)b->world.radius * b->world.radius, y = v3_luma(l->intensity);
     switch (l->kind) {
@@ -241,7 +327,7 @@ static double frz_light_power(const fr_builder *b, const fr_light *l)
         const fr_prim *p = (const fr_prim *)b->prims.data + l->prim;
         const fr_material *m = (const fr_material *)b->materials.data + p->material;
         /* In double: emission and area may each be near the float limit. */
-        return FM_PI * emission_luma(b, p, m) * l->area * (m->two_sided ? 2.0 : 1.0);
+        return FM_PI * emission_luma(c, b, p, m) * l->area * (m->two_sided ? 2.0 : 1.0);
     }
     default:
         return 0.0;
@@ -313,10 +399,24 @@ int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
     double total = 0.0, *power = malloc((b->lights.count + 1) * sizeof *power);
     if (!power)
         return fr_fail(err, "out of memory for lights");
+    emit_ctx ec;
+    memset(&ec, 0, sizeof ec);
+    ec.view.textures = b->textures.data;
+    ec.view.n_textures = b->textures.count;
+    ec.view.texels = b->texels.data;
+    ec.view.n_texels = b->texels.count;
+    ec.mean = malloc((b->textures.count + 1) * sizeof *ec.mean);
+    if (!ec.mean) {
+        free(power);
+        return fr_fail(err, "out of memory for lights");
+    }
+    for (uint32_t i = 0; i < b->textures.count; i++)
+        ec.mean[i] = v3s(-1.0f);
     for (uint32_t i = 0; i < b->lights.count; i++) {
-        power[i] = lights[i].kind == FR_LIGHT_ENV ? env_power : frz_light_power(b, &lights[i]);
+        power[i] = lights[i].kind == FR_LIGHT_ENV ? env_power : frz_light_power(&ec, b, &lights[i]);
         total += power[i];
     }
+    free(ec.mean);
     double acc = 0.0;
     for (uint32_t i = 0; i < b->lights.count; i++) {
         double p = total > 0.0 ? power[i] / total : 1.0 / b->lights.count;
