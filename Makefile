@@ -62,7 +62,7 @@ BENCH_SRC   = $(wildcard tests/bench/*.c)
 BENCH_BIN   = $(BENCH_SRC:tests/bench/%.c=bin/bench/%)
 LIB         = $(B)/libfranja.a
 
-WORKER_LIBS = $(CJSON_LIBS) $(ZSTD_LIBS) -lm
+WORKER_LIBS = $(CJSON_LIBS) $(ZSTD_LIBS) -lm -pthread
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) $(ZSTD_LIBS) -ldl -lm -pthread
 
 .PHONY: all deps bench-deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
