@@ -62,6 +62,10 @@ typedef struct {
      * builder, and count what they read and build against it.  May be
      * NULL: no limits. */
     fr_budget *budget;
+    /** Where the readers write the binary scene (freeze.h's
+     * frz_scene_file: the builder freed before the file is mapped back),
+     * or NULL: it is made in memory (frz_scene). */
+    const char *fbin;
 } scene_hooks;
 
 #endif
