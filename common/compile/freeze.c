@@ -3,6 +3,7 @@
 
 #include "compile/freeze.h"
 
+#include <malloc.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -161,6 +162,10 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
 int frz_scene_file(fr_builder *b, const char *path, fr_scene *out, fr_error *err)
 {
     memset(out, 0, sizeof *out);
+    /* What the readers freed (mesh files, their parsed arrays) goes back
+     * to the system before the BVH's working memory is taken, and the
+     * builder's before the file is mapped: else it stays the process's. */
+    malloc_trim(0);
     frozen f;
     fr_scene view;
     int rc = prepare(b, &f, &view, err);
@@ -170,6 +175,7 @@ int frz_scene_file(fr_builder *b, const char *path, fr_scene *out, fr_error *err
         rc = fbin_write_view(&view, path, &hash, &size, err);
     frozen_free(&f);
     bld_free(b);
+    malloc_trim(0);
     /* Checked as a worker will check it, from the file. */
     if (rc == 0)
         rc = fbin_load(path, out, err);
