@@ -94,41 +94,113 @@ static const void *sec_data(const fr_scene *s, int id, uint64_t *count)
 
 void fbin_hash_hex(uint64_t hash, char buf[17]) { snprintf(buf, 17, "%016llx", (unsigned long long)hash); }
 
-int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err)
+/* The bytes before the first section: header (hash still zero) and
+ * table, then zeros to the first section's alignment. */
+enum { HEAD_SIZE = (HEADER_SIZE + ENTRY_SIZE * SEC_COUNT + ALIGN - 1) & ~(ALIGN - 1) };
+
+/* Lays the sections of `view` out: head[HEAD_SIZE] filled, offsets[id]
+ * the byte of each section; returns the file's size. */
+static size_t layout(const fr_scene *view, unsigned char head[HEAD_SIZE], size_t offsets[SEC_COUNT + 1])
 {
-    if (*(const uint32_t *)"\1\0\0\0" != 1)
-        return fr_fail(err, "binary scenes are little-endian; this host is not");
-    size_t off = align_up(HEADER_SIZE + (size_t)ENTRY_SIZE * SEC_COUNT);
-    size_t offsets[SEC_COUNT + 1];
+    size_t off = HEAD_SIZE;
+    memset(head, 0, HEAD_SIZE);
     for (int id = 1; id <= SEC_COUNT; id++) {
         uint64_t count;
         sec_data(view, id, &count);
         offsets[id] = off;
+        unsigned char *e = head + HEADER_SIZE + (size_t)ENTRY_SIZE * (id - 1);
+        put32(e, (uint32_t)id);
+        put32(e + 4, sections[id].elem);
+        put64(e + 8, off);
+        put64(e + 16, count);
+        put64(e + 24, count * sections[id].elem);
         off = align_up(off + count * sections[id].elem);
     }
+    memcpy(head, fbin_magic, 8);
+    put32(head + 8, FBIN_VERSION);
+    put32(head + 12, 0x01020304u);
+    put32(head + 16, HEADER_SIZE);
+    put32(head + 20, SEC_COUNT);
+    put64(head + 24, off);
+    return off;
+}
+
+static int little_endian(fr_error *err)
+{
+    if (*(const uint32_t *)"\1\0\0\0" != 1)
+        return fr_fail(err, "binary scenes are little-endian; this host is not");
+    return 0;
+}
+
+int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err)
+{
+    if (little_endian(err) < 0)
+        return -1;
+    unsigned char head[HEAD_SIZE];
+    size_t offsets[SEC_COUNT + 1];
+    size_t off = layout(view, head, offsets);
     unsigned char *p = calloc(1, off);
     if (!p)
         return fr_fail(err, "out of memory serializing the scene (%zu bytes)", off);
-    memcpy(p, fbin_magic, 8);
-    put32(p + 8, FBIN_VERSION);
-    put32(p + 12, 0x01020304u);
-    put32(p + 16, HEADER_SIZE);
-    put32(p + 20, SEC_COUNT);
-    put64(p + 24, off);
+    memcpy(p, head, HEAD_SIZE);
     for (int id = 1; id <= SEC_COUNT; id++) {
         uint64_t count;
         const void *data = sec_data(view, id, &count);
-        unsigned char *e = p + HEADER_SIZE + (size_t)ENTRY_SIZE * (id - 1);
-        put32(e, (uint32_t)id);
-        put32(e + 4, sections[id].elem);
-        put64(e + 8, offsets[id]);
-        put64(e + 16, count);
-        put64(e + 24, count * sections[id].elem);
         if (count)
             memcpy(p + offsets[id], data, count * sections[id].elem);
     }
     put64(p + 32, XXH3_64bits(p + HEADER_SIZE, off - HEADER_SIZE));
     *blob = p;
+    *size = off;
+    return 0;
+}
+
+int fbin_write_view(const fr_scene *view, const char *path, uint64_t *hash, size_t *size, fr_error *err)
+{
+    if (little_endian(err) < 0)
+        return -1;
+    static const unsigned char zeros[ALIGN];
+    unsigned char head[HEAD_SIZE];
+    size_t offsets[SEC_COUNT + 1];
+    size_t off = layout(view, head, offsets);
+    /* The hash first (the header holds it), over the bytes the file will
+     * hold: XXH3's streaming form gives the one-shot value. */
+    XXH3_state_t *st = XXH3_createState();
+    if (!st || XXH3_64bits_reset(st) != XXH_OK) {
+        XXH3_freeState(st);
+        return fr_fail(err, "%s: out of memory hashing the scene", path);
+    }
+    XXH3_64bits_update(st, head + HEADER_SIZE, HEAD_SIZE - HEADER_SIZE);
+    for (int id = 1; id <= SEC_COUNT; id++) {
+        uint64_t count;
+        const void *data = sec_data(view, id, &count);
+        size_t bytes = count * sections[id].elem, end = id < SEC_COUNT ? offsets[id + 1] : off;
+        if (bytes)
+            XXH3_64bits_update(st, data, bytes);
+        XXH3_64bits_update(st, zeros, end - offsets[id] - bytes);
+    }
+    uint64_t h = XXH3_64bits_digest(st);
+    XXH3_freeState(st);
+    put64(head + 32, h);
+    file_out o;
+    if (file_out_open(path, &o, err))
+        return -1;
+    int rc = file_out_write(&o, head, HEAD_SIZE, err);
+    for (int id = 1; id <= SEC_COUNT && rc == 0; id++) {
+        uint64_t count;
+        const void *data = sec_data(view, id, &count);
+        size_t bytes = count * sections[id].elem, end = id < SEC_COUNT ? offsets[id + 1] : off;
+        rc = file_out_write(&o, data, bytes, err);
+        if (rc == 0)
+            rc = file_out_write(&o, zeros, end - offsets[id] - bytes, err);
+    }
+    if (rc) {
+        file_out_abort(&o);
+        return -1;
+    }
+    if (file_out_commit(&o, path, err))
+        return -1;
+    *hash = h;
     *size = off;
     return 0;
 }

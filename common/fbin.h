@@ -25,6 +25,12 @@
  * the caller) and compute its hash. */
 int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err);
 
+/** Write the bytes fbin_serialize would make of `view` (the same file,
+ * the same hash) to `path`, section by section from the arrays `view`
+ * points at, never holding them twice: atomically (file.h's file_out: a
+ * temporary name, then rename).  *hash and *size: the file's. */
+int fbin_write_view(const fr_scene *view, const char *path, uint64_t *hash, size_t *size, fr_error *err);
+
 /** Validate `blob` (16-byte aligned, as malloc and mmap give) and point *out
  * into it.  On success *out owns the blob (freed or unmapped by scn_free
  * according to `mapped`); on failure the caller still owns it. */

@@ -57,7 +57,7 @@ static int scene_binary(const frame_settings *a, const char *jobdir, char *path,
      * keeps any other compile out of this directory. */
     compile_child_sweep(path);
     /* In a child process, so that Ctrl-C stops a long compile at once. */
-    compile_opts co = {a->camera, print_warning, (void *)"franja", a->allow, a->n_allow, &a->limits};
+    compile_opts co = {a->camera, print_warning, (void *)"franja", a->allow, a->n_allow, &a->limits, NULL};
     if (compile_child(a->scene, &co, path, stop, NULL, err))
         return -1;
     return fbin_load(path, sc, err);

@@ -3,6 +3,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -96,8 +97,8 @@ extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type ty
 }
 
 // Reads the first image of an opened input into *pixels (see iio_read).
-static int read_open(ImageInput *in, const char *name, void **pixels, iio_type *type, uint32_t *width,
-                     uint32_t *height, uint32_t *channels, fr_error *err)
+static int read_open(ImageInput *in, const char *name, const iio_dest *dest, void **pixels, iio_type *type,
+                     uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     const ImageSpec &spec = in->spec();
     uint64_t n = (uint64_t)spec.width * (uint64_t)spec.height * (uint64_t)spec.nchannels;
@@ -116,25 +117,50 @@ static int read_open(ImageInput *in, const char *name, void **pixels, iio_type *
     } else if (spec.format.basetype == TypeDesc::HALF) {
         td = TypeDesc::HALF, t = IIO_F16, size = 2;
     }
-    void *px = malloc(n * size);
+    // The caller's place (only the channels it keeps), else malloc'd.
+    uint32_t keep = (uint32_t)spec.nchannels;
+    void *px = dest && dest->at ? dest->at(dest, (uint32_t)spec.width, (uint32_t)spec.height, keep, t, &keep)
+                                : nullptr;
+    bool own = !px;
+    if (own) {
+        keep = (uint32_t)spec.nchannels;
+        px = malloc(n * size);
+    } else if (keep < 1 || keep > (uint32_t)spec.nchannels) {
+        return fr_fail(err, "%s: asked to keep %u of %d channels", name, keep, spec.nchannels);
+    }
     if (!px)
         return fr_fail(err, "%s: out of memory for %llu values", name, (unsigned long long)n);
-    bool ok;
+    bool ok = true;
     try {
-        ok = in->read_image(0, 0, 0, spec.nchannels, td, px);
+        if (spec.tile_width > 0) {
+            ok = in->read_image(0, 0, 0, (int)keep, td, px);
+        } else {
+            // Scanline files a few MiB of rows at a time: read_image
+            // would decode the whole image into a buffer of its own
+            // first, a second copy.
+            size_t row = (size_t)spec.width * keep * size;
+            int chunk = (int)std::max<size_t>(1, ((size_t)4 << 20) / row);
+            for (int y = 0; y < spec.height && ok; y += chunk) {
+                int end = std::min(spec.height, y + chunk);
+                ok = in->read_scanlines(0, 0, spec.y + y, spec.y + end, spec.z, 0, (int)keep, td,
+                                        (char *)px + (size_t)y * row);
+            }
+        }
     } catch (...) {
-        free(px);
+        if (own)
+            free(px);
         throw;
     }
     if (!ok) {
-        free(px);
+        if (own)
+            free(px);
         return fr_fail(err, "%s: %s", name, in->geterror().c_str());
     }
     *pixels = px;
     *type = t;
     *width = (uint32_t)spec.width;
     *height = (uint32_t)spec.height;
-    *channels = (uint32_t)spec.nchannels;
+    *channels = keep;
     return 0;
 }
 
@@ -143,8 +169,8 @@ static int read_open(ImageInput *in, const char *name, void **pixels, iio_type *
 // reader is chosen by the extension of `name`; a reader without I/O proxy
 // support (older OpenImageIO) reads a private memory file through
 // /proc/self/fd instead.
-extern "C" int iio_read(const char *name, const void *data, size_t len, void **pixels, iio_type *type,
-                        uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
+extern "C" int iio_read(const char *name, const void *data, size_t len, const iio_dest *dest, void **pixels,
+                        iio_type *type, uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     *pixels = nullptr;
     const char *dot = strrchr(name, '.'), *slash = strrchr(name, '/');
@@ -183,7 +209,7 @@ extern "C" int iio_read(const char *name, const void *data, size_t len, void **p
         }
         if (!ok)
             (void)in->geterror(); // the reader's words may quote the bytes: cleared, not shown
-        int rc = ok ? read_open(in.get(), name, pixels, type, width, height, channels, err)
+        int rc = ok ? read_open(in.get(), name, dest, pixels, type, width, height, channels, err)
                     : fr_fail(err, "%s: not a readable %s image", name, ext.c_str());
         in.reset();
         if (fd >= 0)
@@ -198,8 +224,8 @@ extern "C" int iio_read(const char *name, const void *data, size_t len, void **p
     }
 }
 
-extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, void **pixels, iio_type *type,
-                            uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
+extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, const iio_dest *dest, void **pixels,
+                            iio_type *type, uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     *pixels = nullptr;
     // The format by its signature first (a MIME type may be wrong), then
@@ -221,7 +247,7 @@ extern "C" int iio_read_mem(const void *data, size_t len, const char *mime, void
         std::unique_ptr<ImageInput> in = ImageInput::open(name, nullptr, &mem);
         if (!in)
             return fr_fail(err, "embedded %s image: %s", name + 9, OIIO::geterror().c_str());
-        return read_open(in.get(), "embedded image", pixels, type, width, height, channels, err);
+        return read_open(in.get(), "embedded image", dest, pixels, type, width, height, channels, err);
     } catch (const std::exception &e) {
         free(*pixels);
         *pixels = nullptr;

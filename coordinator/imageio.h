@@ -45,23 +45,34 @@ typedef struct {
 int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_t width, uint32_t height,
                     const iio_options *o, unsigned char **data, size_t *len, fr_error *err);
 
+/** Where iio_read may decode an image instead of malloc'ing it. */
+typedef struct iio_dest {
+    /** Called once the image's size, channels and type are known: where
+     * to decode it, keeping the first *keep (1 to channels) channels of
+     * each pixel, or NULL: malloc it whole. */
+    void *(*at)(const struct iio_dest *d, uint32_t width, uint32_t height, uint32_t channels, iio_type type,
+                uint32_t *keep);
+} iio_dest;
+
 /** Decodes the first image of the file `name`, whose `len` bytes the
  * caller has read into `data` (OpenImageIO opens no file: the reader is
- * chosen by name's extension), at its own precision: *pixels (malloc'd,
- * the caller frees) holds width*height*channels values of *type, top row
- * first, as stored (no colour conversion): 8-bit files as IIO_U8, 16-bit
- * ones as IIO_U16, half-float ones as IIO_F16, every other type (float,
- * 32-bit integers ...) as IIO_F32 (integers scaled to [0, 1]).  Fails for
- * an unknown extension, undecodable bytes (without quoting them) and
+ * chosen by name's extension), at its own precision: *pixels holds
+ * width*height*channels values of *type, top row first, as stored (no
+ * colour conversion): 8-bit files as IIO_U8, 16-bit ones as IIO_U16,
+ * half-float ones as IIO_F16, every other type (float, 32-bit integers
+ * ...) as IIO_F32 (integers scaled to [0, 1]).  *pixels is where `dest`
+ * said (dest NULL, or its `at` NULL: malloc'd, the caller frees), and
+ * *channels then the channels kept; on failure *pixels is NULL.  Fails
+ * for an unknown extension, undecodable bytes (without quoting them) and
  * images over 2^29 values. */
-int iio_read(const char *name, const void *data, size_t len, void **pixels, iio_type *type, uint32_t *width,
-             uint32_t *height, uint32_t *channels, fr_error *err);
+int iio_read(const char *name, const void *data, size_t len, const iio_dest *dest, void **pixels, iio_type *type,
+             uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err);
 
 /** Reads an image held in memory (`len` bytes of a PNG or JPEG file, told
  * apart by their signatures, else by `mime`) as iio_read does a file.
  * Fails for other formats and for undecodable bytes. */
-int iio_read_mem(const void *data, size_t len, const char *mime, void **pixels, iio_type *type, uint32_t *width,
-                 uint32_t *height, uint32_t *channels, fr_error *err);
+int iio_read_mem(const void *data, size_t len, const char *mime, const iio_dest *dest, void **pixels,
+                 iio_type *type, uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err);
 
 /** Returns 1 if OpenImageIO has a writer for the file name's extension. */
 int iio_can_write(const char *path);

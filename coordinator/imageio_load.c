@@ -23,10 +23,10 @@
 
 typedef int (*encode_fn)(const char *, const void *, iio_type, uint32_t, uint32_t, const iio_options *,
                          unsigned char **, size_t *, fr_error *);
-typedef int (*read_fn)(const char *, const void *, size_t, void **, iio_type *, uint32_t *, uint32_t *, uint32_t *,
-                       fr_error *);
-typedef int (*read_mem_fn)(const void *, size_t, const char *, void **, iio_type *, uint32_t *, uint32_t *,
-                           uint32_t *, fr_error *);
+typedef int (*read_fn)(const char *, const void *, size_t, const iio_dest *, void **, iio_type *, uint32_t *,
+                       uint32_t *, uint32_t *, fr_error *);
+typedef int (*read_mem_fn)(const void *, size_t, const char *, const iio_dest *, void **, iio_type *, uint32_t *,
+                           uint32_t *, uint32_t *, fr_error *);
 typedef int (*can_write_fn)(const char *);
 
 static struct {
@@ -103,24 +103,24 @@ int iio_encode_with(const char *name, const void *pixels, iio_type type, uint32_
     return plug.encode_with(name, pixels, type, width, height, o, data, len, err);
 }
 
-int iio_read(const char *name, const void *data, size_t len, void **pixels, iio_type *type, uint32_t *width,
-             uint32_t *height, uint32_t *channels, fr_error *err)
+int iio_read(const char *name, const void *data, size_t len, const iio_dest *dest, void **pixels, iio_type *type,
+             uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     *pixels = NULL;
     const char *why = plug_ready();
     if (why)
         return fr_fail(err, "%s: cannot read the image: %s", name, why);
-    return plug.read(name, data, len, pixels, type, width, height, channels, err);
+    return plug.read(name, data, len, dest, pixels, type, width, height, channels, err);
 }
 
-int iio_read_mem(const void *data, size_t len, const char *mime, void **pixels, iio_type *type, uint32_t *width,
-                 uint32_t *height, uint32_t *channels, fr_error *err)
+int iio_read_mem(const void *data, size_t len, const char *mime, const iio_dest *dest, void **pixels,
+                 iio_type *type, uint32_t *width, uint32_t *height, uint32_t *channels, fr_error *err)
 {
     *pixels = NULL;
     const char *why = plug_ready();
     if (why)
         return fr_fail(err, "cannot read an embedded image: %s", why);
-    return plug.read_mem(data, len, mime, pixels, type, width, height, channels, err);
+    return plug.read_mem(data, len, mime, dest, pixels, type, width, height, channels, err);
 }
 
 int iio_can_write(const char *path) { return plug_ready() ? 0 : plug.can_write(path); }

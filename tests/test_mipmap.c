@@ -4,7 +4,8 @@
  * filter of the one above, by the rule scene.h and texstore.h give; the
  * level of detail follows the footprint; and a far textured plane rendered
  * with mip-maps at 4 spp is closer to a supersampled reference than with
- * level 0 only, while a close-up renders the same bits either way. */
+ * level 0 only, while a close-up renders the same bits either way; an
+ * image decoded straight into the texels stores what it would malloc'd. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -322,6 +323,80 @@ static void mip_levels(void)
     bld_free(&b);
 }
 
+/* ---- decoded straight into the texels ------------------------------------ */
+
+/* An image decoded where texstore_target says (a hook keeping the first
+ * channels it is told) stores the same texels, words and fields as the
+ * same image malloc'd whole; float images, and halves to be sRGB-decoded,
+ * are not taken in place. */
+static void in_place(void)
+{
+    enum { W = 23, H = 9 };
+    static uint16_t src[W * H * 4];
+    for (int i = 0; i < W * H * 4; i++)
+        src[i] = (uint16_t)(mix((uint32_t)i + 7u) % 0x7800u);
+    static const uint32_t types[] = {SCENE_PIX_U8, SCENE_PIX_U16, SCENE_PIX_F16};
+    int bad = 0, cases = 0;
+    for (int ti = 0; ti < 3; ti++)
+        for (uint32_t ch = 1; ch <= 4; ch++)
+            for (int srgb = 0; srgb < 2; srgb++) {
+                uint32_t type = types[ti], size = type == SCENE_PIX_U8 ? 1 : 2;
+                fr_builder whole, placed;
+                bld_init(&whole);
+                bld_init(&placed);
+                /* Something before it, so the place is not the array's start. */
+                uint32_t before = store(&whole, src, SCENE_PIX_U8, 3, 5, 3, 0);
+                store(&placed, src, SCENE_PIX_U8, 3, 5, 3, 0);
+                uint32_t a = store(&whole, src, type, W, H, ch, srgb);
+                texstore_target into;
+                texstore_target_init(&into, &placed, srgb);
+                uint32_t keep = 0;
+                unsigned char *at = into.dest.at(&into.dest, W, H, ch, type, &keep);
+                if (type == SCENE_PIX_F16 && srgb) {
+                    bad += at != NULL;
+                } else if (!at || keep != (ch >= 3 ? 3u : 1u)) {
+                    bad++;
+                } else {
+                    for (uint32_t i = 0; i < W * H; i++)
+                        memcpy(at + (size_t)i * keep * size, (const unsigned char *)src + (size_t)i * ch * size,
+                               (size_t)keep * size);
+                    scene_image img;
+                    memset(&img, 0, sizeof img);
+                    img.data = at;
+                    img.type = type;
+                    img.width = W, img.height = H, img.channels = keep;
+                    img.borrowed = 1;
+                    fr_texture t;
+                    memset(&t, 0, sizeof t);
+                    t.kind = FR_TEX_IMAGE;
+                    t.scale = (vec2){1, 1};
+                    fr_error err;
+                    uint32_t words = placed.texels.count;
+                    if (a == FR_NONE || before == FR_NONE ||
+                        texstore_image(&placed, &img, srgb, &t, "in place", &err) < 0 ||
+                        placed.texels.count != whole.texels.count ||
+                        memcmp(&t, (fr_texture *)whole.textures.data + a, sizeof t) ||
+                        memcmp(placed.texels.data, whole.texels.data, (size_t)whole.texels.count * 4) ||
+                        words == placed.texels.count)
+                        bad++;
+                    cases++;
+                }
+                bld_free(&whole);
+                bld_free(&placed);
+            }
+    CHECK(bad == 0 && cases == 20, "decoded in place: %d of %d cases differ from the image malloc'd whole", bad,
+          cases);
+    texstore_target into;
+    fr_builder b;
+    bld_init(&b);
+    texstore_target_init(&into, &b, 0);
+    uint32_t keep = 0;
+    CHECK(into.dest.at(&into.dest, W, H, 3, SCENE_PIX_F32, &keep) == NULL &&
+          into.dest.at(&into.dest, FR_TEX_MAX_SIDE + 1, 1, 3, SCENE_PIX_U8, &keep) == NULL,
+          "float and oversized images are not decoded in place");
+    bld_free(&b);
+}
+
 /* ---- the level of detail follows the footprint --------------------------- */
 
 static void lod(void)
@@ -495,6 +570,7 @@ int main(void)
     formats();
     half_bits();
     mip_levels();
+    in_place();
     lod();
     far_plane();
     return check_done();

@@ -8,7 +8,8 @@
  * .fbin file are the same thing, with the same content hash.
  *
  * The builder owns its arrays; bld_free() releases them (also after
- * frz_scene, which copies what it needs).
+ * frz_scene, which copies what it needs, and after frz_scene_file, which
+ * has released them already: bld_free leaves a zeroed builder).
  */
 #ifndef FRANJA_BUILDER_H
 #define FRANJA_BUILDER_H

@@ -795,6 +795,11 @@ int bvh_build_with(fr_builder *b, const bvh_options *opt, fr_array *nodes, fr_ar
         B.min_overlap = bvh2_area(all.box) * OVERLAP;
         uint32_t broot, root;
         rc = bin_build(&B, &all, 1, 0, &broot);
+        /* The references' boxes are in the tree now: gone before the
+         * wide tree and its leaves are made (a peak of the compile). */
+        free(B.box);
+        free(B.tbox);
+        B.box = B.tbox = NULL;
         if (rc == 0 && reinsert)
             rc = bvh_reinsert(B.bn, B.n_bn, &broot, err);
         if (rc == 0)

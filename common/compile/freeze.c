@@ -3,6 +3,7 @@
 
 #include "compile/freeze.h"
 
+#include <malloc.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -77,23 +78,41 @@ static int build_meshes(fr_builder *b, fr_array *mp, fr_array *mnodes, fr_array 
     return 0;
 }
 
-int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
+/* The arrays freezing makes beside the builder's. */
+typedef struct {
+    fr_array nodes, leaves, mnodes, mleaves, table;
+} frozen;
+
+static void frozen_free(frozen *f)
 {
-    memset(out, 0, sizeof *out);
+    free(f->nodes.data);
+    free(f->leaves.data);
+    free(f->mnodes.data);
+    free(f->mleaves.data);
+    free(f->table.data);
+}
+
+/* Everything but the bytes: camera, BVH, lights; *view points at the
+ * builder's arrays and f's (f freed by the caller, also on failure). */
+static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
+{
+    f->nodes = (fr_array){NULL, 0, 0, sizeof(fr_bvh_node)};
+    f->leaves = (fr_array){NULL, 0, 0, sizeof(fr_bvh_leaf)};
+    f->mnodes = (fr_array){NULL, 0, 0, sizeof(fr_bvh_node)};
+    f->mleaves = (fr_array){NULL, 0, 0, sizeof(fr_bvh_leaf)};
+    f->table = (fr_array){NULL, 0, 0, sizeof(fr_mesh)};
     if (bld_camera_finish(&b->camera, err) < 0 || bld_drop_unused_vertices(b, err) < 0 || bld_flatten(b, 0, err) < 0)
         return -1;
-    fr_array nodes = {NULL, 0, 0, sizeof(fr_bvh_node)}, leaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)};
-    fr_array mprims = {NULL, 0, 0, sizeof(fr_prim)}, mnodes = {NULL, 0, 0, sizeof(fr_bvh_node)};
-    fr_array mleaves = {NULL, 0, 0, sizeof(fr_bvh_leaf)}, table = {NULL, 0, 0, sizeof(fr_mesh)};
+    fr_array mprims = {NULL, 0, 0, sizeof(fr_prim)};
     /* With instances, two levels: a tree per mesh, then the scene's over
      * the other prims and the instances (bld_flatten has dropped meshes
      * without instances, so a scene without any takes the one-level path
      * unchanged). */
-    int rc = b->meshes.count ? build_meshes(b, &mprims, &mnodes, &mleaves, &table, err) : 0;
+    int rc = b->meshes.count ? build_meshes(b, &mprims, &f->mnodes, &f->mleaves, &f->table, err) : 0;
     /* The BVH reorders prims, so lights (which point at prims) come after. */
     uint32_t *placed = NULL;
     if (rc == 0)
-        rc = bvh_build(b, &nodes, &leaves, &placed, err);
+        rc = bvh_build(b, &f->nodes, &f->leaves, &placed, err);
     if (rc == 0)
         rc = frz_lights(b, placed, err);
     free(placed);
@@ -102,36 +121,63 @@ int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
             rc = fr_fail(err, "out of memory for the meshes");
     free(mprims.data);
 
-    fr_scene view;
-    memset(&view, 0, sizeof view);
-    view.settings = b->settings;
-    view.camera = b->camera;
-#define VIEW(field, arr) view.field = arr.data, view.n_##field = arr.count
+    memset(view, 0, sizeof *view);
+    view->settings = b->settings;
+    view->camera = b->camera;
+#define VIEW(field, arr) view->field = arr.data, view->n_##field = arr.count
     VIEW(materials, b->materials); VIEW(prims, b->prims); VIEW(spheres, b->spheres);
     VIEW(rects, b->rects); VIEW(triangles, b->triangles); VIEW(positions, b->positions);
     VIEW(normals, b->normals); VIEW(uvs, b->uvs); VIEW(planes, b->planes);
-    VIEW(lights, b->lights); VIEW(nodes, nodes); VIEW(leaves, leaves);
+    VIEW(lights, b->lights); VIEW(nodes, f->nodes); VIEW(leaves, f->leaves);
     VIEW(textures, b->textures); VIEW(texels, b->texels); VIEW(media, b->media);
-    view.volume = b->volume;
-    view.tonemap = b->tonemap;
-    view.world = b->world;
+    view->volume = b->volume;
+    view->tonemap = b->tonemap;
+    view->world = b->world;
     VIEW(distrib, b->distrib);
-    VIEW(meshes, table); VIEW(instances, b->instances);
-    VIEW(mesh_nodes, mnodes); VIEW(mesh_leaves, mleaves);
+    VIEW(meshes, f->table); VIEW(instances, b->instances);
+    VIEW(mesh_nodes, f->mnodes); VIEW(mesh_leaves, f->mleaves);
     VIEW(light_nodes, b->light_nodes);
 #undef VIEW
+    return rc;
+}
+
+int frz_scene(fr_builder *b, fr_scene *out, fr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    frozen f;
+    fr_scene view;
+    int rc = prepare(b, &f, &view, err);
     void *blob = NULL;
     size_t size = 0;
     if (rc == 0)
         rc = fbin_serialize(&view, &blob, &size, err);
-    free(nodes.data);
-    free(leaves.data);
-    free(mnodes.data);
-    free(mleaves.data);
-    free(table.data);
+    frozen_free(&f);
     if (rc == 0)
         rc = fbin_open_mem(blob, size, 0, out, err);
     if (rc < 0)
         free(blob);
+    return rc;
+}
+
+int frz_scene_file(fr_builder *b, const char *path, fr_scene *out, fr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    /* What the readers freed (mesh files, their parsed arrays) goes back
+     * to the system before the BVH's working memory is taken, and the
+     * builder's before the file is mapped: else it stays the process's. */
+    malloc_trim(0);
+    frozen f;
+    fr_scene view;
+    int rc = prepare(b, &f, &view, err);
+    uint64_t hash;
+    size_t size;
+    if (rc == 0)
+        rc = fbin_write_view(&view, path, &hash, &size, err);
+    frozen_free(&f);
+    bld_free(b);
+    malloc_trim(0);
+    /* Checked as a worker will check it, from the file. */
+    if (rc == 0)
+        rc = fbin_load(path, out, err);
     return rc;
 }

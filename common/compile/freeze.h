@@ -22,4 +22,12 @@
  * non-finite geometry, a scene the binary format refuses). */
 int frz_scene(fr_builder *b, fr_scene *out, fr_error *err);
 
+/** As frz_scene, but the bytes go to the file `path` (fbin_write_view:
+ * the same bytes, the same hash) instead of memory, and the builder is
+ * freed (bld_free) once they are written, before *out maps the file
+ * (fbin_load): the compile's peak memory is then the builder's arrays,
+ * never those and the scene's bytes at once.  On failure the builder is
+ * freed too, and `path` may be left behind (complete, but refused). */
+int frz_scene_file(fr_builder *b, const char *path, fr_scene *out, fr_error *err);
+
 #endif

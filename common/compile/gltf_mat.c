@@ -77,6 +77,9 @@ static int image(gmat_ctx *c, uint32_t i, int srgb, fr_texture *t, fr_error *err
         return gdoc_fail(d, err, ptr, "mimeType: expected a string");
     scene_image img;
     memset(&img, 0, sizeof img);
+    texstore_target into;
+    texstore_target_init(&into, c->b, srgb);
+    img.dest = &into.dest;
     fr_error e;
     int rc;
     int in_memory = !uri || !strncmp(uri->valuestring, "data:", 5);
@@ -110,13 +113,15 @@ static int image(gmat_ctx *c, uint32_t i, int srgb, fr_texture *t, fr_error *err
         free(data);
     }
     if (rc < 0) {
-        free(img.pixels);
+        if (!img.borrowed)
+            free(img.pixels);
         return gdoc_fail(d, err, ptr, "%s", e.msg);
     }
     fr_texture tex;
     memset(&tex, 0, sizeof tex);
     rc = texstore_image(c->b, &img, srgb, &tex, ptr, &e);
-    free(img.pixels);
+    if (!img.borrowed)
+        free(img.pixels);
     if (rc < 0)
         return gdoc_fail(d, err, NULL, "%s", e.msg);
     c->img[srgb][i] = tex;

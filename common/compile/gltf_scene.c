@@ -845,7 +845,7 @@ int gltf_load_scene(const char *path, const scene_hooks *hooks, const char *came
     int rc = gltf_build_scene(path, NULL, 0, hooks, camera, 0, &b, err);
     if (rc == 0) {
         fr_error e;
-        if ((rc = frz_scene(&b, out, &e)) < 0)
+        if ((rc = hooks && hooks->fbin ? frz_scene_file(&b, hooks->fbin, out, &e) : frz_scene(&b, out, &e)) < 0)
             fr_fail(err, "%s: %s", path, e.msg);
     }
     bld_free(&b);

@@ -181,6 +181,9 @@ static int texture_ref(json_appear *a, const char *name, int as_colour, const ch
                            ".fbin", tw);
         scene_image img;
         memset(&img, 0, sizeof img);
+        texstore_target into;
+        texstore_target_init(&into, a->b, from_srgb);
+        img.dest = &into.dest;
         fr_error e;
         char *data;
         size_t len;
@@ -191,13 +194,15 @@ static int texture_ref(json_appear *a, const char *name, int as_colour, const ch
         int bad = a->hooks->texture(path, data, len, &img, &e);
         free(data);
         if (bad < 0) {
-            free(img.pixels);
+            if (!img.borrowed)
+                free(img.pixels);
             return fr_fail(err, "%s.file: %s", tw, e.msg);
         }
         char iw[PATHLEN + 4096];
         snprintf(iw, sizeof iw, "%s.file '%s'", tw, path);
         int rc = texstore_image(a->b, &img, from_srgb, &tex, iw, err);
-        free(img.pixels);
+        if (!img.borrowed)
+            free(img.pixels);
         if (rc < 0)
             return -1;
     }

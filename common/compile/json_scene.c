@@ -454,7 +454,7 @@ int json_scene_load(const char *path, const scene_hooks *hooks, fr_scene *out, f
     free(text);
     if (rc == 0) {
         fr_error e;
-        rc = frz_scene(&b, out, &e);
+        rc = hooks && hooks->fbin ? frz_scene_file(&b, hooks->fbin, out, &e) : frz_scene(&b, out, &e);
         if (rc < 0)
             fr_fail(err, "%s: %s", path, e.msg);
     }

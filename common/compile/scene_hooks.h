@@ -16,11 +16,23 @@
 /** How a decoded image's values are held: the file's own precision. */
 enum { SCENE_PIX_F32 = 0, SCENE_PIX_U8 = 1, SCENE_PIX_U16 = 2, SCENE_PIX_F16 = 3 };
 
+/** Where a texture hook may decode an image instead of malloc'ing it
+ * (texstore.h gives one that is the texels' own place). */
+typedef struct scene_image_dest {
+    /** Called by the hook once it knows the image's size, channels and
+     * type (SCENE_PIX_*): where to decode it, keeping the first *keep
+     * channels of each pixel (width*height*keep values), or NULL: malloc
+     * it whole as usual. */
+    void *(*at)(const struct scene_image_dest *d, uint32_t width, uint32_t height, uint32_t channels,
+                uint32_t type, uint32_t *keep);
+} scene_image_dest;
+
 /** An image as a texture hook decodes it: width*height*channels values of
  * `type` (SCENE_PIX_*; 0, float, unless the hook says otherwise), top row
  * first, as stored: no colour conversion (8- and 16-bit integers mean
  * k / 255 and k / 65535, halves are IEEE 754 binary16 bits).  The pixels
- * are malloc'd; the reader frees them. */
+ * are malloc'd, and the reader frees them, unless the hook decoded them
+ * where `dest` said (`borrowed`). */
 typedef struct {
     union {
         float *pixels;         /**< SCENE_PIX_F32 */
@@ -28,6 +40,8 @@ typedef struct {
     };
     uint32_t width, height, channels;
     uint32_t type;             /**< SCENE_PIX_* */
+    const scene_image_dest *dest; /**< set by the reader: where the hook may decode (NULL: malloc) */
+    int borrowed;              /**< set by the hook: 1 when data is dest's memory, not to be freed */
 } scene_image;
 
 /** The asset loaders (any may be NULL) and the compile's budget. */
@@ -62,6 +76,10 @@ typedef struct {
      * builder, and count what they read and build against it.  May be
      * NULL: no limits. */
     fr_budget *budget;
+    /** Where the readers write the binary scene (freeze.h's
+     * frz_scene_file: the builder freed before the file is mapped back),
+     * or NULL: it is made in memory (frz_scene). */
+    const char *fbin;
 } scene_hooks;
 
 #endif

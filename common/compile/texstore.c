@@ -210,6 +210,76 @@ static uint32_t choose_format(const scene_image *img, int from_srgb, uint32_t ke
     return FR_TEXEL_F16;
 }
 
+/* The image fields of tex (width, height, channels, format set) that
+ * depend on its size: levels; words[k], the words of level k; returns
+ * their sum. */
+static uint64_t plan(fr_texture *tex, uint64_t words[FR_TEX_MAX_LEVELS])
+{
+    uint32_t side = tex->width > tex->height ? tex->width : tex->height, levels = 1;
+    while (side >> levels)
+        levels++;
+    tex->levels = levels;
+    uint32_t bytes = tex_format_bytes(tex->format);
+    uint64_t total = 0;
+    for (uint32_t k = 0; k < levels; k++) {
+        uint32_t w, h;
+        tex_level_size(tex, k, &w, &h);
+        words[k] = ((uint64_t)w * h * tex->channels * bytes + 3) / 4;
+        total += words[k];
+    }
+    return total;
+}
+
+/* Room for `total` more words of texels, all at once (no doubling);
+ * 0, or -1 past MAX_WORDS or out of memory (*oom set then). */
+static int reserve(fr_builder *b, uint64_t total, int *oom)
+{
+    *oom = 0;
+    if (total >= MAX_WORDS || b->texels.count >= MAX_WORDS - total)
+        return -1;
+    uint32_t need = b->texels.count + (uint32_t)total;
+    if (need > b->texels.cap) {
+        void *p = realloc(b->texels.data, (size_t)need * sizeof(uint32_t));
+        if (!p) {
+            *oom = 1;
+            return -1;
+        }
+        b->texels.data = p;
+        b->texels.cap = need;
+    }
+    return 0;
+}
+
+static void *target_at(const scene_image_dest *d, uint32_t width, uint32_t height, uint32_t channels,
+                       uint32_t type, uint32_t *keep)
+{
+    const texstore_target *t = (const texstore_target *)d;
+    if (width == 0 || height == 0 || channels == 0 || channels > 4 || width > FR_TEX_MAX_SIDE ||
+        height > FR_TEX_MAX_SIDE || !(type == SCENE_PIX_U8 || type == SCENE_PIX_U16 ||
+                                      (type == SCENE_PIX_F16 && !t->from_srgb)))
+        return NULL;
+    scene_image img = {.width = width, .height = height, .channels = channels, .type = type};
+    fr_texture tex;
+    memset(&tex, 0, sizeof tex);
+    tex.width = width;
+    tex.height = height;
+    tex.channels = channels >= 3 ? 3 : 1;
+    tex.format = choose_format(&img, t->from_srgb, tex.channels);
+    uint64_t words[FR_TEX_MAX_LEVELS];
+    int oom;
+    if (reserve(t->b, plan(&tex, words), &oom) < 0)
+        return NULL;
+    *keep = tex.channels;
+    return (uint32_t *)t->b->texels.data + t->b->texels.count;
+}
+
+void texstore_target_init(texstore_target *t, fr_builder *b, int from_srgb)
+{
+    t->dest.at = target_at;
+    t->b = b;
+    t->from_srgb = from_srgb;
+}
+
 int texstore_image(fr_builder *b, const scene_image *img, int from_srgb, fr_texture *tex, const char *where,
                    fr_error *err)
 {
@@ -233,38 +303,32 @@ int texstore_image(fr_builder *b, const scene_image *img, int from_srgb, fr_text
     tex->height = img->height;
     tex->channels = keep;
     tex->format = choose_format(img, from_srgb, keep);
-    uint32_t side = img->width > img->height ? img->width : img->height, levels = 1;
-    while (side >> levels)
-        levels++;
-    tex->levels = levels;
-    uint32_t bytes = tex_format_bytes(tex->format);
-    uint64_t total = 0, words[FR_TEX_MAX_LEVELS];
-    for (uint32_t k = 0; k < levels; k++) {
+    uint64_t words[FR_TEX_MAX_LEVELS];
+    uint64_t total = plan(tex, words);
+    int oom;
+    if (reserve(b, total, &oom) < 0)
+        return oom ? fr_fail(err, "%s: out of memory for texels (%llu bytes)", where, (unsigned long long)total * 4)
+                   : fr_fail(err, "%s: the scene's textures exceed %u MiB of texels", where, (MAX_WORDS >> 20) * 4);
+    uint32_t base = b->texels.count, bytes = tex_format_bytes(tex->format);
+    uint32_t *texels = b->texels.data;
+    /* Decoded in place (texstore_target): level 0 is there already. */
+    int in_place = img->data == (void *)(texels + base);
+    if (in_place && (img->channels != keep || (img->type != SCENE_PIX_U8 && img->type != SCENE_PIX_U16 &&
+                                               img->type != SCENE_PIX_F16) || tex->format == FR_TEXEL_F32))
+        return fr_fail(err, "%s: an image decoded in place must be stored as it is", where);
+    memset(tex->first, 0, sizeof tex->first);
+    for (uint32_t k = 0, at = base; k < tex->levels; at += (uint32_t)words[k], k++) {
+        /* The padding after the level's values, zeroed. */
         uint32_t w, h;
         tex_level_size(tex, k, &w, &h);
-        words[k] = ((uint64_t)w * h * keep * bytes + 3) / 4;
-        total += words[k];
-    }
-    if (total >= MAX_WORDS || b->texels.count >= MAX_WORDS - total)
-        return fr_fail(err, "%s: the scene's textures exceed %u MiB of texels", where, (MAX_WORDS >> 20) * 4);
-    /* Room for every level at once (no doubling), zeroed (the padding). */
-    uint32_t base = b->texels.count, need = base + (uint32_t)total;
-    if (need > b->texels.cap) {
-        void *p = realloc(b->texels.data, (size_t)need * sizeof(uint32_t));
-        if (!p)
-            return fr_fail(err, "%s: out of memory for texels (%llu bytes)", where, (unsigned long long)total * 4);
-        b->texels.data = p;
-        b->texels.cap = need;
-    }
-    uint32_t *texels = b->texels.data;
-    memset(texels + base, 0, (size_t)total * sizeof(uint32_t));
-    b->texels.count = need;
-    memset(tex->first, 0, sizeof tex->first);
-    for (uint32_t k = 0, at = base; k < levels; at += (uint32_t)words[k], k++)
+        size_t used = (size_t)w * h * keep * bytes;
+        memset((unsigned char *)(texels + at) + used, 0, (size_t)words[k] * 4 - used);
         tex->first[k] = at;
+    }
+    b->texels.count = base + (uint32_t)total;
     /* Level 0: integers and halves as they are, floats rounded. */
     unsigned char *l0 = (unsigned char *)(texels + base);
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n && !in_place; i++)
         for (uint32_t c = 0; c < keep; c++) {
             size_t src = i * img->channels + c, dst = i * keep + c;
             uint32_t code;
@@ -281,7 +345,7 @@ int texstore_image(fr_builder *b, const scene_image *img, int from_srgb, fr_text
             }
             put(l0, dst, bytes, code);
         }
-    for (uint32_t k = 1; k < levels; k++)
+    for (uint32_t k = 1; k < tex->levels; k++)
         build_level(texels, tex, k, (unsigned char *)(texels + tex->first[k]));
     return 0;
 }

@@ -29,10 +29,29 @@
 /** Append image `img` with its mip levels to b->texels and fill tex's
  * image fields (width, height, channels, format, levels, first);
  * `from_srgb` decodes the sRGB curve (at lookup, for integer images).
+ * An image decoded through texstore_target is already level 0 and is
+ * not copied.
  * Fails (naming `where`) on an empty or oversized image, a non-finite
  * value, or when the scene's texels would pass 2^31 words (8 GiB). */
 int texstore_image(fr_builder *b, const scene_image *img, int from_srgb, fr_texture *tex, const char *where,
                    fr_error *err);
+
+/** A scene_image_dest (scene_hooks.h) that has an image decoded straight
+ * into b->texels, where texstore_image then takes it as level 0, so the
+ * decoded image is not held beside its texels: for 8- and 16-bit images
+ * and half-float ones not sRGB-decoded, whose level 0 is the values as
+ * decoded (the first 3 channels of 3 or 4, the first of 1 or 2); for
+ * other images `at` returns NULL (the hook mallocs them).  It only
+ * reserves room: texstore_image must follow, with the same builder and
+ * from_srgb, before anything else appends texels. */
+typedef struct {
+    scene_image_dest dest;     /**< first, so that hooks are given &t.dest */
+    fr_builder *b;
+    int from_srgb;
+} texstore_target;
+
+/** Set *t up for builder b and from_srgb (as texstore_image's). */
+void texstore_target_init(texstore_target *t, fr_builder *b, int from_srgb);
 
 /** The stored value (the bits of a byte, 16-bit integer, half or float)
  * of texel format `format` nearest to linear value v: for the sRGB

@@ -17,23 +17,49 @@ static uint32_t pix_type(iio_type t)
     return t == IIO_U8 ? SCENE_PIX_U8 : t == IIO_U16 ? SCENE_PIX_U16 : t == IIO_F16 ? SCENE_PIX_F16 : SCENE_PIX_F32;
 }
 
+/* The reader's scene_image_dest as imageio.h's iio_dest. */
+typedef struct {
+    iio_dest d;
+    const scene_image_dest *to;
+    void *given;               /* what to->at returned */
+} dest_bridge;
+
+static void *bridge_at(const iio_dest *d, uint32_t width, uint32_t height, uint32_t channels, iio_type type,
+                       uint32_t *keep)
+{
+    dest_bridge *b = (dest_bridge *)d;
+    b->given = b->to->at(b->to, width, height, channels, pix_type(type), keep);
+    return b->given;
+}
+
+/* After iio_read: the image's type, and whether it is in the reader's place. */
+static int decoded(int rc, iio_type t, const dest_bridge *b, scene_image *img)
+{
+    img->type = pix_type(t);
+    img->borrowed = rc == 0 && img->data && img->data == b->given;
+    return rc;
+}
+
 /* The texture hook: images are decoded by OpenImageIO (imageio.h) at
- * their own precision, from the bytes the reader read through its scope. */
+ * their own precision, from the bytes the reader read through its scope,
+ * into the place the reader gives (img->dest) when it gives one. */
 static int texture_load(const char *path, const void *data, size_t len, scene_image *img, fr_error *err)
 {
     iio_type t = IIO_F32;
-    int rc = iio_read(path, data, len, &img->data, &t, &img->width, &img->height, &img->channels, err);
-    img->type = pix_type(t);
-    return rc;
+    dest_bridge b = {{bridge_at}, img->dest, NULL};
+    int rc = iio_read(path, data, len, img->dest ? &b.d : NULL, &img->data, &t, &img->width, &img->height,
+                      &img->channels, err);
+    return decoded(rc, t, &b, img);
 }
 
 /* Images embedded in glTF files, likewise. */
 static int image_load(const void *data, size_t len, const char *mime, scene_image *img, fr_error *err)
 {
     iio_type t = IIO_F32;
-    int rc = iio_read_mem(data, len, mime, &img->data, &t, &img->width, &img->height, &img->channels, err);
-    img->type = pix_type(t);
-    return rc;
+    dest_bridge b = {{bridge_at}, img->dest, NULL};
+    int rc = iio_read_mem(data, len, mime, img->dest ? &b.d : NULL, &img->data, &t, &img->width, &img->height,
+                          &img->channels, err);
+    return decoded(rc, t, &b, img);
 }
 
 int compile_is_gltf(const char *path)
@@ -51,7 +77,8 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
         budget_init(&budget);
     memset(budget.used, 0, sizeof budget.used);
     scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
-                         o ? o->allow : NULL, o ? o->n_allow : 0, &budget};
+                         o ? o->allow : NULL, o ? o->n_allow : 0, &budget,
+                         o ? o->fbin : NULL};
     int rc;
     if (compile_is_gltf(path))
         rc = gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);

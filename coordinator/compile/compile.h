@@ -20,7 +20,8 @@
 /** How to compile: the glTF camera to take (NULL: the first), where
  * warnings go (NULL: nowhere; `user` is passed back), the folders
  * besides the scene's own that its files may lie in (`--allow-path`;
- * confine.h), and the limits (budget.h; NULL: the defaults). */
+ * confine.h), the limits (budget.h; NULL: the defaults) and the file the
+ * binary scene goes to. */
 typedef struct {
     const char *camera;
     void (*warn)(void *user, const char *msg);
@@ -28,6 +29,8 @@ typedef struct {
     const char *const *allow;
     unsigned n_allow;
     const fr_budget *limits;
+    const char *fbin;          /**< where the binary scene is written as it is made (scene_hooks.h); NULL:
+                                    in memory only */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */

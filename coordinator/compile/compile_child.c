@@ -62,8 +62,15 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
     else
         budget_init(&lim);
     set_limits(&lim);
+    /* The scene goes to `file` as it is made: never in memory twice. */
+    compile_opts co;
+    if (o)
+        co = *o;
+    else
+        memset(&co, 0, sizeof co);
+    co.fbin = file;
     double t0 = clock_now();
-    a.rc = compile_scene(scene, o, &s, &a.err);
+    a.rc = compile_scene(scene, &co, &s, &a.err);
     if (a.rc && strstr(a.err.msg, "out of memory")) {
         size_t n = strlen(a.err.msg);
         snprintf(a.err.msg + n, sizeof a.err.msg - n, " (the compile may map %llu MiB: --limit memory=BYTES raises it)",
@@ -71,7 +78,6 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
     }
     if (a.rc == 0) {
         a.st.seconds = clock_now() - t0;
-        a.rc = fbin_write(&s, file, &a.err);
         fbin_hash_hex(s.hash, a.st.hash);
         a.st.bytes = s.blob_size;
         a.st.prims = s.n_prims;
