@@ -41,6 +41,24 @@ int file_open_regular(const char *path, size_t max, int *fd, size_t *size, fr_er
     return 0;
 }
 
+int file_write_all(int fd, const void *buf, size_t n)
+{
+    const char *p = buf;
+    while (n > 0) {
+        ssize_t k = write(fd, p, n);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            if (k == 0)
+                errno = 0;
+            return -1;
+        }
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
 int file_read(const char *path, char **text, size_t *len, fr_error *err)
 {
     int fd;

@@ -31,6 +31,11 @@
  * the M this reader takes"; *fd is then -1. */
 int file_open_regular(const char *path, size_t max, int *fd, size_t *size, fr_error *err);
 
+/** Writes buf[0..n) to descriptor fd whole, again after EINTR and short
+ * writes.  Returns 0, or -1 with errno set by the failed write (0 when a
+ * write wrote nothing). */
+int file_write_all(int fd, const void *buf, size_t n);
+
 /** Read the whole regular file at path (file_open_regular with
  * FILE_READ_MAX) into a new malloc'd buffer with a NUL after its *len bytes
  * (the file may hold NULs of its own).  The caller frees *text.  Fails with

@@ -30,22 +30,6 @@ int unpack_file(const char *in, const char *out, uint64_t *hash, fr_error *err)
 
 int unpack_available(void) { return 1; }
 
-/* Writes buf[0..n) to fd whole. */
-static int write_all(int fd, const void *buf, size_t n)
-{
-    const char *p = buf;
-    while (n > 0) {
-        ssize_t k = write(fd, p, n);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0)
-            return -1;
-        p += k;
-        n -= (size_t)k;
-    }
-    return 0;
-}
-
 /* Streams the frame of fd_in into fd_out; err names `in`. */
 static int decompress(const char *in, int fd_in, int fd_out, fr_error *err)
 {
@@ -76,7 +60,7 @@ static int decompress(const char *in, int fd_in, int fd_out, fr_error *err)
             left = ZSTD_decompressStream(dc, &ob, &ib);
             if (ZSTD_isError(left))
                 rc = fr_fail(err, "%s: damaged compressed scene (%s)", in, ZSTD_getErrorName(left));
-            else if (write_all(fd_out, obuf, ob.pos) < 0)
+            else if (file_write_all(fd_out, obuf, ob.pos) < 0)
                 rc = fr_fail(err, "%s: write error: %s", in, strerror(errno));
             else if (left == 0 && ib.pos < ib.size)
                 rc = fr_fail(err, "%s: bytes after the end of the compressed scene", in);
@@ -89,7 +73,7 @@ static int decompress(const char *in, int fd_in, int fd_out, fr_error *err)
         left = ZSTD_decompressStream(dc, &ob, &ib);
         if (ZSTD_isError(left))
             rc = fr_fail(err, "%s: damaged compressed scene (%s)", in, ZSTD_getErrorName(left));
-        else if (write_all(fd_out, obuf, ob.pos) < 0)
+        else if (file_write_all(fd_out, obuf, ob.pos) < 0)
             rc = fr_fail(err, "%s: write error: %s", in, strerror(errno));
         else if (ob.pos == 0 && left != 0)
             rc = fr_fail(err, "%s: the compressed scene is cut short", in);

@@ -20,6 +20,7 @@
 #include "fbin.h"
 #include "file.h"
 #include "clock.h"
+#include "compile/rlimit.h"
 
 /* What the child sends back, in one write. */
 typedef struct {
@@ -27,29 +28,6 @@ typedef struct {
     fr_error err;
     compile_child_stats st;
 } answer;
-
-/* The compile's own limits: CPU seconds, and address space beyond what
- * the process maps already (libraries, the copy of the parent). */
-static void set_limits(const fr_budget *lim)
-{
-    struct rlimit r = {0, 0};
-    setrlimit(RLIMIT_CORE, &r);
-    long pages = 0, page = sysconf(_SC_PAGESIZE);
-    FILE *statm = fopen("/proc/self/statm", "r");
-    if (statm) {
-        if (fscanf(statm, "%ld", &pages) != 1)
-            pages = 0;
-        fclose(statm);
-    }
-    if (pages > 0 && page > 0 && lim->limit[BUDGET_MEMORY] < RLIM_INFINITY / 2) {
-        r.rlim_cur = r.rlim_max = (rlim_t)pages * (rlim_t)page + (rlim_t)lim->limit[BUDGET_MEMORY];
-        setrlimit(RLIMIT_AS, &r);
-    }
-    /* SIGXCPU at the limit; SIGKILL a little later if that is caught. */
-    r.rlim_cur = (rlim_t)lim->limit[BUDGET_CPU];
-    r.rlim_max = r.rlim_cur + 5;
-    setrlimit(RLIMIT_CPU, &r);
-}
 
 static void child(const char *scene, const compile_opts *o, const char *file, int fd)
 {
@@ -61,7 +39,8 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
         lim = *o->limits;
     else
         budget_init(&lim);
-    set_limits(&lim);
+    /* CPU: SIGXCPU at the limit, SIGKILL a little later if that is caught. */
+    rlimit_child(lim.limit[BUDGET_MEMORY], lim.limit[BUDGET_CPU], lim.limit[BUDGET_CPU] + 5);
     /* The scene goes to `file` as it is made: never in memory twice. */
     compile_opts co;
     if (o)

@@ -24,6 +24,7 @@
 #include "file.h"
 #include "compile/plyhead.h"
 #include "clock.h"
+#include "compile/rlimit.h"
 
 #define BUDGET_BASE ((size_t)256 << 20)   /* address space for an import, plus ... */
 #define BUDGET_PER_BYTE 64                 /* ... this much per byte of the file */
@@ -242,38 +243,25 @@ static void io_close(struct aiFileIO *io, struct aiFile *f)
 
 #define MAGIC 0x494d5246u   /* "FRMI" */
 
-static int write_all(int fd, const void *buf, size_t n)
-{
-    const char *p = buf;
-    while (n) {
-        ssize_t w = write(fd, p, n);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0)
-            return -1;
-        p += w;
-        n -= (size_t)w;
-    }
-    return 0;
-}
-
 static void send_error(int fd, const fr_error *e)
 {
     uint32_t head[3] = {MAGIC, 1, (uint32_t)strlen(e->msg)};
-    if (write_all(fd, head, sizeof head) == 0)
-        write_all(fd, e->msg, head[2]);
+    if (file_write_all(fd, head, sizeof head) == 0)
+        file_write_all(fd, e->msg, head[2]);
 }
 
 static void send_mesh(int fd, const mesh_data *m)
 {
     uint32_t head[7] = {MAGIC, 0, m->n_vert, m->n_tri, m->n_mats, m->nrm != NULL, m->uv != NULL};
     size_t nv = m->n_vert, nt = m->n_tri;
-    if (write_all(fd, head, sizeof head) < 0 || write_all(fd, m->mats, m->n_mats * sizeof *m->mats) < 0 ||
-        write_all(fd, m->pos, nv * sizeof *m->pos) < 0 || (m->nrm && write_all(fd, m->nrm, nv * sizeof *m->nrm) < 0) ||
-        (m->uv && write_all(fd, m->uv, nv * sizeof *m->uv) < 0) || write_all(fd, m->tri, nt * sizeof *m->tri) < 0 ||
-        write_all(fd, m->tri_flags, nt) < 0)
+    if (file_write_all(fd, head, sizeof head) < 0 ||
+        file_write_all(fd, m->mats, m->n_mats * sizeof *m->mats) < 0 ||
+        file_write_all(fd, m->pos, nv * sizeof *m->pos) < 0 ||
+        (m->nrm && file_write_all(fd, m->nrm, nv * sizeof *m->nrm) < 0) ||
+        (m->uv && file_write_all(fd, m->uv, nv * sizeof *m->uv) < 0) ||
+        file_write_all(fd, m->tri, nt * sizeof *m->tri) < 0 || file_write_all(fd, m->tri_flags, nt) < 0)
         return;
-    write_all(fd, m->tri_mat, nt * sizeof *m->tri_mat);
+    file_write_all(fd, m->tri_mat, nt * sizeof *m->tri_mat);
 }
 
 /* The child's whole life: limits, the import, the answer. */
@@ -287,23 +275,10 @@ static void child(const char *path, const confine *scope, size_t size, int out)
         dup2(null, STDERR_FILENO);
         close(null);
     }
-    struct rlimit r = {0, 0};
-    setrlimit(RLIMIT_CORE, &r);
-    /* Address space: what the process maps already (libraries, the copy of
-     * the parent) plus the import's budget. */
-    long pages = 0, page = sysconf(_SC_PAGESIZE);
-    FILE *statm = fopen("/proc/self/statm", "r");
-    if (statm) {
-        if (fscanf(statm, "%ld", &pages) != 1)
-            pages = 0;
-        fclose(statm);
-    }
-    if (pages > 0 && page > 0) {
-        r.rlim_cur = r.rlim_max = (rlim_t)pages * (rlim_t)page + BUDGET_BASE + (rlim_t)BUDGET_PER_BYTE * size;
-        setrlimit(RLIMIT_AS, &r);
-    }
-    r.rlim_cur = r.rlim_max = 60 + size / ((size_t)1 << 20);
-    setrlimit(RLIMIT_CPU, &r);
+    /* Address space: what the process maps already plus the import's
+     * budget; a minute of CPU and one more second a MiB. */
+    uint64_t cpu = 60 + size / ((size_t)1 << 20);
+    rlimit_child(BUDGET_BASE + (uint64_t)BUDGET_PER_BYTE * size, cpu, cpu);
 
     struct aiFileIO io = {io_open, io_close, NULL};
     const struct aiScene *sc = aiImportFileEx(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |

@@ -13,21 +13,6 @@
 #include "fbin.h"
 #include "file.h"
 
-static int write_all(int fd, const void *buf, size_t n)
-{
-    const char *p = buf;
-    while (n > 0) {
-        ssize_t k = write(fd, p, n);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0)
-            return -1;
-        p += k;
-        n -= (size_t)k;
-    }
-    return 0;
-}
-
 int pack_file(const char *in, const char *out, int level, uint64_t *size, fr_error *err)
 {
     *size = 0;
@@ -68,7 +53,7 @@ int pack_file(const char *in, const char *out, int level, uint64_t *size, fr_err
             size_t left = ZSTD_compressStream2(cc, &ob, &ib, last ? ZSTD_e_end : ZSTD_e_continue);
             if (ZSTD_isError(left))
                 rc = fr_fail(err, "%s: zstd: %s (the file changed while it was read?)", in, ZSTD_getErrorName(left));
-            else if (write_all(fo, obuf, ob.pos) < 0)
+            else if (file_write_all(fo, obuf, ob.pos) < 0)
                 rc = fr_fail(err, "%s: write error: %s", out, strerror(errno));
             else
                 *size += ob.pos;
