@@ -18,17 +18,10 @@
 #include "compile/freeze.h"
 #include "compile/json_scene.h"
 #include "compile/texstore.h"
+#include "sampler.h"
 
 /* An integer hash, for test images that are the same on every run. */
-static uint32_t mix(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
+static uint32_t mix(uint32_t x) { return smp_hash(x); }
 
 /* A scene view of the builder's textures and texels, for lookups. */
 static fr_scene view_of(const fr_builder *b)
