@@ -524,10 +524,9 @@ static double mean(const float *a, int n)
 
 static void far_plane(void)
 {
-    snprintf(dir, sizeof dir, "/tmp/franja-mip-%ld", (long)getpid());
+    snprintf(dir, sizeof dir, "/tmp/franja-mip-XXXXXX");
     char cmd[160];
-    snprintf(cmd, sizeof cmd, "mkdir -p %s && touch %s/checks.png", dir, dir);
-    if (system(cmd) != 0) {
+    if (!mkdtemp(dir) || (snprintf(cmd, sizeof cmd, "touch %s/checks.png", dir), system(cmd) != 0)) {
         CHECK(0, "cannot create %s", dir);
         return;
     }
