@@ -2,7 +2,8 @@
  * sum to one at every point and are the frequencies its walk picks with (a
  * chi-square test over the lights), lgt_pick_pdf gives the walk's pick bit
  * for bit; a scene of one light renders the same bits with the tree and
- * with the power table; a lamp-lit ground converges to the same mean with
+ * with the power table, and so does one flat lamp (which gets no tree); a
+ * lamp-lit ground converges to the same mean with
  * and without the tree, and with much less noise with it; a furnace of
  * emissive triangles gives its closed form; the triangles of a mostly
  * black textured screen are picked by the light on them. */
@@ -267,6 +268,63 @@ static void one_light(void)
     scn_free(&b);
 }
 
+/* A ground lit by the quads (each four corners, JSON) of quads_json. */
+static void quad_lamps(const char *quads_json, const char *sampling, fr_scene *s)
+{
+    text t = {0};
+    put(&t, "{\"image\": {\"width\": 16, \"height\": 16, \"spp\": 1, \"max_depth\": 2, \"light_sampling\": \"%s\"},"
+            " \"camera\": {\"position\": [0, 1.5, -3], \"target\": [0, 0, 0], \"fov\": 60},"
+            " \"materials\": {\"ground\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]},"
+            "   \"lamp\": {\"type\": \"emitter\", \"emission\": [40, 38, 30]}},"
+            " \"shapes\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"ground\"}",
+        sampling);
+    for (const char *q = quads_json; *q;) {
+        const char *e = strchr(q, ';');
+        int len = e ? (int)(e - q) : (int)strlen(q);
+        put(&t, ", {\"type\": \"quad\", \"material\": \"lamp\", \"vertices\": %.*s}", len, q);
+        q += len + (e != NULL);
+    }
+    put(&t, "]}");
+    test_scene(t.p, s);
+    free(t.p);
+}
+
+/* One flat lamp -- a quad (two triangles), level or tilted, or two quads
+ * side by side in one plane -- gets no tree: the tree could only pick its
+ * triangles as the power table does, so the image has the power table's
+ * bits.  Quads at two heights, or facing two ways, keep it. */
+static void flat_lamp(void)
+{
+    static const struct { const char *quads; int tree; } cases[] = {
+        {"[[-0.5, 2, -0.5], [0.5, 2, -0.5], [0.5, 2, 0.5], [-0.5, 2, 0.5]]", 0},
+        {"[[-0.5, 2, -0.5], [0.5, 2.3, -0.5], [0.5, 2.3, 0.5], [-0.5, 2, 0.5]]", 0},
+        {"[[-1.5, 2, -0.5], [-0.5, 2, -0.5], [-0.5, 2, 0.5], [-1.5, 2, 0.5]];"
+         "[[0.5, 2, -0.5], [1.5, 2, -0.5], [1.5, 2, 0.5], [0.5, 2, 0.5]]", 0},
+        {"[[-1.5, 2, -0.5], [-0.5, 2, -0.5], [-0.5, 2, 0.5], [-1.5, 2, 0.5]];"
+         "[[0.5, 3, -0.5], [1.5, 3, -0.5], [1.5, 3, 0.5], [0.5, 3, 0.5]]", 1},
+        {"[[-1.5, 2, -0.5], [-0.5, 2, -0.5], [-0.5, 2, 0.5], [-1.5, 2, 0.5]];"
+         "[[0.5, 2, 0.5], [1.5, 2, 0.5], [1.5, 2, -0.5], [0.5, 2, -0.5]]", 1},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        fr_scene a, b;
+        quad_lamps(cases[c].quads, "tree", &a);
+        quad_lamps(cases[c].quads, "power", &b);
+        uint32_t nl = a.n_lights - lgt_n_distant(&a);
+        CHECK(cases[c].tree ? a.n_light_nodes == 2 * nl - 1 : a.n_light_nodes == 0,
+              "lamp case %zu: %u tree nodes for %u lights", c, a.n_light_nodes, nl);
+        int same = 1;
+        for (uint32_t y = 0; y < 16; y++)
+            for (uint32_t x = 0; x < 16; x++)
+                for (uint32_t i = 0; i < 4; i++) {
+                    vec3 ca = pt_sample(&a, PT_MIS, x, y, i), cb = pt_sample(&b, PT_MIS, x, y, i);
+                    same &= memcmp(&ca, &cb, sizeof ca) == 0;
+                }
+        CHECK(cases[c].tree || same, "lamp case %zu: the image differs from the power table's", c);
+        scn_free(&a);
+        scn_free(&b);
+    }
+}
+
 /* A furnace: a small Lambert square (albedo 0.5) inside a closed icosphere
  * of 320 inward-facing emissive triangles of radiance 2, seen with direct
  * light only.  The square's upper side sees emitters over its whole
@@ -472,6 +530,7 @@ int main(void)
     pick_probabilities();
     sample_pdf();
     one_light();
+    flat_lamp();
     lamp_sums();
     lamp_ground();
     furnace();
