@@ -35,11 +35,15 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 SPP=${SPP:-64} FREF_SPP=${FREF_SPP:-8192} CREF_SPP=${CREF_SPP:-2048} RUNS=${RUNS:-3} PCT=${PCT:-99.9} N=$(nproc)
 CACHE=${FRANJA_BENCH_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/franja-bench}
-SCENE=tests/bench/scenes/showcase.json
-W=160 H=90
-echo "== showcase against Cycles: 160x90, RMSE against each renderer's own converged image (Franja $FREF_SPP spp, Cycles $CREF_SPP spp), medians of $RUNS seeds"
+# SCENE: another scene both renderers read (its image size is used), such
+# as tests/data/cycles-metals.json (scenes/metals.json for both).
+SCENE=${SCENE:-tests/bench/scenes/showcase.json}
+NAME=$(basename "$SCENE" .json)
+set -- $(python3 -c 'import json, sys; i = json.load(open(sys.argv[1]))["image"]; print(i["width"], i["height"])' "$SCENE") || exit 1
+W=$1 H=$2
+echo "== $NAME against Cycles: ${W}x$H, RMSE against each renderer's own converged image (Franja $FREF_SPP spp, Cycles $CREF_SPP spp), medians of $RUNS seeds"
 echo "machine: $N cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "reproduce: sh tests/bench/showcase.sh   (SPP, FREF_SPP, CREF_SPP, RUNS, PCT, FRANJA_BENCH_CACHE in the environment)"
+echo "reproduce: SCENE=$SCENE sh tests/bench/showcase.sh   (SPP, FREF_SPP, CREF_SPP, RUNS, PCT, FRANJA_BENCH_CACHE in the environment)"
 median() { tr ' ' '\n' | grep . | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 rmse() { bin/tools/imgcmp "$1" "$2" | sed -n 's/^rmse \([0-9.]*\).*/\1/p'; }
 crmse() { bin/tools/imgcmp "$1" "$2" --clamp-pct "$PCT" | sed -n 's/^clamped rmse \([0-9.]*\).*/\1/p'; }
@@ -84,7 +88,7 @@ cached() {
     name=$1
     shift
     key=$(for k in "$@"; do if [ -f "$k" ]; then sha256sum <"$k"; else echo "$k"; fi; done | sha256sum | cut -c1-16)
-    ref="$CACHE/showcase-$name-$key.pfm"
+    ref="$CACHE/$NAME-$name-$key.pfm"
     [ -s "$ref" ]
 }
 # keep FILE: moves a finished reference into the cache, whole or not at all.
