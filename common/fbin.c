@@ -5,6 +5,7 @@
 
 #include "bvh.h"
 #include "file.h"
+#include "passes.h"
 #include "proto_limits.h"
 #include "scene_pages.h"
 #include "texture.h"
@@ -494,6 +495,9 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     if (!(st->noise_threshold >= 0.0f && st->noise_threshold <= 1.0f))
         return fr_fail(err, "section settings, byte %zu: noise threshold not in [0, 1]",
                        AT1(SEC_SETTINGS, fr_settings, noise_threshold));
+    if (st->passes & ~PASS_ALL)
+        return fr_fail(err, "section settings, byte %zu: unknown render passes %#x",
+                       AT1(SEC_SETTINGS, fr_settings, passes), st->passes & ~PASS_ALL);
     const fr_camera *c = &s->camera;
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
         !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !isfinite(c->aperture) ||

@@ -39,7 +39,7 @@ typedef struct {
     uint32_t integrator;       /**< FR_INTEGRATOR_* */
     float noise_threshold;     /**< adaptive sampling: a pixel stops once the estimated relative standard error of
                                     its mean luminance is below this (pathtrace.h); 0 = off, every pixel takes spp */
-    uint32_t pad;
+    uint32_t passes;           /**< render passes `franja render` asks for by default (passes.h bits); 0 = none */
 } fr_settings;
 
 /** A pinhole or thin-lens camera. */

@@ -56,6 +56,8 @@ typedef struct {
     int overwrite;             /* --overwrite */
     int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
+    uint32_t passes;           /* --passes: render passes (passes.h mask) */
+    int passes_set;            /* --passes given: overrides the scene's */
     fr_budget limits;          /* --limit: the compile's (budget.h) */
     tr_options tr;
     cli_slurm slurm;
@@ -104,6 +106,7 @@ typedef struct {
     unsigned char *have;
     uint32_t *base;
     float *rgb;
+    float *passes;             /* the render passes (passes.h) once stitched, or NULL */
     frame_passes ps;
     int rows_job, rows_have;
     double t0;
