@@ -213,14 +213,15 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
             free(have);
             if (!ok) {
                 fr_fail(err, "%s: this job directory belongs to another render (different scene, "
-                        "size, integrator or noise threshold); remove it or render without --resume", dir);
+                        "size, integrator, noise threshold or render passes); remove it or render without --resume", dir);
                 return JOB_REFUSED;
             }
             if (old.spp != spec->spp && !job_sums(spec)) {
                 fr_fail(err, "%s: holds a render with %u samples per pixel; %s cannot be continued to %u "
-                        "exactly (only path tracing without --noise-threshold keeps each pixel's sample "
-                        "sums): render with --fresh, or with --spp %u", dir, old.spp,
+                        "exactly (only path tracing without --noise-threshold or render passes keeps each "
+                        "pixel's sample sums): render with --fresh, or with --spp %u", dir, old.spp,
                         spec->integrator == FR_INTEGRATOR_BDPT ? "a bidirectional render"
+                        : spec->passes                         ? "a render with passes"
                                                                : "an adaptive render",
                         spec->spp, old.spp);
                 return JOB_REFUSED;
