@@ -200,7 +200,8 @@ static int parse_materials(ctx *c, const cJSON *o)
         fr_material mat;
         if (parse_material(c, m, where, &mat) < 0)
             return -1;
-        if (bld_push(&c->b->materials, &mat) == FR_NONE)
+        uint32_t k = bld_push(&c->b->materials, &mat);
+        if (k == FR_NONE || bld_material_name(c->b, k, m->string) < 0)
             return fr_fail(c->err, "%s: out of memory", where);
     }
     c->materials = o;
