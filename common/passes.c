@@ -23,6 +23,7 @@ static const pass_info passes[PASS_COUNT] = {
     [PASS_TRANSMISSION_DIRECT] = {"transmission_direct", "TransDir", "RGB"},
     [PASS_TRANSMISSION_INDIRECT] = {"transmission_indirect", "TransInd", "RGB"},
     [PASS_MATERIAL_ID] = {"material_id", "IndexMA", "X"},
+    [PASS_CRYPTO_MATERIAL] = {"crypto_material", "CryptoMaterial", "RGBARGBARGBA"},
 };
 
 const pass_info *pass_get(int i) { return &passes[i]; }
@@ -193,11 +194,59 @@ static int values(const pass_sample *p, int i, float *v)
 /* Whether pass i keeps sample 0's value rather than the mean. */
 static int first_only(int i) { return i == PASS_DEPTH || i == PASS_POSITION || i == PASS_MATERIAL_ID; }
 
+/* Doubles pass_accumulate keeps for pass i. */
+static int acc_width(int i)
+{
+    return i == PASS_CRYPTO_MATERIAL ? 2 * PASS_CRYPTO_SLOTS : (int)strlen(passes[i].channels);
+}
+
+/* The Cryptomatte slots (id + 1, samples): one more sample on material id
+ * (1 + index, 0: nothing hit). */
+static void crypto_count(double *slot, uint32_t id)
+{
+    for (int k = 0; k < PASS_CRYPTO_SLOTS; k++) {
+        if (slot[2 * k + 1] > 0 && slot[2 * k] == (double)id + 1) {
+            slot[2 * k + 1] += 1;
+            return;
+        }
+        if (slot[2 * k + 1] == 0) {
+            slot[2 * k] = (double)id + 1;
+            slot[2 * k + 1] = 1;
+            return;
+        }
+    }
+}
+
+/* The ranked (id, coverage) pairs of n samples from the slots. */
+static void crypto_rank(const double *slot, uint32_t n, float *out)
+{
+    int used[PASS_CRYPTO_SLOTS] = {0};
+    for (int r = 0; r < PASS_CRYPTO_RANKS; r++) {
+        int best = -1;
+        for (int k = 0; k < PASS_CRYPTO_SLOTS; k++) {
+            if (used[k] || slot[2 * k + 1] == 0)
+                continue;
+            if (best < 0 || slot[2 * k + 1] > slot[2 * best + 1] ||
+                (slot[2 * k + 1] == slot[2 * best + 1] && slot[2 * k] < slot[2 * best]))
+                best = k;
+        }
+        out[2 * r] = best < 0 ? 0.0f : (float)(slot[2 * best] - 1);
+        out[2 * r + 1] = best < 0 ? 0.0f : (float)(slot[2 * best + 1] / n);
+        if (best >= 0)
+            used[best] = 1;
+    }
+}
+
 void pass_accumulate(double *acc, uint32_t mask, const pass_sample *p, uint32_t index)
 {
     for (int i = 0; i < PASS_COUNT; i++) {
         if (!(mask >> i & 1u))
             continue;
+        if (i == PASS_CRYPTO_MATERIAL) {
+            crypto_count(acc, p->material);
+            acc += acc_width(i);
+            continue;
+        }
         float v[3];
         int n = values(p, i, v);
         for (int c = 0; c < n; c++) {
@@ -216,8 +265,12 @@ void pass_finish(const double *acc, uint32_t mask, uint32_t n, float *out)
         if (!(mask >> i & 1u))
             continue;
         int k = (int)strlen(passes[i].channels);
-        for (int c = 0; c < k; c++)
-            *out++ = first_only(i) ? (float)acc[c] : (float)(acc[c] / n);
-        acc += k;
+        if (i == PASS_CRYPTO_MATERIAL)
+            crypto_rank(acc, n, out);
+        else
+            for (int c = 0; c < k; c++)
+                out[c] = first_only(i) ? (float)acc[c] : (float)(acc[c] / n);
+        out += k;
+        acc += acc_width(i);
     }
 }

@@ -42,6 +42,15 @@
  *   and these six sum to the beauty (within float rounding).
  * - material_id (X): 1 + the index of the material first hit (sample 0),
  *   the order of the scene's materials; 0 where nothing is hit.
+ * - crypto_material (12 channels): the Cryptomatte ranking of the
+ *   materials first hit: PASS_CRYPTO_RANKS pairs (id, coverage), the
+ *   materials by the share of the pixel's samples that hit them first
+ *   (most first; equal shares by id), id 1 + the material's index (0:
+ *   nothing hit, and unused ranks (0, 0)).  The coordinator turns ids into
+ *   the hashes of the materials' names (Cryptomatte's uint32_to_float32).
+ *   At most PASS_CRYPTO_SLOTS materials a pixel are counted; the
+ *   coverages of a pixel then sum to 1 when it sees at most
+ *   PASS_CRYPTO_RANKS of them.
  *
  * Every value is finite.  Light passes and albedo are means over the
  * pixel's samples like the beauty, so any split of rows gives the same
@@ -71,6 +80,7 @@ enum {
     PASS_TRANSMISSION_DIRECT,
     PASS_TRANSMISSION_INDIRECT,
     PASS_MATERIAL_ID,
+    PASS_CRYPTO_MATERIAL,
     PASS_COUNT
 };
 
@@ -78,7 +88,17 @@ enum {
 #define PASS_ALL ((1u << PASS_COUNT) - 1u)
 
 /** Most channels a pixel's passes have (all of them). */
-#define PASS_MAX_CHANNELS 32
+#define PASS_MAX_CHANNELS 44
+
+/** Ranks of the Cryptomatte pass (each an id and its coverage). */
+#define PASS_CRYPTO_RANKS 6
+
+/** Materials a pixel's Cryptomatte pass tells apart; a sample on a
+ * further one is not counted. */
+#define PASS_CRYPTO_SLOTS 16
+
+/** Most doubles pass_accumulate keeps for a pixel (all the passes). */
+#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 2 * PASS_CRYPTO_RANKS + 2 * PASS_CRYPTO_SLOTS)
 
 /** Depth where the camera ray hits nothing. */
 #define PASS_DEPTH_NONE 1e10f

@@ -329,7 +329,7 @@ void pt_render_rows_passes(const fr_scene *s, pt_strategy strategy, uint32_t y0,
         for (uint32_t x = 0; x < w; x++) {
             /* The decision to stop reads this pixel's own samples only, so
              * a slab renders the same bits whatever the split. */
-            double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0, pacc[PASS_MAX_CHANNELS] = {0};
+            double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0, pacc[PASS_MAX_ACC] = {0};
             uint32_t n = 0;
             while (n < spp) {
                 vec3 c = pt_sample_seeded(s, strategy, x, y, n, &shared, ps);

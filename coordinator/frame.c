@@ -305,8 +305,16 @@ int frame_open(frame_image *im)
         im->tm.exposure = a->exposure;
     if (a->curve)
         tm_curve_parse(a->curve, &im->tm.curve);
+    /* The materials' names, for the metadata of material_id and
+     * crypto_material. */
+    im->n_materials = sc.n_materials;
+    if (spec.passes && sc.n_material_names && (im->mat_names = malloc(sc.n_material_names * sizeof *im->mat_names)))
+        memcpy(im->mat_names, sc.material_names, (im->n_mat_names = sc.n_material_names) * sizeof *im->mat_names);
     scn_free(&sc);
     im->spec = spec;
+    if ((spec.passes >> PASS_CRYPTO_MATERIAL & 1u) && !out_has_ext(a->out, "exr"))
+        fprintf(stderr, "franja render: warning: crypto_material is written to .exr outputs only; %s gets the "
+                "other passes\n", a->out);
 
     im->have = calloc(spec.height, 1);
     im->base = calloc(spec.height, sizeof *im->base);
@@ -433,7 +441,8 @@ int frame_write(frame_image *im, const char *used)
     if (a->reproducible)
         out_meta_set_time(&meta, reproducible_epoch());
     a->io.attrs = meta.attrs;
-    if (passout_write(a->out, rgb, im->passes, &out_spec, &im->tm, &a->io, &err)) {
+    crypto_names names = {im->mat_names, im->n_mat_names};
+    if (passout_write(a->out, rgb, im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &err)) {
         /* Said only once checked: the rows are still there. */
         if (job_rows_present(im->jobdir) >= im->rows_job) {
             fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
@@ -474,6 +483,7 @@ void frame_close(frame_image *im, int rc)
     free(im->ps.scratch);
     free(im->rgb);
     free(im->passes);
+    free(im->mat_names);
     free(im);
 }
 

@@ -21,7 +21,7 @@ static void pass_file(const char *path, const char *name, char *out, size_t cap)
 
 /* The multilayer OpenEXR: the beauty in RGBA, then the passes' channels. */
 static int write_exr(const char *path, const float *rgb, const float *passes, const job_spec *spec,
-                     const iio_options *o, fr_error *err)
+                     const iio_options *o, const crypto_names *cn, uint32_t n_materials, fr_error *err)
 {
     uint32_t nch = pass_channels(spec->passes), all = 4 + nch;
     size_t npx = (size_t)spec->width * spec->height;
@@ -44,13 +44,21 @@ static int write_exr(const char *path, const float *rgb, const float *passes, co
     uint32_t c = 0;
     for (; c < 4; c++)
         snprintf(names[c], sizeof names[c], "ViewLayer.Combined.%c", rgba[c]);
+    uint32_t crypto_at = 0;
     for (int i = 0; i < PASS_COUNT; i++) {
         if (!(spec->passes >> i & 1u))
             continue;
         const pass_info *p = pass_get(i);
+        if (i == PASS_CRYPTO_MATERIAL)
+            crypto_at = c;
         for (const char *ch = p->channels; *ch; ch++, c++)
-            snprintf(names[c], sizeof names[c], "ViewLayer.%s.%c", p->layer, *ch);
+            if (i == PASS_CRYPTO_MATERIAL) /* Cryptomatte's own layers: CryptoMaterial00.R ... 02.A */
+                snprintf(names[c], sizeof names[c], "%s%02u.%c", p->layer, (unsigned)(ch - p->channels) / 4, *ch);
+            else
+                snprintf(names[c], sizeof names[c], "ViewLayer.%s.%c", p->layer, *ch);
     }
+    if (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)
+        crypto_ids(px + crypto_at, npx, all, cn);
     for (c = 0; c < all; c++)
         ptrs[c] = names[c];
     /* The caller's attributes and franja:passes. */
@@ -58,15 +66,29 @@ static int write_exr(const char *path, const float *rgb, const float *passes, co
     pass_format(spec->passes, list, sizeof list);
     const char *attrs[64];
     size_t k = 0;
-    for (const char *const *a = o ? o->attrs : NULL; a && a[0] && a[1] && k + 4 < 64; a += 2)
+    for (const char *const *a = o ? o->attrs : NULL; a && a[0] && a[1] && k + 16 < 64; a += 2)
         attrs[k++] = a[0], attrs[k++] = a[1];
     attrs[k++] = "franja:passes", attrs[k++] = list;
+    char *table = NULL, *crypto = NULL;
+    int rc = 0;
+    if (spec->passes & (1u << PASS_MATERIAL_ID | 1u << PASS_CRYPTO_MATERIAL)) {
+        rc = crypto_name_table(cn, n_materials, &table, err);
+        if (rc == 0)
+            attrs[k++] = "franja:materials", attrs[k++] = table;
+    }
+    if (rc == 0 && (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)) {
+        rc = crypto_metadata(pass_get(PASS_CRYPTO_MATERIAL)->layer, cn, n_materials, attrs + k, &crypto, err);
+        k += 8;
+    }
     attrs[k] = NULL;
     iio_options with = o ? *o : (iio_options){0};
     with.attrs = attrs;
     with.channels = all;
     with.channel_names = ptrs;
-    int rc = out_write_with(path, px, spec, NULL, &with, err);
+    if (rc == 0)
+        rc = out_write_with(path, px, spec, NULL, &with, err);
+    free(table);
+    free(crypto);
     free(px);
     free(names);
     free(ptrs);
@@ -98,12 +120,13 @@ static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, si
 }
 
 int passout_write(const char *path, const float *rgb, const float *passes, const job_spec *spec,
-                  const fr_tonemap *tm, const iio_options *o, fr_error *err)
+                  const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
+                  fr_error *err)
 {
     if (!passes || !spec->passes)
         return out_write_with(path, rgb, spec, tm, o, err);
     if (out_has_ext(path, "exr"))
-        return write_exr(path, rgb, passes, spec, o, err);
+        return write_exr(path, rgb, passes, spec, o, names, n_materials, err);
     if (out_write_with(path, rgb, spec, tm, o, err))
         return -1;
     size_t npx = (size_t)spec->width * spec->height;
@@ -119,6 +142,10 @@ int passout_write(const char *path, const float *rgb, const float *passes, const
         if (!(spec->passes >> i & 1u))
             continue;
         const pass_info *p = pass_get(i);
+        if (i == PASS_CRYPTO_MATERIAL) { /* OpenEXR only (frame.c says so) */
+            at += (uint32_t)strlen(p->channels);
+            continue;
+        }
         char file[4200];
         pass_file(path, p->name, file, sizeof file);
         pass_image(passes, nch, at, i, npx, ldr, img);

@@ -31,10 +31,14 @@ oiiotool --info -v j1.exr >info 2>&1
 for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Albedo.G" \
     "ViewLayer.Denoising Normal.Z" "ViewLayer.Depth.Z" "ViewLayer.Position.X" "ViewLayer.Emit.B" \
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
-    "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X"; do
+    "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "CryptoMaterial00.R" \
+    "CryptoMaterial02.A"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
-check "the EXR has 36 channels" grep -q "36 channel" info
+check "the EXR has 48 channels" grep -q "48 channel" info
+check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "CryptoMaterial"' info
+check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
+check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info
 check "the EXR names its passes" grep -q 'franja:passes: "albedo,normal,depth' info
 
 # The image is the same bytes with and without passes (PFM: Franja's own
