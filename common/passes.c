@@ -24,6 +24,7 @@ static const pass_info passes[PASS_COUNT] = {
     [PASS_TRANSMISSION_INDIRECT] = {"transmission_indirect", "TransInd", "RGB"},
     [PASS_MATERIAL_ID] = {"material_id", "IndexMA", "X"},
     [PASS_CRYPTO_MATERIAL] = {"crypto_material", "CryptoMaterial", "RGBARGBARGBA"},
+    [PASS_VARIANCE] = {"variance", "Variance", "RGB"},
 };
 
 const pass_info *pass_get(int i) { return &passes[i]; }
@@ -197,7 +198,7 @@ static int first_only(int i) { return i == PASS_DEPTH || i == PASS_POSITION || i
 /* Doubles pass_accumulate keeps for pass i. */
 static int acc_width(int i)
 {
-    return i == PASS_CRYPTO_MATERIAL ? 2 * PASS_CRYPTO_SLOTS : (int)strlen(passes[i].channels);
+    return i == PASS_CRYPTO_MATERIAL ? 2 * PASS_CRYPTO_SLOTS : i == PASS_VARIANCE ? 6 : (int)strlen(passes[i].channels);
 }
 
 /* The Cryptomatte slots (id + 1, samples): one more sample on material id
@@ -242,8 +243,15 @@ void pass_accumulate(double *acc, uint32_t mask, const pass_sample *p, uint32_t 
     for (int i = 0; i < PASS_COUNT; i++) {
         if (!(mask >> i & 1u))
             continue;
-        if (i == PASS_CRYPTO_MATERIAL) {
-            crypto_count(acc, p->material);
+        if (i == PASS_CRYPTO_MATERIAL || i == PASS_VARIANCE) {
+            if (i == PASS_CRYPTO_MATERIAL)
+                crypto_count(acc, p->material);
+            else
+                for (int c = 0; c < 3; c++) {
+                    double v = v3_get(p->beauty, c);
+                    acc[c] += v;
+                    acc[3 + c] += v * v;
+                }
             acc += acc_width(i);
             continue;
         }
@@ -267,6 +275,11 @@ void pass_finish(const double *acc, uint32_t mask, uint32_t n, float *out)
         int k = (int)strlen(passes[i].channels);
         if (i == PASS_CRYPTO_MATERIAL)
             crypto_rank(acc, n, out);
+        else if (i == PASS_VARIANCE)
+            for (int c = 0; c < 3; c++) {
+                double var = n > 1 ? (acc[3 + c] - acc[c] * acc[c] / n) / (n - 1) / n : 0.0;
+                out[c] = var > 0.0 ? (float)var : 0.0f;
+            }
         else
             for (int c = 0; c < k; c++)
                 out[c] = first_only(i) ? (float)acc[c] : (float)(acc[c] / n);

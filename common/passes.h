@@ -51,6 +51,10 @@
  *   At most PASS_CRYPTO_SLOTS materials a pixel are counted; the
  *   coverages of a pixel then sum to 1 when it sees at most
  *   PASS_CRYPTO_RANKS of them.
+ * - variance (RGB): the variance of the pixel's mean, per channel: the
+ *   unbiased sample variance of its samples (as the image has them, a
+ *   dropped sample as 0) over their number; 0 for a single sample.  What
+ *   a denoiser or the adaptive sampler's user weighs the pixel by.
  *
  * Every value is finite.  Light passes and albedo are means over the
  * pixel's samples like the beauty, so any split of rows gives the same
@@ -81,6 +85,7 @@ enum {
     PASS_TRANSMISSION_INDIRECT,
     PASS_MATERIAL_ID,
     PASS_CRYPTO_MATERIAL,
+    PASS_VARIANCE,
     PASS_COUNT
 };
 
@@ -88,7 +93,7 @@ enum {
 #define PASS_ALL ((1u << PASS_COUNT) - 1u)
 
 /** Most channels a pixel's passes have (all of them). */
-#define PASS_MAX_CHANNELS 44
+#define PASS_MAX_CHANNELS 47
 
 /** Ranks of the Cryptomatte pass (each an id and its coverage). */
 #define PASS_CRYPTO_RANKS 6
@@ -98,7 +103,7 @@ enum {
 #define PASS_CRYPTO_SLOTS 16
 
 /** Most doubles pass_accumulate keeps for a pixel (all the passes). */
-#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 2 * PASS_CRYPTO_RANKS + 2 * PASS_CRYPTO_SLOTS)
+#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 2 * PASS_CRYPTO_RANKS + 2 * PASS_CRYPTO_SLOTS + 3)
 
 /** Depth where the camera ray hits nothing. */
 #define PASS_DEPTH_NONE 1e10f
@@ -135,6 +140,7 @@ typedef struct {
     uint32_t material;         /**< 1 + index, 0: none */
     int kind;                  /**< the first scattering's kind: 0 diffuse, 1 glossy, 2 transmission; -1 none yet */
     vec3 light[7];             /**< emission, then diffuse, glossy, transmission each direct and indirect */
+    vec3 beauty;               /**< the sample's radiance, as the image adds it (variance) */
 } pass_sample;
 
 /** A sample's passes before its camera ray is traced. */

@@ -278,6 +278,8 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             pass_drop_light(ps);
         return v3s(0.0f);
     }
+    if (ps)
+        ps->beauty = L;
     return L;
 }
 

@@ -66,7 +66,7 @@ static const char usage[] =
     "                       diffuse_indirect, glossy_direct, glossy_indirect,\n"
     "                       transmission_direct, transmission_indirect,\n"
     "                       material_id, crypto_material (Cryptomatte, .exr\n"
-    "                       only), or all, light, denoise, none; .exr: one\n"
+    "                       only), variance, or all, light, denoise, none; .exr: one\n"
     "                       multilayer file, other types: one file per pass\n"
     "                       beside OUT (OUT.albedo.png ...) (default: the scene's)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"

@@ -32,10 +32,10 @@ for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Alb
     "ViewLayer.Denoising Normal.Z" "ViewLayer.Depth.Z" "ViewLayer.Position.X" "ViewLayer.Emit.B" \
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
     "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "CryptoMaterial00.R" \
-    "CryptoMaterial02.A"; do
+    "CryptoMaterial02.A" "ViewLayer.Variance.B"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
-check "the EXR has 48 channels" grep -q "48 channel" info
+check "the EXR has 51 channels" grep -q "51 channel" info
 check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "CryptoMaterial"' info
 check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
 check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info

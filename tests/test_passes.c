@@ -24,7 +24,7 @@
 /* Offsets of the passes' channels with every pass on (passes.h order). */
 enum {
     C_ALBEDO = 0, C_NORMAL = 3, C_DEPTH = 6, C_POSITION = 7, C_EMISSION = 10, C_LIGHT = 13, C_MATERIAL = 31,
-    C_CRYPTO = 32, C_ALL = 44
+    C_CRYPTO = 32, C_VARIANCE = 44, C_ALL = 47
 };
 
 static int load(const char *path, fr_scene *s)
@@ -168,6 +168,34 @@ static void check_cornell(void)
     CHECK(depth_bad == 0, "cornell: %d pixels whose depth is not the distance to their position", depth_bad);
     CHECK(red > 20 && red_bad == 0, "cornell: %d red wall pixels, %d not with normal -x", red, red_bad);
     CHECK(green > 20 && green_bad == 0, "cornell: %d green wall pixels, %d not with normal +x", green, green_bad);
+    /* The variance of each pixel's mean, from its samples as pt_sample
+     * gives them, on a few pixels; and never negative anywhere. */
+    int var_bad = 0, var_neg = 0, var_pos = 0;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = pass[i * C_ALL + C_VARIANCE + c];
+            var_neg += !(v >= 0.0f);
+            var_pos += v > 0.0f;
+        }
+    for (uint32_t y = 3; y < H; y += 7)
+        for (uint32_t x = 2; x < W; x += 9) {
+            double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+            for (uint32_t k = 0; k < SPP; k++) {
+                vec3 l = pt_sample(&s, PT_MIS, x, y, k);
+                for (int c = 0; c < 3; c++) {
+                    double v = v3_get(l, c);
+                    sum[c] += v;
+                    sum2[c] += v * v;
+                }
+            }
+            for (int c = 0; c < 3; c++) {
+                double want = (sum2[c] - sum[c] * sum[c] / SPP) / (SPP - 1) / SPP;
+                float got = pass[((size_t)y * W + x) * C_ALL + C_VARIANCE + c];
+                var_bad += fabs(got - want) > 1e-6 * want + 1e-12;
+            }
+        }
+    CHECK(var_bad == 0, "cornell: %d variance values differ from their samples' variance of the mean", var_bad);
+    CHECK(var_neg == 0 && var_pos > (int)n, "cornell: %d negative variances, %d positive", var_neg, var_pos);
     free(rgb);
     free(pass);
     scn_free(&s);
@@ -226,7 +254,7 @@ static void check_names(void)
     fr_error err;
     CHECK(pass_parse("albedo,normal", &m, &err) == 0 && m == (1u << PASS_ALBEDO | 1u << PASS_NORMAL),
           "albedo,normal parses");
-    CHECK(pass_parse("all", &m, &err) == 0 && m == PASS_ALL && pass_channels(m) == 44, "all: every pass, 44 channels");
+    CHECK(pass_parse("all", &m, &err) == 0 && m == PASS_ALL && pass_channels(m) == 47, "all: every pass, 47 channels");
     CHECK(pass_parse("none", &m, &err) == 0 && m == 0, "none parses to no pass");
     CHECK(pass_parse("albedo,nromal", &m, &err) < 0 && strstr(err.msg, "nromal"), "a misspelt pass is named: %s",
           err.msg);

@@ -62,7 +62,8 @@ static const char usage[] =
     "                 with sums): comma-separated albedo, normal, depth, position,\n"
     "                 emission, diffuse_direct, diffuse_indirect, glossy_direct,\n"
     "                 glossy_indirect, transmission_direct, transmission_indirect,\n"
-    "                 material_id, crypto_material; or all, light, denoise, none\n"
+    "                 material_id, crypto_material, variance; or all, light,\n"
+    "                 denoise, none\n"
     "\n"
     "Writing to a pipe (-o -), the worker ends itself when the pipe's reader is\n"
     "gone or its parent process ends.\n";
