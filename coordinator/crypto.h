@@ -6,9 +6,9 @@
  * A material's id is the MurmurHash3_x86_32 hash (seed 0) of its name,
  * stored as a float by uint32_to_float32 (the bits of the hash with the
  * exponent clamped to 1..254, so never a NaN, an infinity or a
- * denormal); nothing hit is 0.  The layer "CryptoMaterial" is written as
- * CryptoMaterial00, 01, 02 (R: id, G: coverage, B: id, A: coverage of the
- * next rank), with the metadata cryptomatte/KEY/name, hash
+ * denormal); nothing hit is 0.  The layer "ViewLayer.CryptoMaterial" (as
+ * Blender names it) is written as ViewLayer.CryptoMaterial00, 01, 02 (R:
+ * id, G: coverage, B: id, A: coverage of the next rank), with the metadata cryptomatte/KEY/name, hash
  * ("MurmurHash3_32"), conversion ("uint32_to_float32") and manifest (a
  * JSON object, name to the 8 hex digits of the id's float bits), KEY being
  * the first 7 hex digits of the hash of the layer's name.

@@ -52,8 +52,9 @@ static int write_exr(const char *path, const float *rgb, const float *passes, co
         if (i == PASS_CRYPTO_MATERIAL)
             crypto_at = c;
         for (const char *ch = p->channels; *ch; ch++, c++)
-            if (i == PASS_CRYPTO_MATERIAL) /* Cryptomatte's own layers: CryptoMaterial00.R ... 02.A */
-                snprintf(names[c], sizeof names[c], "%s%02u.%c", p->layer, (unsigned)(ch - p->channels) / 4, *ch);
+            if (i == PASS_CRYPTO_MATERIAL) /* Cryptomatte's ranks: ViewLayer.CryptoMaterial00.R ... 02.A */
+                snprintf(names[c], sizeof names[c], "ViewLayer.%s%02u.%c", p->layer,
+                         (unsigned)(ch - p->channels) / 4, *ch);
             else
                 snprintf(names[c], sizeof names[c], "ViewLayer.%s.%c", p->layer, *ch);
     }
@@ -77,7 +78,7 @@ static int write_exr(const char *path, const float *rgb, const float *passes, co
             attrs[k++] = "franja:materials", attrs[k++] = table;
     }
     if (rc == 0 && (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)) {
-        rc = crypto_metadata(pass_get(PASS_CRYPTO_MATERIAL)->layer, cn, n_materials, attrs + k, &crypto, err);
+        rc = crypto_metadata("ViewLayer.CryptoMaterial", cn, n_materials, attrs + k, &crypto, err);
         k += 8;
     }
     attrs[k] = NULL;

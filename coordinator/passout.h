@@ -9,7 +9,8 @@
  * ViewLayer.Combined.R, .G, .B and .A (alpha 1), then each pass's layer
  * (passes.h: "Denoising Albedo" RGB, "Denoising Normal" XYZ, "Depth" Z,
  * "Position" XYZ, "Emit" RGB, "DiffDir" ... "TransInd" RGB, "IndexMA" X),
- * then the Cryptomatte layer CryptoMaterial00, 01, 02 (RGBA, crypto.h),
+ * then the Cryptomatte layer ViewLayer.CryptoMaterial00, 01, 02 (RGBA,
+ * crypto.h, named as Blender names its own),
  * and the attributes franja:passes naming the passes, franja:materials
  * (with material_id or crypto_material: the materials' names as a JSON
  * array, IndexMA k being entry k - 1) and Cryptomatte's.

@@ -3,12 +3,13 @@
 #
 # franja render --passes: the multilayer EXR is byte-identical between -j 1,
 # -j 2 --slab-rows 5 and fake SSH hosts; oiiotool lists its layers by
-# Blender's names; the image's bytes do not change with passes; PNG and
+# Blender's names and Blender's compositor offers them; the image's bytes
+# do not change with passes; PNG and
 # PFM outputs get one file per pass; the scene's "passes" key is read;
 # --crop, --resume and adaptive sampling work with passes; bdpt and
 # --time-limit are refused with a message.
 . "$(dirname "$0")/support/fakehosts.sh"
-need oiiotool
+need oiiotool blender
 fh_init
 cd "$FH" || exit 1
 SIZE="--size 40x30 --spp 4"
@@ -31,15 +32,31 @@ oiiotool --info -v j1.exr >info 2>&1
 for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Albedo.G" \
     "ViewLayer.Denoising Normal.Z" "ViewLayer.Depth.Z" "ViewLayer.Position.X" "ViewLayer.Emit.B" \
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
-    "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "CryptoMaterial00.R" \
-    "CryptoMaterial02.A" "ViewLayer.Variance.B"; do
+    "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "ViewLayer.CryptoMaterial00.R" \
+    "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
 check "the EXR has 51 channels" grep -q "51 channel" info
-check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "CryptoMaterial"' info
+check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoMaterial"' info
 check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
 check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info
 check "the EXR names its passes" grep -q 'franja:passes: "albedo,normal,depth' info
+
+# Blender opens the file as a multilayer EXR: its compositor's Image node
+# offers every pass.
+cat >open.py <<'PY'
+import bpy, sys
+img = bpy.data.images.load(sys.argv[sys.argv.index("--") + 1])
+bpy.context.scene.use_nodes = True
+node = bpy.context.scene.node_tree.nodes.new("CompositorNodeImage")
+node.image = img
+print("PASSES |" + "|".join(o.name for o in node.outputs) + "|")
+PY
+blender -b --factory-startup --python open.py -- j1.exr >blender.log 2>&1
+for p in Combined "Denoising Albedo" "Denoising Normal" Depth Position Emit DiffDir DiffInd GlossDir GlossInd \
+    TransDir TransInd IndexMA CryptoMaterial00 CryptoMaterial02 Variance; do
+    check "Blender's Image node offers $p" grep -q "^PASSES .*|$p|" blender.log
+done
 
 # The image is the same bytes with and without passes (PFM: Franja's own
 # writer, so the bytes are the pixels and the header).
