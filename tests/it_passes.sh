@@ -93,6 +93,15 @@ check "--resume with other passes: said" grep -q "another render (.*render passe
 check "--resume with more samples and passes is refused" test $? -eq 2
 check "--resume with more samples and passes: said" grep -q "a render with passes cannot be continued" log16
 
+# An animation: every frame gets its passes.
+cp "$ROOT/scenes/cornell.json" f.0001.json
+cp "$ROOT/scenes/cornell.json" f.0002.json
+"$FRANJA" render 'f.####.json' --frames 1-2 -o 'anim/f.####.exr' $SIZE -j 2 --passes denoise 2>log17
+check "--frames with passes" test $? -eq 0
+for f in 0001 0002; do
+    check "frame $f has its albedo pass" sh -c "oiiotool --info -v anim/f.$f.exr | grep -q 'Denoising Albedo.R'"
+done
+
 # Adaptive sampling with passes.
 "$FRANJA" render "$SCENE" -o adapt.exr --size 40x30 --spp 64 --noise-threshold 0.5 -j 2 --passes light 2>log12
 check "adaptive sampling with passes" test $? -eq 0
