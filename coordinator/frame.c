@@ -442,7 +442,7 @@ int frame_write(frame_image *im, const char *used)
         out_meta_set_time(&meta, reproducible_epoch());
     a->io.attrs = meta.attrs;
     crypto_names names = {im->mat_names, im->n_mat_names};
-    if (passout_write(a->out, rgb, im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &err)) {
+    if (passout_write(a->out, rgb, &im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &err)) {
         /* Said only once checked: the rows are still there. */
         if (job_rows_present(im->jobdir) >= im->rows_job) {
             fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "

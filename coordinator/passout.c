@@ -19,26 +19,31 @@ static void pass_file(const char *path, const char *name, char *out, size_t cap)
     snprintf(out, cap, "%.*s.%s%s", (int)stem, path, name, dot ? dot : "");
 }
 
-/* The multilayer OpenEXR: the beauty in RGBA, then the passes' channels. */
-static int write_exr(const char *path, const float *rgb, const float *passes, const job_spec *spec,
+/* The multilayer OpenEXR: the beauty in RGBA, then the passes' channels,
+ * interleaved in *passes itself (grown), so that the passes are not held
+ * twice. */
+static int write_exr(const char *path, const float *rgb, float **passes, const job_spec *spec,
                      const iio_options *o, const crypto_names *cn, uint32_t n_materials, fr_error *err)
 {
     uint32_t nch = pass_channels(spec->passes), all = 4 + nch;
     size_t npx = (size_t)spec->width * spec->height;
-    float *px = malloc(npx * all * sizeof *px);
+    float *px = realloc(*passes, npx * all * sizeof *px);
     char (*names)[64] = malloc(all * sizeof *names);
     const char **ptrs = malloc(all * sizeof *ptrs);
+    if (px)
+        *passes = px;
     if (!px || !names || !ptrs) {
-        free(px);
         free(names);
         free(ptrs);
         return fr_fail(err, "%s: out of memory for %u channels of %ux%u pixels", path, all, spec->width,
                        spec->height);
     }
-    for (size_t i = 0; i < npx; i++) {
+    /* From the last pixel back, each pixel's passes move up to their place
+     * (never over a pixel not yet moved) and the beauty goes before them. */
+    for (size_t i = npx; i-- > 0;) {
         float *d = px + i * all;
+        memmove(d + 4, px + i * nch, nch * sizeof *d);
         d[0] = rgb[i * 3], d[1] = rgb[i * 3 + 1], d[2] = rgb[i * 3 + 2], d[3] = 1.0f;
-        memcpy(d + 4, passes + i * nch, nch * sizeof *d);
     }
     static const char rgba[] = "RGBA";
     uint32_t c = 0;
@@ -90,7 +95,6 @@ static int write_exr(const char *path, const float *rgb, const float *passes, co
         rc = out_write_with(path, px, spec, NULL, &with, err);
     free(table);
     free(crypto);
-    free(px);
     free(names);
     free(ptrs);
     return rc;
@@ -120,14 +124,15 @@ static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, si
         }
 }
 
-int passout_write(const char *path, const float *rgb, const float *passes, const job_spec *spec,
+int passout_write(const char *path, const float *rgb, float **pass_buf, const job_spec *spec,
                   const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
                   fr_error *err)
 {
+    const float *passes = pass_buf ? *pass_buf : NULL;
     if (!passes || !spec->passes)
         return out_write_with(path, rgb, spec, tm, o, err);
     if (out_has_ext(path, "exr"))
-        return write_exr(path, rgb, passes, spec, o, names, n_materials, err);
+        return write_exr(path, rgb, pass_buf, spec, o, names, n_materials, err);
     if (out_write_with(path, rgb, spec, tm, o, err))
         return -1;
     size_t npx = (size_t)spec->width * spec->height;

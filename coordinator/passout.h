@@ -32,13 +32,16 @@
 #include "jobdir.h"
 #include "tonemap.h"
 
-/** Writes the beauty rgb (width*height*3 floats) and, when passes is not
+/** Writes the beauty rgb (width*height*3 floats) and, when *passes is not
  * NULL and spec->passes not 0, the passes (width*height*pass_channels
- * floats, top row first) to path as passout.h says, each file atomically.
+ * floats, top row first, malloc'd, the caller's) to path as passout.h
+ * says, each file atomically.  An OpenEXR is made in *passes itself,
+ * reallocated (*passes updated; its values are then the file's), so the
+ * passes are not held twice.
  * o: the writer's options (NULL: none); names: the materials' names
  * (n_materials of them), for the metadata.  Fails naming the file not
  * written (files written before it stay). */
-int passout_write(const char *path, const float *rgb, const float *passes, const job_spec *spec,
+int passout_write(const char *path, const float *rgb, float **passes, const job_spec *spec,
                   const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
                   fr_error *err);
 
