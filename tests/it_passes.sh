@@ -80,6 +80,11 @@ check "--passes none overrides the scene's" sh -c 'test -s none.png && test ! -e
 check "--crop --crop-output with passes" test $? -eq 0
 check "the cropped EXR is the window, with its passes" \
     sh -c 'oiiotool --info -v crop.exr | grep -q "24 x   16, 10 channel"'
+"$FRANJA" render "$SCENE" -o full.exr $SIZE -j 2 --passes denoise 2>log8b
+oiiotool full.exr --cut 24x16+5+7 -o cut.exr
+oiiotool full.exr --cut 24x16+6+7 -o off.exr
+check "the window's image and passes are the full render's" sh -c 'oiiotool --diff cut.exr crop.exr | grep -q PASS'
+check "(a window one pixel off is not)" sh -c '! oiiotool --diff off.exr crop.exr | grep -q PASS'
 
 # --resume: the kept slabs, with their passes, give the same file.
 "$FRANJA" render "$SCENE" -o kept.exr $SIZE -j 2 --passes all --reproducible --keep-job 2>log9
