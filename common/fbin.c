@@ -5,6 +5,7 @@
 
 #include "bvh.h"
 #include "file.h"
+#include "passes.h"
 #include "proto_limits.h"
 #include "scene_pages.h"
 #include "texture.h"
@@ -30,8 +31,8 @@ enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
-    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE,
-    SEC_COUNT = SEC_LIGHTTREE
+    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE, SEC_NAMES,
+    SEC_COUNT = SEC_NAMES
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -71,6 +72,7 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_MESH_NODES, "mesh_nodes", mesh_nodes, fr_bvh_node),
     ARR(SEC_MESH_LEAVES, "mesh_leaves", mesh_leaves, fr_bvh_leaf),
     ARR(SEC_LIGHTTREE, "lighttree", light_nodes, fr_light_node),
+    ARR(SEC_NAMES, "material_names", material_names, fr_name),
 };
 #undef ARR
 
@@ -494,6 +496,9 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     if (!(st->noise_threshold >= 0.0f && st->noise_threshold <= 1.0f))
         return fr_fail(err, "section settings, byte %zu: noise threshold not in [0, 1]",
                        AT1(SEC_SETTINGS, fr_settings, noise_threshold));
+    if (st->passes & ~PASS_ALL)
+        return fr_fail(err, "section settings, byte %zu: unknown render passes %#x",
+                       AT1(SEC_SETTINGS, fr_settings, passes), st->passes & ~PASS_ALL);
     const fr_camera *c = &s->camera;
     if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
         !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !isfinite(c->aperture) ||
@@ -519,6 +524,19 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     }
     if (s->n_prims > 0 && s->n_materials == 0)
         return fr_fail(err, "section materials: primitives but no material");
+    if (s->n_material_names && s->n_material_names != s->n_materials)
+        return fr_fail(err, "section material_names: %u names for %u materials (expected 0 or one each)",
+                       s->n_material_names, s->n_materials);
+    for (uint32_t i = 0; i < s->n_material_names; i++) {
+        const char *n = s->material_names[i].name;
+        size_t k = strnlen(n, sizeof s->material_names[i].name);
+        int ok = k < sizeof s->material_names[i].name;
+        for (size_t j = 0; ok && j < k; j++)
+            ok = (unsigned char)n[j] >= 0x20 && n[j] != 0x7f;
+        if (!ok)
+            return fr_fail(err, "section material_names, byte %zu: name %u: not NUL-terminated text of at most 63 "
+                           "bytes without control characters", AT(n), i);
+    }
     if (validate_instances(s, base, err) < 0)
         return -1;
     uint32_t top = s->n_meshes ? s->meshes[0].prim_first : s->n_prims;

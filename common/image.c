@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <float.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,6 +14,7 @@
 #include <xxhash.h>
 
 #include "fmath.h"
+#include "passes.h"
 #include "proto_limits.h"
 #include "splat.h"
 
@@ -61,14 +63,44 @@ static int write_chunk(const unsigned char *bytes, size_t len, void *ctx)
     return fwrite(bytes, 1, len, ctx) == len ? 0 : -1;
 }
 
+/* The pass block's bytes (width*rows*pass_channels floats, little-endian)
+ * into a malloc'd *out, and the header's tail naming the passes and the
+ * block's hash. */
+static int pass_bytes(const img_partial_info *info, const float *pass, unsigned char **out, size_t *len,
+                      char *tail, size_t cap)
+{
+    size_t n = (size_t)info->width * (info->y1 - info->y0) * pass_channels(info->passes);
+    unsigned char *b = malloc(n ? n * 4 : 1);
+    if (!b)
+        return -1;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t bits;
+        memcpy(&bits, &pass[i], 4);
+        for (int k = 0; k < 4; k++)
+            b[i * 4 + k] = (unsigned char)(bits >> (8 * k));
+    }
+    char names[400];
+    pass_format(info->passes, names, sizeof names);
+    snprintf(tail, cap, " passes=%s:%016" PRIx64, names, (uint64_t)XXH3_64bits(b, n * 4));
+    *out = b;
+    *len = n * 4;
+    return 0;
+}
+
 /* The image, then (PF only) a block of nsplat 64-bit values after the
- * pixels: the splats (sums == 0) or the sample sums (sums != 0). */
+ * pixels: the splats (sums == 0) or the sample sums (sums != 0); or the
+ * render passes' block (pass not NULL, info->passes not 0). */
 static int write_image(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb,
-                       const uint64_t *splat, size_t nsplat, int sums, fr_error *err)
+                       const uint64_t *splat, size_t nsplat, int sums, const float *pass, fr_error *err)
 {
     uint32_t w = info->width, rows = info->y1 - info->y0;
-    char tail[64] = "";
-    unsigned char *tmp = NULL;
+    char tail[512] = "";
+    unsigned char *tmp = NULL, *pb = NULL;
+    size_t pblen = 0;
+    if (pass && fmt != IMG_PF)
+        return fr_fail(err, "render passes need the PF format");
+    if (pass && pass_bytes(info, pass, &pb, &pblen, tail, sizeof tail) < 0)
+        return fr_fail(err, "out of memory writing the image");
     if (splat) {
         if (fmt != IMG_PF)
             return fr_fail(err, "%s need the PF format", sums ? "sample sums" : "light-tracing splats");
@@ -93,6 +125,7 @@ static int write_image(FILE *f, img_format fmt, const img_partial_info *info, co
     unsigned char *line = malloc(rowbytes ? rowbytes : 1);
     if (!line) {
         free(tmp);
+        free(pb);
         return fr_fail(err, "out of memory writing the image");
     }
     for (uint32_t r = 0; r < rows; r++) {
@@ -115,12 +148,15 @@ static int write_image(FILE *f, img_format fmt, const img_partial_info *info, co
         if (fwrite(line, 1, rowbytes, f) != rowbytes) {
             free(line);
             free(tmp);
+            free(pb);
             return fr_fail(err, "write failed: %s", strerror(errno));
         }
     }
     free(line);
     int bad = splat && splat_bytes(splat, nsplat, tmp, write_chunk, f) < 0;
+    bad |= pb && fwrite(pb, 1, pblen, f) != pblen;
     free(tmp);
+    free(pb);
     if (bad || fflush(f) != 0)
         return fr_fail(err, "write failed: %s", strerror(errno));
     return 0;
@@ -129,7 +165,12 @@ static int write_image(FILE *f, img_format fmt, const img_partial_info *info, co
 int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float *rgb, const uint64_t *splat,
               fr_error *err)
 {
-    return write_image(f, fmt, info, rgb, splat, (size_t)info->width * info->height * 3, 0, err);
+    return write_image(f, fmt, info, rgb, splat, (size_t)info->width * info->height * 3, 0, NULL, err);
+}
+
+int img_write_passes(FILE *f, const img_partial_info *info, const float *rgb, const float *passes, fr_error *err)
+{
+    return write_image(f, IMG_PF, info, rgb, NULL, 0, 0, info->passes ? passes : NULL, err);
 }
 
 int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, const double *sums, fr_error *err)
@@ -139,7 +180,7 @@ int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, cons
     if (!bits)
         return fr_fail(err, "out of memory writing the image");
     memcpy(bits, sums, n * sizeof *bits);
-    int rc = write_image(f, IMG_PF, info, rgb, bits, n, 1, err);
+    int rc = write_image(f, IMG_PF, info, rgb, bits, n, 1, NULL, err);
     free(bits);
     return rc;
 }
@@ -171,6 +212,16 @@ static double get_double(const unsigned char *p)
     return d;
 }
 
+void img_passes_get(const unsigned char *buf, const img_partial_info *info, float *out)
+{
+    size_t n = (size_t)info->width * (info->y1 - info->y0) * pass_channels(info->passes);
+    const unsigned char *p = buf + info->passes_offset;
+    for (size_t i = 0; i < n; i++, p += 4) {
+        uint32_t bits = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        memcpy(&out[i], &bits, 4);
+    }
+}
+
 void img_sums_get(const unsigned char *buf, const img_partial_info *info, double *sums)
 {
     size_t n = (size_t)info->width * (info->y1 - info->y0) * 3;
@@ -180,12 +231,13 @@ void img_sums_get(const unsigned char *buf, const img_partial_info *info, double
 
 int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *info, float **rgb, fr_error *err)
 {
-    char line[256];
+    char line[512];
     size_t pos = 0, at;
     if (header_line(buf, len, &pos, line, sizeof line) < 0 || strcmp(line, "PF") != 0)
         return fr_fail(err, "byte 0: not a PF (float RGB) partial image");
     at = pos;
-    unsigned long long scene, paths = 0, hash = 0, shash = 0;
+    unsigned long long scene, paths = 0, hash = 0, shash = 0, phash = 0;
+    uint32_t passes = 0;
     int sums = 0;
     unsigned y0, y1, spp, fw, fh;
     char tail;
@@ -203,6 +255,21 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
             e2 != 22 || rest[e2] != 0)
             return fr_fail(err, "byte %zu: malformed franja header comment (expected sums=<16 hex digits>)", at);
         sums = 1;
+    } else if (!strncmp(rest, " passes=", 8)) {
+        /* " passes=<names>:<16 hex>": the render passes follow the pixels. */
+        char names[400];
+        const char *colon = strrchr(rest, ':');
+        size_t k = colon ? (size_t)(colon - (rest + 8)) : 0;
+        fr_error e2;
+        if (!colon || k == 0 || k >= sizeof names || strlen(colon + 1) != 16 ||
+            strspn(colon + 1, "0123456789abcdef") != 16)
+            return fr_fail(err, "byte %zu: malformed franja header comment (expected passes=<names>:<16 hex digits>)",
+                           at);
+        memcpy(names, rest + 8, k);
+        names[k] = 0;
+        if (pass_parse(names, &passes, &e2) < 0 || !passes)
+            return fr_fail(err, "byte %zu: franja header comment: passes=: %s", at, passes ? e2.msg : "no pass");
+        phash = strtoull(colon + 1, NULL, 16);
     } else if (*rest) {
         /* " splat=<paths>:<16 hex>": a positive count, a whole hash. */
         int e2 = -1;
@@ -211,7 +278,7 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
             sscanf(rest, " splat=%llu:%16llx%n", &paths, &hash, &e2) != 2 || e2 < 0 || rest[e2] != 0 ||
             strlen(colon + 1) != 16)
             return fr_fail(err, "byte %zu: malformed franja header comment (after size=: expected nothing, "
-                                "sums=<16 hex digits> or splat=<paths>:<16 hex digits>)", at);
+                                "sums=<16 hex digits>, splat=<paths>:<16 hex digits> or passes=<names>:<16 hex digits>)", at);
     }
     at = pos;
     unsigned w, h;
@@ -224,9 +291,21 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
         return fr_fail(err, "byte %zu: size %ux%u does not match rows %u:%u of a %ux%u image", at, w, h, y0, y1,
                        fw, fh);
     size_t n = (size_t)w * h * 3, nsplat = paths ? (size_t)fw * fh * 3 : sums ? n : 0;
-    if (len - pos != n * 4 + nsplat * 8)
+    size_t npass = (size_t)w * h * pass_channels(passes);
+    if (len - pos != n * 4 + nsplat * 8 + npass * 4)
         return fr_fail(err, "byte %zu: %zu bytes of pixels%s, expected %zu", pos, len - pos,
-                       paths ? " and splats" : sums ? " and sums" : "", n * 4 + nsplat * 8);
+                       paths ? " and splats" : sums ? " and sums" : passes ? " and passes" : "",
+                       n * 4 + nsplat * 8 + npass * 4);
+    if (passes && XXH3_64bits(buf + pos + n * 4, npass * 4) != phash)
+        return fr_fail(err, "byte %zu: the passes block does not match its hash %016llx", pos + n * 4, phash);
+    for (size_t i = 0; i < npass; i++) {
+        const unsigned char *p = buf + pos + n * 4 + i * 4;
+        uint32_t bits = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        float v;
+        memcpy(&v, &bits, 4);
+        if (!isfinite(v))
+            return fr_fail(err, "byte %zu: a render pass value is not finite", pos + n * 4 + i * 4);
+    }
     if (paths && XXH3_64bits(buf + pos + n * 4, nsplat * 8) != hash)
         return fr_fail(err, "byte %zu: the splat block does not match its hash %016llx", pos + n * 4, hash);
     if (sums && XXH3_64bits(buf + pos + n * 4, nsplat * 8) != shash)
@@ -268,6 +347,8 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     info->splat_hash = hash;
     info->splat_offset = paths ? pos + n * 4 : 0;
     info->sums_offset = sums ? pos + n * 4 : 0;
+    info->passes = passes;
+    info->passes_offset = passes ? pos + n * 4 : 0;
     *rgb = out;
     return 0;
 }

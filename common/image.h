@@ -23,6 +23,15 @@
  * little-endian, top row first, each the sum of the pixel channel's spp
  * samples in sample order; each pixel value is (float)(sum / spp), which
  * the reader checks to the bit.
+ *
+ * A path-traced PF partial may instead carry render passes (passes.h;
+ * franja-worker --passes): the comment line ends with
+ * " passes=<names>:<16 hex>", the passes' names comma-separated in their
+ * fixed order and the XXH3-64 hash of the block that follows the pixels:
+ * W*(y1-y0)*C IEEE 754 floats, little-endian, top row first (unlike the
+ * PFM pixels), each pixel's C channels (pass_channels) in pass order.
+ * The reader checks the hash and that every value is finite (normals and
+ * positions may be negative).
  */
 #ifndef FRANJA_IMAGE_H
 #define FRANJA_IMAGE_H
@@ -46,6 +55,8 @@ typedef struct {
     uint64_t splat_hash;       /**< img_read_partial: XXH3-64 of the splat block */
     size_t splat_offset;       /**< img_read_partial: where the splat block starts in the buffer */
     size_t sums_offset;        /**< img_read_partial: where the sums block starts; 0: none */
+    uint32_t passes;           /**< render passes (passes.h mask) whose block follows the pixels; 0: none */
+    size_t passes_offset;      /**< img_read_partial: where the passes block starts */
 } img_partial_info;
 
 /** Write rows (3 floats per pixel, top row first, width*(y1-y0) pixels) in
@@ -59,6 +70,16 @@ int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float
 /** Write a PF partial with its sample sums (width*(y1-y0)*3 doubles, top
  * row first) after the pixels.  Returns -1 with err set if writing fails. */
 int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, const double *sums, fr_error *err);
+
+/** Write a PF partial with the render passes info->passes (not 0) after
+ * the pixels: passes holds width*(y1-y0)*pass_channels(info->passes)
+ * floats, top row first.  Returns -1 with err set if writing fails. */
+int img_write_passes(FILE *f, const img_partial_info *info, const float *rgb, const float *passes, fr_error *err);
+
+/** Copies the passes block of a partial that img_read_partial accepted with
+ * passes != 0 into out (width*(y1-y0)*pass_channels(passes) floats, the
+ * caller's), top row first. */
+void img_passes_get(const unsigned char *buf, const img_partial_info *info, float *out);
 
 /** Copies the sums block of a partial that img_read_partial accepted with
  * sums_offset != 0 into sums (width*(y1-y0)*3 doubles, the caller's). */

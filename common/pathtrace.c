@@ -4,6 +4,7 @@
 #include "pathtrace.h"
 
 #include "camera.h"
+#include "passes.h"
 #include "texture.h"
 #include "vertex.h"
 
@@ -135,9 +136,11 @@ static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta
 }
 
 /* pt_sample, with the pixel's sampler seeds kept in *shared when it is not
- * NULL (smp_start_shared): the same bits either way. */
+ * NULL (smp_start_shared): the same bits either way.  With ps not NULL,
+ * what the sample brings to the render passes goes there too (passes.h);
+ * the radiance is the same either way. */
 static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index,
-                             smp_shared *shared)
+                             smp_shared *shared, pass_sample *ps)
 {
     fr_sampler smp;
     if (shared)
@@ -151,6 +154,9 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
     else
         smp_skip(&smp);        /* a pinhole has no lens to sample */
     fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
+    vec3 camera = ray.o;
+    if (ps)
+        pass_start(ps);
 
     vec3 L = v3s(0.0f), beta = v3s(1.0f);
     float prev_pdf = 0.0f;     /* solid-angle pdf of the last BSDF or phase sample */
@@ -169,9 +175,21 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
     for (uint32_t depth = 0;; depth++) {
         vtx_vertex v;
         int equi = mis.equiangular && depth < max_depth && s->n_lights;
+        vec3 before = L;
         int kind = vtx_next(s, &smp, &ray, &medium, &beta, mis, equi ? &L : NULL, &v);
-        if (kind == VTX_ESCAPED)
-            L = v3_add(L, escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta));
+        if (ps) {
+            /* Light scattered in a medium on the way: one more bounce. */
+            pass_light(ps, depth + 1, v3_sub(L, before));
+            if (depth == 0 && (kind == VTX_SURFACE || kind == VTX_MEDIUM))
+                pass_first_hit(ps, kind == VTX_SURFACE ? v.sf.p : v.p,
+                               kind == VTX_SURFACE ? v.sf.material : FR_NONE, camera);
+        }
+        if (kind == VTX_ESCAPED) {
+            vec3 e = escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta);
+            L = v3_add(L, e);
+            if (ps)
+                pass_light(ps, depth, e);
+        }
         if (kind == VTX_ESCAPED || kind == VTX_LOST)
             break;
         /* Each vertex draws a pair for the light (light_numbers), one for
@@ -186,9 +204,16 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
                 break;
             light_numbers(s, v.p, v3s(0.0f), light_sampling, &smp, &light, &pick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
-            if (vtx_direct_medium(s, &v, medium, beta, mis, light, pick, u1, u2, &d))
+            if (vtx_direct_medium(s, &v, medium, beta, mis, light, pick, u1, u2, &d)) {
                 L = v3_add(L, d.L);
+                if (ps)
+                    pass_light(ps, depth + 1, d.L);
+            }
             vtx_scatter_medium(s, &v, medium, v1, v2, &ray, &prev_pdf);
+            if (ps && depth == 0)
+                pass_first_kind(ps, NULL, NULL, v3s(0.0f), ray.d, 0.0f);
+            if (ps)
+                ps->albedo_done = 1;
             prev_delta = 0;
             prev_p = v.p;
             prev_n = v3s(0.0f);
@@ -202,9 +227,15 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             }
             const fr_material *m = tex_material(s, &s->materials[v.sf.material], &v.sf, &textured);
             vec3 wo = v3_neg(ray.d);
-            if (v.sf.light != FR_NONE)
-                L = v3_add(L, emission(s, strategy, mis, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p, prev_n, &prev_v,
-                                       prev_medium));
+            if (ps && !ps->albedo_done)
+                pass_albedo_at(ps, m, &v.sf, ray.d);
+            if (v.sf.light != FR_NONE) {
+                vec3 e = emission(s, strategy, mis, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p, prev_n, &prev_v,
+                                  prev_medium);
+                L = v3_add(L, e);
+                if (ps)
+                    pass_light(ps, depth, e);
+            }
             if (depth >= max_depth)
                 break;
             if (bsdf_needs_lobe(m)) {
@@ -214,11 +245,20 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             light_numbers(s, v.sf.p, v.sf.ns, light_sampling && bsdf_has_smooth(m), &smp, &light, &pick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
             vtx_origin org = vtx_origin_at(&v.sf, wo);
-            if (vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, light, pick, u1, u2, &org, &d))
+            if (vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, light, pick, u1, u2, &org, &d)) {
                 L = v3_add(L, d.L);
+                if (ps && depth == 0)
+                    pass_light_first(ps, m, &v.sf, wo, d.ls.wi, d.L);
+                else if (ps)
+                    pass_light(ps, depth + 1, d.L);
+            }
             fr_bsdf_sample bs;
             if (!vtx_scatter_surface(s, m, &v.sf, wo, ulobe, v1, v2, &org, &bs, &ray, &medium))
                 break;
+            if (ps && depth == 0)
+                pass_first_kind(ps, m, &v.sf, wo, bs.wi, ulobe);
+            if (ps && !ps->albedo_done)
+                pass_albedo_through(ps, bs.weight);
             beta = v3_mul(beta, bs.weight);
             prev_pdf = bs.pdf;
             prev_delta = bs.delta;
@@ -233,14 +273,19 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
     }
     /* A NaN or infinity from a degenerate configuration would poison the
      * pixel; drop the sample instead (it happens the same way everywhere). */
-    if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z))
+    if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z)) {
+        if (ps)
+            pass_drop_light(ps);
         return v3s(0.0f);
+    }
+    if (ps)
+        ps->beauty = L;
     return L;
 }
 
 vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index)
 {
-    return pt_sample_seeded(s, strategy, x, y, index, NULL);
+    return pt_sample_seeded(s, strategy, x, y, index, NULL, NULL);
 }
 
 /* Adaptive sampling: a pixel's error is estimated after every block of
@@ -270,6 +315,14 @@ static int adapt_done(double sum, double sum2, uint32_t n, float e)
 
 void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb)
 {
+    pt_render_rows_passes(s, strategy, y0, y1, rgb, 0, NULL);
+}
+
+void pt_render_rows_passes(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb,
+                           uint32_t passes, float *out)
+{
+    uint32_t nch = pass_channels(passes);
+    pass_sample sample, *ps = passes ? &sample : NULL;
     uint32_t w = s->settings.width, spp = s->settings.spp;
     float e = s->settings.noise_threshold;
     uint32_t first_check = e > 0.0f ? adapt_min(spp) : spp;
@@ -278,10 +331,13 @@ void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32
         for (uint32_t x = 0; x < w; x++) {
             /* The decision to stop reads this pixel's own samples only, so
              * a slab renders the same bits whatever the split. */
-            double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0;
+            double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0, pacc[PASS_MAX_ACC] = {0};
             uint32_t n = 0;
             while (n < spp) {
-                vec3 c = pt_sample_seeded(s, strategy, x, y, n++, &shared);
+                vec3 c = pt_sample_seeded(s, strategy, x, y, n, &shared, ps);
+                if (ps)
+                    pass_accumulate(pacc, passes, ps, n);
+                n++;
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
                 if (first_check < spp) {
                     double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
@@ -295,6 +351,8 @@ void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32
             px[0] = (float)(acc[0] / n);
             px[1] = (float)(acc[1] / n);
             px[2] = (float)(acc[2] / n);
+            if (ps)
+                pass_finish(pacc, passes, n, out + ((size_t)(y - y0) * w + x) * nch);
         }
     }
 }
@@ -311,7 +369,7 @@ void pt_render_rows_sums(const fr_scene *s, pt_strategy strategy, uint32_t y0, u
             size_t k = ((size_t)(y - y0) * w + x) * 3;
             double acc[3] = {sums[k], sums[k + 1], sums[k + 2]};
             for (uint32_t n = first; n < spp; n++) {
-                vec3 c = pt_sample_seeded(s, strategy, x, y, n, &shared);
+                vec3 c = pt_sample_seeded(s, strategy, x, y, n, &shared, NULL);
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
             }
             for (int i = 0; i < 3; i++) {

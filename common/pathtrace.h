@@ -43,6 +43,13 @@ vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, 
  * samples, so any split of the rows renders the same bits. */
 void pt_render_rows(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb);
 
+/** pt_render_rows that also renders the render passes in the mask
+ * `passes` (passes.h; 0: none, out not used) into out:
+ * pass_channels(passes) floats per pixel, row y0 first, caller-owned.
+ * The beauty has the bits of pt_render_rows either way. */
+void pt_render_rows_passes(const fr_scene *s, pt_strategy strategy, uint32_t y0, uint32_t y1, float *rgb,
+                           uint32_t passes, float *out);
+
 /** Like pt_render_rows without adaptive sampling (noise_threshold is
  * ignored), keeping each pixel's sums: sums (width*(y1-y0)*3 doubles)
  * holds the sums of samples [0, first) on entry (zeros for first = 0) and

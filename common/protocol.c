@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "fbin.h"
+#include "passes.h"
 #include "scene.h"
 #include "trace.h"
 
@@ -121,6 +122,11 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
         a->argv[n++] = "--continue";
         a->argv[n++] = s->continue_from;
     }
+    if (s->passes & PASS_ALL) {
+        pass_format(s->passes & PASS_ALL, a->passes, sizeof a->passes);
+        a->argv[n++] = "--passes";
+        a->argv[n++] = a->passes;
+    }
     a->argv[n] = NULL;
     return 0;
 }
@@ -152,7 +158,7 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
                                 !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "--integrator") ||
                                 !strcmp(a, "--noise-threshold") || !strcmp(a, "--continue") || !strcmp(a, "-o") ||
-                                !strcmp(a, "--unpack"))) {
+                                !strcmp(a, "--unpack") || !strcmp(a, "--passes"))) {
             return fr_fail(err, "%s needs a value", a);
         } else if (!strcmp(a, "--scene")) {
             r->slab.scene = argv[++i];
@@ -183,11 +189,15 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             r->slab.continue_from = argv[++i];
         } else if (!strcmp(a, "--unpack")) {
             r->unpack = argv[++i];
+        } else if (!strcmp(a, "--passes")) {
+            fr_error e;
+            if (pass_parse(argv[++i], &r->slab.passes, &e) < 0)
+                return fr_fail(err, "--passes: %s", e.msg);
         } else {
             static const char *const known[] = {"help",       "version",         "check",    "lifeline", "sums",
                                                 "scene",      "rows",            "spp",      "size",     "format",
                                                 "integrator", "noise-threshold", "continue", "o",        "h",
-                                                "features",   "unpack"};
+                                                "features",   "unpack",          "passes"};
             char near[64];
             if (a[0] == '-' && sug_option(a, known, sizeof known / sizeof *known, near, sizeof near) == 0)
                 return fr_fail(err, "unknown argument '%s' (did you mean %s? see --help)", a, near);

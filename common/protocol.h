@@ -45,6 +45,7 @@ typedef struct {
     int sums;                  /**< --sums: the PF partial carries its sample sums (image.h) */
     const char *continue_from; /**< --continue FILE: a partial with sums of the same slab and fewer samples,
                                     whose samples are not rendered again; NULL = none */
+    uint32_t passes;           /**< --passes LIST: render passes (passes.h mask) in the PF partial; 0 = none */
 } proto_slab;
 
 /** A worker command line built by proto_slab_argv: argv points into the
@@ -52,7 +53,7 @@ typedef struct {
  * without the program name. */
 typedef struct {
     const char *argv[24];
-    char rows[32], size[32], spp[16], noise[32];
+    char rows[32], size[32], spp[16], noise[32], passes[400];
 } proto_argv;
 
 /** Builds the worker arguments that ask for slab s.  Fails when a number

@@ -39,7 +39,7 @@ typedef struct {
     uint32_t integrator;       /**< FR_INTEGRATOR_* */
     float noise_threshold;     /**< adaptive sampling: a pixel stops once the estimated relative standard error of
                                     its mean luminance is below this (pathtrace.h); 0 = off, every pixel takes spp */
-    uint32_t pad;
+    uint32_t passes;           /**< render passes `franja render` asks for by default (passes.h bits); 0 = none */
 } fr_settings;
 
 /** A pinhole or thin-lens camera. */
@@ -381,6 +381,13 @@ typedef struct {
     uint32_t pad[3];
 } fr_instance;
 
+/** A material's name (material_names section): NUL-terminated UTF-8, at
+ * most 63 bytes (longer names are cut), no control character; "" when
+ * the scene file gave none. */
+typedef struct {
+    char name[64];
+} fr_name;
+
 /** A whole scene: its settings and camera, and each section as an array
  * and its length (pointing into `blob`). */
 typedef struct {
@@ -411,6 +418,7 @@ typedef struct {
     const fr_bvh_node *mesh_nodes; uint32_t n_mesh_nodes;
     const fr_bvh_leaf *mesh_leaves; uint32_t n_mesh_leaves;
     const fr_light_node *light_nodes; uint32_t n_light_nodes;
+    const fr_name *material_names; uint32_t n_material_names; /**< 0, or one per material */
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

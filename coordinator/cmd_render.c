@@ -19,6 +19,7 @@
 #include "monitor.h"
 #include "opt.h"
 #include "output.h"
+#include "passes.h"
 #include "preview.h"
 #include "progress.h"
 #include "protocol.h"
@@ -60,6 +61,14 @@ static const char usage[] =
     "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
     "                       the relative error of its mean is below E, in (0, 1]\n"
     "                       (default: the scene's, else off)\n"
+    "  --passes LIST        render passes beside the image (path tracing): albedo,\n"
+    "                       normal, depth, position, emission, diffuse_direct,\n"
+    "                       diffuse_indirect, glossy_direct, glossy_indirect,\n"
+    "                       transmission_direct, transmission_indirect,\n"
+    "                       material_id, crypto_material (Cryptomatte, .exr\n"
+    "                       only), variance, or all, light, denoise, none; .exr: one\n"
+    "                       multilayer file, other types: one file per pass\n"
+    "                       beside OUT (OUT.albedo.png ...) (default: the scene's)\n"
     "  --exposure E         scale LDR outputs by 2^E before the sRGB curve\n"
     "                       (default: the scene's tonemap; HDR outputs .exr\n"
     "                       .hdr .pfm keep linear radiance)\n"
@@ -109,7 +118,7 @@ enum {
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
     OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
-    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH, OPT_LIMIT
+    OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH, OPT_LIMIT, OPT_PASSES
 };
 
 /* Returns 0 to go on, 1 when done (help), 2 on a usage error. */
@@ -149,6 +158,7 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
         {"limit", required_argument, NULL, OPT_LIMIT},
+        {"passes", required_argument, NULL, OPT_PASSES},
         {NULL, 0, NULL, 0},
     };
     static const char *const curves[] = {"none", "filmic", NULL};
@@ -289,6 +299,13 @@ static int parse(int argc, char **argv, frame_settings *a)
             fr_error e;
             if ((bad = budget_set(&a->limits, v, &e)) < 0)
                 fprintf(stderr, "franja %s: --limit %s\n", cmd, e.msg);
+            break;
+        }
+        case OPT_PASSES: {
+            fr_error e;
+            if ((bad = pass_parse(v, &a->passes, &e)) < 0)
+                fprintf(stderr, "franja %s: --passes: %s\n", cmd, e.msg);
+            a->passes_set = 1;
             break;
         }
         case OPT_PREVIEW_EVERY:

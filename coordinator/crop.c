@@ -42,20 +42,31 @@ int crop_check(const crop_window *c, uint32_t width, uint32_t height, fr_error *
 
 void crop_black(const crop_window *c, float *rgb, uint32_t width, uint32_t height)
 {
+    crop_black_n(c, rgb, width, height, 3);
+}
+
+void crop_black_n(const crop_window *c, float *px, uint32_t width, uint32_t height, uint32_t channels)
+{
     for (uint32_t y = 0; y < height; y++) {
-        float *row = rgb + (size_t)y * width * 3;
+        float *row = px + (size_t)y * width * channels;
         if (y < c->y0 || y >= c->y1) {
-            memset(row, 0, (size_t)width * 3 * sizeof *row);
+            memset(row, 0, (size_t)width * channels * sizeof *row);
             continue;
         }
-        memset(row, 0, (size_t)c->x0 * 3 * sizeof *row);
-        memset(row + (size_t)c->x1 * 3, 0, (size_t)(width - c->x1) * 3 * sizeof *row);
+        memset(row, 0, (size_t)c->x0 * channels * sizeof *row);
+        memset(row + (size_t)c->x1 * channels, 0, (size_t)(width - c->x1) * channels * sizeof *row);
     }
 }
 
 void crop_extract(const crop_window *c, const float *rgb, uint32_t width, float *out)
 {
+    crop_extract_n(c, rgb, width, 3, out);
+}
+
+void crop_extract_n(const crop_window *c, const float *px, uint32_t width, uint32_t channels, float *out)
+{
     size_t w = c->x1 - c->x0;
     for (uint32_t y = c->y0; y < c->y1; y++)
-        memcpy(out + (size_t)(y - c->y0) * w * 3, rgb + ((size_t)y * width + c->x0) * 3, w * 3 * sizeof *out);
+        memcpy(out + (size_t)(y - c->y0) * w * channels, px + ((size_t)y * width + c->x0) * channels,
+               w * channels * sizeof *out);
 }

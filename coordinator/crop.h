@@ -30,6 +30,12 @@ int crop_check(const crop_window *c, uint32_t width, uint32_t height, fr_error *
  * the window to black. */
 void crop_black(const crop_window *c, float *rgb, uint32_t width, uint32_t height);
 
+/** crop_black for pixels of `channels` floats (render passes). */
+void crop_black_n(const crop_window *c, float *px, uint32_t width, uint32_t height, uint32_t channels);
+
+/** crop_extract for pixels of `channels` floats (render passes). */
+void crop_extract_n(const crop_window *c, const float *px, uint32_t width, uint32_t channels, float *out);
+
 /** Copies the window's pixels of rgb (width pixels a row) into out
  * ((x1-x0)*(y1-y0)*3 floats, the caller's), top row first. */
 void crop_extract(const crop_window *c, const float *rgb, uint32_t width, float *out);

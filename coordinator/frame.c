@@ -16,6 +16,8 @@
 #include "fbin.h"
 #include "opt.h"
 #include "protocol.h"
+#include "passes.h"
+#include "passout.h"
 #include "quick.h"
 
 static int ends_with(const char *s, const char *suffix)
@@ -79,9 +81,9 @@ static int unlock_with(joblock *lk, int rc)
  * left as they are); fails naming the window's rows that are missing.
  * have (height bytes) is scratch. */
 static int crop_stitch(const char *jobdir, const job_spec *spec, const crop_window *win, float *rgb,
-                       unsigned char *have, fr_error *err)
+                       float *passes, unsigned char *have, fr_error *err)
 {
-    if (job_gather(jobdir, spec, rgb, have, NULL, err) < 0)
+    if (job_gather_passes(jobdir, spec, rgb, passes, have, NULL, err) < 0)
         return -1;
     int missing = 0;
     for (uint32_t y = 0; y < spec->height; y++) {
@@ -162,7 +164,7 @@ int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err)
 int frame_pass_image(frame_passes *ps, fr_error *err)
 {
     if (ps->crop_rows)
-        return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->scratch, err);
+        return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, NULL, ps->scratch, err);
     return job_stitch(ps->jobdir, &ps->spec, ps->rgb, &ps->a->tr.notes, err);
 }
 
@@ -241,7 +243,8 @@ int frame_open(frame_image *im)
     job_spec spec = {sc.hash, a->width ? a->width : sc.settings.width, a->height ? a->height : sc.settings.height,
                      a->spp ? a->spp : sc.settings.spp,
                      a->integrator ? (uint32_t)(a->integrator - 1) : sc.settings.integrator,
-                     a->noise_threshold > 0.0f ? a->noise_threshold : sc.settings.noise_threshold};
+                     a->noise_threshold > 0.0f ? a->noise_threshold : sc.settings.noise_threshold,
+                     a->passes_set ? a->passes : sc.settings.passes};
     if (a->scale > 0) {
         spec.width = opt_scaled(sc.settings.width, a->scale);
         spec.height = opt_scaled(sc.settings.height, a->scale);
@@ -261,7 +264,15 @@ int frame_open(frame_image *im)
     }
     if (!rc && spec.integrator == FR_INTEGRATOR_BDPT)
         spec.noise_threshold = 0.0f; /* bidirectional workers take every sample */
-    if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
+    if (!rc && spec.passes && spec.integrator == FR_INTEGRATOR_BDPT) {
+        fprintf(stderr, "franja render: %s: render passes are made by the path integrator, not bdpt (use "
+                "--integrator path, or --passes none)\n", a->passes_set ? "--passes" : a->scene);
+        rc = 2;
+    } else if (!rc && spec.passes && a->time_limit > 0) {
+        fprintf(stderr, "franja render: --time-limit with render passes: its passes add samples to kept sample "
+                "sums, which slabs with render passes do not keep (use --passes none, or no --time-limit)\n");
+        rc = 2;
+    } else if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
         fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a->scene, err.msg);
         rc = a->integrator ? 2 : 1;
     } else if (!rc && a->time_limit > 0 && !job_sums(&spec)) {
@@ -294,8 +305,16 @@ int frame_open(frame_image *im)
         im->tm.exposure = a->exposure;
     if (a->curve)
         tm_curve_parse(a->curve, &im->tm.curve);
+    /* The materials' names, for the metadata of material_id and
+     * crypto_material. */
+    im->n_materials = sc.n_materials;
+    if (spec.passes && sc.n_material_names && (im->mat_names = malloc(sc.n_material_names * sizeof *im->mat_names)))
+        memcpy(im->mat_names, sc.material_names, (im->n_mat_names = sc.n_material_names) * sizeof *im->mat_names);
     scn_free(&sc);
     im->spec = spec;
+    if ((spec.passes >> PASS_CRYPTO_MATERIAL & 1u) && !out_has_ext(a->out, "exr"))
+        fprintf(stderr, "franja render: warning: crypto_material is written to .exr outputs only; %s gets the "
+                "other passes\n", a->out);
 
     im->have = calloc(spec.height, 1);
     im->base = calloc(spec.height, sizeof *im->base);
@@ -378,25 +397,41 @@ int frame_write(frame_image *im, const char *used)
                     a->time_limit, ps->reached, ps->stopped);
         else
             fprintf(stderr, "franja: every %u samples per pixel within the time limit\n", ps->reached);
-    } else if (im->crop_rows ? crop_stitch(im->jobdir, &spec, &a->win, im->rgb, im->have, &err)
-                             : job_stitch(im->jobdir, &spec, im->rgb, &a->tr.notes, &err)) {
+    } else if (spec.passes && !(im->passes = malloc((size_t)spec.width * spec.height *
+                                                    pass_channels(spec.passes) * sizeof *im->passes))) {
+        fprintf(stderr, "franja render: out of memory for the render passes of a %ux%u image\n", spec.width,
+                spec.height);
+        return 1;
+    } else if (im->crop_rows ? crop_stitch(im->jobdir, &spec, &a->win, im->rgb, im->passes, im->have, &err)
+                             : job_stitch_passes(im->jobdir, &spec, im->rgb, im->passes, &a->tr.notes, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return 1;
     }
     job_spec out_spec = spec;
     float *rgb = im->rgb;
+    uint32_t nch = pass_channels(spec.passes);
     if (a->crop) {
         crop_black(&a->win, rgb, spec.width, spec.height);
+        if (im->passes)
+            crop_black_n(&a->win, im->passes, spec.width, spec.height, nch);
         if (a->crop_output) {
             /* The window moves to the start of the buffer. */
-            float *w = malloc((size_t)(a->win.x1 - a->win.x0) * (a->win.y1 - a->win.y0) * 3 * sizeof *w);
-            if (!w) {
+            size_t wn = (size_t)(a->win.x1 - a->win.x0) * (a->win.y1 - a->win.y0);
+            float *w = malloc(wn * 3 * sizeof *w), *wp = im->passes ? malloc(wn * nch * sizeof *wp) : NULL;
+            if (!w || (im->passes && !wp)) {
+                free(w);
+                free(wp);
                 fprintf(stderr, "franja render: out of memory for the window\n");
                 return 1;
             }
             crop_extract(&a->win, rgb, spec.width, w);
             free(rgb);
             rgb = im->rgb = ps->rgb = w;
+            if (wp) {
+                crop_extract_n(&a->win, im->passes, spec.width, nch, wp);
+                free(im->passes);
+                im->passes = wp;
+            }
             out_spec.width = a->win.x1 - a->win.x0;
             out_spec.height = a->win.y1 - a->win.y0;
         }
@@ -406,7 +441,8 @@ int frame_write(frame_image *im, const char *used)
     if (a->reproducible)
         out_meta_set_time(&meta, reproducible_epoch());
     a->io.attrs = meta.attrs;
-    if (out_write_with(a->out, rgb, &out_spec, &im->tm, &a->io, &err)) {
+    crypto_names names = {im->mat_names, im->n_mat_names};
+    if (passout_write(a->out, rgb, &im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &err)) {
         /* Said only once checked: the rows are still there. */
         if (job_rows_present(im->jobdir) >= im->rows_job) {
             fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
@@ -446,6 +482,8 @@ void frame_close(frame_image *im, int rc)
     free(im->base);
     free(im->ps.scratch);
     free(im->rgb);
+    free(im->passes);
+    free(im->mat_names);
     free(im);
 }
 
@@ -456,6 +494,8 @@ void frame_shrink(frame_image *im)
     free(im->base);
     free(im->ps.scratch);
     free(im->rgb);
+    free(im->passes);
+    im->passes = NULL;
     im->have = NULL;
     im->base = NULL;
     im->ps.scratch = NULL;

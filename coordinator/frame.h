@@ -56,6 +56,8 @@ typedef struct {
     int overwrite;             /* --overwrite */
     int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
+    uint32_t passes;           /* --passes: render passes (passes.h mask) */
+    int passes_set;            /* --passes given: overrides the scene's */
     fr_budget limits;          /* --limit: the compile's (budget.h) */
     tr_options tr;
     cli_slurm slurm;
@@ -104,6 +106,9 @@ typedef struct {
     unsigned char *have;
     uint32_t *base;
     float *rgb;
+    float *passes;             /* the render passes (passes.h) once stitched, or NULL */
+    fr_name *mat_names;        /* the materials' names (n_mat_names, 0 or n_materials), for the passes' metadata */
+    uint32_t n_mat_names, n_materials;
     frame_passes ps;
     int rows_job, rows_have;
     double t0;

@@ -47,7 +47,16 @@ extern "C" int iio_encode_with(const char *name, const void *pixels, iio_type ty
             rc = fr_fail(err, "%s: no image writer for this extension: %s", name, OIIO::geterror().c_str());
         } else {
             // Half floats are stored from the float pixels (OpenImageIO converts).
-            ImageSpec spec((int)width, (int)height, 3, o && o->half && type == IIO_F32 ? TypeDesc::HALF : td);
+            int nch = o && o->channels && type == IIO_F32 ? (int)o->channels : 3;
+            ImageSpec spec((int)width, (int)height, nch, o && o->half && type == IIO_F32 ? TypeDesc::HALF : td);
+            if (nch != 3 && o->channel_names) {
+                // Named channels (render passes): "Layer.Pass.Channel", the
+                // first four the beauty's RGBA.
+                spec.channelnames.clear();
+                for (int c = 0; c < nch; c++)
+                    spec.channelnames.emplace_back(o->channel_names[c]);
+                spec.alpha_channel = nch >= 4 ? 3 : -1;
+            }
             spec.attribute("oiio:ColorSpace", type == IIO_F32 ? "linear" : "sRGB");
             spec.attribute("Software", "franja");
             if (o && o->compression)

@@ -31,10 +31,12 @@ typedef struct {
                                     "Software" and "ImageDescription" reach every format that has them
                                     (PNG text chunks, TIFF tags, EXR, JPEG); other names (say
                                     "franja:spp") only formats with free-form attributes (OpenEXR) */
+    uint32_t channels;         /**< channels per pixel of float pixels (OpenEXR); 0: 3 (RGB) */
+    const char *const *channel_names; /**< with channels: their names, as OpenEXR stores them */
 } iio_options;
 
 /** Encodes width x height RGB pixels (top row first, 3 values of `type`
- * per pixel) in the format the extension of `name` names (png, exr, tif,
+ * per pixel, or o->channels floats named o->channel_names) in the format the extension of `name` names (png, exr, tif,
  * jpg, hdr, bmp, tga, ppm ...), into memory: *data (malloc'd, the caller
  * frees) receives the *len bytes of the file, which the caller writes.
  * Nothing is written to disk, so a full file system cannot truncate the

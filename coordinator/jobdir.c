@@ -10,13 +10,14 @@
 #include <unistd.h>
 
 #include "file.h"
+#include "passes.h"
 #include "protocol.h"
 #include "scene.h"
 #include "splat.h"
 
 int job_sums(const job_spec *spec)
 {
-    return spec->integrator == FR_INTEGRATOR_PATH && !(spec->noise_threshold > 0.0f);
+    return spec->integrator == FR_INTEGRATOR_PATH && !(spec->noise_threshold > 0.0f) && !spec->passes;
 }
 
 /* A partial checked against the render (scene, size, rows, splats for its
@@ -46,6 +47,12 @@ static int check_slab(const unsigned char *buf, size_t len, const job_spec *spec
         return paths ? fr_fail(err, "%llu light subpaths splatted, expected %llu (one per pixel sample of its rows)",
                                (unsigned long long)info.splat_paths, (unsigned long long)paths)
                      : fr_fail(err, "light-tracing splats in a path-traced render");
+    if (info.passes != spec->passes) {
+        char got[400], want[400];
+        pass_format(info.passes, got, sizeof got);
+        pass_format(spec->passes, want, sizeof want);
+        return fr_fail(err, "render passes %s, expected %s", got, want);
+    }
     *out = info;
     return 0;
 }
@@ -83,16 +90,23 @@ size_t job_max_partial(const job_spec *spec, uint32_t y0, uint32_t y1)
         n += (size_t)spec->width * (y1 - y0) * 24;
     if (spec->integrator == FR_INTEGRATOR_BDPT)
         n += (size_t)spec->width * spec->height * 24;
+    n += (size_t)spec->width * (y1 - y0) * pass_channels(spec->passes) * 4 + 512;
     return n;
 }
 
 static void spec_text(const job_spec *s, char *out, size_t cap)
 {
-    char noise[48] = "";
+    char noise[48] = "", passes[420] = "";
     if (s->noise_threshold > 0.0f) /* nine significant digits give back the same float */
         snprintf(noise, sizeof noise, "noise_threshold=%.9g\n", (double)s->noise_threshold);
-    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n%s%s", (unsigned long long)s->hash,
-             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT ? "integrator=bdpt\n" : "", noise);
+    if (s->passes) {
+        char names[400];
+        pass_format(s->passes, names, sizeof names);
+        snprintf(passes, sizeof passes, "passes=%s\n", names);
+    }
+    snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n%s%s%s", (unsigned long long)s->hash,
+             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT ? "integrator=bdpt\n" : "", noise,
+             passes);
 }
 
 /* Calls fn for every slab file name in dir ("rows-Y0-Y1.pf"). */
@@ -176,7 +190,7 @@ static int max_spp_one(const char *dir, const char *name, uint32_t y0, uint32_t 
 
 int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
 {
-    char want[256], path[4200];
+    char want[768], path[4200];
     spec_text(spec, want, sizeof want);
     snprintf(path, sizeof path, "%s/job", dir);
     if (mkdir(dir, 0755) && errno != EEXIST)
@@ -193,20 +207,21 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
             job_spec same = *spec;
             if (known)
                 same.spp = old.spp;
-            char was[256];
+            char was[768];
             spec_text(&same, was, sizeof was);
             int ok = known && len == strlen(was) && !memcmp(have, was, len);
             free(have);
             if (!ok) {
                 fr_fail(err, "%s: this job directory belongs to another render (different scene, "
-                        "size, integrator or noise threshold); remove it or render without --resume", dir);
+                        "size, integrator, noise threshold or render passes); remove it or render without --resume", dir);
                 return JOB_REFUSED;
             }
             if (old.spp != spec->spp && !job_sums(spec)) {
                 fr_fail(err, "%s: holds a render with %u samples per pixel; %s cannot be continued to %u "
-                        "exactly (only path tracing without --noise-threshold keeps each pixel's sample "
-                        "sums): render with --fresh, or with --spp %u", dir, old.spp,
+                        "exactly (only path tracing without --noise-threshold or render passes keeps each "
+                        "pixel's sample sums): render with --fresh, or with --spp %u", dir, old.spp,
                         spec->integrator == FR_INTEGRATOR_BDPT ? "a bidirectional render"
+                        : spec->passes                         ? "a render with passes"
                                                                : "an adaptive render",
                         spec->spp, old.spp);
                 return JOB_REFUSED;
@@ -243,6 +258,7 @@ typedef struct {
     uint32_t *best;            /* per row: SCAN, the most samples below spec->spp with sums (NULL: not
                                   wanted); GATHER, the samples of the row in rgb */
     float *rgb;                /* STITCH and GATHER */
+    float *passes;             /* STITCH and GATHER: the render passes, or NULL */
     int rows;
     const note_sink *notes;
     int mode;
@@ -258,13 +274,23 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     size_t len;
     fr_error e;
     img_partial_info info;
-    float *rows = NULL;
+    float *rows = NULL, *prows = NULL;
+    size_t nch = pass_channels(c->spec->passes);
     int bad = file_read(path, &text, &len, &e);
     if (!bad) {
         bad = read_slab((const unsigned char *)text, len, c->spec, y0, y1, &info, &rows, &e);
         if (!c->rgb) {
             free(rows);
             rows = NULL;
+        }
+        if (!bad && c->rgb && c->passes && nch) {
+            prows = malloc((size_t)c->spec->width * (y1 - y0) * nch * sizeof *prows);
+            if (!prows) {
+                bad = 1;
+                snprintf(e.msg, sizeof e.msg, "out of memory for its render passes");
+            } else {
+                img_passes_get((const unsigned char *)text, &info, prows);
+            }
         }
         free(text);
     }
@@ -288,16 +314,21 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
         }
         if (!use && !bad) {
             free(rows);
+            free(prows);
             return 0;
         }
     }
     if (bad && c->mode == GATHER) {
         c->skipped++;
+        free(rows);
+        free(prows);
         return 0;
     }
     if (bad) {
         note_say(c->notes, "%s: discarded (%s)", path, e.msg);
         unlink(path);
+        free(rows);
+        free(prows);
         return 0;
     }
     size_t row = (size_t)c->spec->width * 3;
@@ -309,17 +340,22 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
         }
         if (rows)
             memcpy(c->rgb + y * row, rows + (y - y0) * row, row * sizeof(float));
+        if (prows) {
+            size_t prow = (size_t)c->spec->width * nch;
+            memcpy(c->passes + y * prow, prows + (y - y0) * prow, prow * sizeof(float));
+        }
         c->rows += !c->have[y];
         c->have[y] = 1;
     }
     free(rows);
+    free(prows);
     return 0;
 }
 
 int job_scan(const char *dir, const job_spec *spec, unsigned char *have, uint32_t *base, const note_sink *notes,
              fr_error *err)
 {
-    scan_ctx c = {spec, have, base, NULL, 0, notes, SCAN, 0};
+    scan_ctx c = {spec, have, base, NULL, NULL, 0, notes, SCAN, 0};
     memset(have, 0, spec->height);
     if (base)
         memset(base, 0, spec->height * sizeof *base);
@@ -489,7 +525,7 @@ int job_cont_build(const char *dir, const job_spec *spec, uint32_t y0, uint32_t 
             rc = fr_fail(err, "%s: row %u with %u samples per pixel and their sums is no longer there", dir, y, spp);
             goto out;
         }
-    img_partial_info info = {spec->hash, y0, y1, spp, spec->width, spec->height, 0, 0, 0, 0};
+    img_partial_info info = {spec->hash, y0, y1, spp, spec->width, spec->height, 0, 0, 0, 0, 0, 0};
     FILE *f = open_memstream(&buf, &len);
     if (!f) {
         rc = fr_fail(err, "out of memory for the sums of rows %u:%u", y0, y1);
@@ -649,10 +685,16 @@ out:
 
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err)
 {
+    return job_stitch_passes(dir, spec, rgb, NULL, notes, err);
+}
+
+int job_stitch_passes(const char *dir, const job_spec *spec, float *rgb, float *passes, const note_sink *notes,
+                      fr_error *err)
+{
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, NULL, spec->integrator == FR_INTEGRATOR_BDPT ? NULL : rgb, 0, notes, STITCH, 0};
+    scan_ctx c = {spec, have, NULL, spec->integrator == FR_INTEGRATOR_BDPT ? NULL : rgb, passes, 0, notes, STITCH, 0};
     int rc = each_slab(dir, scan_one, &c, err);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];
@@ -668,10 +710,16 @@ int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sin
 int job_gather(const char *dir, const job_spec *spec, float *rgb, unsigned char *have, int *skipped,
                fr_error *err)
 {
+    return job_gather_passes(dir, spec, rgb, NULL, have, skipped, err);
+}
+
+int job_gather_passes(const char *dir, const job_spec *spec, float *rgb, float *passes, unsigned char *have,
+                      int *skipped, fr_error *err)
+{
     uint32_t *best = calloc(spec->height, sizeof *best);
     if (!best)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, best, rgb, 0, NULL, GATHER, 0};
+    scan_ctx c = {spec, have, best, rgb, passes, 0, NULL, GATHER, 0};
     memset(have, 0, spec->height);
     int rc = each_slab(dir, scan_one, &c, err);
     free(best);
@@ -692,9 +740,10 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
     int n = -1, bdpt = 0;
     float noise = 0.0f;
     /* Exactly what spec_text writes, and nothing after it. */
-    int ok = len < 200 && memchr(text, 0, len) == NULL;
+    uint32_t passes = 0;
+    int ok = len < 700 && memchr(text, 0, len) == NULL;
     if (ok) {
-        char copy[200];
+        char copy[700];
         memcpy(copy, text, len);
         copy[len] = 0;
         ok = sscanf(copy, "franja job\nscene=%16llx\nsize=%ux%u\nspp=%u\n%n", &hash, &w, &h, &spp, &n) == 4 && n > 0;
@@ -702,22 +751,34 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
             bdpt = 1;
             n += 16;
         }
-        if (ok && n < (int)len) {
+        if (ok && n < (int)len && !strncmp(copy + n, "noise_threshold=", 16)) {
             int m = -1;
-            ok = sscanf(copy + n, "noise_threshold=%g\n%n", &noise, &m) == 1 && m > 0 && n + m == (int)len &&
-                 noise > 0.0f && noise <= 1.0f && !bdpt;
+            ok = sscanf(copy + n, "noise_threshold=%g\n%n", &noise, &m) == 1 && m > 0 && noise > 0.0f &&
+                 noise <= 1.0f && !bdpt;
+            n += ok ? m : 0;
+        }
+        if (ok && n < (int)len) {
+            /* "passes=<names>\n", the last line. */
+            char *nl = strchr(copy + n, '\n');
+            fr_error e2;
+            ok = !strncmp(copy + n, "passes=", 7) && nl && nl + 1 == copy + len && !bdpt;
+            if (ok) {
+                *nl = 0;
+                ok = pass_parse(copy + n + 7, &passes, &e2) == 0 && passes;
+            }
         }
     }
     free(text);
     if (!ok || w == 0 || h == 0 || w > PROTO_MAX_SIZE || h > PROTO_MAX_SIZE || spp == 0 || spp > PROTO_MAX_SPP)
         return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, maybe integrator=bdpt "
-                       "or noise_threshold=E in (0, 1], sizes in 1..%u)", path, PROTO_MAX_SIZE);
+                       "or noise_threshold=E in (0, 1] and passes=NAMES, sizes in 1..%u)", path, PROTO_MAX_SIZE);
     spec->hash = hash;
     spec->width = w;
     spec->height = h;
     spec->spp = spp;
     spec->integrator = bdpt ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH;
     spec->noise_threshold = noise;
+    spec->passes = passes;
     return 0;
 }
 

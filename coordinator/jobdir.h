@@ -38,13 +38,15 @@ typedef struct {
     uint32_t spp;              /**< samples per pixel */
     uint32_t integrator;       /**< FR_INTEGRATOR_* (scene.h): bidirectional partials carry splats */
     float noise_threshold;     /**< adaptive sampling threshold the workers render with (pathtrace.h); 0 = off */
+    uint32_t passes;           /**< render passes every slab carries (passes.h mask); 0 = none */
 } job_spec;
 
 /** job_open's status for a job directory it will not use. */
 #define JOB_REFUSED (-2)
 
 /** Whether the slabs of this render keep each pixel's sample sums, so that
- * samples can be added later: path tracing without adaptive sampling. */
+ * samples can be added later: path tracing without adaptive sampling and
+ * without render passes (whose slabs carry the passes instead). */
 int job_sums(const job_spec *spec);
 
 /** Checks a partial image (PF bytes) against the spec and the rows asked
@@ -108,6 +110,17 @@ int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf
  * summed in fixed point, in any order to the same bits, and added to the
  * rows (spl_resolve); it fails if no such split is among the slabs. */
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err);
+
+/** job_stitch that also copies the render passes of the slabs (spec->passes
+ * not 0) into passes: width*height*pass_channels(spec->passes) floats, top
+ * row first. */
+int job_stitch_passes(const char *dir, const job_spec *spec, float *rgb, float *passes, const note_sink *notes,
+                      fr_error *err);
+
+/** job_gather that also copies the slabs' render passes, as
+ * job_stitch_passes does, into passes (NULL: not wanted). */
+int job_gather_passes(const char *dir, const job_spec *spec, float *rgb, float *passes, unsigned char *have,
+                      int *skipped, fr_error *err);
 
 /** Reads what render the job directory dir belongs to (DIR/job) into
  * *spec.  Fails naming the file and what is wrong when it is missing or

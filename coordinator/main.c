@@ -11,7 +11,7 @@ static const char usage[] =
     "                     [--workdir DIR | --shared-workdir DIR]] [-j N] [--spp N]\n"
     "                     [--size WxH | --scale S] [--crop X0:Y0:X1:Y1 [--crop-output]]\n"
     "                     [--camera NAME] [--allow-path DIR]... [--integrator path|bdpt]\n"
-    "                     [--noise-threshold E]\n"
+    "                     [--noise-threshold E] [--passes LIST]\n"
     "                     [--exposure E] [--tonemap none|filmic] [--exr-half]\n"
     "                     [--exr-compression C] [--jpeg-quality Q] [--reproducible]\n"
     "                     [--frames LIST [--overwrite]] [--time-limit T]\n"

@@ -28,6 +28,8 @@ static const char *extension(const char *path)
 
 static int is_ext(const char *path, const char *ext) { return !strcasecmp(extension(path), ext); }
 
+int out_has_ext(const char *path, const char *ext) { return is_ext(path, ext); }
+
 /* PFM is written to a path ending in .pfm, and to a stream file_out
  * writes in place whose name has no extension (/dev/null, /dev/stdout, a
  * named pipe): it has no name to choose a format by, and PFM is the one

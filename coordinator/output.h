@@ -45,6 +45,9 @@ void out_meta_make(out_meta *m, const job_spec *spec, double seconds, const char
  * out of the years 1970..9999 gives 1970:01:01 00:00:00. */
 void out_meta_set_time(out_meta *m, long long epoch);
 
+/** Whether path's extension is ext (without the dot, any case). */
+int out_has_ext(const char *path, const char *ext);
+
 /** Fails if no writer handles the path's extension. */
 int out_check_type(const char *path, fr_error *err);
 

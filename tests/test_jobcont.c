@@ -43,7 +43,7 @@ static void slab(const char *dir, const job_spec *sp, uint32_t y0, uint32_t y1, 
     size_t len = 0;
     snprintf(path, sizeof path, "%s/rows-%05u-%05u.pf", dir, y0, y1);
     FILE *f = open_memstream(&buf, &len);
-    img_partial_info info = {sp->hash, y0, y1, spp, W, H, 0, 0, 0, 0};
+    img_partial_info info = {sp->hash, y0, y1, spp, W, H, 0, 0, 0, 0, 0, 0};
     fr_error err;
     int rc = sums ? img_write_sums(f, &info, rgb, s, &err) : img_write(f, IMG_PF, &info, rgb, NULL, &err);
     fclose(f);
@@ -67,7 +67,7 @@ int main(void)
         perror("mkdtemp");
         return 1;
     }
-    job_spec sp = {0x1234abcdULL, W, H, 8, 0, 0.0f};
+    job_spec sp = {0x1234abcdULL, W, H, 8, 0, 0.0f, 0};
     fr_error err;
     CHECK(job_sums(&sp), "path tracing without a threshold keeps sums");
     CHECK(job_open(dir, &sp, 0, &err) == 0, "job_open: %s", err.msg);

@@ -23,7 +23,7 @@ static unsigned char *written(const uint64_t *splat, img_format fmt, size_t *len
     float rgb[W * (Y1 - Y0) * 3];
     for (int i = 0; i < W * (Y1 - Y0) * 3; i++)
         rgb[i] = 0.25f * (float)i;
-    img_partial_info info = {0x0123456789abcdefull, Y0, Y1, 8, W, H, splat ? (uint64_t)W * (Y1 - Y0) * 8 : 0, 0, 0, 0};
+    img_partial_info info = {0x0123456789abcdefull, Y0, Y1, 8, W, H, splat ? (uint64_t)W * (Y1 - Y0) * 8 : 0, 0, 0, 0, 0, 0};
     char *buf = NULL;
     FILE *f = open_memstream(&buf, len);
     fr_error err;

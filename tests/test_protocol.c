@@ -7,6 +7,7 @@
 
 #include "check.h"
 #include "fbin.h"
+#include "passes.h"
 #include "protocol.h"
 #include "scene.h"
 #include "trace.h"
@@ -25,13 +26,15 @@ static void test_round_trip(void)
 {
     const proto_slab cases[] = {
         /* lifeline, integrator (1 + FR_INTEGRATOR_*, 0 for the scene's), noise threshold, sums, continue */
-        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},
-        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH, 0.0123f, 0, NULL},
+        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},
+        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH, 0.0123f, 0, NULL, 0},
         {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-", 0,
-         1 + FR_INTEGRATOR_BDPT, 1.0f, 0, NULL},
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL}, /* the scene's size, samples, integrator, threshold */
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2, 0.05f, 0, NULL}, /* --lifeline, --integrator bdpt, a threshold */
-        {"s.fbin", 3, 9, 0, 0, 20, IMG_PF, "-", 1, 0, 0.0f, 1, "job dir/rows-3-9.pf"}, /* --sums, --continue */
+         1 + FR_INTEGRATOR_BDPT, 1.0f, 0, NULL, 0},
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0}, /* the scene's size, samples, integrator, threshold */
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2, 0.05f, 0, NULL, 0}, /* --lifeline, --integrator bdpt, a threshold */
+        {"s.fbin", 3, 9, 0, 0, 20, IMG_PF, "-", 1, 0, 0.0f, 1, "job dir/rows-3-9.pf", 0}, /* --sums, --continue */
+        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, PASS_ALL},                /* --passes, every one */
+        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 1u << PASS_NORMAL | 1u << PASS_MATERIAL_ID},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         const proto_slab *s = &cases[k];
@@ -62,22 +65,23 @@ static void test_round_trip(void)
                                                                !strcmp(r.slab.continue_from, s->continue_from)
                                                          : !r.slab.continue_from),
               "case %zu: sums %d, continue %s", k, r.slab.sums, r.slab.continue_from ? r.slab.continue_from : "-");
+        CHECK(r.slab.passes == s->passes, "case %zu: passes %#x, expected %#x", k, r.slab.passes, s->passes);
     }
 }
 
 static void test_build_refuses(void)
 {
     const proto_slab bad[] = {
-        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},                     /* empty rows */
-        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},                     /* rows past the height */
-        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},    /* too wide */
-        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},     /* too many samples */
-        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},                     /* half a size */
-        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL},                    /* no scene */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS, 0.0f, 0, NULL},   /* no such integrator */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1, 0.0f, 0, NULL},                   /* no such integrator */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 1.5f, 0, NULL},                     /* threshold above 1 */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, -0.5f, 0, NULL},                    /* negative threshold */
+        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                     /* empty rows */
+        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                     /* rows past the height */
+        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},    /* too wide */
+        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},     /* too many samples */
+        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                     /* half a size */
+        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                    /* no scene */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS, 0.0f, 0, NULL, 0},   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1, 0.0f, 0, NULL, 0},                   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 1.5f, 0, NULL, 0},                     /* threshold above 1 */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, -0.5f, 0, NULL, 0},                    /* negative threshold */
     };
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
         proto_argv a;

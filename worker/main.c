@@ -14,6 +14,7 @@
 #include "file.h"
 #include "image.h"
 #include "lifeline.h"
+#include "passes.h"
 #include "pathtrace.h"
 #include "protocol.h"
 #include "quick.h"
@@ -27,7 +28,7 @@
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
     "                     [--integrator path|bdpt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
-    "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE]\n"
+    "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE] [--passes LIST]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --unpack FILE.zst --scene FILE\n"
     "       franja-worker --features\n"
@@ -57,6 +58,12 @@ static const char usage[] =
     "  --continue FILE  start from the sums in FILE, a --sums image of the same\n"
     "                 rows with fewer samples: only the samples it lacks are\n"
     "                 rendered, to the bits of a render of them all\n"
+    "  --passes LIST  append render passes to the PF image (path integrator, not\n"
+    "                 with sums): comma-separated albedo, normal, depth, position,\n"
+    "                 emission, diffuse_direct, diffuse_indirect, glossy_direct,\n"
+    "                 glossy_indirect, transmission_direct, transmission_indirect,\n"
+    "                 material_id, crypto_material, variance; or all, light,\n"
+    "                 denoise, none\n"
     "\n"
     "Writing to a pipe (-o -), the worker ends itself when the pipe's reader is\n"
     "gone or its parent process ends.\n";
@@ -188,17 +195,27 @@ int main(int argc, char **argv)
         scn_free(&scene);
         return 2;
     }
+    uint32_t passes = sl->passes;
+    if (passes && (bdpt || keep_sums || sl->format != IMG_PF)) {
+        fprintf(stderr, "franja-worker: --passes needs the path integrator and --format pf, without --sums or "
+                        "--continue (this render %s)\n",
+                bdpt ? "is bidirectional" : keep_sums ? "keeps sample sums" : "is not --format pf");
+        scn_free(&scene);
+        return 2;
+    }
     /* The coordinator gone, the slab is wasted work: stop (lifeline.h). */
     lifeline_start(to_stdout, sl->lifeline);
     size_t n = (size_t)width * (y1 - y0) * 3;
     float *rgb = malloc(n * sizeof *rgb);
     uint64_t *splat = bdpt ? calloc((size_t)width * height * 3, sizeof *splat) : NULL;
     double *sums = keep_sums ? calloc(n, sizeof *sums) : NULL;
-    if (!rgb || (bdpt && !splat) || (keep_sums && !sums)) {
+    float *pass = passes ? malloc(n / 3 * pass_channels(passes) * sizeof *pass) : NULL;
+    if (!rgb || (bdpt && !splat) || (keep_sums && !sums) || (passes && !pass)) {
         fprintf(stderr, "franja-worker: out of memory for %zu pixels\n", bdpt ? (size_t)width * height : n / 3);
         free(rgb);
         free(splat);
         free(sums);
+        free(pass);
         lifeline_stop();
         scn_free(&scene);
         return 1;
@@ -212,7 +229,7 @@ int main(int argc, char **argv)
         scn_free(&scene);
         return 2;
     }
-    img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0, 0};
+    img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0, 0, passes, 0};
     if (bdpt) {
         if (bd_render_rows(&scene, y0, y1, rgb, splat, &err) < 0) {
             fprintf(stderr, "franja-worker: %s\n", err.msg);
@@ -233,7 +250,7 @@ int main(int argc, char **argv)
     } else if (keep_sums) {
         pt_render_rows_sums(&scene, PT_MIS, y0, y1, first, sums, rgb);
     } else {
-        pt_render_rows(&scene, PT_MIS, y0, y1, rgb);
+        pt_render_rows_passes(&scene, PT_MIS, y0, y1, rgb, passes, pass);
     }
     lifeline_stop();
 
@@ -258,8 +275,9 @@ int main(int argc, char **argv)
             rc = 1;
         }
     }
-    if (f && (sl->sums ? img_write_sums(f, &info, rgb, sums, &err) : img_write(f, sl->format, &info, rgb, splat, &err)) <
-                 0) {
+    if (f && (sl->sums     ? img_write_sums(f, &info, rgb, sums, &err)
+              : passes ? img_write_passes(f, &info, rgb, pass, &err)
+                       : img_write(f, sl->format, &info, rgb, splat, &err)) < 0) {
         fprintf(stderr, "franja-worker: %s: %s\n", to_stdout ? "standard output" : out, err.msg);
         rc = 1;
     }
@@ -278,6 +296,7 @@ int main(int argc, char **argv)
     free(rgb);
     free(splat);
     free(sums);
+    free(pass);
     scn_free(&scene);
     return rc;
 }

@@ -31,6 +31,7 @@ void bld_init(fr_builder *b)
     array_init(&b->meshes, sizeof(bld_mesh));
     array_init(&b->instances, sizeof(fr_instance));
     array_init(&b->light_nodes, sizeof(fr_light_node));
+    array_init(&b->material_names, sizeof(fr_name));
     b->world.env_light = b->world.env_texture = FR_NONE;
     b->world.rot_cos = 1.0f;
 }
@@ -40,10 +41,32 @@ void bld_free(fr_builder *b)
     fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
                        &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
                        &b->textures, &b->texels, &b->media, &b->distrib, &b->meshes, &b->instances,
-                       &b->light_nodes};
+                       &b->light_nodes, &b->material_names};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->data);
     memset(b, 0, sizeof *b);
+}
+
+int bld_material_name(fr_builder *b, uint32_t material, const char *name)
+{
+    fr_name empty;
+    memset(&empty, 0, sizeof empty);
+    while (b->material_names.count <= material)
+        if (bld_push(&b->material_names, &empty) == FR_NONE)
+            return -1;
+    fr_name *n = (fr_name *)b->material_names.data + material;
+    size_t k = strlen(name);
+    if (k > sizeof n->name - 1) {
+        k = sizeof n->name - 1;
+        while (k > 0 && ((unsigned char)name[k] & 0xc0) == 0x80)
+            k--; /* not inside a UTF-8 character */
+    }
+    memset(n->name, 0, sizeof n->name);
+    for (size_t i = 0; i < k; i++) {
+        unsigned char ch = (unsigned char)name[i];
+        n->name[i] = ch < 0x20 || ch == 0x7f ? '?' : (char)ch;
+    }
+    return 0;
 }
 
 uint32_t bld_push(fr_array *a, const void *elem)

@@ -54,6 +54,7 @@ typedef struct {
     void *warn_user;           /**< passed back to warn */
     fr_array light_nodes;      /**< fr_light_node: the light tree, built by frz_scene */
     int no_light_tree;         /**< 1: no light tree, next-event estimation picks by the power table alone */
+    fr_array material_names;   /**< fr_name: the materials' names as far as given (bld_material_name) */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero, no
@@ -61,6 +62,11 @@ typedef struct {
 void bld_init(fr_builder *b);
 /** Free every array and zero *b. */
 void bld_free(fr_builder *b);
+
+/** Names material `material` (an index into b->materials) `name`, cut to
+ * 63 bytes at a character boundary, control characters as '?'; materials
+ * not named are "".  -1 when memory runs out. */
+int bld_material_name(fr_builder *b, uint32_t material, const char *name);
 
 /** Append one element (copied); return its index, or FR_NONE when memory or
  * the 32-bit index space runs out. */

@@ -121,6 +121,12 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
             rc = fr_fail(err, "out of memory for the meshes");
     free(mprims.data);
 
+    /* Every material has a name ("" when none was given), or none has. */
+    fr_name unnamed;
+    memset(&unnamed, 0, sizeof unnamed);
+    while (rc == 0 && b->material_names.count && b->material_names.count < b->materials.count)
+        if (bld_push(&b->material_names, &unnamed) == FR_NONE)
+            rc = fr_fail(err, "out of memory for the materials' names");
     memset(view, 0, sizeof *view);
     view->settings = b->settings;
     view->camera = b->camera;
@@ -137,6 +143,7 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     VIEW(meshes, f->table); VIEW(instances, b->instances);
     VIEW(mesh_nodes, f->mnodes); VIEW(mesh_leaves, f->mleaves);
     VIEW(light_nodes, b->light_nodes);
+    VIEW(material_names, b->material_names);
 #undef VIEW
     return rc;
 }

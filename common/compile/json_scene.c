@@ -11,6 +11,7 @@
 #include "bsdf.h"
 #include "file.h"
 #include "fmath.h"
+#include "passes.h"
 #include "compile/freeze.h"
 #include "compile/jsoncheck.h"
 #include "compile/jsonval.h"
@@ -41,7 +42,7 @@ static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
 static int parse_image(ctx *c, const cJSON *o)
 {
     static const char *const fields[] = {"width", "height", "spp", "max_depth", "seed", "integrator",
-                                         "noise_threshold", "light_sampling", NULL};
+                                         "noise_threshold", "light_sampling", "passes", NULL};
     static const char *const integrators[] = {"path", "bdpt", NULL};
     static const char *const light_samplings[] = {"tree", "power", NULL};
     fr_settings *s = &c->b->settings;
@@ -60,6 +61,14 @@ static int parse_image(ctx *c, const cJSON *o)
         return -1;
     s->integrator = (uint32_t)integrator;
     c->b->no_light_tree = light_sampling == 1;
+    const cJSON *passes = cJSON_GetObjectItemCaseSensitive(o, "passes");
+    if (passes) {
+        fr_error e;
+        if (!cJSON_IsString(passes))
+            return fr_fail(c->err, "image.passes: expected a string of pass names separated by commas");
+        if (pass_parse(passes->valuestring, &s->passes, &e) < 0)
+            return fr_fail(c->err, "image.passes: %s", e.msg);
+    }
     if (!(s->noise_threshold >= 0.0f && s->noise_threshold <= 1.0f))
         return fr_fail(c->err, "image.noise_threshold: expected a number in [0, 1] (0: off), got %g",
                        (double)s->noise_threshold);
@@ -191,7 +200,8 @@ static int parse_materials(ctx *c, const cJSON *o)
         fr_material mat;
         if (parse_material(c, m, where, &mat) < 0)
             return -1;
-        if (bld_push(&c->b->materials, &mat) == FR_NONE)
+        uint32_t k = bld_push(&c->b->materials, &mat);
+        if (k == FR_NONE || bld_material_name(c->b, k, m->string) < 0)
             return fr_fail(c->err, "%s: out of memory", where);
     }
     c->materials = o;

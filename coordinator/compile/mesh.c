@@ -315,7 +315,8 @@ int mesh_add(fr_builder *b, const cJSON *o, const char *where, const char *dir, 
             }
             fr_material fm;
             mesh_data_material(&m.mats[k], &fm);
-            if ((mat_of[k] = bld_push(&b->materials, &fm)) == FR_NONE)
+            if ((mat_of[k] = bld_push(&b->materials, &fm)) == FR_NONE ||
+                bld_material_name(b, mat_of[k], m.mats[k].name) < 0)
                 rc = fr_fail(err, "%s: out of memory", where);
         }
         if (rc == 0 && undefined > 0 && b->warn) {

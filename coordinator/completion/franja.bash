@@ -59,6 +59,10 @@ _franja()
     --job | --dist | --workdir | --shared-workdir | --allow-path)
         COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     --worker) _franja_files "$cur" ""; return 0 ;;
+    --passes)
+        COMPREPLY=($(compgen -W "all light denoise none albedo normal depth position emission diffuse_direct \
+diffuse_indirect glossy_direct glossy_indirect transmission_direct transmission_indirect material_id crypto_material variance" -- "$cur"))
+        return 0 ;;
     -j | --spp | --size | --scale | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
         --monitor | --crop | --jpeg-quality | --noise-threshold | --frames | --time-limit)
         return 0 ;;

@@ -49,7 +49,7 @@ static void use(const unsigned char *buf, size_t len, const img_partial_info *in
         if (!(rgb[i] >= 0.0f))
             abort();
     job_spec spec = {info->scene, info->width, info->height, info->spp,
-                     info->splat_paths ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH, 0.0f};
+                     info->splat_paths ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH, 0.0f, info->passes};
     fr_error err;
     /* When the render it names takes it, the scheduler's bound on a
      * worker's output leaves room for it. */

@@ -1,0 +1,164 @@
+/* passout.c -- the final image with its render passes: one multilayer
+ * OpenEXR, or one file per pass beside the beauty (see passout.h). */
+#include "passout.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output.h"
+#include "passes.h"
+
+/* The file of pass `name` beside path (out.png: out.NAME.png) into
+ * out[cap]. */
+static void pass_file(const char *path, const char *name, char *out, size_t cap)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash : path, '.');
+    size_t stem = dot ? (size_t)(dot - path) : strlen(path);
+    snprintf(out, cap, "%.*s.%s%s", (int)stem, path, name, dot ? dot : "");
+}
+
+/* The multilayer OpenEXR: the beauty in RGBA, then the passes' channels,
+ * interleaved in *passes itself (grown), so that the passes are not held
+ * twice. */
+static int write_exr(const char *path, const float *rgb, float **passes, const job_spec *spec,
+                     const iio_options *o, const crypto_names *cn, uint32_t n_materials, fr_error *err)
+{
+    uint32_t nch = pass_channels(spec->passes), all = 4 + nch;
+    size_t npx = (size_t)spec->width * spec->height;
+    float *px = realloc(*passes, npx * all * sizeof *px);
+    char (*names)[64] = malloc(all * sizeof *names);
+    const char **ptrs = malloc(all * sizeof *ptrs);
+    if (px)
+        *passes = px;
+    if (!px || !names || !ptrs) {
+        free(names);
+        free(ptrs);
+        return fr_fail(err, "%s: out of memory for %u channels of %ux%u pixels", path, all, spec->width,
+                       spec->height);
+    }
+    /* From the last pixel back, each pixel's passes move up to their place
+     * (never over a pixel not yet moved) and the beauty goes before them. */
+    for (size_t i = npx; i-- > 0;) {
+        float *d = px + i * all;
+        memmove(d + 4, px + i * nch, nch * sizeof *d);
+        d[0] = rgb[i * 3], d[1] = rgb[i * 3 + 1], d[2] = rgb[i * 3 + 2], d[3] = 1.0f;
+    }
+    static const char rgba[] = "RGBA";
+    uint32_t c = 0;
+    for (; c < 4; c++)
+        snprintf(names[c], sizeof names[c], "ViewLayer.Combined.%c", rgba[c]);
+    uint32_t crypto_at = 0;
+    for (int i = 0; i < PASS_COUNT; i++) {
+        if (!(spec->passes >> i & 1u))
+            continue;
+        const pass_info *p = pass_get(i);
+        if (i == PASS_CRYPTO_MATERIAL)
+            crypto_at = c;
+        for (const char *ch = p->channels; *ch; ch++, c++)
+            if (i == PASS_CRYPTO_MATERIAL) /* Cryptomatte's ranks: ViewLayer.CryptoMaterial00.R ... 02.A */
+                snprintf(names[c], sizeof names[c], "ViewLayer.%s%02u.%c", p->layer,
+                         (unsigned)(ch - p->channels) / 4, *ch);
+            else
+                snprintf(names[c], sizeof names[c], "ViewLayer.%s.%c", p->layer, *ch);
+    }
+    if (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)
+        crypto_ids(px + crypto_at, npx, all, cn);
+    for (c = 0; c < all; c++)
+        ptrs[c] = names[c];
+    /* The caller's attributes and franja:passes. */
+    char list[400];
+    pass_format(spec->passes, list, sizeof list);
+    const char *attrs[64];
+    size_t k = 0;
+    for (const char *const *a = o ? o->attrs : NULL; a && a[0] && a[1] && k + 16 < 64; a += 2)
+        attrs[k++] = a[0], attrs[k++] = a[1];
+    attrs[k++] = "franja:passes", attrs[k++] = list;
+    char *table = NULL, *crypto = NULL;
+    int rc = 0;
+    if (spec->passes & (1u << PASS_MATERIAL_ID | 1u << PASS_CRYPTO_MATERIAL)) {
+        rc = crypto_name_table(cn, n_materials, &table, err);
+        if (rc == 0)
+            attrs[k++] = "franja:materials", attrs[k++] = table;
+    }
+    if (rc == 0 && (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)) {
+        rc = crypto_metadata("ViewLayer.CryptoMaterial", cn, n_materials, attrs + k, &crypto, err);
+        k += 8;
+    }
+    attrs[k] = NULL;
+    iio_options with = o ? *o : (iio_options){0};
+    with.attrs = attrs;
+    with.channels = all;
+    with.channel_names = ptrs;
+    if (rc == 0)
+        rc = out_write_with(path, px, spec, NULL, &with, err);
+    free(table);
+    free(crypto);
+    free(names);
+    free(ptrs);
+    return rc;
+}
+
+/* Pass i of the passes as an RGB image for a file of its own: one-channel
+ * passes grey; for LDR files the normal as 0.5 + 0.5 n and the depth and
+ * material_id over their largest value (a depth of nothing hit as 1). */
+static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, size_t npx, int ldr, float *out)
+{
+    const pass_info *p = pass_get(i);
+    int k = (int)strlen(p->channels);
+    float top = 0.0f;
+    for (size_t j = 0; j < npx; j++) {
+        float v = passes[j * nch + at];
+        if (v < PASS_DEPTH_NONE && v > top)
+            top = v;
+    }
+    for (size_t j = 0; j < npx; j++)
+        for (int c = 0; c < 3; c++) {
+            float v = passes[j * nch + at + (k == 3 ? (uint32_t)c : 0)];
+            if (ldr && i == PASS_NORMAL)
+                v = 0.5f + 0.5f * v;
+            else if (ldr && (i == PASS_DEPTH || i == PASS_MATERIAL_ID))
+                v = v >= PASS_DEPTH_NONE ? 1.0f : top > 0.0f ? v / top : 0.0f;
+            out[j * 3 + c] = v;
+        }
+}
+
+int passout_write(const char *path, const float *rgb, float **pass_buf, const job_spec *spec,
+                  const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
+                  fr_error *err)
+{
+    const float *passes = pass_buf ? *pass_buf : NULL;
+    if (!passes || !spec->passes)
+        return out_write_with(path, rgb, spec, tm, o, err);
+    if (out_has_ext(path, "exr"))
+        return write_exr(path, rgb, pass_buf, spec, o, names, n_materials, err);
+    if (out_write_with(path, rgb, spec, tm, o, err))
+        return -1;
+    size_t npx = (size_t)spec->width * spec->height;
+    uint32_t nch = pass_channels(spec->passes), at = 0;
+    float *img = malloc(npx * 3 * sizeof *img);
+    if (!img)
+        return fr_fail(err, "%s: out of memory for its render passes", path);
+    int ldr = !(out_has_ext(path, "hdr") || out_has_ext(path, "pfm"));
+    /* LDR data passes are not tone-mapped beyond the sRGB curve. */
+    fr_tonemap plain = {0};
+    int rc = 0;
+    for (int i = 0; i < PASS_COUNT && rc == 0; i++) {
+        if (!(spec->passes >> i & 1u))
+            continue;
+        const pass_info *p = pass_get(i);
+        if (i == PASS_CRYPTO_MATERIAL) { /* OpenEXR only (frame.c says so) */
+            at += (uint32_t)strlen(p->channels);
+            continue;
+        }
+        char file[4200];
+        pass_file(path, p->name, file, sizeof file);
+        pass_image(passes, nch, at, i, npx, ldr, img);
+        int light = i >= PASS_EMISSION && i <= PASS_TRANSMISSION_INDIRECT;
+        rc = out_write_with(file, img, spec, light ? tm : &plain, o, err);
+        at += (uint32_t)strlen(p->channels);
+    }
+    free(img);
+    return rc;
+}

@@ -1,0 +1,126 @@
+#!/bin/sh
+# it_passes.sh -- tests render passes through the coordinator, locally and on fake SSH hosts.
+#
+# franja render --passes: the multilayer EXR is byte-identical between -j 1,
+# -j 2 --slab-rows 5 and fake SSH hosts; oiiotool lists its layers by
+# Blender's names and Blender's compositor offers them; the image's bytes
+# do not change with passes; PNG and
+# PFM outputs get one file per pass; the scene's "passes" key is read;
+# --crop, --resume and adaptive sampling work with passes; bdpt and
+# --time-limit are refused with a message.
+. "$(dirname "$0")/support/fakehosts.sh"
+need oiiotool blender
+fh_init
+cd "$FH" || exit 1
+SIZE="--size 40x30 --spp 4"
+SCENE="$ROOT/scenes/spheres.json"
+
+"$FRANJA" render "$SCENE" -o j1.exr $SIZE -j 1 --passes all --reproducible 2>log1
+check "render with every pass (-j 1)" test $? -eq 0
+"$FRANJA" render "$SCENE" -o j2.exr $SIZE -j 2 --slab-rows 5 --passes all --reproducible 2>log2
+check "render with every pass (-j 2 --slab-rows 5)" test $? -eq 0
+check "-j 2 --slab-rows 5 gives the bytes of -j 1" cmp -s j1.exr j2.exr
+
+fh_start a 2 2
+fh_start b 3 3
+fr render "$SCENE" -o ssh.exr --hosts hosts $SIZE --passes all --reproducible 2>log3
+check "render with every pass on two SSH hosts" test $? -eq 0
+check "both hosts rendered slabs" sh -c 'grep -Eq "^  a +[0-9]+ +[1-9]" log3 && grep -Eq "^  b +[0-9]+ +[1-9]" log3'
+check "SSH hosts give the bytes of -j 1" cmp -s j1.exr ssh.exr
+
+oiiotool --info -v j1.exr >info 2>&1
+for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Albedo.G" \
+    "ViewLayer.Denoising Normal.Z" "ViewLayer.Depth.Z" "ViewLayer.Position.X" "ViewLayer.Emit.B" \
+    "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
+    "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "ViewLayer.CryptoMaterial00.R" \
+    "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B"; do
+    check "oiiotool --info -v lists $ch" grep -q "$ch" info
+done
+check "the EXR has 51 channels" grep -q "51 channel" info
+check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoMaterial"' info
+check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
+check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info
+check "the EXR names its passes" grep -q 'franja:passes: "albedo,normal,depth' info
+
+# Blender opens the file as a multilayer EXR: its compositor's Image node
+# offers every pass.
+cat >open.py <<'PY'
+import bpy, sys
+img = bpy.data.images.load(sys.argv[sys.argv.index("--") + 1])
+bpy.context.scene.use_nodes = True
+node = bpy.context.scene.node_tree.nodes.new("CompositorNodeImage")
+node.image = img
+print("PASSES |" + "|".join(o.name for o in node.outputs) + "|")
+PY
+blender -b --factory-startup --python open.py -- j1.exr >blender.log 2>&1
+for p in Combined "Denoising Albedo" "Denoising Normal" Depth Position Emit DiffDir DiffInd GlossDir GlossInd \
+    TransDir TransInd IndexMA CryptoMaterial00 CryptoMaterial02 Variance; do
+    check "Blender's Image node offers $p" grep -q "^PASSES .*|$p|" blender.log
+done
+
+# The image is the same bytes with and without passes (PFM: Franja's own
+# writer, so the bytes are the pixels and the header).
+"$FRANJA" render "$SCENE" -o plain.pfm $SIZE -j 2 2>log4
+"$FRANJA" render "$SCENE" -o with.pfm $SIZE -j 2 --passes all 2>log5
+check "the image keeps its bytes with passes" cmp -s plain.pfm with.pfm
+for p in albedo normal depth position emission diffuse_direct glossy_indirect transmission_indirect material_id; do
+    check "PFM output: with.$p.pfm written" test -s "with.$p.pfm"
+done
+
+# A scene that asks for passes; PNG files beside the image.
+sed 's/"image": {/"image": { "passes": "albedo,normal",/' "$ROOT/scenes/cornell.json" >asks.json
+"$FRANJA" render asks.json -o asks.png $SIZE -j 2 2>log6
+check "the scene's passes: albedo and normal PNGs" sh -c 'test -s asks.albedo.png && test -s asks.normal.png'
+check "the scene's passes: no other pass" test ! -e asks.depth.png
+"$FRANJA" render asks.json -o none.png $SIZE -j 2 --passes none 2>log7
+check "--passes none overrides the scene's" sh -c 'test -s none.png && test ! -e none.albedo.png'
+
+# --crop with passes: the window's rows only.
+"$FRANJA" render "$SCENE" -o crop.exr $SIZE -j 2 --passes denoise --crop 5:7:29:23 --crop-output 2>log8
+check "--crop --crop-output with passes" test $? -eq 0
+check "the cropped EXR is the window, with its passes" \
+    sh -c 'oiiotool --info -v crop.exr | grep -q "24 x   16, 10 channel"'
+"$FRANJA" render "$SCENE" -o full.exr $SIZE -j 2 --passes denoise 2>log8b
+oiiotool full.exr --cut 24x16+5+7 -o cut.exr
+oiiotool full.exr --cut 24x16+6+7 -o off.exr
+check "the window's image and passes are the full render's" sh -c 'oiiotool --diff cut.exr crop.exr | grep -q PASS'
+check "(a window one pixel off is not)" sh -c '! oiiotool --diff off.exr crop.exr | grep -q PASS'
+
+# --resume: the kept slabs, with their passes, give the same file.
+"$FRANJA" render "$SCENE" -o kept.exr $SIZE -j 2 --passes all --reproducible --keep-job 2>log9
+"$FRANJA" render "$SCENE" -o kept.exr $SIZE -j 2 --passes all --reproducible --resume --keep-job 2>log10
+check "--resume with passes writes the same bytes" cmp -s kept.exr j1.exr
+check "--resume with passes rendered nothing again" grep -q "already done" log10
+"$FRANJA" render "$SCENE" -o kept.exr $SIZE -j 2 --passes albedo --resume 2>log11
+check "--resume with other passes is refused" test $? -eq 2
+check "--resume with other passes: said" grep -q "another render (.*render passes)" log11
+"$FRANJA" render "$SCENE" -o kept.exr --size 40x30 --spp 8 -j 2 --passes all --resume 2>log16
+check "--resume with more samples and passes is refused" test $? -eq 2
+check "--resume with more samples and passes: said" grep -q "a render with passes cannot be continued" log16
+
+# An animation: every frame gets its passes.
+cp "$ROOT/scenes/cornell.json" f.0001.json
+cp "$ROOT/scenes/cornell.json" f.0002.json
+"$FRANJA" render 'f.####.json' --frames 1-2 -o 'anim/f.####.exr' $SIZE -j 2 --passes denoise 2>log17
+check "--frames with passes" test $? -eq 0
+for f in 0001 0002; do
+    check "frame $f has its albedo pass" sh -c "oiiotool --info -v anim/f.$f.exr | grep -q 'Denoising Albedo.R'"
+done
+
+# Adaptive sampling with passes.
+"$FRANJA" render "$SCENE" -o adapt.exr --size 40x30 --spp 64 --noise-threshold 0.5 -j 2 --passes light 2>log12
+check "adaptive sampling with passes" test $? -eq 0
+
+# Refusals, with a message.
+"$FRANJA" render "$SCENE" -o b.png $SIZE --passes albedo --integrator bdpt 2>log13
+check "bdpt with passes: status 2" test $? -eq 2
+check "bdpt with passes: said" grep -q "path integrator, not bdpt" log13
+"$FRANJA" render "$SCENE" -o t.png $SIZE --passes albedo --time-limit 10s 2>log14
+check "--time-limit with passes: status 2" test $? -eq 2
+check "--time-limit with passes: said" grep -q "time-limit with render passes" log14
+"$FRANJA" render "$SCENE" -o t.png $SIZE --passes albedo,nrm 2>log15
+check "an unknown pass: status 2" test $? -eq 2
+check "an unknown pass is named" grep -q "unknown pass 'nrm'" log15
+
+fh_cleanup
+summary
