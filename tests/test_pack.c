@@ -111,12 +111,20 @@ int main(void)
     /* The shared copy: one file for two holders, gone after both. */
     char p1[4200], p2[4200];
     uint64_t n1, n2;
-    CHECK(pack_acquire(scene, want, p1, sizeof p1, &n1, &err) == 0, "%s", err.msg);
-    CHECK(pack_acquire(scene, want, p2, sizeof p2, &n2, &err) == 0, "%s", err.msg);
+    CHECK(pack_acquire(scene, want, PACK_ZSTD, p1, sizeof p1, &n1, &err) == 0, "%s", err.msg);
+    CHECK(pack_acquire(scene, want, PACK_ZSTD, p2, sizeof p2, &n2, &err) == 0, "%s", err.msg);
     CHECK(!strcmp(p1, p2) && n1 == n2 && !strncmp(p1, dir, strlen(dir)), "one copy in $TMPDIR: %s %s", p1, p2);
-    pack_release(want);
+    /* The other form: a copy of its own, smaller. */
+    char p3[4200];
+    uint64_t n3;
+    CHECK(pack_acquire(scene, want, PACK_PARTS, p3, sizeof p3, &n3, &err) == 0, "%s", err.msg);
+    CHECK(strcmp(p1, p3) && n3 < n1 && access(p3, F_OK) == 0, "a packed scene beside: %s %llu, %llu", p3,
+          (unsigned long long)n3, (unsigned long long)n1);
+    pack_release(want, PACK_PARTS);
+    CHECK(access(p3, F_OK) < 0 && access(p1, F_OK) == 0, "each form released on its own");
+    pack_release(want, PACK_ZSTD);
     CHECK(access(p1, F_OK) == 0, "kept while held");
-    pack_release(want);
+    pack_release(want, PACK_ZSTD);
     CHECK(access(p1, F_OK) < 0, "removed after the last holder");
 
     unlink(scene);

@@ -1,0 +1,63 @@
+/* xform.c -- reversible byte transforms of arrays before compression (see
+ * xform.h). */
+#include "xform.h"
+
+#include <string.h>
+
+void xform_shuffle(const unsigned char *in, size_t n, unsigned char *out, int undo)
+{
+    size_t words = n / 4;
+    for (size_t i = 0; i < words; i++)
+        for (size_t b = 0; b < 4; b++) {
+            if (undo)
+                out[4 * i + b] = in[b * words + i];
+            else
+                out[b * words + i] = in[4 * i + b];
+        }
+}
+
+/* Value i of img (`bytes` bytes, little-endian). */
+static uint32_t value(const unsigned char *img, size_t i, uint32_t bytes)
+{
+    return bytes == 1 ? img[i] : (uint32_t)img[2 * i] | (uint32_t)img[2 * i + 1] << 8;
+}
+
+static void store(unsigned char *p, size_t i, uint32_t bytes, uint32_t v)
+{
+    if (bytes == 1) {
+        p[i] = (unsigned char)v;
+    } else {
+        p[2 * i] = (unsigned char)v;
+        p[2 * i + 1] = (unsigned char)(v >> 8);
+    }
+}
+
+void xform_predict(unsigned char *img, uint32_t w, uint32_t n, uint32_t bytes, size_t from, size_t to,
+                   unsigned char *res, int undo)
+{
+    size_t row = (size_t)w * n;
+    uint32_t mask = bytes == 1 ? 0xffu : 0xffffu;
+    size_t y = from / row, col = from % row;
+    for (size_t i = from; i < to; i++) {
+        size_t x = col / n;
+        uint32_t a, b, c, d;
+        if (y == 0) {
+            a = x ? value(img, i - n, bytes) : 0;
+            b = c = d = a;
+        } else {
+            b = value(img, i - row, bytes);
+            a = x ? value(img, i - n, bytes) : b;
+            c = x ? value(img, i - row - n, bytes) : b;
+            d = x + 1 < w ? value(img, i - row + n, bytes) : b;
+        }
+        uint32_t p = (a + b + c + d + 2) >> 2;
+        if (undo)
+            store(img, i, bytes, (value(res, i - from, bytes) + p) & mask);
+        else
+            store(res, i - from, bytes, (value(img, i, bytes) - p) & mask);
+        if (++col == row) {
+            col = 0;
+            y++;
+        }
+    }
+}
