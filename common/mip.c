@@ -67,26 +67,36 @@ static uint32_t srgb_nearest(double v, uint32_t maxcode)
  * the nearest code to v is the number of midpoints below v (a tie, v on a
  * midpoint, goes to the lower code). */
 static double srgb8_mid[255];
+/* srgb8_below[b]: the number of midpoints below b / SRGB8_BUCKETS, where
+ * the count for v in bucket b starts (a few steps at most). */
+enum { SRGB8_BUCKETS = 4096 };
+static uint8_t srgb8_below[SRGB8_BUCKETS];
 static pthread_once_t srgb8_once = PTHREAD_ONCE_INIT;
 
 static void srgb8_init(void)
 {
     for (uint32_t k = 0; k < 255; k++)
         srgb8_mid[k] = 0.5 * (srgb_decoded(k, 255) + srgb_decoded(k + 1, 255));
+    uint32_t k = 0;
+    for (uint32_t b = 0; b < SRGB8_BUCKETS; b++) {
+        while (k < 255 && srgb8_mid[k] < (double)b / SRGB8_BUCKETS)
+            k++;
+        srgb8_below[b] = (uint8_t)k;
+    }
 }
 
 static uint32_t srgb8_nearest(double v)
 {
     pthread_once(&srgb8_once, srgb8_init);
-    uint32_t lo = 0, hi = 255;          /* the answer is in [lo, hi] */
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;   /* is srgb8_mid[mid] (between mid and mid + 1) below v? */
-        if (srgb8_mid[mid] < v)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
+    if (!(v > srgb8_mid[0]))
+        return 0;
+    if (v > srgb8_mid[254])
+        return 255;
+    /* 0 < v < 1: b / SRGB8_BUCKETS <= v (the scaling is exact). */
+    uint32_t k = srgb8_below[(uint32_t)(v * SRGB8_BUCKETS)];
+    while (srgb8_mid[k] < v)   /* k < 255: srgb8_mid[254] >= v */
+        k++;
+    return k;
 }
 
 uint32_t mip_encode(uint32_t format, double v)

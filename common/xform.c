@@ -17,12 +17,12 @@ void xform_shuffle(const unsigned char *in, size_t n, unsigned char *out, int un
 }
 
 /* Value i of img (`bytes` bytes, little-endian). */
-static uint32_t value(const unsigned char *img, size_t i, uint32_t bytes)
+static inline uint32_t value(const unsigned char *img, size_t i, uint32_t bytes)
 {
     return bytes == 1 ? img[i] : (uint32_t)img[2 * i] | (uint32_t)img[2 * i + 1] << 8;
 }
 
-static void store(unsigned char *p, size_t i, uint32_t bytes, uint32_t v)
+static inline void store(unsigned char *p, size_t i, uint32_t bytes, uint32_t v)
 {
     if (bytes == 1) {
         p[i] = (unsigned char)v;
@@ -37,27 +37,30 @@ void xform_predict(unsigned char *img, uint32_t w, uint32_t n, uint32_t bytes, s
 {
     size_t row = (size_t)w * n;
     uint32_t mask = bytes == 1 ? 0xffu : 0xffffu;
-    size_t y = from / row, col = from % row;
+    size_t y = from / row;
+    uint32_t x = (uint32_t)(from % row / n), c = (uint32_t)(from % n);
     for (size_t i = from; i < to; i++) {
-        size_t x = col / n;
-        uint32_t a, b, c, d;
+        uint32_t a, b, cc, d;
         if (y == 0) {
             a = x ? value(img, i - n, bytes) : 0;
-            b = c = d = a;
+            b = cc = d = a;
         } else {
             b = value(img, i - row, bytes);
             a = x ? value(img, i - n, bytes) : b;
-            c = x ? value(img, i - row - n, bytes) : b;
+            cc = x ? value(img, i - row - n, bytes) : b;
             d = x + 1 < w ? value(img, i - row + n, bytes) : b;
         }
-        uint32_t p = (a + b + c + d + 2) >> 2;
+        uint32_t p = (a + b + cc + d + 2) >> 2;
         if (undo)
             store(img, i, bytes, (value(res, i - from, bytes) + p) & mask);
         else
             store(res, i - from, bytes, (value(img, i, bytes) - p) & mask);
-        if (++col == row) {
-            col = 0;
-            y++;
+        if (++c == n) {
+            c = 0;
+            if (++x == w) {
+                x = 0;
+                y++;
+            }
         }
     }
 }
