@@ -162,6 +162,10 @@ bin/tools/nolockfs: tests/tools/nolockfs.c
 # alike (tests/bench/README.md, "Benchmarks linked with 2 MiB segments").
 # The code is the same; the file is sparse where it is padded.
 BENCH_LDFLAGS = -Wl,-z,max-page-size=0x200000
+# packbench packs scenes as the coordinator does: its library and zstd.
+bin/bench/packbench: tests/bench/packbench.c $(COORD_LIB) $(LIB)
+	@mkdir -p bin/bench
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) -iquote coordinator -o $@ $< $(COORD_LIB) $(LIB) -Wl,--as-needed $(COORD_LIBS)
 bin/bench/%: tests/bench/%.c $(wildcard tests/bench/*.h) $(LIB)
 	@mkdir -p bin/bench
 	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) $(BENCH_LDFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
