@@ -172,7 +172,8 @@ bin/bench/%: tests/bench/%.c $(wildcard tests/bench/*.h) $(LIB)
 
 # Fuzzing: libFuzzer targets tests/fuzz/fuzz_*.c, built with clang, ASan
 # and UBSan over the common sources, each run for FUZZ_SECONDS
-# (tests/fuzz/run.sh; it makes seeds with bin/franja and bin/franja-worker).
+# (tests/fuzz/run.sh; it makes seeds with bin/franja, bin/franja-worker and
+# bin/bench/packbench).
 # make test builds them too and runs each for a few seconds (tests/run.sh).
 # FUZZ_TARGETS names some (hosts partial ...); default: all.
 FUZZ_SECONDS ?= 60
@@ -202,7 +203,7 @@ bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	    -o $@ $< $(FUZZ_COORD_LIB) \
 	    $(FUZZ_OBJ) $(CJSON_LIBS) $(ZSTD_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) $(SSH_LIBS) $(MHD_LIBS) -ldl -lm -pthread
 
-fuzz: all $(FUZZ_BIN)
+fuzz: all $(FUZZ_BIN) bin/bench/packbench
 	sh tests/fuzz/run.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 deps:
@@ -216,7 +217,7 @@ bench-deps:
 # make test runs the first part alone.
 check: test check-cross
 
-test: all $(TEST_BIN) $(TOOL_BIN) $(FUZZ_BIN)
+test: all $(TEST_BIN) $(TOOL_BIN) $(FUZZ_BIN) bin/bench/packbench
 	sh tests/run.sh
 
 bench: all $(TOOL_BIN) $(BENCH_BIN)

@@ -1,6 +1,8 @@
 /* packbench.c -- times packing and unpacking a binary scene in both forms.
  *
  *   bin/bench/packbench SCENE.fbin [REPS]
+ *   bin/bench/packbench SCENE.fbin -o OUT     (the packed scene)
+ *   bin/bench/packbench SCENE.fbin -O OUT     (its header and frame content)
  *
  * Packs SCENE as one zstd frame (pack_file, what older workers get) and as
  * a packed scene (pack_scene_file), at PACK_LEVEL, REPS times each
@@ -8,13 +10,18 @@
  * that it is SCENE byte for byte.  Prints per form the packed size, its
  * ratio to the .fbin, and the median pack and unpack wall times.  Scratch
  * files go beside SCENE.  Exit status 1 if a copy does not unpack to the
- * scene.  Results: tests/bench/README.md, "A production-like scene". */
+ * scene.  With -o, writes the packed scene to OUT instead; with -O, its
+ * header followed by the content of its zstd frame, uncompressed (the
+ * seeds of tests/fuzz/fuzz_unpack.c).  Results: tests/bench/README.md,
+ * "A production-like scene". */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
+
+#include <zstd.h>
 
 #include "file.h"
 #include "transport/pack.h"
@@ -52,8 +59,43 @@ static int same(const char *a, const char *b)
     return eq;
 }
 
+/* Writes the packed scene of `scene` to out, with its frame decompressed
+ * when `open`. */
+static int write_packed(const char *scene, const char *out, int open)
+{
+    fr_error err;
+    uint64_t size;
+    unlink(out);
+    if (pack_scene_file(scene, out, PACK_LEVEL, &size, &err) < 0) {
+        fprintf(stderr, "packbench: %s\n", err.msg);
+        return 1;
+    }
+    if (!open)
+        return 0;
+    char *f;
+    size_t n;
+    if (file_read(out, &f, &n, &err) < 0) {
+        fprintf(stderr, "packbench: %s\n", err.msg);
+        return 1;
+    }
+    unsigned long long c = ZSTD_getFrameContentSize(f + UNPACK_HEADER, n - UNPACK_HEADER);
+    char *o = c < ((size_t)1 << 32) ? malloc(UNPACK_HEADER + c) : NULL;
+    int rc = !o || ZSTD_decompress(o + UNPACK_HEADER, c, f + UNPACK_HEADER, n - UNPACK_HEADER) != c;
+    if (!rc) {
+        memcpy(o, f, UNPACK_HEADER);
+        rc = file_write_atomic(out, o, UNPACK_HEADER + c, &err) < 0;
+    }
+    if (rc)
+        fprintf(stderr, "packbench: %s: cannot write the frame's content\n", out);
+    free(o);
+    free(f);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && (!strcmp(argv[2], "-o") || !strcmp(argv[2], "-O")))
+        return write_packed(argv[1], argv[3], argv[2][1] == 'O');
     if (argc < 2) {
         fprintf(stderr, "usage: packbench SCENE.fbin [REPS]\n");
         return 2;
