@@ -71,10 +71,15 @@ static double srgb8_mid[255];
  * the count for v in bucket b starts (a few steps at most). */
 enum { SRGB8_BUCKETS = 4096 };
 static uint8_t srgb8_below[SRGB8_BUCKETS];
+/* The decoded value of each 8-bit sRGB code, as lookups decode it (the
+ * same floats as texture.c's table: test_texture checks that one). */
+static float srgb8_linear[256];
 static pthread_once_t srgb8_once = PTHREAD_ONCE_INIT;
 
 static void srgb8_init(void)
 {
+    for (uint32_t k = 0; k < 256; k++)
+        srgb8_linear[k] = tex_srgb_to_linear((float)k / 255.0f);
     for (uint32_t k = 0; k < 255; k++)
         srgb8_mid[k] = 0.5 * (srgb_decoded(k, 255) + srgb_decoded(k + 1, 255));
     uint32_t k = 0;
@@ -149,7 +154,9 @@ void mip_level(const uint32_t *texels, const fr_texture *t, uint32_t k, uint32_t
     uint32_t w, h, pw, ph, n = t->channels, bytes = tex_format_bytes(t->format);
     tex_level_size(t, k, &w, &h);
     tex_level_size(t, k - 1, &pw, &ph);
-    int integer = t->format == FR_TEXEL_U8 || t->format == FR_TEXEL_U16;
+    int integer = t->format == FR_TEXEL_U8 || t->format == FR_TEXEL_U16, srgb8 = t->format == FR_TEXEL_U8_SRGB;
+    if (srgb8)
+        pthread_once(&srgb8_once, srgb8_init);
     const unsigned char *prev = (const unsigned char *)(texels + t->first[k - 1]);
     for (uint32_t y = y0r; y < y1r; y++) {
         uint32_t y0 = ph == 1 ? 0 : 2 * y, y1 = ph == 1 ? 1 : y + 1 == h ? ph : 2 * y + 2;
@@ -163,6 +170,9 @@ void mip_level(const uint32_t *texels, const fr_texture *t, uint32_t k, uint32_t
                     if (integer) {
                         for (uint32_t c = 0; c < n; c++)
                             isum[c] += get_int(prev, ((size_t)yy * pw + xx) * n + c, bytes);
+                    } else if (srgb8) {    /* tex_texel's values, without its calls */
+                        for (uint32_t c = 0; c < n; c++)
+                            sum[c] += srgb8_linear[prev[((size_t)yy * pw + xx) * n + c]];
                     } else {
                         float v[3];
                         tex_texel(texels, t, k - 1, xx, yy, v);

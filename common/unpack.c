@@ -254,24 +254,40 @@ static int texture_at(const unsigned char *map, uint64_t size, uint64_t done, ui
     return 0;
 }
 
-/* Part i of the table (at `entry`) into the scene mapped at map. */
-static int part(reader *r, unsigned char *map, uint64_t size, const unsigned char *entry, uint32_t i,
+/* The scene being written: the file (its offset at the next part's
+ * start, for parts written with write(): pages filled whole, which the
+ * kernel need not zero first) and a shared mapping of it (for the parts
+ * that read what is written: predicted texels and the levels above). */
+typedef struct {
+    int fd;
+    const char *tmp;
+    unsigned char *map;
+} sink;
+
+static int put(const sink *o, const void *p, size_t n, fr_error *err)
+{
+    if (file_write_all(o->fd, p, n) < 0)
+        return fr_fail(err, "%s: write error: %s", o->tmp, strerror(errno));
+    return 0;
+}
+
+/* Part i of the table (at `entry`) into the scene. */
+static int part(reader *r, const sink *o, uint64_t size, const unsigned char *entry, uint32_t i,
                 unsigned char *scratch, fr_error *err)
 {
     uint32_t how = u32_at(entry), arg = u32_at(entry + 4);
     uint64_t off = u64_at(entry + 8), len = u64_at(entry + 16);
-    if (how == UNPACK_COPY) {
-        for (uint64_t done = 0; done < len; done += XFORM_BLOCK)
-            if (rd_need(r, map + off + done, len - done < XFORM_BLOCK ? len - done : XFORM_BLOCK, err))
-                return -1;
-        return 0;
-    }
-    if (how == UNPACK_SHUFFLE) {
+    unsigned char *map = o->map;
+    if (how == UNPACK_COPY || how == UNPACK_SHUFFLE) {
+        unsigned char *sh = scratch + XFORM_BLOCK;
         for (uint64_t done = 0; done < len; done += XFORM_BLOCK) {
             size_t n = len - done < XFORM_BLOCK ? len - done : XFORM_BLOCK;
             if (rd_need(r, scratch, n, err))
                 return -1;
-            xform_shuffle(scratch, n, map + off + done, 1);
+            if (how == UNPACK_SHUFFLE)
+                xform_shuffle(scratch, n, sh, 1);
+            if (put(o, how == UNPACK_SHUFFLE ? sh : scratch, n, err))
+                return -1;
         }
         return 0;
     }
@@ -291,18 +307,30 @@ static int part(reader *r, unsigned char *map, uint64_t size, const unsigned cha
                 return -1;
             xform_predict(map + off, t.width, t.channels, bytes, v, v + n, scratch, 1);
         }
-        return rd_need(r, map + off + values * bytes, len - values * bytes, err);
+        if (rd_need(r, map + off + values * bytes, len - values * bytes, err))
+            return -1;
+        if (lseek(o->fd, (off_t)(off + len), SEEK_SET) < 0)
+            return fr_fail(err, "%s: %s", o->tmp, strerror(errno));
+        return 0;
     }
     if (len == 0 || off != rg[2] || len != rg[3])
         return fr_fail(err, "%s: part %u: not the mip levels of texture %u", r->path, i, arg);
+    /* Level by level, in strips of rows: level k - 1 read back through the map. */
     const uint32_t *texels = (const uint32_t *)(map + texels_at);
+    static const unsigned char zero[4];
     for (uint32_t k = 1; k < t.levels; k++) {
         uint32_t w, h;
         tex_level_size(&t, k, &w, &h);
-        unsigned char *lv = map + texels_at + 4 * (uint64_t)t.first[k];
-        size_t used = (size_t)w * h * t.channels * bytes;
-        mip_level(texels, &t, k, 0, h, lv);
-        memset(lv + used, 0, (4 - used % 4) % 4);
+        size_t row = (size_t)w * t.channels * bytes, used = row * h;
+        uint32_t rows = row >= XFORM_BLOCK ? 1 : (uint32_t)(XFORM_BLOCK / row);
+        for (uint32_t y = 0; y < h; y += rows) {
+            uint32_t y1 = h - y < rows ? h : y + rows;
+            mip_level(texels, &t, k, y, y1, scratch);
+            if (put(o, scratch, (y1 - y) * row, err))
+                return -1;
+        }
+        if (put(o, zero, (4 - used % 4) % 4, err))
+            return -1;
     }
     return 0;
 }
@@ -361,7 +389,7 @@ static int unpack_parts(const char *in, int fd, const unsigned char *hd, int fd_
     reader r = {.path = in, .fd = fd, .dc = ZSTD_createDCtx(), .cap = ZSTD_DStreamInSize(),
                 .read_total = UNPACK_HEADER, .left = 1};
     r.buf = malloc(r.cap);
-    unsigned char *table = malloc((size_t)n * UNPACK_ENTRY), *scratch = malloc(XFORM_BLOCK);
+    unsigned char *table = malloc((size_t)n * UNPACK_ENTRY), *scratch = malloc(2 * XFORM_BLOCK);
     int rc = 0;
     if (!r.dc || !r.buf || !table || !scratch)
         rc = fr_fail(err, "%s: out of memory", in);
@@ -377,8 +405,9 @@ static int unpack_parts(const char *in, int fd, const unsigned char *hd, int fd_
         rc = rd_need(&r, table, (size_t)n * UNPACK_ENTRY, err);
     if (rc == 0)
         rc = check_table(in, table, n, size, err);
+    sink o = {fd_out, tmp, map};
     for (uint32_t i = 0; rc == 0 && i < n; i++)
-        rc = part(&r, map, size, table + (size_t)i * UNPACK_ENTRY, i, scratch, err);
+        rc = part(&r, &o, size, table + (size_t)i * UNPACK_ENTRY, i, scratch, err);
     if (rc == 0)
         rc = rd_finish(&r, err);
     if (munmap(map, size) < 0 && rc == 0)

@@ -55,7 +55,9 @@ int unpack_texture_ranges(const fr_texture *t, uint64_t texels_at, uint64_t texe
  * packed scene's header or part table out of its rules), a scene that
  * does not check out, or a write error (a full disk).  Memory: zstd's
  * window (at most 2^27 bytes), the part table (24 bytes a part) and
- * 2 MiB; the scene is written through a shared mapping of the file. */
+ * 2 MiB; the scene is written to the file (predicted texels through a
+ * shared mapping of it, through which mip levels read their level
+ * above), after its size is reserved on disk. */
 int unpack_file(const char *in, const char *out, uint64_t *hash, fr_error *err);
 
 #endif

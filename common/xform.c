@@ -32,8 +32,11 @@ static inline void store(unsigned char *p, size_t i, uint32_t bytes, uint32_t v)
     }
 }
 
-void xform_predict(unsigned char *img, uint32_t w, uint32_t n, uint32_t bytes, size_t from, size_t to,
-                   unsigned char *res, int undo)
+/* xform_predict for one value size (inlined with a constant `bytes`, so
+ * that each size gets its own loop). */
+static inline __attribute__((always_inline)) void predict(unsigned char *img, uint32_t w, uint32_t n,
+                                                          uint32_t bytes, size_t from, size_t to,
+                                                          unsigned char *res, int undo)
 {
     size_t row = (size_t)w * n;
     uint32_t mask = bytes == 1 ? 0xffu : 0xffffu;
@@ -63,4 +66,13 @@ void xform_predict(unsigned char *img, uint32_t w, uint32_t n, uint32_t bytes, s
             }
         }
     }
+}
+
+void xform_predict(unsigned char *img, uint32_t w, uint32_t n, uint32_t bytes, size_t from, size_t to,
+                   unsigned char *res, int undo)
+{
+    if (bytes == 1)
+        predict(img, w, n, 1, from, to, res, undo);
+    else
+        predict(img, w, n, 2, from, to, res, undo);
 }
