@@ -5,7 +5,6 @@
  * are not the filter's keeps them; every rule of the header and the part
  * table is enforced with an error naming the file, and nothing is left of
  * a refused transfer. */
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +12,7 @@
 #include <zstd.h>
 
 #include "check.h"
+#include "tmpfiles.h"
 #include "fbin.h"
 #include "file.h"
 #include "transport/pack.h"
@@ -20,49 +20,18 @@
 
 static char dir[64], scene[128], pak[128], out[128];
 
-/* Entries of dir other than . and .. */
-static int entries(void)
-{
-    DIR *d = opendir(dir);
-    int n = 0;
-    struct dirent *e;
-    while (d && (e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    if (d)
-        closedir(d);
-    return n;
-}
+static int entries(void) { return tmpfiles_entries(dir); }
 
-static int same_file(const char *a, const char *b)
+/* The little-endian number of `bytes` bytes (4 or 8) at p. */
+static uint64_t get(const unsigned char *p, int bytes)
 {
-    char *x, *y;
-    size_t nx, ny;
-    fr_error err;
-    if (file_read(a, &x, &nx, &err))
-        return 0;
-    if (file_read(b, &y, &ny, &err)) {
-        free(x);
-        return 0;
-    }
-    int same = nx == ny && !memcmp(x, y, nx);
-    free(x);
-    free(y);
-    return same;
-}
-
-static uint32_t get32(const unsigned char *p)
-{
-    uint32_t v;
-    memcpy(&v, p, 4);
+    uint64_t v = 0;
+    for (int i = bytes - 1; i >= 0; i--)
+        v = v << 8 | p[i];
     return v;
 }
-
-static uint64_t get64(const unsigned char *p)
-{
-    uint64_t v;
-    memcpy(&v, p, 8);
-    return v;
-}
+#define get32(p) ((uint32_t)get((p), 4))
+#define get64(p) get((p), 8)
 
 /* The packed scene at pak: its header in hd, its frame's content (malloc'd). */
 static unsigned char *content(unsigned char hd[UNPACK_HEADER], size_t *len)
@@ -126,14 +95,13 @@ int main(void)
     snprintf(dir, sizeof dir, "/tmp/franja-test-unpack-XXXXXX");
     CHECK(mkdtemp(dir) != NULL, "mkdtemp");
     snprintf(scene, sizeof scene, "%s/s.fbin", dir);
-    snprintf(pak, sizeof pak, "%s/s.fpak", dir);
-    snprintf(out, sizeof out, "%s/cache.fbin", dir);
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "bin/franja compile scenes/cornell-textured.json -o %s >/dev/null 2>&1", scene);
-    CHECK(system(cmd) == 0, "compile");
+    CHECK(tmpfiles_compile("scenes/cornell-textured.json", scene) == 0, "compile");
     fr_scene s;
     fr_error err;
     CHECK(fbin_load(scene, &s, &err) == 0, "%s", err.msg);
+    snprintf(pak, sizeof pak, "%s/s.fpak", dir);
+    snprintf(out, sizeof out, "%s/cache.fbin", dir);
+    char cmd[300];
     uint64_t want = s.hash, fbin = s.blob_size;
     uint32_t textures = s.n_textures;
 
@@ -156,7 +124,7 @@ int main(void)
     int sh = find(body, n, UNPACK_SHUFFLE), pr = find(body, n, UNPACK_PREDICT), mp = find(body, n, UNPACK_MIP);
     CHECK(sh >= 0 && pr >= 0 && mp >= 0, "shuffled (%d), predicted (%d) and mip (%d) parts", sh, pr, mp);
     CHECK(unpack_file(pak, out, &hash, &err) == 0, "%s", err.msg);
-    CHECK(hash == want && same_file(out, scene), "the unpacked scene is the scene");
+    CHECK(hash == want && tmpfiles_same(out, scene), "the unpacked scene is the scene");
     CHECK(access(pak, F_OK) < 0, "the packed file is removed");
     unlink(out);
 
@@ -180,7 +148,7 @@ int main(void)
         free(copy);
         uint64_t psz;
         CHECK(pack_scene_file(odd, pak, PACK_LEVEL, &psz, &err) == 0, "%s", err.msg);
-        CHECK(unpack_file(pak, out, &hash, &err) == 0 && hash == oh && same_file(out, odd), "odd levels: %s",
+        CHECK(unpack_file(pak, out, &hash, &err) == 0 && hash == oh && tmpfiles_same(out, odd), "odd levels: %s",
               err.msg);
         unlink(out);
         unlink(odd);
