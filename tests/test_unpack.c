@@ -1,8 +1,9 @@
 /* test_unpack.c -- packed scenes (FORMAT.md, "Packed scenes";
  * coordinator/transport/pack.h: pack_scene_file, common/unpack.h): a
  * textured scene travels as shuffled, predicted and copied parts with its
- * mip levels left out, and unpacks to its bytes; a scene whose mip levels
- * are not the filter's keeps them; every rule of the header and the part
+ * mip levels left out, and unpacks to its bytes, with images of every
+ * texel format and odd sizes added; a scene whose mip levels are not the
+ * filter's keeps them; every rule of the header and the part
  * table is enforced with an error naming the file, and nothing is left of
  * a refused transfer. */
 #include <stdio.h>
@@ -13,6 +14,7 @@
 
 #include "check.h"
 #include "tmpfiles.h"
+#include "compile/texstore.h"
 #include "fbin.h"
 #include "file.h"
 #include "transport/pack.h"
@@ -90,6 +92,69 @@ static int find(const unsigned char *body, uint32_t n, uint32_t how)
     return -1;
 }
 
+/* Scene s with seven images of odd sizes added, one of each texel format
+ * and of 1 and 3 channels (unused by its materials), written to path;
+ * *added gets their number. */
+static int every_format(const fr_scene *s, const char *path, uint32_t *added)
+{
+    enum { W = 37, H = 23 };
+    static uint8_t u8[W * H * 3];
+    static uint16_t u16[W * H * 3], f16[W * H * 3];
+    static float f32[W * H], big[W * H];
+    uint32_t r = 12345;
+    for (int i = 0; i < W * H * 3; i++) {
+        r = r * 1103515245u + 12345u;
+        u8[i] = (uint8_t)(i / 3 + (r >> 28));            /* a gradient with grain */
+        u16[i] = (uint16_t)(i * 40 + (r >> 20));
+        f16[i] = (uint16_t)(0x3000 + (i & 0xfff) + (r >> 29)); /* finite halves */
+        if (i < W * H)
+            f32[i] = big[i] = (float)(r >> 16) / 1000.0f;
+    }
+    big[3] = 1e6f;                                      /* past half's range: floats */
+    struct { const void *data; uint32_t type, ch; int srgb; } img[] = {
+        {u8, SCENE_PIX_U8, 3, 1},   {u8, SCENE_PIX_U8, 1, 0},   {u16, SCENE_PIX_U16, 3, 0},
+        {u16, SCENE_PIX_U16, 1, 1}, {f16, SCENE_PIX_F16, 3, 0}, {f32, SCENE_PIX_F32, 1, 0},
+        {big, SCENE_PIX_F32, 1, 0},
+    };
+    uint32_t n = sizeof img / sizeof img[0];
+    fr_builder b;
+    bld_init(&b);
+    fr_texture *tex = malloc((s->n_textures + n) * sizeof *tex);
+    memcpy(tex, s->textures, s->n_textures * sizeof *tex);
+    /* The scene's texels first, then the new images'. */
+    uint32_t *room = malloc((size_t)s->n_texels * 4);
+    memcpy(room, s->texels, (size_t)s->n_texels * 4);
+    b.texels.data = room;
+    b.texels.count = b.texels.cap = s->n_texels;
+    int rc = 0;
+    for (uint32_t i = 0; i < n && rc == 0; i++) {
+        scene_image im = {.data = (void *)img[i].data, .type = img[i].type, .width = W, .height = H,
+                          .channels = img[i].ch};
+        fr_texture *t = &tex[s->n_textures + i];
+        memset(t, 0, sizeof *t);
+        t->kind = FR_TEX_IMAGE;
+        t->scale = (vec2){1, 1};
+        fr_error err;
+        rc = texstore_image(&b, &im, img[i].srgb, t, "test image", &err);
+        CHECK(rc == 0, "%s", err.msg);
+    }
+    fr_scene view = *s;
+    view.textures = tex;
+    view.n_textures = s->n_textures + n;
+    view.texels = b.texels.data;
+    view.n_texels = b.texels.count;
+    uint64_t h;
+    size_t size;
+    fr_error err;
+    if (rc == 0 && fbin_write_view(&view, path, &h, &size, &err) < 0)
+        rc = fr_fail(&err, "%s", err.msg);
+    CHECK(rc == 0, "every format: %s", err.msg);
+    free(tex);
+    bld_free(&b);
+    *added = n;
+    return rc;
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/franja-test-unpack-XXXXXX");
@@ -127,6 +192,32 @@ int main(void)
     CHECK(hash == want && tmpfiles_same(out, scene), "the unpacked scene is the scene");
     CHECK(access(pak, F_OK) < 0, "the packed file is removed");
     unlink(out);
+
+    /* Images of every format added: each level 0 of 8 or 16 bits
+     * predicted, every texture's mip levels rebuilt, the same bytes. */
+    char all[128];
+    uint32_t added = 0, mips_before = 0, mips = 0, preds = 0;
+    snprintf(all, sizeof all, "%s/all.fbin", dir);
+    for (uint32_t i = 0; i < n; i++)
+        mips_before += get32(body + (size_t)i * UNPACK_ENTRY) == UNPACK_MIP;
+    if (every_format(&s, all, &added) == 0) {
+        uint64_t psz;
+        CHECK(pack_scene_file(all, pak, PACK_LEVEL, &psz, &err) == 0, "%s", err.msg);
+        size_t alen;
+        unsigned char ahd[UNPACK_HEADER], *abody = content(ahd, &alen);
+        for (uint32_t i = 0; abody && i < get32(ahd + 32); i++) {
+            uint32_t how = get32(abody + (size_t)i * UNPACK_ENTRY), arg = get32(abody + (size_t)i * UNPACK_ENTRY + 4);
+            mips += how == UNPACK_MIP && arg >= s.n_textures;
+            preds += how == UNPACK_PREDICT && arg >= s.n_textures;
+        }
+        free(abody);
+        CHECK(mips == added && preds == 4, "every format: %u of %u mip parts, %u predicted (4 expected)", mips,
+              added, preds);
+        CHECK(unpack_file(pak, out, &hash, &err) == 0 && tmpfiles_same(out, all), "every format: %s", err.msg);
+        unlink(out);
+        unlink(all);
+    }
+    CHECK(mips_before > 0, "the scene's own textures have mip parts");
 
     /* Mip levels that are not the filter's (another compiler's): kept. */
     const fr_texture *t = NULL;
