@@ -343,17 +343,17 @@ static int check_table(const char *in, const unsigned char *table, uint32_t n, u
         const unsigned char *e = table + (size_t)i * UNPACK_ENTRY;
         uint32_t how = u32_at(e), arg = u32_at(e + 4);
         uint64_t off = u64_at(e + 8), len = u64_at(e + 16);
-        unsigned long long at = UNPACK_HEADER + (unsigned long long)i * UNPACK_ENTRY;
+        unsigned long long at = (unsigned long long)i * UNPACK_ENTRY;
         if (how >= UNPACK_TRANSFORMS)
-            return fr_fail(err, "%s: part %u (byte %llu of the frame): unknown transform %u", in, i, at, how);
+            return fr_fail(err, "%s: part %u (byte %llu of the frame's content): unknown transform %u", in, i, at, how);
         if (off != end || len == 0 || len > size - off)
-            return fr_fail(err, "%s: part %u (byte %llu of the frame): bytes %llu to %llu do not follow the last "
+            return fr_fail(err, "%s: part %u (byte %llu of the frame's content): bytes %llu to %llu do not follow the last "
                            "part (which ended at %llu) inside the scene's %llu", in, i, at, (unsigned long long)off,
                            (unsigned long long)(off + len), (unsigned long long)end, (unsigned long long)size);
         if ((how == UNPACK_COPY || how == UNPACK_SHUFFLE) && arg != 0)
-            return fr_fail(err, "%s: part %u (byte %llu of the frame): argument %u (0 expected)", in, i, at, arg);
+            return fr_fail(err, "%s: part %u (byte %llu of the frame's content): argument %u (0 expected)", in, i, at, arg);
         if (how == UNPACK_SHUFFLE && len % 4)
-            return fr_fail(err, "%s: part %u (byte %llu of the frame): %llu bytes of words", in, i, at,
+            return fr_fail(err, "%s: part %u (byte %llu of the frame's content): %llu bytes of words", in, i, at,
                            (unsigned long long)len);
         end = off + len;
     }
