@@ -16,8 +16,8 @@
 #include "error.h"
 
 /** The zstd level scenes travel at (tests/bench/README.md, "Compressed
- * transfer": the ratio of level 3 at several times the speed of the
- * higher levels). */
+ * transfer" and "Packed scenes": the ratio of level 3 at several times
+ * the speed of the higher levels; long-distance matching gains 0.3 %). */
 #define PACK_LEVEL 3
 
 /** Compresses the file `in` into the new file `out` (one zstd frame with
