@@ -126,8 +126,10 @@ static int decompress(const char *in, int fd_in, int fd_out, fr_error *err)
 
 /* ---- packed scenes (FORMAT.md, "Packed scenes") ---- */
 
-/* Ids of the sections a part may name (FORMAT.md, "Sections"). */
-enum { SEC_TEXTURES = 15, SEC_TEXELS = 16 };
+/* Ids of the sections a part may name (FORMAT.md, "Sections"), and the end
+ * of the section table's entries up to theirs: bytes every scene has,
+ * whatever its number of sections. */
+enum { SEC_TEXTURES = 15, SEC_TEXELS = 16, TABLE_END = 64 + 32 * SEC_TEXELS };
 
 /* The zstd frame of a packed scene, read as it is needed. */
 typedef struct {
@@ -240,7 +242,7 @@ static int texture_at(const unsigned char *map, uint64_t size, uint64_t done, ui
     uint64_t at = u64_at(tx + 8), count = u64_at(tx + 16), bytes = u64_at(tx + 24);
     *texels_at = u64_at(tl + 8);
     uint64_t texels_size = u64_at(tl + 24);
-    if (u32_at(tx + 4) != sizeof(fr_texture) || at < 896 || bytes != count * sizeof(fr_texture) || at > done ||
+    if (u32_at(tx + 4) != sizeof(fr_texture) || at < TABLE_END || bytes != count * sizeof(fr_texture) || at > done ||
         bytes > done - at)
         return fr_fail(err, "the textures section is not before the part");
     if (index >= count)
@@ -376,7 +378,7 @@ static int unpack_parts(const char *in, int fd, const unsigned char *hd, int fd_
     if (u32_at(hd + 12) != UNPACK_HEADER || u32_at(hd + 36) != 0 || u64_at(hd + 40) != 0)
         return fr_fail(err, "%s: byte 12: not a packed scene header of %d bytes with its reserved fields zero", in,
                        UNPACK_HEADER);
-    if (size < 896 || size > UNPACK_MAX_SCENE || size > SIZE_MAX)
+    if (size < TABLE_END || size > UNPACK_MAX_SCENE || size > SIZE_MAX)
         return fr_fail(err, "%s: byte 16: a scene of %llu bytes", in, (unsigned long long)size);
     if (n == 0 || n > UNPACK_MAX_PARTS)
         return fr_fail(err, "%s: byte 32: %u parts (1 to %d)", in, n, UNPACK_MAX_PARTS);
