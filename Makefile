@@ -162,13 +162,18 @@ bin/tools/nolockfs: tests/tools/nolockfs.c
 # alike (tests/bench/README.md, "Benchmarks linked with 2 MiB segments").
 # The code is the same; the file is sparse where it is padded.
 BENCH_LDFLAGS = -Wl,-z,max-page-size=0x200000
+# packbench packs scenes as the coordinator does: its library and zstd.
+bin/bench/packbench: tests/bench/packbench.c $(COORD_LIB) $(LIB)
+	@mkdir -p bin/bench
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) -iquote coordinator -o $@ $< $(COORD_LIB) $(LIB) -Wl,--as-needed $(COORD_LIBS)
 bin/bench/%: tests/bench/%.c $(wildcard tests/bench/*.h) $(LIB)
 	@mkdir -p bin/bench
 	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) $(BENCH_LDFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
 
 # Fuzzing: libFuzzer targets tests/fuzz/fuzz_*.c, built with clang, ASan
 # and UBSan over the common sources, each run for FUZZ_SECONDS
-# (tests/fuzz/run.sh; it makes seeds with bin/franja and bin/franja-worker).
+# (tests/fuzz/run.sh; it makes seeds with bin/franja, bin/franja-worker and
+# bin/bench/packbench).
 # make test builds them too and runs each for a few seconds (tests/run.sh).
 # FUZZ_TARGETS names some (hosts partial ...); default: all.
 FUZZ_SECONDS ?= 60
@@ -198,7 +203,7 @@ bin/fuzz/%: tests/fuzz/%.c $(FUZZ_OBJ) $(FUZZ_COORD_LIB)
 	    -o $@ $< $(FUZZ_COORD_LIB) \
 	    $(FUZZ_OBJ) $(CJSON_LIBS) $(ZSTD_LIBS) -Wl,--as-needed $(ASSIMP_LIBS) $(SSH_LIBS) $(MHD_LIBS) -ldl -lm -pthread
 
-fuzz: all $(FUZZ_BIN)
+fuzz: all $(FUZZ_BIN) bin/bench/packbench
 	sh tests/fuzz/run.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
 deps:
@@ -212,7 +217,7 @@ bench-deps:
 # make test runs the first part alone.
 check: test check-cross
 
-test: all $(TEST_BIN) $(TOOL_BIN) $(FUZZ_BIN)
+test: all $(TEST_BIN) $(TOOL_BIN) $(FUZZ_BIN) bin/bench/packbench
 	sh tests/run.sh
 
 bench: all $(TOOL_BIN) $(BENCH_BIN)

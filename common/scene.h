@@ -139,7 +139,7 @@ typedef struct {
  * zero bytes).  Level k's texel (x, y) is the mean, in linear values, of
  * the texels (2x..2x+1, 2y..2y+1) of level k - 1, the last column (row)
  * also taking the odd one left over, rounded to the nearest value of the
- * format (compile/texstore.h: texstore_encode). */
+ * format (mip.h: mip_encode). */
 enum { FR_TEX_IMAGE = 0, FR_TEX_CHECKER = 1 };
 /** The largest image width or height a texture may have, in pixels. */
 #define FR_TEX_MAX_SIDE 65536u

@@ -14,22 +14,12 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "tmpfiles.h"
 #include "file.h"
 
 static char dir[64];
 
-/* Entries of dir other than . and .. */
-static int entries(void)
-{
-    DIR *d = opendir(dir);
-    int n = 0;
-    struct dirent *e;
-    while (d && (e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    if (d)
-        closedir(d);
-    return n;
-}
+static int entries(void) { return tmpfiles_entries(dir); }
 
 static int has(const char *path, const char *want)
 {

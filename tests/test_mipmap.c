@@ -18,6 +18,7 @@
 #include "compile/freeze.h"
 #include "compile/json_scene.h"
 #include "compile/texstore.h"
+#include "mip.h"
 #include "sampler.h"
 
 /* An integer hash, for test images that are the same on every run. */
@@ -127,7 +128,7 @@ static void formats(void)
             bad += at_centre(&s, t16, x, y).x != (float)u16[i] / 65535.0f;
             bad += at_centre(&s, t16s, x, y).y != tex_srgb_to_linear((float)u16[i] / 65535.0f);
             bad += at_centre(&s, th, x, y).x != tex_half_to_float(f16[i]);
-            float hf = tex_half_to_float((uint16_t)texstore_encode(FR_TEXEL_F16, f32[i]));
+            float hf = tex_half_to_float((uint16_t)mip_encode(FR_TEXEL_F16, f32[i]));
             bad += at_centre(&s, tf, x, y).x != hf;
             bad += fabsf(hf - f32[i]) > f32[i] * 0x1p-11f;   /* half's rounding */
             bad += at_centre(&s, tb, x, y).x != big[i];
@@ -148,18 +149,18 @@ static void half_bits(void)
         if ((h & 0x7c00u) == 0x7c00u)
             continue;
         float f = tex_half_to_float((uint16_t)h);
-        bad += texstore_encode(FR_TEXEL_F16, f) != h;
+        bad += mip_encode(FR_TEXEL_F16, f) != h;
     }
     CHECK(bad == 0, "%d halves do not come back to their bits", bad);
     /* 1 + 2^-11 is halfway between 1 and 1 + 2^-10: to the even, 1. */
-    CHECK(texstore_encode(FR_TEXEL_F16, 1.0 + 0x1p-11) == 0x3c00 &&
-          texstore_encode(FR_TEXEL_F16, 1.0 + 3 * 0x1p-11) == 0x3c02 &&
-          texstore_encode(FR_TEXEL_F16, 65519.0) == 0x7bff && texstore_encode(FR_TEXEL_F16, 65520.0) == 0x7c00,
+    CHECK(mip_encode(FR_TEXEL_F16, 1.0 + 0x1p-11) == 0x3c00 &&
+          mip_encode(FR_TEXEL_F16, 1.0 + 3 * 0x1p-11) == 0x3c02 &&
+          mip_encode(FR_TEXEL_F16, 65519.0) == 0x7bff && mip_encode(FR_TEXEL_F16, 65520.0) == 0x7c00,
           "half rounding ties and overflow");
     /* The sRGB table: every code decodes as the curve does. */
     int off = 0;
     for (uint32_t k = 0; k < 256; k++)
-        off += texstore_encode(FR_TEXEL_U8_SRGB, tex_srgb_to_linear((float)k / 255.0f)) != k;
+        off += mip_encode(FR_TEXEL_U8_SRGB, tex_srgb_to_linear((float)k / 255.0f)) != k;
     CHECK(off == 0, "%d sRGB codes do not encode back to themselves", off);
 }
 
@@ -251,7 +252,7 @@ static void check_levels(const fr_scene *s, uint32_t t, const char *what)
                         break;
                     default: {
                         /* Halves: the stored one, and no neighbour nearer the mean. */
-                        uint16_t hb = (uint16_t)texstore_encode(FR_TEXEL_F16, mean);
+                        uint16_t hb = (uint16_t)mip_encode(FR_TEXEL_F16, mean);
                         double d = fabs(tex_half_to_float(hb) - mean);
                         bad += fabs(tex_half_to_float((uint16_t)(hb + 1)) - mean) < d;
                         bad += hb > 0 && fabs(tex_half_to_float((uint16_t)(hb - 1)) - mean) < d;

@@ -3,7 +3,6 @@
  * is the scene byte for byte, with its hash; a damaged or cut stream and a
  * file that is no scene are refused, leaving nothing behind; the shared
  * compressed copy is made once and removed with its last holder. */
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +10,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "tmpfiles.h"
 #include "fbin.h"
 #include "file.h"
 #include "transport/pack.h"
@@ -18,35 +18,7 @@
 
 static char dir[64];
 
-/* Entries of dir other than . and .. */
-static int entries(void)
-{
-    DIR *d = opendir(dir);
-    int n = 0;
-    struct dirent *e;
-    while (d && (e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    if (d)
-        closedir(d);
-    return n;
-}
-
-static int same_file(const char *a, const char *b)
-{
-    char *x, *y;
-    size_t nx, ny;
-    fr_error err;
-    if (file_read(a, &x, &nx, &err))
-        return 0;
-    if (file_read(b, &y, &ny, &err)) {
-        free(x);
-        return 0;
-    }
-    int same = nx == ny && !memcmp(x, y, nx);
-    free(x);
-    free(y);
-    return same;
-}
+static int entries(void) { return tmpfiles_entries(dir); }
 
 int main(void)
 {
@@ -58,9 +30,7 @@ int main(void)
     snprintf(zst, sizeof zst, "%s/s.fbin.zst", dir);
     snprintf(out, sizeof out, "%s/cache.fbin", dir);
     /* Compiled into the test's own directory: no fixed name in /tmp. */
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "bin/franja compile scenes/cornell-textured.json -o %s >/dev/null 2>&1", scene);
-    CHECK(system(cmd) == 0, "compile");
+    CHECK(tmpfiles_compile("scenes/cornell-textured.json", scene) == 0, "compile");
     fr_scene s;
     fr_error err;
     CHECK(fbin_load(scene, &s, &err) == 0, "%s", err.msg);
@@ -77,7 +47,7 @@ int main(void)
     CHECK(pack_file(scene, zst, PACK_LEVEL, &size, &err) < 0, "an existing file is not overwritten");
     CHECK(unpack_available() == 1, "this build unpacks");
     CHECK(unpack_file(zst, out, &hash, &err) == 0, "%s", err.msg);
-    CHECK(hash == want && same_file(out, scene), "the unpacked scene is the scene");
+    CHECK(hash == want && tmpfiles_same(out, scene), "the unpacked scene is the scene");
     CHECK(access(zst, F_OK) < 0 && entries() == 2, "only the scene and its copy are left: %d", entries());
 
     /* A damaged stream: refused by zstd's checksum, nothing left. */
@@ -98,7 +68,7 @@ int main(void)
         CHECK(entries() == 1, "damage %d: only the scene is left (%d entries)", k, entries());
     }
     /* Not a scene (a damaged .fbin, packed whole): refused by its hash. */
-    char bad[128];
+    char bad[128], cmd[300];
     snprintf(bad, sizeof bad, "%s/bad.fbin", dir);
     snprintf(cmd, sizeof cmd, "cp %s %s && printf X | dd of=%s bs=1 seek=5000 conv=notrunc 2>/dev/null", scene, bad,
              bad);
@@ -111,12 +81,20 @@ int main(void)
     /* The shared copy: one file for two holders, gone after both. */
     char p1[4200], p2[4200];
     uint64_t n1, n2;
-    CHECK(pack_acquire(scene, want, p1, sizeof p1, &n1, &err) == 0, "%s", err.msg);
-    CHECK(pack_acquire(scene, want, p2, sizeof p2, &n2, &err) == 0, "%s", err.msg);
+    CHECK(pack_acquire(scene, want, PACK_ZSTD, p1, sizeof p1, &n1, &err) == 0, "%s", err.msg);
+    CHECK(pack_acquire(scene, want, PACK_ZSTD, p2, sizeof p2, &n2, &err) == 0, "%s", err.msg);
     CHECK(!strcmp(p1, p2) && n1 == n2 && !strncmp(p1, dir, strlen(dir)), "one copy in $TMPDIR: %s %s", p1, p2);
-    pack_release(want);
+    /* The other form: a copy of its own, smaller. */
+    char p3[4200];
+    uint64_t n3;
+    CHECK(pack_acquire(scene, want, PACK_PARTS, p3, sizeof p3, &n3, &err) == 0, "%s", err.msg);
+    CHECK(strcmp(p1, p3) && n3 < n1 && access(p3, F_OK) == 0, "a packed scene beside: %s %llu, %llu", p3,
+          (unsigned long long)n3, (unsigned long long)n1);
+    pack_release(want, PACK_PARTS);
+    CHECK(access(p3, F_OK) < 0 && access(p1, F_OK) == 0, "each form released on its own");
+    pack_release(want, PACK_ZSTD);
     CHECK(access(p1, F_OK) == 0, "kept while held");
-    pack_release(want);
+    pack_release(want, PACK_ZSTD);
     CHECK(access(p1, F_OK) < 0, "removed after the last holder");
 
     unlink(scene);

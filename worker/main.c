@@ -30,7 +30,7 @@ static const char usage[] =
     "                     [--integrator path|bdpt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
     "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE] [--passes LIST]\n"
     "       franja-worker --scene FILE --check\n"
-    "       franja-worker --unpack FILE.zst --scene FILE\n"
+    "       franja-worker --unpack FILE --scene FILE\n"
     "       franja-worker --features\n"
     "       franja-worker --help | --version\n"
     "\n"
@@ -47,10 +47,10 @@ static const char usage[] =
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
-    "  --unpack F     decompress the zstd file F into the --scene file, check it\n"
-    "                 as --check does (printing its hash) and remove F\n"
+    "  --unpack F     unpack the packed scene or zstd file F into the --scene file,\n"
+    "                 check it as --check does (printing its hash) and remove F\n"
     "  --features     print what this build can do besides rendering\n"
-    "                 (" PROTO_FEATURE_UNPACK ": --unpack)\n"
+    "                 (" PROTO_FEATURE_UNPACK ", " UNPACK_FEATURE ": --unpack of the two forms)\n"
     "  --lifeline     end when standard input (a pipe) reaches its end\n"
     "  --sums         append each pixel's sample sums to the PF image, so that a\n"
     "                 later render can add samples exactly (path integrator, no\n"
@@ -118,7 +118,7 @@ int main(int argc, char **argv)
         return 0;
     }
     if (req.mode == PROTO_FEATURES) {
-        printf("%s\n", unpack_available() ? PROTO_FEATURE_UNPACK : "");
+        printf("%s\n", unpack_available() ? PROTO_FEATURE_UNPACK " " UNPACK_FEATURE : "");
         return 0;
     }
     if (req.mode == PROTO_UNPACK) {

@@ -3,142 +3,15 @@
 #include "compile/texstore.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmath.h"
+#include "mip.h"
 #include "texture.h"
 
 /* The most words of texels a scene may hold (8 GiB): the builder's arrays
  * stop below 2^31 elements. */
 #define MAX_WORDS (1u << 31)
-
-/* Binary16 bits nearest to v (round to nearest even; infinity past the
- * largest half, NaN kept a NaN). */
-static uint16_t half_bits(double v)
-{
-    uint16_t sign = signbit(v) ? 0x8000u : 0;
-    double a = fabs(v);
-    if (isnan(v))
-        return 0x7e00u;
-    if (a >= 65520.0)                       /* halfway to 2^16 and beyond */
-        return sign | 0x7c00u;
-    if (a < 0x1p-14) {                      /* subnormal: multiples of 2^-24 */
-        double q = nearbyint(a * 0x1p24);   /* exact scaling; ties to even */
-        return sign | (uint16_t)q;          /* q = 1024 is the smallest normal */
-    }
-    int e;
-    frexp(a, &e);                           /* a = f 2^e, f in [0.5, 1) */
-    double q = nearbyint(ldexp(a, 11 - e)); /* 11 significant bits: [1024, 2048] */
-    if (q == 2048.0) {
-        q = 1024.0;
-        e++;
-    }
-    if (e - 1 > 15)
-        return sign | 0x7c00u;
-    return sign | (uint16_t)((uint32_t)(e - 1 + 15) << 10 | ((uint32_t)q - 1024u));
-}
-
-/* The linear value of sRGB code k of `maxcode` + 1 codes, as lookups decode it. */
-static double srgb_decoded(uint32_t k, uint32_t maxcode)
-{
-    return tex_srgb_to_linear((float)k / (float)maxcode);
-}
-
-/* The sRGB code nearest (in decoded value) to linear v; ties to the lower. */
-static uint32_t srgb_nearest(double v, uint32_t maxcode)
-{
-    if (!(v > 0.0))
-        return 0;
-    if (v >= 1.0)
-        return maxcode;
-    float fv = (float)v;
-    float e = fv <= 0.0031308f ? 12.92f * fv : 1.055f * fm_powf(fv, 1.0f / 2.4f) - 0.055f;
-    double g = nearbyint((double)e * maxcode);
-    long c0 = (long)g - 2, best = -1;
-    double bd = 0.0;
-    for (long c = c0 < 0 ? 0 : c0; c <= (long)g + 2 && c <= (long)maxcode; c++) {
-        double d = fabs(srgb_decoded((uint32_t)c, maxcode) - v);
-        if (best < 0 || d < bd) {
-            best = c;
-            bd = d;
-        }
-    }
-    return (uint32_t)best;
-}
-
-/* Midpoints between the decoded values of consecutive 8-bit sRGB codes:
- * the nearest code to v is the number of midpoints below v (a tie, v on a
- * midpoint, goes to the lower code). */
-static double srgb8_mid[255];
-static pthread_once_t srgb8_once = PTHREAD_ONCE_INIT;
-
-static void srgb8_init(void)
-{
-    for (uint32_t k = 0; k < 255; k++)
-        srgb8_mid[k] = 0.5 * (srgb_decoded(k, 255) + srgb_decoded(k + 1, 255));
-}
-
-static uint32_t srgb8_nearest(double v)
-{
-    pthread_once(&srgb8_once, srgb8_init);
-    uint32_t lo = 0, hi = 255;          /* the answer is in [lo, hi] */
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;   /* is srgb8_mid[mid] (between mid and mid + 1) below v? */
-        if (srgb8_mid[mid] < v)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
-uint32_t texstore_encode(uint32_t format, double v)
-{
-    switch (format) {
-    case FR_TEXEL_U8_SRGB:
-        return v != v ? 0 : srgb8_nearest(v);
-    case FR_TEXEL_U16_SRGB:
-        return srgb_nearest(v, 65535);
-    case FR_TEXEL_U8:
-    case FR_TEXEL_U16: {
-        double m = format == FR_TEXEL_U8 ? 255.0 : 65535.0;
-        return !(v > 0.0) ? 0 : v >= 1.0 ? (uint32_t)m : (uint32_t)floor(v * m + 0.5);
-    }
-    case FR_TEXEL_F16:
-        return half_bits(v);
-    default: {
-        float f = (float)v;
-        uint32_t b;
-        memcpy(&b, &f, sizeof b);
-        return b;
-    }
-    }
-}
-
-/* Store value `code` (of `bytes` bytes) as value i of a level's bytes. */
-static void put(unsigned char *p, size_t i, uint32_t bytes, uint32_t code)
-{
-    if (bytes == 1) {
-        p[i] = (unsigned char)code;
-    } else if (bytes == 2) {
-        uint16_t h = (uint16_t)code;
-        memcpy(p + 2 * i, &h, 2);
-    } else {
-        memcpy(p + 4 * i, &code, 4);
-    }
-}
-
-/* The raw integer of value i of a level (8- or 16-bit formats). */
-static uint32_t get_int(const unsigned char *p, size_t i, uint32_t bytes)
-{
-    if (bytes == 1)
-        return p[i];
-    uint16_t h;
-    memcpy(&h, p + 2 * i, 2);
-    return h;
-}
 
 /* Decoded value of channel c of pixel i of the hook's image (before any
  * sRGB decoding), as a double. */
@@ -150,42 +23,6 @@ static double image_value(const scene_image *img, size_t i, uint32_t c)
     case SCENE_PIX_U16: return ((const uint16_t *)img->data)[k] / 65535.0;
     case SCENE_PIX_F16: return tex_half_to_float(((const uint16_t *)img->data)[k]);
     default: return img->pixels[k];
-    }
-}
-
-/* Level k (>= 1) from level k - 1, as texstore.h says. */
-static void build_level(const uint32_t *texels, const fr_texture *t, uint32_t k, unsigned char *out)
-{
-    uint32_t w, h, pw, ph, n = t->channels, bytes = tex_format_bytes(t->format);
-    tex_level_size(t, k, &w, &h);
-    tex_level_size(t, k - 1, &pw, &ph);
-    int integer = t->format == FR_TEXEL_U8 || t->format == FR_TEXEL_U16;
-    const unsigned char *prev = (const unsigned char *)(texels + t->first[k - 1]);
-    for (uint32_t y = 0; y < h; y++) {
-        uint32_t y0 = ph == 1 ? 0 : 2 * y, y1 = ph == 1 ? 1 : y + 1 == h ? ph : 2 * y + 2;
-        for (uint32_t x = 0; x < w; x++) {
-            uint32_t x0 = pw == 1 ? 0 : 2 * x, x1 = pw == 1 ? 1 : x + 1 == w ? pw : 2 * x + 2;
-            uint32_t count = (y1 - y0) * (x1 - x0);
-            double sum[3] = {0, 0, 0};
-            uint64_t isum[3] = {0, 0, 0};
-            for (uint32_t yy = y0; yy < y1; yy++)
-                for (uint32_t xx = x0; xx < x1; xx++) {
-                    if (integer) {
-                        for (uint32_t c = 0; c < n; c++)
-                            isum[c] += get_int(prev, ((size_t)yy * pw + xx) * n + c, bytes);
-                    } else {
-                        float v[3];
-                        tex_texel(texels, t, k - 1, xx, yy, v);
-                        for (uint32_t c = 0; c < n; c++)
-                            sum[c] += v[c];
-                    }
-                }
-            for (uint32_t c = 0; c < n; c++) {
-                uint32_t code = integer ? (uint32_t)((2 * isum[c] + count) / (2 * (uint64_t)count))
-                                        : texstore_encode(t->format, sum[c] / count);
-                put(out, ((size_t)y * w + x) * n + c, bytes, code);
-            }
-        }
     }
 }
 
@@ -341,11 +178,15 @@ int texstore_image(fr_builder *b, const scene_image *img, int from_srgb, fr_text
                 double v = image_value(img, i, c);
                 if (from_srgb)
                     v = tex_srgb_to_linear((float)v);
-                code = texstore_encode(tex->format, v);
+                code = mip_encode(tex->format, v);
             }
-            put(l0, dst, bytes, code);
+            mip_put(l0, dst, bytes, code);
         }
     for (uint32_t k = 1; k < tex->levels; k++)
-        build_level(texels, tex, k, (unsigned char *)(texels + tex->first[k]));
+    {
+        uint32_t w, h;
+        tex_level_size(tex, k, &w, &h);
+        mip_level(texels, tex, k, 0, h, (unsigned char *)(texels + tex->first[k]));
+    }
     return 0;
 }

@@ -12,13 +12,8 @@
  * decoded and stored as floats.  Three or
  * four channels keep three (RGB; alpha is not used), one or two keep one.
  *
- * Mip levels: level k (max(1, w >> k) x max(1, h >> k)) down to 1 x 1;
- * its texel (x, y) averages the texels 2x..2x+1 by 2y..2y+1 of level
- * k - 1, the last column (row) also the odd one left over, so every texel
- * of level k - 1 counts once.  The mean is taken of the linear values and
- * stored as texstore_encode rounds it, except for linear 8- and 16-bit
- * integers, whose mean is that of the integers rounded half up (the same
- * value, as they are proportional to the linear ones).
+ * Mip levels: mip.h builds them (level k down to 1 x 1, each the box
+ * filter of the one above, rounded by mip_encode).
  */
 #ifndef FRANJA_TEXSTORE_H
 #define FRANJA_TEXSTORE_H
@@ -52,13 +47,5 @@ typedef struct {
 
 /** Set *t up for builder b and from_srgb (as texstore_image's). */
 void texstore_target_init(texstore_target *t, fr_builder *b, int from_srgb);
-
-/** The stored value (the bits of a byte, 16-bit integer, half or float)
- * of texel format `format` nearest to linear value v: for the sRGB
- * formats the code whose decoded value is nearest (ties to the lower
- * code), for the linear integers round(v x 255) or round(v x 65535)
- * clamped to their range, for half and float IEEE rounding to nearest
- * even (half: infinity past 65519.99). */
-uint32_t texstore_encode(uint32_t format, double v);
 
 #endif

@@ -13,6 +13,7 @@
 
 #include "fbin.h"
 #include "transport/pack.h"
+#include "unpack.h"
 
 /* The exit status of the cache check when there is no cached copy (the
  * worker's own statuses are 0, 1 and 2). */
@@ -113,8 +114,8 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err)
 
 /* 1 when the cached copy at path checks out, 0 when there is none, 2 when
  * it is damaged (or unreadable for this worker), -1 on error.  When there
- * is none, *unpack says whether the worker can unpack a compressed scene
- * (else it is 0). */
+ * is none, *unpack says in which form the worker can unpack a compressed
+ * scene (PACK_PARTS, PACK_ZSTD; else it is 0). */
 static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash, int *unpack, fr_error *err)
 {
     *unpack = 0;
@@ -136,7 +137,9 @@ static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash
         rc = failed(h, p, "scene check", err);
     else if (tr_proc_status(p) == ABSENT) {
         rc = 0;
-        *unpack = proto_has_feature(out, len, PROTO_FEATURE_UNPACK);
+        *unpack = proto_has_feature(out, len, UNPACK_FEATURE)         ? PACK_PARTS
+                  : proto_has_feature(out, len, PROTO_FEATURE_UNPACK) ? PACK_ZSTD
+                                                                      : 0;
     }
     else
         rc = tr_proc_status(p) == 0 && proto_parse_check(out, len, &got, &e) == 0 && got == hash ? 1 : 2;
@@ -159,17 +162,17 @@ static int lease_name(const char *remote, char *lease, size_t cap)
                     ts.tv_nsec / 1000000) >= (int)cap;
 }
 
-/* Sends the scene compressed (pack.h) under a name of its own beside
+/* Sends the scene compressed (pack.h, in form `form`) under a name of its own beside
  * `remote` and has the host's worker unpack it into `remote` (unpack.h),
  * adding the bytes sent to *sent.  0 when the unpacked scene has the
  * expected hash; 1 when the unpacking failed (a damaged transfer: worth
  * sending again); -1 on error (the upload failed). */
-static int send_packed(tr_host *h, const char *local_path, uint64_t hash, const char *remote, uint64_t *sent,
-                       fr_error *err)
+static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int form, const char *remote,
+                       uint64_t *sent, fr_error *err)
 {
     char packed[4200], name[1400];
     uint64_t size;
-    if (pack_acquire(local_path, hash, packed, sizeof packed, &size, err))
+    if (pack_acquire(local_path, hash, form, packed, sizeof packed, &size, err))
         return -1;
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
@@ -180,7 +183,7 @@ static int send_packed(tr_host *h, const char *local_path, uint64_t hash, const 
             *c = '_';
     snprintf(name, sizeof name, "%s.zst-%s-%ld-%ld", remote, host, (long)getpid(), (long)ts.tv_nsec);
     int rc = tr_upload(h, packed, name, 0600, err);
-    pack_release(hash);
+    pack_release(hash, form);
     if (rc)
         return -1;
     *sent += size;
@@ -251,7 +254,7 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
      * the scene is sent again, then sent as it is. */
     int packed = -1;
     for (int i = 0; i < PACKED_TRIES && tr_host_link_upload(h) && unpack && packed != 0; i++)
-        if ((packed = send_packed(h, local_path, hash, remote, sent, err)) < 0)
+        if ((packed = send_packed(h, local_path, hash, unpack, remote, sent, err)) < 0)
             return -1;
     if (packed != 0) {
         if (packed == 1)

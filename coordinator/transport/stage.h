@@ -35,7 +35,8 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
  *
  * Over a network link (tr_host_link_upload) to a worker that can unpack
  * (`--features`, asked in the round trip that finds no cached copy), the
- * scene travels compressed (pack.h) under a name of its own and the
+ * scene travels compressed (pack.h: a packed scene, or one zstd frame to
+ * a worker that only unpacks those) under a name of its own and the
  * worker unpacks it into the cache, checking its hash before it takes the
  * cache's name; a transfer that does not unpack (damaged on the way) is
  * noted and sent again, and after two such it is sent uncompressed.

@@ -13,7 +13,8 @@
 #   - bytes sent per host (the render summary's `sent`) to HOSTS fake SSH
 #     hosts (tests/support/fakehosts.sh; default 2) of WORKERS slots each
 #     (default 2), and the render's time, first (scene sent) and second
-#     (scene cached);
+#     (scene cached); the time to pack the scene and to unpack it, in
+#     both forms (bin/bench/packbench);
 #   - worker start-up: `franja-worker --check` and a one-row render
 #     (medians of REPS, default 3; page cache warm);
 #   - memory: the coordinator's peak RSS, and a host's workers sampled from
@@ -42,7 +43,8 @@ REPS=${REPS:-3}
 FLAT_MAX=${FLAT_MAX:-1000000}
 [ -x /usr/bin/time ] || { echo "production.sh needs GNU time (/usr/bin/time)"; exit 1; }
 command -v oiiotool >/dev/null || { echo "production.sh needs oiiotool"; exit 1; }
-make -s bin/franja bin/franja-worker bin/gen/genmesh bin/gen/gentex bin/tools/imgstat bin/tools/imgcmp >/dev/null || exit 1
+make -s bin/franja bin/franja-worker bin/gen/genmesh bin/gen/gentex bin/tools/imgstat bin/tools/imgcmp bin/bench/packbench >/dev/null ||
+    exit 1
 . tests/support/fakehosts.sh
 fh_init
 D=$FH/scene
@@ -265,6 +267,10 @@ while [ $k -le "$HOSTS" ]; do
          "| goal: <= half the .fbin for a textured scene: $(verdict "$(calc "$b <= $F / 2" 0)")"
     k=$((k + 1))
 done
+
+# Packing alone (what the first host waits for) and unpacking on a host.
+echo "-- packing at PACK_LEVEL (bin/bench/packbench, medians of $REPS; unpacked scene checked byte for byte)"
+bin/bench/packbench "$D/prod.fbin" "$REPS" || exit 1
 
 # ---- memory ------------------------------------------------------------
 ROWS=$(sed -n 's/.*[^0-9]\([0-9][0-9]*\) slabs.*/\1/p' "$FH/r1" | head -n 1)

@@ -27,6 +27,7 @@
 #            SLURM_JOB_CPUS_PER_NODE
 #   jobdir   a job directory on --resume and `franja stitch` (job file,
 #            slab files, stitching, continuing from kept sums)
+#   unpack   a packed scene or zstd frame a worker unpacks (--unpack)
 #
 # Seeds: tests/fuzz/corpus/TARGET, written by hand (inputs of remote and
 # args start with a byte that picks the reader; see each target's
@@ -34,7 +35,8 @@
 # of the current formats: binary scenes compiled from the example scenes
 # without meshes and from tests/fuzz/corpus/fbin/*.json; partial images
 # that franja-worker writes (path-traced with sums, bidirectional with
-# splats, without sums, 8- and 16-bit P6); job directories that franja
+# splats, without sums, 8- and 16-bit P6); the binary scene seeds packed
+# (bin/bench/packbench), as sent and with their frame open; job directories that franja
 # render --keep-job leaves (path and bidirectional, and one whose slabs
 # have fewer samples than its job file asks for, to be continued).  The
 # fuzzer reads at most MAX_LEN bytes of an input: example scenes that
@@ -44,11 +46,11 @@
 cd "$(dirname "$0")/../.." || exit 1
 SECS=${1:-60}
 [ $# -gt 0 ] && shift
-TARGETS=${*:-fbin json obj gltf ply hosts partial remote args jobdir}
+TARGETS=${*:-fbin json obj gltf ply hosts partial remote args jobdir unpack}
 W=build/fuzz/run
 MAX_LEN=65536
 rm -rf "$W"
-mkdir -p "$W/seed-fbin" "$W/seed-partial" "$W/seed-jobdir" "$W/render"
+mkdir -p "$W/seed-fbin" "$W/seed-partial" "$W/seed-jobdir" "$W/seed-unpack" "$W/render"
 
 fail_seed() { echo "fuzz: cannot make seeds: $*"; echo "0 passed, 1 failed"; exit 1; }
 
@@ -99,6 +101,19 @@ render "$R/one" --size 4x3 --spp 1
 jobseed "$W/seed-jobdir/path" "$R/path"
 jobseed "$W/seed-jobdir/bdpt" "$R/bdpt"
 jobseed "$W/seed-jobdir/continue" "$R/one" "$R/path/job"
+# Packed scenes (fuzz_unpack.c): a first byte 0, then the file as sent; 1,
+# then its header and its frame's content.
+for f in "$W"/seed-fbin/*.fbin; do
+    b="$W/seed-unpack/$(basename "$f" .fbin)"
+    bin/bench/packbench "$f" -o "$b.pk" && bin/bench/packbench "$f" -O "$b.open" ||
+        fail_seed "bin/bench/packbench $f"
+    for m in 0:pk 1:open; do
+        { printf "\\00${m%%:*}"; cat "$b.${m#*:}"; } >"$b.${m%%:*}"
+        rm -f "$b.${m#*:}"
+        [ "$(wc -c <"$b.${m%%:*}")" -le "$MAX_LEN" ] || rm -f "$b.${m%%:*}"
+    done
+done
+[ -n "$(ls "$W/seed-unpack")" ] || fail_seed "no packed scene under $MAX_LEN bytes"
 for f in "$P"/* "$W"/seed-jobdir/*; do
     [ "$(wc -c <"$f")" -le "$MAX_LEN" ] || fail_seed "$f is larger than $MAX_LEN bytes"
 done
