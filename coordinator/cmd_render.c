@@ -50,6 +50,9 @@ static const char usage[] =
     "                       animation: # in SCENE, -o, --job and --preview stands\n"
     "                       for the zero-padded frame number (f.####.json)\n"
     "  --overwrite          with --frames: render frames whose output exists\n"
+    "  --fps F              with --frames of one glTF file (no # in SCENE): frames\n"
+    "                       per second; frame N is posed at time N / F seconds,\n"
+    "                       as Blender's glTF exporter writes key times (default 24)\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
@@ -108,7 +111,7 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_FPS, OPT_TIME_LIMIT,
     OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH, OPT_LIMIT
 };
 
@@ -147,6 +150,7 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"reproducible", no_argument, NULL, OPT_REPRODUCIBLE},
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
+        {"fps", required_argument, NULL, OPT_FPS},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
         {"limit", required_argument, NULL, OPT_LIMIT},
         {NULL, 0, NULL, 0},
@@ -282,6 +286,12 @@ static int parse(int argc, char **argv, frame_settings *a)
         case OPT_OVERWRITE:
             a->overwrite = 1;
             break;
+        case OPT_FPS: {
+            float f = 0;
+            bad = opt_float(cmd, "--fps", v, 0.001f, 1000.0f, &f);
+            a->fps = f;
+            break;
+        }
         case OPT_TIME_LIMIT:
             bad = opt_duration(cmd, "--time-limit", v, &a->time_limit);
             break;
@@ -340,6 +350,10 @@ static int parse(int argc, char **argv, frame_settings *a)
     }
     if (a->overwrite && !a->frames) {
         fprintf(stderr, "franja render: --overwrite is for --frames (a single render always writes its output)\n");
+        return 2;
+    }
+    if (a->fps > 0 && (!a->frames || !compile_is_gltf(a->scene))) {
+        fprintf(stderr, "franja render: --fps is for --frames of one glTF file (its animation posed per frame)\n");
         return 2;
     }
     if (a->resume && a->fresh) {

@@ -54,6 +54,9 @@ typedef struct {
     int resume, keep_job, fresh, no_lock;
     const char *frames;        /* --frames LIST, or NULL */
     int overwrite;             /* --overwrite */
+    double fps;                /* --fps, 0 when not given (GANIM_FPS) */
+    int timed;                 /* an animation's frame of one scene file: posed at `frame` (set per frame) */
+    uint32_t frame;            /* the frame number, when timed */
     int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
     fr_budget limits;          /* --limit: the compile's (budget.h) */

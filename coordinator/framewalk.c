@@ -96,7 +96,7 @@ int framewalk_begin(framewalk_iter *it, int argc, char **argv, const framewalk_j
         return 2;
     }
     const char *what = NULL, *name = NULL;
-    if (!framelist_is_pattern(job->scene))
+    if (!framelist_is_pattern(job->scene) && !job->one_scene)
         what = "the scene", name = job->scene;
     else if (!framelist_is_pattern(job->out))
         what = "the output (-o, else named after the scene)", name = job->out;
@@ -104,7 +104,8 @@ int framewalk_begin(framewalk_iter *it, int argc, char **argv, const framewalk_j
         what = "--job", name = job->jobdir;
     if (what) {
         fprintf(stderr, "franja render: --frames: %s '%s' has no # for the frame number (e.g. "
-                "shots/f.####.json -o out/f.####.exr: each frame its own file)\n", what, name);
+                "shots/f.####.json -o out/f.####.exr: each frame its own file; an animated\n"
+                "glTF file is one scene for every frame)\n", what, name);
         framelist_free(&it->fl);
         return 2;
     }

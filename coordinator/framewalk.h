@@ -25,6 +25,7 @@ typedef struct {
     const char *list;       /**< the --frames value */
     int overwrite;          /**< --overwrite: render frames whose output exists */
     const char *scene, *out, *jobdir, *preview;
+    int one_scene;          /**< the scene is one animated file, posed per frame: it needs no # */
 } framewalk_job;
 
 /** The exit status of an animation that --time-limit stopped before

@@ -14,7 +14,7 @@ static const char usage[] =
     "                     [--noise-threshold E]\n"
     "                     [--exposure E] [--tonemap none|filmic] [--exr-half]\n"
     "                     [--exr-compression C] [--jpeg-quality Q] [--reproducible]\n"
-    "                     [--frames LIST [--overwrite]] [--time-limit T]\n"
+    "                     [--frames LIST [--overwrite] [--fps F]] [--time-limit T]\n"
     "                     [--limit NAME=VALUE]...\n"
     "                     [--resume | --fresh]\n"
     "                     [--job DIR] [--keep-job] [--no-lock] [--slab-rows N]\n"

@@ -11,6 +11,7 @@
 #include "compile/builder_instance.h"
 #include "compile/builder_light.h"
 #include "compile/freeze.h"
+#include "compile/gltf_anim.h"
 #include "compile/gltf_doc.h"
 #include "compile/gltf_mat.h"
 
@@ -81,6 +82,7 @@ typedef struct {
     int counting;              /* the first pass over the nodes: only count the uses of each mesh */
     uint32_t *uses;            /* per glTF mesh: nodes that draw it */
     uint32_t *mesh_of;         /* per glTF mesh drawn more than once: its builder mesh, or FR_NONE */
+    ganim_pose pose;           /* the animated nodes (o->animate), else empty */
 } imp;
 
 /* ---- nodes ------------------------------------------------------------ */
@@ -99,6 +101,18 @@ static int local_transform(imp *c, uint32_t n, affine *out, fr_error *err)
         gdoc_numbers(d, o, ptr, "scale", 3, s, &has_s, err) < 0)
         return -1;
     af_identity(out);
+    const ganim_node *an = n < c->pose.n ? &c->pose.node[n] : NULL;
+    if (an && an->set) {
+        if (has_m)
+            return gdoc_fail(d, err, ptr, "matrix: a node animated by /animations/%u/channels/%u must give "
+                             "translation/rotation/scale instead", an->anim, an->channel);
+        if (an->set & GANIM_T)
+            memcpy(t, an->t, sizeof t);
+        if (an->set & GANIM_R)
+            memcpy(q, an->r, sizeof q), has_r = 1;
+        if (an->set & GANIM_S)
+            memcpy(s, an->s, sizeof s);
+    }
     if (has_m) {
         if (has_t || has_r || has_s)
             return gdoc_fail(d, err, ptr, "both matrix and translation/rotation/scale");
@@ -705,15 +719,24 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
                       fr_error *err)
 {
     memset(r, 0, sizeof *r);
-    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0, NULL, NULL};
+    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0, NULL, NULL, {0}};
     gdoc_warn_extensions(d, known_extensions);
-    const cJSON *an = cJSON_GetObjectItemCaseSensitive(d->root, "animations");
-    if (cJSON_GetArraySize(an) > 0)
-        gdoc_warn(d, "animations", "/animations: animations are not supported: the scene is drawn at rest");
-    if (gmat_begin(&c.mat, d, hooks, b, err) < 0)
+    if (o->animate) {
+        if (ganim_eval(d, o->time, &c.pose, err) < 0) {
+            ganim_free(&c.pose);
+            return -1;
+        }
+    } else if (ganim_present(d)) {
+        gdoc_warn(d, "animations", "/animations: not played: the scene is drawn at rest (render with --frames to "
+                  "pose it per frame)");
+    }
+    if (gmat_begin(&c.mat, d, hooks, b, err) < 0) {
+        ganim_free(&c.pose);
         return -1;
+    }
     int rc = traverse(&c, err);
     gmat_end(&c.mat);
+    ganim_free(&c.pose);
     if (rc == 0 && o->take_camera && o->camera && c.cam_node < 0) {
         char names[256];
         camera_names(d, names, sizeof names);
@@ -796,6 +819,8 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scen
     gltf_options_default(&o);
     o.camera = camera;
     o.max_triangles = max_triangles;
+    o.animate = hooks && hooks->timed;
+    o.time = hooks ? hooks->time : 0.0;
     int rc = bytes ? gltf_import_mem(bytes, len, path, hooks, &o, b, &r, err) : gltf_import(path, hooks, &o, b, &r, err);
     if (rc < 0)
         return -1;

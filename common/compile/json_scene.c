@@ -105,7 +105,8 @@ static int camera(ctx *c, const cJSON *root)
     if (cam)
         return parse_camera(c, cam);
     c->gltf_camera = 1;
-    return json_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->scope, c->err);
+    return json_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->scope, c->hooks,
+                            c->err);
 }
 
 #define TYPES "lambert, phong, mirror, glass, mix, conductor, principled, emitter or interface"

@@ -80,6 +80,11 @@ typedef struct {
      * frz_scene_file: the builder freed before the file is mapped back),
      * or NULL: it is made in memory (frz_scene). */
     const char *fbin;
+    /** When timed: the time, in seconds, at which animated scenes are
+     * posed (glTF animations: gltf_anim.h); otherwise they are read at
+     * rest. */
+    int timed;
+    double time;
 } scene_hooks;
 
 #endif

@@ -31,6 +31,8 @@ typedef struct {
     const fr_budget *limits;
     const char *fbin;          /**< where the binary scene is written as it is made (scene_hooks.h); NULL:
                                     in memory only */
+    int timed;                 /**< pose animated scenes at `time` (scene_hooks.h); 0: at rest */
+    double time;               /**< seconds, when timed */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */
