@@ -53,6 +53,9 @@ static const char usage[] =
     "  --fps F              with --frames of one glTF file (no # in SCENE): frames\n"
     "                       per second; frame N is posed at time N / F seconds,\n"
     "                       as Blender's glTF exporter writes key times (default 24)\n"
+    "  --shutter S          with --frames of one glTF file: motion blur over a shutter\n"
+    "                       open S of a frame (0 to 1), centred on the frame's time\n"
+    "                       as Blender's default; the camera's motion is blurred\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
@@ -111,7 +114,7 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_FPS, OPT_TIME_LIMIT,
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_FPS, OPT_SHUTTER, OPT_TIME_LIMIT,
     OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH, OPT_LIMIT
 };
 
@@ -151,6 +154,7 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
         {"fps", required_argument, NULL, OPT_FPS},
+        {"shutter", required_argument, NULL, OPT_SHUTTER},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
         {"limit", required_argument, NULL, OPT_LIMIT},
         {NULL, 0, NULL, 0},
@@ -292,6 +296,12 @@ static int parse(int argc, char **argv, frame_settings *a)
             a->fps = f;
             break;
         }
+        case OPT_SHUTTER: {
+            float f = 0;
+            bad = opt_float(cmd, "--shutter", v, 0.0f, 1.0f, &f);
+            a->shutter = f;
+            break;
+        }
         case OPT_TIME_LIMIT:
             bad = opt_duration(cmd, "--time-limit", v, &a->time_limit);
             break;
@@ -352,8 +362,9 @@ static int parse(int argc, char **argv, frame_settings *a)
         fprintf(stderr, "franja render: --overwrite is for --frames (a single render always writes its output)\n");
         return 2;
     }
-    if (a->fps > 0 && (!a->frames || !compile_is_gltf(a->scene))) {
-        fprintf(stderr, "franja render: --fps is for --frames of one glTF file (its animation posed per frame)\n");
+    if ((a->fps > 0 || a->shutter > 0) && (!a->frames || !compile_is_gltf(a->scene) || framelist_is_pattern(a->scene))) {
+        fprintf(stderr, "franja render: --%s is for --frames of one glTF file (its animation posed per frame)\n",
+                a->fps > 0 ? "fps" : "shutter");
         return 2;
     }
     if (a->resume && a->fresh) {

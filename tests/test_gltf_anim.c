@@ -14,6 +14,7 @@
 #include "check.h"
 #include "compile/gltf_anim.h"
 #include "compile/gltf_scene.h"
+#include "warnings.h"
 
 #define T(c) CHECK(c, "%s", #c)
 
@@ -258,22 +259,14 @@ static void test_refused(void)
     ganim_free(&p);
 }
 
-/* Through the scene reader: an animated node with a matrix is refused; a
- * second channel on the same property is warned about, the first used. */
-static int n_warnings;
-static char last_warning[800];
-static void on_warn(void *user, const char *msg)
-{
-    (void)user;
-    n_warnings++;
-    snprintf(last_warning, sizeof last_warning, "%s", msg);
-}
 
 #define SCENES ",\"scenes\":[{\"nodes\":[1,2]}]"
 
+/* Through the scene reader: an animated node with a matrix is refused; a
+ * second channel on the same property is warned about, the first used. */
 static void test_scene(void)
 {
-    static const scene_hooks hooks = {.warn = on_warn};
+    const scene_hooks hooks = warn_hooks;
     gltf_options o;
     gltf_options_default(&o);
     o.take_camera = 0;

@@ -506,7 +506,7 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
         gdoc_warn(d, "skin", "%s/skin: skinning is not supported: the mesh is drawn in its bind pose", ptr);
     if (cJSON_GetObjectItemCaseSensitive(o, "weights"))
         gdoc_warn(d, "morph", "%s/weights: morph targets are not supported: the base mesh is drawn", ptr);
-    if ((m != UINT32_MAX && mesh(c, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
+    if ((m != UINT32_MAX && !c->o->camera_only && mesh(c, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
         (lp && light(c, n, lp, w, err) < 0))
         return -1;
     return 0;
@@ -811,6 +811,42 @@ static int frame_bounds(fr_builder *b, vec3 lo, vec3 hi, fr_error *err)
     return bld_camera_finish(cm, err);
 }
 
+/* The camera of options o (take_camera) posed at time t into *cam. */
+static int camera_at(const char *path, const void *bytes, size_t len, const gltf_options *o, double t,
+                     fr_camera *cam, fr_error *err)
+{
+    gltf_options oc = *o;
+    oc.camera_only = 1;
+    oc.take_lights = 0;
+    oc.time = t;
+    fr_builder tmp;
+    gltf_result r;
+    bld_init(&tmp);
+    int rc = bytes ? gltf_import_mem(bytes, len, path, NULL, &oc, &tmp, &r, err)
+                   : gltf_import(path, NULL, &oc, &tmp, &r, err);
+    *cam = tmp.camera;
+    bld_free(&tmp);
+    return rc;
+}
+
+/* With a shutter: the camera at shutter open (b->camera) and close
+ * (b->motion), when they differ. */
+static int camera_motion(const char *path, const void *bytes, size_t len, const scene_hooks *hooks,
+                         const gltf_options *o, fr_builder *b, fr_error *err)
+{
+    fr_camera open, close;
+    double t = hooks->time, h = 0.5 * hooks->shutter;
+    if (camera_at(path, bytes, len, o, t - h, &open, err) < 0 || camera_at(path, bytes, len, o, t + h, &close, err) < 0)
+        return -1;
+    b->motion.shutter = (float)hooks->shutter;
+    if (!memcmp(&open, &close, sizeof open))
+        return 0;
+    b->camera = open;
+    b->motion.camera_close = close;
+    b->motion.flags |= FR_MOTION_CAMERA;
+    return 0;
+}
+
 int gltf_build_scene(const char *path, const void *bytes, size_t len, const scene_hooks *hooks, const char *camera,
                      uint32_t max_triangles, fr_builder *b, fr_error *err)
 {
@@ -843,6 +879,8 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scen
         lo = v3_vmin(lo, p[i]);
         hi = v3_vmax(hi, p[i]);
     }
+    if (r.camera_found && o.animate && hooks->shutter > 0.0 && camera_motion(path, bytes, len, hooks, &o, b, err) < 0)
+        return -1;
     if (!r.camera_found) {
         warn(hooks, path, "no perspective camera in the scene: one frames it from +Z");
         fr_error e;

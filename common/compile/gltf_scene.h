@@ -38,6 +38,7 @@ typedef struct {
     int animate;               /**< pose the nodes by the file's animations at `time` (gltf_anim.h); 0:
                                     the nodes' own transforms (a warning says animations are not played) */
     double time;               /**< seconds, when animate */
+    int camera_only;           /**< take the camera alone: no meshes (nor, with take_lights 0, lights) */
 } gltf_options;
 
 /** Options for a file rendered alone: its first camera, its lights, no
@@ -63,7 +64,9 @@ int gltf_import_mem(const void *bytes, size_t len, const char *name, const scene
                     fr_builder *b, gltf_result *r, fr_error *err);
 
 /** A glTF file as a whole scene, posed at hooks->time when hooks->timed
- * (scene_hooks.h): default image settings (640 pixels wide,
+ * (scene_hooks.h), its camera moving across hooks->shutter (seconds,
+ * centred on that time: the camera posed at shutter open and close,
+ * scene.h's fr_motion, when the two poses differ): default image settings (640 pixels wide,
  * the height from the camera's aspect ratio, else 480; 64 samples, 8
  * bounces), the file's camera `camera` (or its first; with none, one
  * framing the scene's bounds from +Z, with a warning) and its lights (with

@@ -85,6 +85,10 @@ typedef struct {
      * rest. */
     int timed;
     double time;
+    /** When timed: how long, in seconds, the shutter is open, centred on
+     * `time` (0: no motion blur).  What moves across it is blurred
+     * (scene.h's fr_motion). */
+    double shutter;
 } scene_hooks;
 
 #endif

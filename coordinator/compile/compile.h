@@ -33,6 +33,7 @@ typedef struct {
                                     in memory only */
     int timed;                 /**< pose animated scenes at `time` (scene_hooks.h); 0: at rest */
     double time;               /**< seconds, when timed */
+    double shutter;            /**< seconds the shutter is open around `time` (motion blur); 0: none */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */

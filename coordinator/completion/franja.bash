@@ -60,7 +60,7 @@ _franja()
         COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     --worker) _franja_files "$cur" ""; return 0 ;;
     -j | --spp | --size | --scale | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
-        --monitor | --crop | --jpeg-quality | --noise-threshold | --frames | --fps | --time-limit)
+        --monitor | --crop | --jpeg-quality | --noise-threshold | --frames | --fps | --shutter | --time-limit)
         return 0 ;;
     esac
     if [[ $cur == -* ]]; then

@@ -7,7 +7,12 @@
 # time f / 24 in single precision, as Blender's exporter writes them), a
 # point light and the camera on animated nodes too.  DIR/pose0.gltf ..
 # pose3.gltf: the same scene without animations, each node at frame k's
-# key values.  DIR/bad_*.gltf: malformed animation data.
+# key values.  DIR/bad_*.gltf: malformed animation data.  DIR/blur.gltf: a
+# camera moving along +x at 96 units a second (keys at times 0 and 1)
+# before an emissive quad 3 units wide at distance 4 centred on x = 48, with
+# tan(yfov / 2) = 1/2 and aspectRatio 4: at 16 pixels high, 4 pixels a unit,
+# so frame 12 (time 1/2) shows the quad 12 pixels wide centred in the image,
+# and a shutter of half a frame (1/48 s) smears it over 8 pixels.
 import base64
 import json
 import math
@@ -155,3 +160,27 @@ write("bad_weights.gltf", d)
 d = doc(None)
 d["animations"][0]["samplers"][0]["input"] = a_badtime
 write("bad_times.gltf", d)
+
+# The motion blur scene (its own buffer).
+blob, views, accs = bytearray(), [], []
+q_pos = add([[46.5, -5, -4], [49.5, -5, -4], [49.5, 5, -4], [46.5, 5, -4]], 3)
+q_idx = add([0, 1, 2, 0, 2, 3], 1, 5125)
+b_time = add([0.0, 1.0], 1)
+b_cam = add([[0.0, 0.0, 0.0], [96.0, 0.0, 0.0]], 3)
+write("blur.gltf", {
+    "asset": {"version": "2.0"},
+    "scene": 0,
+    "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"name": "quad", "mesh": 0}, {"name": "cam", "camera": 0}],
+    "cameras": [{"type": "perspective",
+                 "perspective": {"yfov": 2 * math.atan(0.5), "aspectRatio": 4.0, "znear": 0.1}}],
+    "materials": [{"emissiveFactor": [1, 1, 1],
+                   "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": q_pos}, "indices": q_idx, "material": 0}]}],
+    "animations": [{"samplers": [{"input": b_time, "output": b_cam}],
+                    "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}],
+    "accessors": accs,
+    "bufferViews": views,
+    "buffers": [{"byteLength": len(blob),
+                 "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()}],
+})
