@@ -50,12 +50,14 @@ static const char usage[] =
     "                       animation: # in SCENE, -o, --job and --preview stands\n"
     "                       for the zero-padded frame number (f.####.json)\n"
     "  --overwrite          with --frames: render frames whose output exists\n"
-    "  --fps F              with --frames of one glTF file (no # in SCENE): frames\n"
-    "                       per second; frame N is posed at time N / F seconds,\n"
-    "                       as Blender's glTF exporter writes key times (default 24)\n"
-    "  --shutter S          with --frames of one glTF file: motion blur over a shutter\n"
-    "                       open S of a frame (0 to 1), centred on the frame's time\n"
-    "                       as Blender's default; the camera's motion is blurred\n"
+    "  --fps F              with --frames of one animated file (no # in SCENE):\n"
+    "                       frames per second; frame N of a glTF file is posed at\n"
+    "                       time N / F seconds, as Blender's glTF exporter writes\n"
+    "                       key times (default 24)\n"
+    "  --shutter S          with --frames of one animated file: motion blur over a\n"
+    "                       shutter open S of a frame (0 to 1), centred on the\n"
+    "                       frame's time as Blender's; the camera's motion is\n"
+    "                       blurred (without it: a JSON camera's shutter key)\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
@@ -362,8 +364,8 @@ static int parse(int argc, char **argv, frame_settings *a)
         fprintf(stderr, "franja render: --overwrite is for --frames (a single render always writes its output)\n");
         return 2;
     }
-    if ((a->fps > 0 || a->shutter > 0) && (!a->frames || !compile_is_gltf(a->scene) || framelist_is_pattern(a->scene))) {
-        fprintf(stderr, "franja render: --%s is for --frames of one glTF file (its animation posed per frame)\n",
+    if ((a->fps > 0 || a->shutter > 0) && (!a->frames || !framewalk_one_scene(a->scene))) {
+        fprintf(stderr, "franja render: --%s is for --frames of one glTF or JSON file (posed per frame)\n",
                 a->fps > 0 ? "fps" : "shutter");
         return 2;
     }

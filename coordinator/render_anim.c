@@ -8,7 +8,6 @@
 #include <unistd.h>
 
 #include "clock.h"
-#include "compile/compile.h"
 #include "transport/cluster.h"
 #include "cmd.h"
 #include "framewalk.h"
@@ -285,7 +284,7 @@ int render_anim(int argc, char **argv, frame_settings *a, render_anim_parse_fn p
 {
     double t_start = clock_now();
     framewalk_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview,
-                        !framelist_is_pattern(a->scene) && compile_is_gltf(a->scene)};
+                        framewalk_one_scene(a->scene)};
     anim_run fx;
     memset(&fx, 0, sizeof fx);
     fx.parse = parse;

@@ -36,7 +36,7 @@ cmp -s "$T/late.9.pfm" "$T/s3.pfm" && ok || bad "frame 9 (after the last key) is
 # without --frames: at rest, said
 $F render "$T/anim.gltf" -o "$T/rest.pfm" $R >/dev/null 2>"$T/err" || bad "render at rest"
 grep -q "/animations: not played" "$T/err" && ok || bad "no warning that the animations are not played"
-expect_error "--fps without --frames" "--fps is for --frames" $F render "$T/anim.gltf" --fps 30 -o "$T/x.pfm"
+expect_error "--fps without --frames" "--fps is for --frames of one glTF or JSON file" $F render "$T/anim.gltf" --fps 30 -o "$T/x.pfm"
 
 # malformed animations: the file and the JSON pointer named
 expect_error "sampler index" "bad_sampler.gltf: /animations/0/channels/1: sampler: 7 is not an index" \

@@ -25,17 +25,9 @@ $F render "$T/blur.gltf" --frames 12 --shutter 0.5 -o "$T/a.#.pfm" $R -j 1 >/dev
 # shutter it is shifted by s in [-4, 4] (uniform); pixel x gets the mean
 # over s and over [x, x + 1) of the coverage.
 python3 - "$T/sharp.12.pfm" "$T/a.12.pfm" <<'PY' >"$T/check" || bad "profile check did not run"
-import struct, sys
-def profile(path):
-    # a PF image as franja writes it: "PF", comment lines, "W H", "-1", rows bottom first
-    data, lines = open(path, 'rb').read(), []
-    while len(lines) < 3:
-        line, data = data.split(b'\n', 1)
-        if not line.startswith(b'#'):
-            lines.append(line)
-    w, h = (int(v) for v in lines[1].split())
-    vals = struct.unpack('<%df' % (3 * w * h), data[:12 * w * h])
-    return [sum(vals[3 * (y * w + x)] for y in range(h)) / h for x in range(w)]
+import sys
+sys.path.insert(0, 'tests/support')
+from pfmcols import columns as profile
 def covered(x, s):
     return max(0.0, min(x + 1, 38 + s) - max(x, 26 + s))
 def smear(x, n=800):
@@ -64,6 +56,6 @@ cmp -s "$T/a.12.pfm" "$T/c.12.pfm" && ok || bad "fake SSH hosts render a differe
 
 expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
     $F render "$T/blur.gltf" --frames 12 --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm" $R
-expect_error "--shutter without --frames" "--shutter is for --frames of one glTF file" \
+expect_error "--shutter without --frames" "--shutter is for --frames of one glTF or JSON file" \
     $F render "$T/blur.gltf" --shutter 0.5 -o "$T/e.pfm" $R
 summary

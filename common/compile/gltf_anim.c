@@ -22,6 +22,11 @@ double ganim_frame_time(double frame, double fps)
     return (double)(float)(frame / fps);
 }
 
+double ganim_hooks_time(const scene_hooks *h, double frame)
+{
+    return ganim_frame_time(frame, h->fps > 0.0 ? h->fps : GANIM_FPS);
+}
+
 int ganim_present(const gltf_doc *d)
 {
     const cJSON *an = cJSON_GetObjectItemCaseSensitive(d->root, "animations");

@@ -31,6 +31,7 @@
 #include <stdint.h>
 
 #include "compile/gltf_doc.h"
+#include "compile/scene_hooks.h"
 
 /** Which properties of a node the animations set. */
 enum { GANIM_T = 1, GANIM_R = 2, GANIM_S = 4 };
@@ -59,6 +60,10 @@ typedef struct {
  * / fps, frame 0 at time 0), rounded to single precision as the file
  * stores times, so that a frame lands exactly on its exported key. */
 double ganim_frame_time(double frame, double fps);
+
+/** ganim_frame_time of frame `frame` (hooks->frame, or a shutter's end
+ * around it) at the hooks' fps (0: GANIM_FPS). */
+double ganim_hooks_time(const scene_hooks *h, double frame);
 
 /** 1 when the document has a non-empty `animations` array. */
 int ganim_present(const gltf_doc *d);

@@ -835,10 +835,11 @@ static int camera_motion(const char *path, const void *bytes, size_t len, const 
                          const gltf_options *o, fr_builder *b, fr_error *err)
 {
     fr_camera open, close;
-    double t = hooks->time, h = 0.5 * hooks->shutter;
-    if (camera_at(path, bytes, len, o, t - h, &open, err) < 0 || camera_at(path, bytes, len, o, t + h, &close, err) < 0)
+    double f = hooks->frame, h = 0.5 * hooks->shutter;
+    if (camera_at(path, bytes, len, o, ganim_hooks_time(hooks, f - h), &open, err) < 0 ||
+        camera_at(path, bytes, len, o, ganim_hooks_time(hooks, f + h), &close, err) < 0)
         return -1;
-    b->motion.shutter = (float)hooks->shutter;
+    b->motion.shutter = (float)(hooks->shutter / hooks->fps);
     if (!memcmp(&open, &close, sizeof open))
         return 0;
     b->camera = open;
@@ -856,7 +857,7 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scen
     o.camera = camera;
     o.max_triangles = max_triangles;
     o.animate = hooks && hooks->timed;
-    o.time = hooks ? hooks->time : 0.0;
+    o.time = o.animate ? ganim_hooks_time(hooks, hooks->frame) : 0.0;
     int rc = bytes ? gltf_import_mem(bytes, len, path, hooks, &o, b, &r, err) : gltf_import(path, hooks, &o, b, &r, err);
     if (rc < 0)
         return -1;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "compile/gltf_anim.h"
 #include "compile/gltf_scene.h"
 #include "compile/jsonval.h"
 
@@ -123,7 +124,7 @@ int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char
     g.take_camera = take_camera && c;
     g.material = material;
     g.animate = hooks && hooks->timed;
-    g.time = hooks ? hooks->time : 0.0;
+    g.time = g.animate ? ganim_hooks_time(hooks, hooks->frame) : 0.0;
     gltf_result r;
     fr_error e;
     if (gltf_import(path, hooks, &g, b, &r, &e) < 0)
@@ -163,7 +164,7 @@ int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const 
         g.take_camera = 1;
         g.take_lights = 0;
         g.animate = hooks && hooks->timed;
-        g.time = hooks ? hooks->time : 0.0;
+        g.time = g.animate ? ganim_hooks_time(hooks, hooks->frame) : 0.0;
         int rc = gltf_import(path, NULL, &g, &tmp, &r, &e);
         if (rc == 0 && !r.camera_found)
             rc = fr_fail(&e, "%s has no perspective camera", path);
