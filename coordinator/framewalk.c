@@ -88,8 +88,9 @@ int framewalk_one_scene(const char *scene)
         return 1;
     if (n <= 5 || strcmp(scene + n - 5, ".json") != 0)
         return 0;
-    /* A JSON scene with keyed values; one that cannot be read counts too,
-     * so that its compile says what is wrong with it. */
+    /* A JSON scene with keyed values or a gltf shape (whose file may be
+     * animated); one that cannot be read counts too, so that its compile
+     * says what is wrong with it. */
     char *text;
     size_t len;
     fr_error err;
@@ -101,8 +102,10 @@ int framewalk_one_scene(const char *scene)
         return 1;
     const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
     int keyed = json_keys_in(cJSON_GetObjectItemCaseSensitive(root, "camera"));
-    for (const cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s && !keyed; s = s->next)
-        keyed = json_keys_in(s);
+    for (const cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s && !keyed; s = s->next) {
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(s, "type");
+        keyed = json_keys_in(s) || (cJSON_IsString(t) && !strcmp(t->valuestring, "gltf"));
+    }
     cJSON_Delete(root);
     return keyed;
 }

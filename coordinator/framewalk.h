@@ -82,8 +82,9 @@ void framewalk_failed(framewalk_iter *it, uint32_t number, const char *scene, co
 int framewalk_end(framewalk_iter *it, int rc);
 
 /** 1 when `scene` is one file for every frame, posed per frame: a glTF
- * file (its animations) or a JSON scene with keyed values (json_keys.h;
- * or one that cannot be read: its compile says why) whose name has no #. */
+ * file (its animations) or a JSON scene with keyed values (json_keys.h)
+ * or a gltf shape (or one that cannot be read: its compile says why),
+ * whose name has no #. */
 int framewalk_one_scene(const char *scene);
 
 /** For a render without --frames: 0, or, when scene is a '#' pattern that

@@ -7,7 +7,8 @@
 # is byte-identical to a static file with the nodes at that frame's key
 # values; --fps 12 puts frame 1 on the key of frame 2; without --frames the
 # file renders at rest with a warning; malformed animation data is refused
-# naming the file and the JSON pointer.
+# naming the file and the JSON pointer; a gltf shape in a JSON scene is
+# posed at the frame too.
 cd "$(dirname "$0")/.." || exit 1
 . tests/support/lib.sh
 need python3 cmp
@@ -32,6 +33,15 @@ cmp -s "$T/fps.1.pfm" "$T/s2.pfm" && ok || bad "--fps 12 frame 1 is not the pose
 # before the first key and after the last, the ends hold
 $F render "$T/anim.gltf" --frames 9 -o "$T/late.#.pfm" $R >/dev/null 2>&1 || bad "frame 9"
 cmp -s "$T/late.9.pfm" "$T/s3.pfm" && ok || bad "frame 9 (after the last key) is not the last key's pose"
+
+# a gltf shape in a JSON scene is posed at the frame's time too
+for f in anim pose1; do
+    printf '{ "image": { "width": 48, "height": 32, "spp": 2 }, "materials": {},\n  "shapes": [ { "type": "gltf", "file": "%s.gltf", "camera": true } ] }\n' \
+        "$f" >"$T/j$f.json"
+done
+$F render "$T/janim.json" --frames 1 -o "$T/jf.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "JSON frames: $(cat "$T/err")"
+$F render "$T/jpose1.json" -o "$T/jpose1.pfm" -j 2 >/dev/null 2>&1 || bad "JSON still"
+cmp -s "$T/jf.1.pfm" "$T/jpose1.pfm" && ok || bad "a gltf shape's frame 1 differs from the still file at that pose"
 
 # without --frames: at rest, said
 $F render "$T/anim.gltf" -o "$T/rest.pfm" $R >/dev/null 2>"$T/err" || bad "render at rest"
