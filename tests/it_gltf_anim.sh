@@ -6,7 +6,9 @@
 # keys at frames 0..3 of 24 per second) rendered with --frames: each frame
 # is byte-identical to a static file with the nodes at that frame's key
 # values; --fps 12 puts frame 1 on the key of frame 2; without --frames the
-# file renders at rest with a warning; malformed animation data is refused
+# file renders at rest with a warning; animated morph target weights
+# reshape a quad as a still file with the shapes worked out does;
+# malformed animation data is refused
 # naming the file and the JSON pointer; a gltf shape in a JSON scene is
 # posed at the frame too.
 cd "$(dirname "$0")/.." || exit 1
@@ -34,6 +36,14 @@ cmp -s "$T/fps.1.pfm" "$T/s2.pfm" && ok || bad "--fps 12 frame 1 is not the pose
 $F render "$T/anim.gltf" --frames 9 -o "$T/late.#.pfm" $R >/dev/null 2>&1 || bad "frame 9"
 cmp -s "$T/late.9.pfm" "$T/s3.pfm" && ok || bad "frame 9 (after the last key) is not the last key's pose"
 
+# morph target weights, animated: each frame is the still quad at its shape
+$F render "$T/morph.gltf" --frames 0-2 -o "$T/mo/f.#.pfm" $R >/dev/null 2>"$T/err" || bad "morph: $(cat "$T/err")"
+for k in 0 1 2; do
+    $F render "$T/morph$k.gltf" -o "$T/m$k.pfm" $R >/dev/null 2>&1 || bad "render morph$k.gltf"
+    cmp -s "$T/mo/f.$k.pfm" "$T/m$k.pfm" && ok || bad "morph frame $k differs from the still quad at its shape"
+done
+cmp -s "$T/m0.pfm" "$T/m2.pfm" && bad "the morph changes nothing" || ok
+
 # a gltf shape in a JSON scene is posed at the frame's time too
 for f in anim pose1; do
     printf '{ "image": { "width": 48, "height": 32, "spp": 2 }, "materials": {},\n  "shapes": [ { "type": "gltf", "file": "%s.gltf", "camera": true } ] }\n' \
@@ -59,6 +69,8 @@ expect_error "cubic count" "/animations/1/samplers/0/output: accessor 9 has 4 el
     $F render "$T/bad_count.gltf" --frames 1 -o "$T/e/d.#.pfm" $R
 expect_error "times" "/animations/0/samplers/0/input: accessor 12: time 2 (0.1) is not after time 1 (0.2)" \
     $F render "$T/bad_times.gltf" --frames 1 -o "$T/e/e.#.pfm" $R
-expect_error "weights" "/animations/0/channels/0/target: path: 'weights': morph target animation is not supported" \
+expect_error "weights type" "/animations/0/samplers/0/output: accessor 6 has type VEC3, expected 1 components" \
     $F render "$T/bad_weights.gltf" --frames 1 -o "$T/e/f.#.pfm" $R
+expect_error "weights count" "/meshes/0/primitives/0/targets: 2 targets, but /animations/0 (a weights channel) gives 3" \
+    $F render "$T/bad_morph.gltf" --frames 1 -o "$T/e/g.#.pfm" $R
 summary

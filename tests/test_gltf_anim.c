@@ -3,7 +3,8 @@
  * glTF animations evaluated at one time (common/compile/gltf_anim.c): STEP
  * holds keys, CUBICSPLINE follows the Hermite spline with tangents scaled
  * by the interval (values worked out by hand below), LINEAR rotations take
- * the shorter arc, the ends hold; malformed samplers and channels, skins
+ * the shorter arc, morph weights blend per target, the ends hold;
+ * malformed samplers and channels, skins
  * moved by an animation and animated matrix nodes are refused naming the
  * JSON pointer.  The documents are .glb files built in memory. */
 #include <math.h>
@@ -44,7 +45,8 @@ static const char *json_fmt =
     "{\"bufferView\":0,\"byteOffset\":12,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
     "{\"bufferView\":0,\"byteOffset\":48,\"componentType\":5126,\"count\":9,\"type\":\"VEC3\"},"
     "{\"bufferView\":0,\"byteOffset\":156,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
-    "{\"bufferView\":0,\"byteOffset\":204,\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\"}],"
+    "{\"bufferView\":0,\"byteOffset\":204,\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\"},"
+    "{\"bufferView\":0,\"byteOffset\":12,\"componentType\":5126,\"count\":6,\"type\":\"SCALAR\"}],"
     "\"nodes\":[{\"name\":\"a\"},{\"name\":\"b\",\"children\":[0]},{\"name\":\"c\"}],"
     "\"animations\":[{\"samplers\":["
     "{\"input\":0,\"output\":1,\"interpolation\":\"STEP\"},"
@@ -201,6 +203,28 @@ static void test_slerp(void)
     }
 }
 
+static void test_weights(void)
+{
+    /* accessor 5: six scalars 1..6, two weights per key: (1, 2) at 0,
+     * (3, 4) at 1, (5, 6) at 3, LINEAR */
+    static const struct { double t, w0, w1; } want[] = {{0, 1, 2}, {0.5, 2, 3}, {1, 3, 4}, {2, 4, 5}, {9, 5, 6}};
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+        ganim_pose p;
+        fr_error e;
+        int rc = eval("", "{\"input\":0,\"output\":3}],\"channels\":[",
+                      "{\"input\":0,\"output\":3},{\"input\":0,\"output\":5}],\"channels\":["
+                      "{\"sampler\":3,\"target\":{\"node\":2,\"path\":\"weights\"}},", want[i].t, &p, &e);
+        CHECK(rc == 0, "weights at %g: %s", want[i].t, rc ? e.msg : "");
+        if (rc == 0) {
+            T(p.node[2].set == GANIM_W && p.node[2].n_weights == 2);
+            CHECK(fabs(p.node[2].w[0] - want[i].w0) < 1e-9 && fabs(p.node[2].w[1] - want[i].w1) < 1e-9,
+                  "weights at %g: (%g %g), want (%g %g)", want[i].t, p.node[2].w[0], p.node[2].w[1], want[i].w0,
+                  want[i].w1);
+        }
+        ganim_free(&p);
+    }
+}
+
 static void test_frame_time(void)
 {
     /* frame / fps rounded to single precision: the exporter's key times */
@@ -240,8 +264,15 @@ static void test_refused(void)
             "/animations/0/channels/1/target: node: 3 is not an index into nodes");
     refused("path", "", "\"path\":\"scale\"", "\"path\":\"colour\"",
             "/animations/0/channels/1/target: path: 'colour' is not translation, rotation, scale or weights");
-    refused("weights", "", "\"path\":\"scale\"", "\"path\":\"weights\"",
-            "/animations/0/channels/1/target: path: 'weights': morph target animation is not supported");
+    refused("weights type", "", "\"path\":\"scale\"", "\"path\":\"weights\"",
+            "/animations/0/samplers/1/output: accessor 2 has type VEC3, expected 1 components");
+    refused("scalar translations", "", "{\"input\":0,\"output\":1,", "{\"input\":0,\"output\":4,",
+            "/animations/0/samplers/0/output: accessor 4 has type SCALAR, expected 3 components");
+    refused("weights count", "", "{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"},{\"input\":0,\"output\":3}],\"channels\":[",
+            "{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"},{\"input\":0,\"output\":3},"
+            "{\"input\":0,\"output\":5,\"interpolation\":\"CUBICSPLINE\"}],\"channels\":["
+            "{\"sampler\":3,\"target\":{\"node\":2,\"path\":\"weights\"}},",
+            "/animations/0/samplers/3/output: accessor 5 has 6 elements: not 3 key times of 1 to 64 weights");
     refused("input type", "", "{\"input\":0,\"output\":3}", "{\"input\":1,\"output\":3}",
             "/animations/0/samplers/2/input: accessor 1 has type VEC3, expected 1 components");
     refused("output accessor", "", "{\"input\":0,\"output\":3}", "{\"input\":0,\"output\":9}",
@@ -310,6 +341,7 @@ int main(void)
     test_step();
     test_cubic();
     test_slerp();
+    test_weights();
     test_frame_time();
     test_refused();
     test_scene();

@@ -10,11 +10,14 @@
 
 enum { INTERP_LINEAR, INTERP_STEP, INTERP_CUBIC };
 
-/* One sampler, checked: its key times and values. */
+/* One sampler, checked: its key times and values.  A value is one
+ * element of `comps` components, or (morph weights) `group` consecutive
+ * scalar elements. */
 typedef struct {
     gdoc_acc in, out;
     int interp;
     uint32_t keys;
+    uint32_t comps, group;
 } sampler;
 
 double ganim_frame_time(double frame, double fps)
@@ -35,13 +38,15 @@ int ganim_present(const gltf_doc *d)
 
 void ganim_free(ganim_pose *p)
 {
+    for (uint32_t i = 0; p->node && i < p->n; i++)
+        free(p->node[i].w);
     free(p->node);
     memset(p, 0, sizeof *p);
 }
 
 /* Sampler `si` of animation `ai` (object `so`), for a property of `comps`
- * components: its accessors and interpolation, every time and value
- * checked. */
+ * components (0: morph weights, a group of scalars per key): its
+ * accessors and interpolation, every time and value checked. */
 static int sampler_read(gltf_doc *d, uint32_t ai, uint32_t si, const cJSON *so, uint32_t comps, sampler *s,
                         fr_error *err)
 {
@@ -66,18 +71,33 @@ static int sampler_read(gltf_doc *d, uint32_t ai, uint32_t si, const cJSON *so, 
             return gdoc_fail(d, err, ptr, "interpolation: '%s' is not LINEAR, STEP or CUBICSPLINE", ip->valuestring);
     }
     static const uint32_t floats[] = {GDOC_F32, 0};
-    static const uint32_t rot_types[] = {GDOC_F32, GDOC_I8, GDOC_U8, GDOC_I16, GDOC_U16, 0};
+    static const uint32_t int_types[] = {GDOC_F32, GDOC_I8, GDOC_U8, GDOC_I16, GDOC_U16, 0};
     char pin[112], pout[112];
     snprintf(pin, sizeof pin, "%s/input", ptr);
     snprintf(pout, sizeof pout, "%s/output", ptr);
+    int weights = comps == 0;
     if (gdoc_accessor(d, iin, pin, 1, floats, &s->in, err) < 0 ||
-        gdoc_accessor(d, iout, pout, comps, comps == 4 ? rot_types : floats, &s->out, err) < 0)
+        gdoc_accessor(d, iout, pout, weights ? 1 : comps, comps == 4 || weights ? int_types : floats, &s->out,
+                      err) < 0)
         return -1;
     if (s->out.ctype != GDOC_F32 && !s->out.normalized)
-        return gdoc_fail(d, err, pout, "accessor %u: integer rotations must be normalized", iout);
+        return gdoc_fail(d, err, pout, "accessor %u: integer %s must be normalized", iout,
+                         weights ? "weights" : "rotations");
     s->keys = s->in.count;
     uint32_t per = s->interp == INTERP_CUBIC ? 3 : 1;
-    if ((uint64_t)s->out.count != (uint64_t)per * s->keys)
+    s->comps = weights ? 1 : comps;
+    s->group = 1;
+    if (weights) {
+        /* As many weights per key as the mesh has targets (checked by the
+         * scene's reader): the elements divide evenly among the keys. */
+        uint64_t n = s->out.count / ((uint64_t)per * s->keys);
+        if (n == 0 || n * per * s->keys != s->out.count || n > GANIM_MAX_WEIGHTS)
+            return gdoc_fail(d, err, pout, "accessor %u has %u elements: not %u key times of 1 to %d weights%s",
+                             iout, s->out.count, s->keys, GANIM_MAX_WEIGHTS,
+                             per == 3 ? " (in-tangents, values, out-tangents per key)" : "");
+        s->group = (uint32_t)n;
+    }
+    if (!weights && (uint64_t)s->out.count != (uint64_t)per * s->keys)
         return gdoc_fail(d, err, pout, "accessor %u has %u elements; %u key times need %llu%s", iout, s->out.count,
                          s->keys, (unsigned long long)per * s->keys,
                          per == 3 ? " (in-tangent, value, out-tangent per key)" : "");
@@ -92,16 +112,21 @@ static int sampler_read(gltf_doc *d, uint32_t ai, uint32_t si, const cJSON *so, 
         prev = t;
     }
     for (uint32_t k = 0; k < s->out.count; k++)
-        for (uint32_t c = 0; c < comps; c++)
+        for (uint32_t c = 0; c < s->comps; c++)
             if (!isfinite(gdoc_get(&s->out, k, c)) || fabs(gdoc_get(&s->out, k, c)) > 1e30)
                 return gdoc_fail(d, err, pout, "accessor %u: element %u is not a finite number", iout, k);
     return 0;
 }
 
-/* Value element e of the output, comps components. */
-static void value(const sampler *s, uint32_t e, uint32_t comps, double *v)
+/* Value e of the output: its comps components, or its group of weights. */
+static void value(const sampler *s, uint32_t e, double *v)
 {
-    for (uint32_t c = 0; c < comps; c++)
+    if (s->group > 1 || s->comps == 1) {
+        for (uint32_t i = 0; i < s->group; i++)
+            v[i] = gdoc_get(&s->out, e * s->group + i, 0);
+        return;
+    }
+    for (uint32_t c = 0; c < s->comps; c++)
         v[c] = gdoc_get(&s->out, e, c);
 }
 
@@ -175,8 +200,9 @@ static void slerp(const double *a, const double *b0, double u, double *out)
 /* The sampler's value at time t into v (comps components): a key's value
  * as stored (the scene's reader normalises rotations, as it does a node's
  * own), an interpolated rotation normalised. */
-static void sample(const sampler *s, double t, uint32_t comps, double *v)
+static void sample(const sampler *s, double t, int rotation, double *v)
 {
+    uint32_t comps = s->comps * s->group;
     int cubic = s->interp == INTERP_CUBIC;
     uint32_t per = cubic ? 3 : 1, mid = cubic ? 1 : 0, n = s->keys;
     double t0 = gdoc_get(&s->in, 0, 0), tn = gdoc_get(&s->in, n - 1, 0);
@@ -196,11 +222,11 @@ static void sample(const sampler *s, double t, uint32_t comps, double *v)
         }
         double ta = gdoc_get(&s->in, lo, 0), tb = gdoc_get(&s->in, hi, 0);
         if (t > ta && s->interp != INTERP_STEP) {
-            double u = (t - ta) / (tb - ta), a[4], b[4];
-            value(s, per * lo + mid, comps, a);
-            value(s, per * hi + mid, comps, b);
+            double u = (t - ta) / (tb - ta), a[GANIM_MAX_WEIGHTS], b[GANIM_MAX_WEIGHTS];
+            value(s, per * lo + mid, a);
+            value(s, per * hi + mid, b);
             if (s->interp == INTERP_LINEAR) {
-                if (comps == 4) {
+                if (rotation) {
                     slerp(a, b, u, v);
                     return;
                 }
@@ -210,19 +236,19 @@ static void sample(const sampler *s, double t, uint32_t comps, double *v)
             }
             /* Hermite: out-tangent of key lo, in-tangent of key hi, both
              * scaled by the interval. */
-            double ma[4], mb[4], td = tb - ta, u2 = u * u, u3 = u2 * u;
-            value(s, per * lo + 2, comps, ma);
-            value(s, per * hi, comps, mb);
+            double ma[GANIM_MAX_WEIGHTS], mb[GANIM_MAX_WEIGHTS], td = tb - ta, u2 = u * u, u3 = u2 * u;
+            value(s, per * lo + 2, ma);
+            value(s, per * hi, mb);
             double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
             for (uint32_t c = 0; c < comps; c++)
                 v[c] = h00 * a[c] + h10 * td * ma[c] + h01 * b[c] + h11 * td * mb[c];
-            if (comps == 4)
+            if (rotation)
                 normalise(v);
             return;
         }
         k = lo;
     }
-    value(s, per * k + mid, comps, v);
+    value(s, per * k + mid, v);
 }
 
 /* Every node's parent (UINT32_MAX for none), from the children arrays as
@@ -263,7 +289,7 @@ static int check_skins(gltf_doc *d, const ganim_pose *p, fr_error *err)
             uint32_t n = (uint32_t)x;
             for (uint32_t steps = 0; n != UINT32_MAX && steps <= d->nodes.n; steps++, n = parent[n]) {
                 const ganim_node *a = &p->node[n];
-                if (a->set) {
+                if (a->set & (GANIM_T | GANIM_R | GANIM_S)) {
                     char ptr[64];
                     snprintf(ptr, sizeof ptr, "/skins/%d/joints/%d", si, ji);
                     rc = gdoc_fail(d, err, ptr, "node %u is moved by /animations/%u/channels/%u, and skinning is "
@@ -307,14 +333,11 @@ static int channel(gltf_doc *d, uint32_t ai, const cJSON *samplers, uint32_t ci,
     }
     const char *pn = path->valuestring;
     unsigned bit = !strcmp(pn, "translation") ? GANIM_T : !strcmp(pn, "rotation") ? GANIM_R
-                 : !strcmp(pn, "scale") ? GANIM_S : 0;
-    if (!strcmp(pn, "weights"))
-        return gdoc_fail(d, err, tp, "path: 'weights': morph target animation is not supported (the mesh would "
-                         "stay frozen)");
+                 : !strcmp(pn, "scale") ? GANIM_S : !strcmp(pn, "weights") ? GANIM_W : 0;
     if (!bit)
         return gdoc_fail(d, err, tp, "path: '%s' is not translation, rotation, scale or weights", pn);
     sampler s;
-    uint32_t comps = bit == GANIM_R ? 4 : 3;
+    uint32_t comps = bit == GANIM_R ? 4 : bit == GANIM_W ? 0 : 3;
     if (sampler_read(d, ai, si, cJSON_GetArrayItem(samplers, (int)si), comps, &s, err) < 0)
         return -1;
     ganim_node *a = &p->node[node];
@@ -330,7 +353,12 @@ static int channel(gltf_doc *d, uint32_t ai, const cJSON *samplers, uint32_t ci,
         a->channel = ci;
     }
     a->set |= bit;
-    sample(&s, t, comps, bit == GANIM_T ? a->t : bit == GANIM_R ? a->r : a->s);
+    if (bit == GANIM_W) {
+        if ((a->w = malloc(GANIM_MAX_WEIGHTS * sizeof *a->w)) == NULL)
+            return gdoc_fail(d, err, ptr, "out of memory");
+        a->n_weights = s.group;
+    }
+    sample(&s, t, bit == GANIM_R, bit == GANIM_T ? a->t : bit == GANIM_R ? a->r : bit == GANIM_S ? a->s : a->w);
     p->channels++;
     return 0;
 }

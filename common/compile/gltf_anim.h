@@ -17,10 +17,12 @@
  *
  * Untrusted input: every sampler and node index, accessor type, count and
  * time array is checked (times finite and strictly increasing; outputs
- * finite, one per key, three per key for CUBICSPLINE); errors name the
- * file and the JSON pointer.  Refused, since the picture would silently
- * stay frozen: channels of morph target weights, and animations that move
- * a joint of a skin (or a node above one).  When two channels animate the
+ * finite, one per key, three per key for CUBICSPLINE; morph weights as
+ * many per key as the elements divide into, at most GANIM_MAX_WEIGHTS,
+ * matched against the mesh's targets by the scene's reader); errors name
+ * the file and the JSON pointer.  Refused, since the picture would
+ * silently stay frozen: animations that move a joint of a skin (or a node
+ * above one).  When two channels animate the
  * same property of a node, the first (in the file's order) wins, with a
  * warning.  Compile time only; + - * / and sqrt alone, as in the render
  * path, so that a pose is the same bits on every host.
@@ -34,14 +36,19 @@
 #include "compile/scene_hooks.h"
 
 /** Which properties of a node the animations set. */
-enum { GANIM_T = 1, GANIM_R = 2, GANIM_S = 4 };
+enum { GANIM_T = 1, GANIM_R = 2, GANIM_S = 4, GANIM_W = 8 };
+
+/** Most morph targets (weights) a mesh may have. */
+#define GANIM_MAX_WEIGHTS 64
 
 /** A node's animated properties (those flagged in `set`). */
 typedef struct {
-    unsigned set;              /**< GANIM_T | GANIM_R | GANIM_S */
+    unsigned set;              /**< GANIM_T | GANIM_R | GANIM_S | GANIM_W */
     double t[3];               /**< translation */
     double r[4];               /**< rotation quaternion x y z w (a key's as stored, else unit length) */
     double s[3];               /**< scale */
+    double *w;                 /**< morph target weights, n_weights of them (malloc'd; NULL without) */
+    uint32_t n_weights;
     uint32_t anim, channel;    /**< where its first animated property comes from (messages) */
 } ganim_node;
 

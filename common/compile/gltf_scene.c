@@ -154,7 +154,64 @@ static uint32_t corner(uint32_t mode, uint32_t t, int k)
     return k == 0 ? t + 1 : k == 1 ? t + 2 : 0; /* fan */
 }
 
-static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const affine *w, fr_error *err)
+/* The morph weights a node gives its mesh. */
+typedef struct {
+    double w[GANIM_MAX_WEIGHTS];
+    uint32_t n;                /* 0: none (the base mesh) */
+    char from[64];             /* where they come from (messages) */
+} morph;
+
+/* The morph targets of primitive `ptr` (object p) with nv vertices, as
+ * weights `mw` blend them: the accessors of the targets of non-zero
+ * weight into t[] (*nt of them, their weights in wt[]), NORMAL ones into
+ * tn[] where present. */
+static int morph_targets(imp *c, const cJSON *p, const char *ptr, uint32_t nv, const morph *mw, gdoc_acc *t,
+                         gdoc_acc *tn, int *has_n, double *wt, uint32_t *nt, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    const cJSON *targets = cJSON_GetObjectItemCaseSensitive(p, "targets");
+    *nt = 0;
+    if (!targets)
+        return 0;
+    char tp[112];
+    snprintf(tp, sizeof tp, "%s/targets", ptr);
+    int n = cJSON_GetArraySize(targets);
+    if (!cJSON_IsArray(targets) || n > GANIM_MAX_WEIGHTS)
+        return gdoc_fail(d, err, tp, "expected an array of at most %d targets", GANIM_MAX_WEIGHTS);
+    if (mw->n && mw->n != (uint32_t)n)
+        return gdoc_fail(d, err, tp, "%d targets, but %s gives %u weights", n, mw->from, mw->n);
+    int k = 0;
+    for (const cJSON *o = targets->child; o; o = o->next, k++) {
+        if (!mw->n || mw->w[k] == 0.0)
+            continue;
+        char op[128];
+        snprintf(op, sizeof op, "%s/%d", tp, k);
+        uint32_t ip, in;
+        if (!cJSON_IsObject(o))
+            return gdoc_fail(d, err, op, "expected an object");
+        if (gdoc_index(d, o, op, "POSITION", 0, d->accessors.n, "accessors", &ip, err) < 0 ||
+            gdoc_index(d, o, op, "NORMAL", 0, d->accessors.n, "accessors", &in, err) < 0)
+            return -1;
+        if (ip == UINT32_MAX && in == UINT32_MAX)
+            continue;
+        gdoc_acc *a = &t[*nt], *an = &tn[*nt];
+        memset(a, 0, sizeof *a);
+        memset(an, 0, sizeof *an);
+        if ((ip != UINT32_MAX && gdoc_accessor(d, ip, op, 3, NULL, a, err) < 0) ||
+            (in != UINT32_MAX && gdoc_accessor(d, in, op, 3, NULL, an, err) < 0))
+            return -1;
+        if ((ip != UINT32_MAX && a->count != nv) || (in != UINT32_MAX && an->count != nv))
+            return gdoc_fail(d, err, op, "a target of a different count than POSITION's %u", nv);
+        has_n[*nt] = in != UINT32_MAX;
+        if (ip == UINT32_MAX)
+            a->count = 0;              /* no position offsets: all zeros */
+        wt[(*nt)++] = mw->w[k];
+    }
+    return 0;
+}
+
+static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const affine *w, const morph *mw,
+                     fr_error *err)
 {
     gltf_doc *d = c->d;
     fr_builder *b = c->b;
@@ -182,8 +239,6 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
                   "the UVs of each triangle)", ap);
     if (cJSON_GetObjectItemCaseSensitive(attrs, "COLOR_0"))
         gdoc_warn(d, "color", "%s/COLOR_0: vertex colours are not supported: ignored", ap);
-    if (cJSON_GetObjectItemCaseSensitive(p, "targets"))
-        gdoc_warn(d, "morph", "%s/targets: morph targets are not supported: the base mesh is drawn", ptr);
     if (mode < MODE_TRIANGLES) {
         gdoc_warn(d, "points", "%s/mode: points and lines are not rendered", ptr);
         return 0;
@@ -235,6 +290,12 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
             return gdoc_fail(d, err, ptr, "indices: accessor %u element %u is %u, not below the vertex count %u",
                              iidx, i, v, nv);
     }
+    gdoc_acc tpos[GANIM_MAX_WEIGHTS], tnrm[GANIM_MAX_WEIGHTS];
+    int tn_has[GANIM_MAX_WEIGHTS];
+    double tw[GANIM_MAX_WEIGHTS];
+    uint32_t nt;
+    if (morph_targets(c, p, ptr, nv, mw, tpos, tnrm, tn_has, tw, &nt, err) < 0)
+        return -1;
     uint32_t mat = c->o->material;
     const double *uvxf = NULL;
     if (mat == FR_NONE && gmat_material(&c->mat, imat, &mat, &uvxf, err) < 0)
@@ -248,6 +309,9 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
         return gdoc_fail(d, err, ptr, "out of memory");
     for (uint32_t i = 0; i < nv; i++) {
         double in[3] = {gdoc_get(&pos, i, 0), gdoc_get(&pos, i, 1), gdoc_get(&pos, i, 2)}, o[3];
+        for (uint32_t k = 0; k < nt; k++)          /* morph targets, in the file's order */
+            for (int j = 0; j < 3 && tpos[k].count; j++)
+                in[j] += tw[k] * gdoc_get(&tpos[k], i, (uint32_t)j);
         af_apply(w, in, 1.0, o);
         vec3 p = v3((float)o[0], (float)o[1], (float)o[2]);
         if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
@@ -256,6 +320,9 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
             return gdoc_fail(d, err, ptr, "out of memory");
         if (use_n) {
             double nn[3] = {gdoc_get(&nrm, i, 0), gdoc_get(&nrm, i, 1), gdoc_get(&nrm, i, 2)}, m[3];
+            for (uint32_t k = 0; k < nt; k++)
+                for (int j = 0; j < 3 && tn_has[k]; j++)
+                    nn[j] += tw[k] * gdoc_get(&tnrm[k], i, (uint32_t)j);
             for (int k = 0; k < 3; k++)
                 m[k] = (det < 0 ? -1.0 : 1.0) * (cof[k][0] * nn[0] + cof[k][1] * nn[1] + cof[k][2] * nn[2]);
             double l = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
@@ -305,7 +372,7 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
     return 0;
 }
 
-static int mesh_prims(imp *c, uint32_t m, const affine *w, fr_error *err)
+static int mesh_prims(imp *c, uint32_t m, const affine *w, const morph *mw, fr_error *err)
 {
     gltf_doc *d = c->d;
     char ptr[48];
@@ -315,25 +382,68 @@ static int mesh_prims(imp *c, uint32_t m, const affine *w, fr_error *err)
         return gdoc_fail(d, err, ptr, "primitives: expected an array");
     uint32_t i = 0;
     for (const cJSON *p = prims->child; p; p = p->next, i++)
-        if (primitive(c, m, i, p, w, err) < 0)
+        if (primitive(c, m, i, p, w, mw, err) < 0)
             return -1;
+    return 0;
+}
+
+/* The morph weights node n gives mesh m: the animations', else the
+ * node's `weights`, else the mesh's; none (n 0) when all are zero. */
+static int morph_weights(imp *c, uint32_t n, uint32_t m, morph *mw, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    const ganim_node *an = n < c->pose.n ? &c->pose.node[n] : NULL;
+    mw->n = 0;
+    if (an && (an->set & GANIM_W)) {
+        mw->n = an->n_weights;
+        memcpy(mw->w, an->w, mw->n * sizeof *mw->w);
+        snprintf(mw->from, sizeof mw->from, "/animations/%u (a weights channel)", an->anim);
+    } else {
+        char ptr[48];
+        const cJSON *o = d->nodes.v[n];
+        snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+        if (!cJSON_GetObjectItemCaseSensitive(o, "weights")) {
+            o = d->meshes.v[m];
+            snprintf(ptr, sizeof ptr, "/meshes/%u", m);
+        }
+        const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, "weights");
+        if (!a)
+            return 0;
+        snprintf(mw->from, sizeof mw->from, "%s/weights", ptr);
+        if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) > GANIM_MAX_WEIGHTS)
+            return gdoc_fail(d, err, mw->from, "expected an array of at most %d numbers", GANIM_MAX_WEIGHTS);
+        for (const cJSON *e = a->child; e; e = e->next) {
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
+                return gdoc_fail(d, err, mw->from, "element %u: expected a finite number", mw->n);
+            mw->w[mw->n++] = e->valuedouble;
+        }
+    }
+    uint32_t nonzero = 0;
+    for (uint32_t i = 0; i < mw->n; i++)
+        nonzero += mw->w[i] != 0.0;
+    if (!nonzero)
+        mw->n = 0;
     return 0;
 }
 
 /* A mesh drawn by one node is placed into the world's triangles; one drawn
  * by several is read once in its own space and placed by an instance per
- * node (builder_instance.h). */
-static int mesh(imp *c, uint32_t m, const affine *w, fr_error *err)
+ * node (builder_instance.h), unless morph weights bend it: then this node's
+ * copy is placed into the world's triangles. */
+static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, fr_error *err)
 {
-    if (c->uses[m] < 2)
-        return mesh_prims(c, m, w, err);
+    morph mw;
+    if (morph_weights(c, n, m, &mw, err) < 0)
+        return -1;
+    if (c->uses[m] < 2 || mw.n)
+        return mesh_prims(c, m, w, &mw, err);
     if (c->mesh_of[m] == FR_NONE) {
         affine id;
         af_identity(&id);
         uint32_t k = bld_mesh_begin(c->b);
         if (k == FR_NONE)
             return gdoc_fail(c->d, err, NULL, "out of memory");
-        if (mesh_prims(c, m, &id, err) < 0)
+        if (mesh_prims(c, m, &id, &mw, err) < 0)
             return -1;
         fr_error e;
         if (bld_mesh_end(c->b, k, &e) < 0)
@@ -504,9 +614,7 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
         lp = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
     if (cJSON_GetObjectItemCaseSensitive(o, "skin"))
         gdoc_warn(d, "skin", "%s/skin: skinning is not supported: the mesh is drawn in its bind pose", ptr);
-    if (cJSON_GetObjectItemCaseSensitive(o, "weights"))
-        gdoc_warn(d, "morph", "%s/weights: morph targets are not supported: the base mesh is drawn", ptr);
-    if ((m != UINT32_MAX && !c->o->camera_only && mesh(c, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
+    if ((m != UINT32_MAX && !c->o->camera_only && mesh(c, n, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
         (lp && light(c, n, lp, w, err) < 0))
         return -1;
     return 0;

@@ -13,6 +13,11 @@
 # tan(yfov / 2) = 1/2 and aspectRatio 4: at 16 pixels high, 4 pixels a unit,
 # so frame 12 (time 1/2) shows the quad 12 pixels wide centred in the image,
 # and a shutter of half a frame (1/48 s) smears it over 8 pixels.
+# DIR/morph.gltf: an emissive quad with two morph targets whose weights
+# are animated (LINEAR, keys at frames 0, 1, 2); DIR/morph0.gltf ..
+# morph2.gltf: the quad without targets, its positions those of frame k
+# worked out here (base plus each weight times its target, in double as
+# the reader does, rounded to single precision).
 import base64
 import json
 import math
@@ -184,3 +189,51 @@ write("blur.gltf", {
     "buffers": [{"byteLength": len(blob),
                  "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()}],
 })
+
+# The morphed quad (its own buffer).
+blob, views, accs = bytearray(), [], []
+m_base = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]]
+m_t0 = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.3, 0.5, 0.0], [0.0, 0.0, 0.0]]
+m_t1 = [[0.0, -0.3, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [-0.4, 0.2, 0.0]]
+m_w = [[0.0, 0.0], [1.0, f32(0.25)], [f32(0.5), 1.0]]
+
+
+def morph_doc(pos, targets, weights):
+    global blob, views, accs
+    blob, views, accs = bytearray(), [], []
+    a_p = add(pos, 3)
+    a_i = add([0, 1, 2, 0, 2, 3], 1, 5125)
+    prim = {"attributes": {"POSITION": a_p}, "indices": a_i, "material": 0}
+    d = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"name": "quad", "mesh": 0}, {"name": "cam", "camera": 0, "translation": [0, 0, 4]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.1}}],
+        "materials": [{"emissiveFactor": [1, 0.5, 0.25], "doubleSided": True,
+                       "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}],
+        "meshes": [{"primitives": [prim]}],
+    }
+    if targets:
+        prim["targets"] = [{"POSITION": add(t, 3)} for t in targets]
+        d["meshes"][0]["weights"] = [0.0, 0.0]
+        a_t = add([f32(k / 24.0) for k in range(len(weights))], 1)
+        a_w = add([w for k in weights for w in k], 1)
+        d["animations"] = [{"samplers": [{"input": a_t, "output": a_w}],
+                            "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}]}]
+    d["accessors"], d["bufferViews"] = accs, views
+    d["buffers"] = [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()}]
+    return d
+
+
+write("morph.gltf", morph_doc(m_base, [m_t0, m_t1], m_w))
+for k, w in enumerate(m_w):
+    pos = []
+    for v in range(4):
+        p = list(m_base[v])
+        for t, wt in zip((m_t0, m_t1), w):
+            if wt != 0.0:
+                for j in range(3):
+                    p[j] += wt * t[v][j]
+        pos.append([f32(c) for c in p])
+    write("morph%d.gltf" % k, morph_doc(pos, None, None))
+write("bad_morph.gltf", morph_doc(m_base, [m_t0, m_t1], [w + [0.0] for w in m_w]))
