@@ -7,7 +7,8 @@
 # is byte-identical to a static file with the nodes at that frame's key
 # values; --fps 12 puts frame 1 on the key of frame 2; without --frames the
 # file renders at rest with a warning; animated morph target weights
-# reshape a quad as a still file with the shapes worked out does;
+# reshape a quad, and a joint moving a skinned strip bends it, as still
+# files with the shapes worked out do;
 # malformed animation data is refused
 # naming the file and the JSON pointer; a gltf shape in a JSON scene is
 # posed at the frame too.
@@ -44,6 +45,14 @@ for k in 0 1 2; do
 done
 cmp -s "$T/m0.pfm" "$T/m2.pfm" && bad "the morph changes nothing" || ok
 
+# a skinned strip whose second joint moves: each frame is the still strip at its pose
+$F render "$T/skin.gltf" --frames 0-2 -o "$T/sk/f.#.pfm" $R >/dev/null 2>"$T/err" || bad "skin: $(cat "$T/err")"
+for k in 0 1 2; do
+    $F render "$T/skin$k.gltf" -o "$T/k$k.pfm" $R >/dev/null 2>&1 || bad "render skin$k.gltf"
+    cmp -s "$T/sk/f.$k.pfm" "$T/k$k.pfm" && ok || bad "skin frame $k differs from the still strip at its pose"
+done
+cmp -s "$T/k0.pfm" "$T/k1.pfm" && bad "the skin changes nothing" || ok
+
 # a gltf shape in a JSON scene is posed at the frame's time too
 for f in anim pose1; do
     printf '{ "image": { "width": 48, "height": 32, "spp": 2 }, "materials": {},\n  "shapes": [ { "type": "gltf", "file": "%s.gltf", "camera": true } ] }\n' \
@@ -73,4 +82,6 @@ expect_error "weights type" "/animations/0/samplers/0/output: accessor 6 has typ
     $F render "$T/bad_weights.gltf" --frames 1 -o "$T/e/f.#.pfm" $R
 expect_error "weights count" "/meshes/0/primitives/0/targets: 2 targets, but /animations/0 (a weights channel) gives 3" \
     $F render "$T/bad_morph.gltf" --frames 1 -o "$T/e/g.#.pfm" $R
+expect_error "skin joints" "/meshes/0/primitives/0/attributes: JOINTS_0: element 2 names joint 1; /skins/0 has 1" \
+    $F render "$T/bad_skin.gltf" --frames 1 -o "$T/e/h.#.pfm" $R
 summary

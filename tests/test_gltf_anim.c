@@ -4,9 +4,8 @@
  * holds keys, CUBICSPLINE follows the Hermite spline with tangents scaled
  * by the interval (values worked out by hand below), LINEAR rotations take
  * the shorter arc, morph weights blend per target, the ends hold;
- * malformed samplers and channels, skins
- * moved by an animation and animated matrix nodes are refused naming the
- * JSON pointer.  The documents are .glb files built in memory. */
+ * malformed samplers and channels and animated matrix nodes are refused
+ * naming the JSON pointer.  The documents are .glb files built in memory. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -279,15 +278,6 @@ static void test_refused(void)
             "/animations/0/samplers/2: output: 9 is not an index into accessors");
     refused("no target", "", "\"target\":{\"node\":0,\"path\":\"translation\"}", "\"x\":1",
             "/animations/0/channels/0: target is missing");
-    /* node 2 is a joint; node 0, its parent, is animated */
-    refused("skin", ",\"skins\":[{\"joints\":[1,2]}]", "{\"name\":\"a\"}", "{\"name\":\"a\",\"children\":[2]}",
-            "/skins/0/joints/1: node 0 is moved by /animations/0/channels/0, and skinning is not supported");
-    /* a skin whose joints stand still is fine */
-    ganim_pose p;
-    fr_error e;
-    int rc = eval(",\"skins\":[{\"joints\":[2]}]", NULL, NULL, 0.5, &p, &e);
-    CHECK(rc == 0, "a still skin: %s", rc ? e.msg : "");
-    ganim_free(&p);
 }
 
 

@@ -20,9 +20,7 @@
  * finite, one per key, three per key for CUBICSPLINE; morph weights as
  * many per key as the elements divide into, at most GANIM_MAX_WEIGHTS,
  * matched against the mesh's targets by the scene's reader); errors name
- * the file and the JSON pointer.  Refused, since the picture would
- * silently stay frozen: animations that move a joint of a skin (or a node
- * above one).  When two channels animate the
+ * the file and the JSON pointer.  When two channels animate the
  * same property of a node, the first (in the file's order) wins, with a
  * warning.  Compile time only; + - * / and sqrt alone, as in the render
  * path, so that a pose is the same bits on every host.

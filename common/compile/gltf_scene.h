@@ -1,9 +1,10 @@
 /** @file gltf_scene.h
  * Importing a glTF 2.0 scene (.gltf or .glb) at compile time: the node
  * hierarchy with its transforms, the meshes' triangles with normals and
- * UVs (bent by their morph targets' weights), materials and textures
- * (gltf_mat.h), the camera and the punctual lights; posed by the file's
- * animations at a time when asked (gltf_anim.h).  The mapping, and what is ignored, is documented in
+ * UVs (bent by their morph targets' weights and their skins' joints),
+ * materials and textures (gltf_mat.h), the camera and the punctual
+ * lights; posed by the file's animations at a time when asked
+ * (gltf_anim.h).  The mapping, and what is ignored, is documented in
  * scenes/README.md.
  *
  * glTF is Y-up, right-handed, in metres; Franja has no fixed up axis, so

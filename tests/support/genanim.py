@@ -17,7 +17,13 @@
 # are animated (LINEAR, keys at frames 0, 1, 2); DIR/morph0.gltf ..
 # morph2.gltf: the quad without targets, its positions those of frame k
 # worked out here (base plus each weight times its target, in double as
-# the reader does, rounded to single precision).
+# the reader does, rounded to single precision).  DIR/skin.gltf: an
+# emissive strip skinned to two joints, the second (a child of the first)
+# translated and scaled by an animation (keys at frames 0, 1, 2), the
+# middle vertices weighted half and half, the mesh's node moved (which
+# glTF ignores for a skinned mesh); DIR/skin0.gltf .. skin2.gltf: the strip
+# unskinned with its positions at each frame, worked out here (every
+# number exact in binary, so any order of the sums gives the same bits).
 import base64
 import json
 import math
@@ -237,3 +243,77 @@ for k, w in enumerate(m_w):
         pos.append([f32(c) for c in p])
     write("morph%d.gltf" % k, morph_doc(pos, None, None))
 write("bad_morph.gltf", morph_doc(m_base, [m_t0, m_t1], [w + [0.0] for w in m_w]))
+
+# The skinned strip (its own buffer).
+s_pos = [[-0.5, 0.0, 0.0], [0.5, 0.0, 0.0], [-0.5, 1.0, 0.0], [0.5, 1.0, 0.0], [-0.5, 2.0, 0.0], [0.5, 2.0, 0.0]]
+s_idx = [0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4]
+s_joint = [[0, 0, 0, 0], [0, 0, 0, 0], [0, 1, 0, 0], [0, 1, 0, 0], [1, 0, 0, 0], [1, 0, 0, 0]]
+s_weight = [[1, 0, 0, 0], [1, 0, 0, 0], [0.5, 0.5, 0, 0], [0.5, 0.5, 0, 0], [1, 0, 0, 0], [1, 0, 0, 0]]
+s_t = [[0.0, 1.0, 0.0], [0.5, 2.0, 0.0], [-0.5, 1.5, 0.0]]
+s_s = [[1.0, 1.0, 1.0], [2.0, 2.0, 2.0], [1.0, 0.5, 1.0]]
+
+
+def skin_doc(pos, skinned):
+    global blob, views, accs
+    blob, views, accs = bytearray(), [], []
+    a_p = add(pos, 3)
+    a_i = add(s_idx, 1, 5125)
+    prim = {"attributes": {"POSITION": a_p}, "indices": a_i, "material": 0}
+    d = {
+        "asset": {"version": "2.0"}, "scene": 0,
+        "nodes": [{"name": "strip", "mesh": 0}, {"name": "cam", "camera": 0, "translation": [0, 1, 6]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "aspectRatio": 1.0, "znear": 0.1}}],
+        "materials": [{"emissiveFactor": [0.3, 1, 0.5], "doubleSided": True,
+                       "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}}],
+        "meshes": [{"primitives": [prim]}],
+    }
+    d["scenes"] = [{"nodes": [0, 1]}]
+    if skinned:
+        # joints as bytes, weights as floats
+        while len(blob) % 4:
+            blob += b"\0"
+        off = len(blob)
+        blob += bytes(c for j in s_joint for c in j)
+        views.append({"buffer": 0, "byteOffset": off, "byteLength": len(blob) - off})
+        accs.append({"bufferView": len(views) - 1, "componentType": 5121, "count": 6, "type": "VEC4"})
+        prim["attributes"]["JOINTS_0"] = len(accs) - 1
+        prim["attributes"]["WEIGHTS_0"] = add(s_weight, 4)
+        ibm = add([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1],
+                   [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, -1, 0, 1]], 1, typ="MAT4")
+        accs[ibm]["count"] = 2
+        d["nodes"][0]["skin"] = 0
+        d["nodes"][0]["translation"] = [5, 0, 0]
+        d["nodes"] += [{"name": "root", "children": [3]}, {"name": "tip", "translation": s_t[0]}]
+        d["scenes"][0]["nodes"].append(2)
+        d["skins"] = [{"joints": [2, 3], "inverseBindMatrices": ibm}]
+        a_k = add([f32(k / 24.0) for k in range(3)], 1)
+        a_t, a_s = add(s_t, 3), add(s_s, 3)
+        d["animations"] = [{"samplers": [{"input": a_k, "output": a_t}, {"input": a_k, "output": a_s}],
+                            "channels": [{"sampler": 0, "target": {"node": 3, "path": "translation"}},
+                                         {"sampler": 1, "target": {"node": 3, "path": "scale"}}]}]
+    d["accessors"], d["bufferViews"] = accs, views
+    d["buffers"] = [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()}]
+    return d
+
+
+write("skin.gltf", skin_doc(s_pos, True))
+for k in range(3):
+    # joint 0: identity; joint 1: scale s and translation t, times the
+    # inverse bind matrix (a translation by -1 in y)
+    pos = []
+    for v in range(6):
+        p0 = s_pos[v]
+        p1 = [s_s[k][j] * p0[j] + s_t[k][j] + (-s_s[k][1] if j == 1 else 0.0) for j in range(3)]
+        w = s_weight[v]
+        js = s_joint[v]
+        placed = [0.0, 0.0, 0.0]
+        for i in range(4):
+            if w[i] != 0:
+                q = p0 if js[i] == 0 else p1
+                placed = [placed[j] + w[i] * q[j] for j in range(3)]
+        pos.append(placed)
+    write("skin%d.gltf" % k, skin_doc(pos, False))
+d = skin_doc(s_pos, True)
+d["skins"][0] = {"joints": [2]}
+write("bad_skin.gltf", d)
