@@ -267,7 +267,8 @@ static void test_refused(void)
             "/animations/0/samplers/1/output: accessor 2 has type VEC3, expected 1 components");
     refused("scalar translations", "", "{\"input\":0,\"output\":1,", "{\"input\":0,\"output\":4,",
             "/animations/0/samplers/0/output: accessor 4 has type SCALAR, expected 3 components");
-    refused("weights count", "", "{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"},{\"input\":0,\"output\":3}],\"channels\":[",
+    refused("weights count", "",
+            "{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"},{\"input\":0,\"output\":3}],\"channels\":[",
             "{\"input\":0,\"output\":2,\"interpolation\":\"CUBICSPLINE\"},{\"input\":0,\"output\":3},"
             "{\"input\":0,\"output\":5,\"interpolation\":\"CUBICSPLINE\"}],\"channels\":["
             "{\"sampler\":3,\"target\":{\"node\":2,\"path\":\"weights\"}},",

@@ -977,7 +977,8 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
                       fr_error *err)
 {
     memset(r, 0, sizeof *r);
-    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0, NULL, NULL, {0}, NULL, NULL};
+    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0,
+             NULL, NULL, {0}, NULL, NULL};
     gdoc_warn_extensions(d, known_extensions);
     if (o->animate) {
         if (ganim_eval(d, o->time, &c.pose, err) < 0) {

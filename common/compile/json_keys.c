@@ -66,7 +66,9 @@ static cJSON *pose_one(const cJSON *kv, const char *where, double frame, fr_erro
         }
     int step = 0;
     const cJSON *ip = cJSON_GetObjectItemCaseSensitive(kv, "interpolation");
-    if (ip && !(cJSON_IsString(ip) && (!strcmp(ip->valuestring, "linear") || (step = !strcmp(ip->valuestring, "step"))))) {
+    if (ip && cJSON_IsString(ip))
+        step = !strcmp(ip->valuestring, "step");
+    if (ip && !(cJSON_IsString(ip) && (step || !strcmp(ip->valuestring, "linear")))) {
         fr_fail(err, "%s.interpolation: expected \"linear\" or \"step\"", where);
         return NULL;
     }
