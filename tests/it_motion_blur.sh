@@ -8,7 +8,8 @@
 # convolved with the 8-pixel shutter path and averaged over the pixel (a
 # trapezoid: ramps 8 pixels long, a plateau of 4), within the noise of
 # 64 x 16 samples a column; the total light is the quad's; the frame is
-# byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
+# byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts,
+# and its pixels the same as a JSON scene's that places the file;
 # the bidirectional integrator refuses the moving camera.
 . "$(dirname "$0")/support/fakehosts.sh"
 need python3 cmp
@@ -53,6 +54,12 @@ fh_start b 3 1
 fr render "$T/blur.gltf" --frames 12 --shutter 0.5 -o "$T/c.#.pfm" $R --hosts "$FH/hosts" --slab-rows 3 \
     >/dev/null 2>"$T/err" || bad "fake SSH hosts: $(cat "$T/err")"
 cmp -s "$T/a.12.pfm" "$T/c.12.pfm" && ok || bad "fake SSH hosts render a different image"
+
+# the same file as a gltf shape of a JSON scene, its camera taken: the same pixels
+printf '{ "image": { "width": 64, "height": 16, "spp": 64 }, "materials": {},\n  "shapes": [ { "type": "gltf", "file": "blur.gltf", "camera": true } ] }\n' >"$T/jblur.json"
+$F render "$T/jblur.json" --frames 12 --shutter 0.5 -o "$T/j.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "JSON: $(cat "$T/err")"
+tail -c 12288 "$T/a.12.pfm" >"$T/a.px" && tail -c 12288 "$T/j.12.pfm" >"$T/j.px"
+cmp -s "$T/a.px" "$T/j.px" && ok || bad "a gltf shape's moving camera is not blurred as the file's own"
 
 expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
     $F render "$T/blur.gltf" --frames 12 --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm" $R

@@ -35,6 +35,8 @@ typedef struct {
     int gltf_camera;           /* the camera comes from a gltf shape */
     fr_error *err;
     json_appear *look;          /* textures, media (json_appear.h) */
+    int gltf_moving;           /* the gltf shape's camera moves across the shutter: *gltf_open is b->camera */
+    fr_camera *gltf_open;
 } ctx;
 
 static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
@@ -159,15 +161,38 @@ static int camera_motion(ctx *c, const cJSON *open, const cJSON *close)
     return 0;
 }
 
-/* The top-level camera, or (without one) the camera of a gltf shape. */
+/* The top-level camera, or (without one) the camera of a gltf shape: with
+ * a shutter, the file's camera at the shutter's opening, and at its
+ * closing in b->motion when it moved. */
 static int camera(ctx *c, const cJSON *root)
 {
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
     if (cam)
         return parse_camera(c, cam);
     c->gltf_camera = 1;
-    return json_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->scope, c->hooks,
-                            c->err);
+    const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
+    const scene_hooks *h = c->hooks;
+    if (json_gltf_camera(c->b, shapes, c->dir, c->scope, h, c->err) < 0)
+        return -1;
+    if (!h || !h->timed || !(h->shutter > 0.0))
+        return 0;
+    scene_hooks at = *h;
+    at.frame = h->frame + 0.5 * h->shutter;
+    if (json_gltf_camera(c->b, shapes, c->dir, c->scope, &at, c->err) < 0)
+        return -1;
+    fr_camera shut = c->b->camera;
+    at.frame = h->frame - 0.5 * h->shutter;
+    if (json_gltf_camera(c->b, shapes, c->dir, c->scope, &at, c->err) < 0)
+        return -1;
+    c->b->motion.shutter = (float)(h->shutter / (h->fps > 0.0 ? h->fps : 24.0));
+    if (memcmp(&shut, &c->b->camera, sizeof shut) != 0) {
+        c->b->motion.camera_close = shut;
+        c->b->motion.flags |= FR_MOTION_CAMERA;
+        /* (the shape takes the camera again, at the frame: undone after) */
+        c->gltf_moving = 1;
+        *c->gltf_open = c->b->camera;
+    }
+    return 0;
 }
 
 #define TYPES "lambert, phong, mirror, glass, mix, conductor, principled, emitter or interface"
@@ -446,7 +471,8 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
     }
     json_appear look;
     memset(&look, 0, sizeof look);
-    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look};
+    fr_camera gltf_open;
+    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look, 0, &gltf_open};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
                                       "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
@@ -487,6 +513,8 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
                 rc = json_appear_finish(&look, root, &e);
             if (rc == 0 && cam_open)
                 rc = camera_motion(&c, cam_open, cam_close);
+            if (c.gltf_moving)
+                b->camera = gltf_open;
         }
     }
     cJSON_Delete(cam_open);
