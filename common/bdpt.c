@@ -85,6 +85,9 @@ int bd_supported(const fr_scene *s, fr_error *err)
     if (media)
         return fr_fail(err, "the scene has participating media (fog or a medium inside a shape), which the "
                             "bidirectional integrator does not support; render it with the path integrator");
+    if (s->motion.flags)
+        return fr_fail(err, "the scene has motion blur, which the bidirectional integrator does not support; "
+                            "render it with the path integrator");
     return 0;
 }
 

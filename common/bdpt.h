@@ -38,8 +38,8 @@
  * Russian roulette.  So each light subpath belongs to one pixel sample, and
  * a split of the image into rows traces every light subpath once.
  *
- * Scenes that use participating media (fog, a medium inside a shape) are
- * refused (bd_supported).
+ * Scenes that use participating media (fog, a medium inside a shape) or
+ * motion blur are refused (bd_supported).
  */
 #ifndef FRANJA_BDPT_H
 #define FRANJA_BDPT_H
@@ -64,7 +64,7 @@ typedef void (*bd_splat_fn)(void *ctx, uint32_t x, uint32_t y, float r, float g,
 typedef struct bd_work bd_work;
 
 /** 0 when bidirectional path tracing can render scene s; otherwise -1
- * with err saying why (participating media). */
+ * with err saying why (participating media, motion blur). */
 int bd_supported(const fr_scene *s, fr_error *err);
 
 /** Allocate working memory for scene s (subpaths of max_depth + 2

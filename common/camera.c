@@ -24,6 +24,33 @@ vec3 cam_lens(const fr_camera *c, float lx, float ly)
     return v3_add(v3_scale(c->right, rad * cs), v3_scale(c->upv, rad * sn));
 }
 
+static vec3 lerp3(vec3 a, vec3 b, float u)
+{
+    return v3_add(v3_scale(a, 1.0f - u), v3_scale(b, u));
+}
+
+void cam_at(const fr_scene *s, float u, fr_camera *out)
+{
+    *out = s->camera;
+    if (!(s->motion.flags & FR_MOTION_CAMERA) || u == 0.0f)
+        return;
+    const fr_camera *a = &s->camera, *b = &s->motion.camera_close;
+    out->position = lerp3(a->position, b->position, u);
+    vec3 f = lerp3(a->forward, b->forward, u), up = lerp3(a->upv, b->upv, u);
+    vec3 r = v3_cross(f, up);
+    if (v3_len2(f) > 1e-12f && v3_len2(r) > 1e-12f) {
+        /* (a half turn within the shutter keeps the shutter-open axes) */
+        f = v3_norm(f);
+        r = v3_norm(v3_cross(f, up));
+        out->forward = f;
+        out->right = r;
+        out->upv = v3_cross(r, f);
+    }
+    out->tan_half = (1.0f - u) * a->tan_half + u * b->tan_half;
+    out->aperture = (1.0f - u) * a->aperture + u * b->aperture;
+    out->focus = (1.0f - u) * a->focus + u * b->focus;
+}
+
 float cam_lens_area(const fr_camera *c)
 {
     return c->aperture > 0.0f ? FM_PI * c->aperture * c->aperture : 1.0f;

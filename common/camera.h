@@ -26,6 +26,14 @@
  * stratification); zero for a pinhole. */
 vec3 cam_lens(const fr_camera *c, float lx, float ly);
 
+/** The camera at time u in [0, 1] across the shutter (scene.h's
+ * fr_motion) into *out: s->camera itself at u = 0 or when the camera does
+ * not move; otherwise position, field of view, aperture and focus blended
+ * linearly toward the shutter-close camera, and the view axis and up
+ * blended and made orthonormal again (right = forward x up, as the
+ * builder derives them). */
+void cam_at(const fr_scene *s, float u, fr_camera *out);
+
 /** Lens area as the importance convention counts it: pi aperture^2, or 1
  * for a pinhole. */
 float cam_lens_area(const fr_camera *c);

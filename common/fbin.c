@@ -31,8 +31,8 @@ enum {
     SEC_SETTINGS = 1, SEC_CAMERA, SEC_MATERIALS, SEC_PRIMS, SEC_SPHERES, SEC_RECTS,
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
-    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE, SEC_NAMES,
-    SEC_COUNT = SEC_NAMES
+    SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE, SEC_NAMES, SEC_MOTION,
+    SEC_COUNT = SEC_MOTION
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -73,6 +73,7 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_MESH_LEAVES, "mesh_leaves", mesh_leaves, fr_bvh_leaf),
     ARR(SEC_LIGHTTREE, "lighttree", light_nodes, fr_light_node),
     ARR(SEC_NAMES, "material_names", material_names, fr_name),
+    [SEC_MOTION] = {"motion", sizeof(fr_motion), offsetof(fr_scene, motion), 0},
 };
 #undef ARR
 
@@ -208,6 +209,15 @@ int fbin_write_view(const fr_scene *view, const char *path, uint64_t *hash, size
 }
 
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+/* A camera a ray can be made from: finite position and basis, a field of
+ * view, a lens that is a pinhole or focused. */
+static int camera_ok(const fr_camera *c)
+{
+    return finite3(c->position) && finite3(c->forward) && finite3(c->right) && finite3(c->upv) &&
+           c->tan_half > 0.0f && isfinite(c->tan_half) && c->aperture >= 0.0f && isfinite(c->aperture) &&
+           (c->focus > 0.0f || c->aperture == 0.0f);
+}
 
 /* Byte offset of an element inside the blob, for messages; sections of a
  * single element are copied out of the blob, so theirs come from the table
@@ -499,11 +509,15 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     if (st->passes & ~PASS_ALL)
         return fr_fail(err, "section settings, byte %zu: unknown render passes %#x",
                        AT1(SEC_SETTINGS, fr_settings, passes), st->passes & ~PASS_ALL);
-    const fr_camera *c = &s->camera;
-    if (!finite3(c->position) || !finite3(c->forward) || !finite3(c->right) || !finite3(c->upv) ||
-        !(c->tan_half > 0.0f) || !isfinite(c->tan_half) || !(c->aperture >= 0.0f) || !isfinite(c->aperture) ||
-        !(c->focus > 0.0f || c->aperture == 0.0f))
+    if (!camera_ok(&s->camera))
         return fr_fail(err, "section camera, byte %zu: degenerate or non-finite camera", AT1(SEC_CAMERA, fr_camera, position));
+    const fr_motion *mo = &s->motion;
+    if (mo->flags & ~(uint32_t)FR_MOTION_CAMERA || !(mo->shutter >= 0.0f && mo->shutter <= 1e6f))
+        return fr_fail(err, "section motion, byte %zu: unknown flags or a shutter not a time in seconds",
+                       AT1(SEC_MOTION, fr_motion, flags));
+    if ((mo->flags & FR_MOTION_CAMERA) && !camera_ok(&mo->camera_close))
+        return fr_fail(err, "section motion, byte %zu: degenerate or non-finite camera at shutter close",
+                       AT1(SEC_MOTION, fr_motion, camera_close));
     if (validate_appearance(s, base, off, err) < 0)
         return -1;
     for (uint32_t i = 0; i < s->n_materials; i++) {

@@ -62,9 +62,11 @@ static void light_numbers(const fr_scene *s, vec3 from, vec3 nrm, int choose, fr
         smp_2d(smp, u1, u2);
 }
 
-fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly)
+/* pt_camera_ray from camera c (camera.h's cam_at: the camera at a time
+ * within the shutter) instead of the scene's. */
+static fr_ray camera_ray_from(const fr_scene *s, const fr_camera *c, uint32_t x, uint32_t y, float px, float py,
+                              float lx, float ly)
 {
-    const fr_camera *c = &s->camera;
     float w = (float)s->settings.width, h = (float)s->settings.height;
     float sx = (2.0f * ((float)x + px) - w) / h * c->tan_half;
     float sy = (h - 2.0f * ((float)y + py)) / h * c->tan_half;
@@ -79,6 +81,11 @@ fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float 
     }
     r.d = v3_norm(r.d);
     return r;
+}
+
+fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly)
+{
+    return camera_ray_from(s, &s->camera, x, y, px, py, lx, ly);
 }
 
 /* Light reached by a BSDF or phase sample (or seen directly) at surface
@@ -153,7 +160,17 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
         smp_2d(&smp, &lx, &ly);
     else
         smp_skip(&smp);        /* a pinhole has no lens to sample */
-    fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
+    fr_camera at;
+    const fr_camera *cam = &s->camera;
+    if (s->motion.flags) {
+        /* The sample's time across the shutter (scenes without motion
+         * draw no pair here: their numbers stay as they were). */
+        float tu, unused;
+        smp_2d(&smp, &tu, &unused);
+        cam_at(s, tu, &at);
+        cam = &at;
+    }
+    fr_ray ray = camera_ray_from(s, cam, x, y, px, py, lx, ly);
     vec3 camera = ray.o;
     if (ps)
         pass_start(ps);

@@ -30,7 +30,10 @@ typedef enum { PT_MIS = 0, PT_LIGHT_ONLY, PT_BSDF_ONLY, PT_MIS_DISTANCE } pt_str
 fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly);
 
 /** Radiance of sample `index` of pixel (x, y); 0 for a sample that came
- * out NaN or infinite (dropped the same way everywhere). */
+ * out NaN or infinite (dropped the same way everywhere).  The sample's
+ * numbers: the pixel pair, the lens pair (skipped by a pinhole), then,
+ * only in a scene with motion (scene.h's fr_motion), a pair whose first
+ * number is the sample's time across the shutter, then the path's. */
 vec3 pt_sample(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index);
 
 /** Render rows [y0, y1) with s->settings' size and spp into rgb

@@ -388,6 +388,21 @@ typedef struct {
     char name[64];
 } fr_name;
 
+/** Motion blur (fr_motion.flags). */
+enum { FR_MOTION_CAMERA = 1 };
+
+/** What moves while the shutter is open.  A camera sample has a time u in
+ * [0, 1) across the shutter (from its sampler, pathtrace.h), 0 at
+ * shutter open; with FR_MOTION_CAMERA the camera at u is `camera` (the
+ * pose at shutter open) blended toward `camera_close` (camera.h's
+ * cam_at).  Without flags nothing moves and no sample draws a time. */
+typedef struct {
+    uint32_t flags;            /**< FR_MOTION_* */
+    float shutter;             /**< how long the shutter is open, seconds (informational; 0: no shutter) */
+    uint32_t pad[2];
+    fr_camera camera_close;    /**< the camera at shutter close (derived fields set), with FR_MOTION_CAMERA */
+} fr_motion;
+
 /** A whole scene: its settings and camera, and each section as an array
  * and its length (pointing into `blob`). */
 typedef struct {
@@ -419,6 +434,7 @@ typedef struct {
     const fr_bvh_leaf *mesh_leaves; uint32_t n_mesh_leaves;
     const fr_light_node *light_nodes; uint32_t n_light_nodes;
     const fr_name *material_names; uint32_t n_material_names; /**< 0, or one per material */
+    fr_motion motion;
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

@@ -51,6 +51,14 @@ static const char usage[] =
     "                       animation: # in SCENE, -o, --job and --preview stands\n"
     "                       for the zero-padded frame number (f.####.json)\n"
     "  --overwrite          with --frames: render frames whose output exists\n"
+    "  --fps F              with --frames of one animated file (no # in SCENE):\n"
+    "                       frames per second; frame N of a glTF file is posed at\n"
+    "                       time N / F seconds, as Blender's glTF exporter writes\n"
+    "                       key times (default 24)\n"
+    "  --shutter S          with --frames of one animated file: motion blur over a\n"
+    "                       shutter open S of a frame (0 to 1), centred on the\n"
+    "                       frame's time as Blender's; the camera's motion is\n"
+    "                       blurred (without it: a JSON camera's shutter key)\n"
     "  --camera NAME        glTF scenes: the camera to use, by its node's or its\n"
     "                       own name (default: the first in the scene)\n"
     "  --allow-path DIR     let a JSON or glTF scene read files in DIR too\n"
@@ -117,7 +125,8 @@ enum {
     OPT_SPP = CLI_OPT_OWN, OPT_SIZE, OPT_CAMERA, OPT_EXPOSURE, OPT_TONEMAP, OPT_RESUME, OPT_FRESH, OPT_JOB,
     OPT_KEEP_JOB, OPT_NO_LOCK, OPT_SLAB_ROWS, OPT_RETRIES, OPT_PREVIEW, OPT_PREVIEW_EVERY,
     OPT_INTEGRATOR, OPT_PROGRESS, OPT_NOISE, OPT_MONITOR, OPT_CROP, OPT_CROP_OUTPUT,
-    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_TIME_LIMIT,
+    OPT_EXR_HALF, OPT_EXR_COMPRESSION, OPT_JPEG_QUALITY, OPT_SCALE, OPT_FRAMES, OPT_OVERWRITE, OPT_FPS, OPT_SHUTTER,
+    OPT_TIME_LIMIT,
     OPT_REPRODUCIBLE, OPT_MONITOR_OPEN, OPT_ALLOW_PATH, OPT_LIMIT, OPT_PASSES
 };
 
@@ -156,6 +165,8 @@ static int parse(int argc, char **argv, frame_settings *a)
         {"reproducible", no_argument, NULL, OPT_REPRODUCIBLE},
         {"frames", required_argument, NULL, OPT_FRAMES},
         {"overwrite", no_argument, NULL, OPT_OVERWRITE},
+        {"fps", required_argument, NULL, OPT_FPS},
+        {"shutter", required_argument, NULL, OPT_SHUTTER},
         {"time-limit", required_argument, NULL, OPT_TIME_LIMIT},
         {"limit", required_argument, NULL, OPT_LIMIT},
         {"passes", required_argument, NULL, OPT_PASSES},
@@ -292,6 +303,18 @@ static int parse(int argc, char **argv, frame_settings *a)
         case OPT_OVERWRITE:
             a->overwrite = 1;
             break;
+        case OPT_FPS: {
+            float f = 0;
+            bad = opt_float(cmd, "--fps", v, 0.001f, 1000.0f, &f);
+            a->fps = f;
+            break;
+        }
+        case OPT_SHUTTER: {
+            float f = 0;
+            bad = opt_float(cmd, "--shutter", v, 0.0f, 1.0f, &f);
+            a->shutter = f;
+            break;
+        }
         case OPT_TIME_LIMIT:
             bad = opt_duration(cmd, "--time-limit", v, &a->time_limit);
             break;
@@ -357,6 +380,11 @@ static int parse(int argc, char **argv, frame_settings *a)
     }
     if (a->overwrite && !a->frames) {
         fprintf(stderr, "franja render: --overwrite is for --frames (a single render always writes its output)\n");
+        return 2;
+    }
+    if ((a->fps > 0 || a->shutter > 0) && (!a->frames || !framewalk_one_scene(a->scene))) {
+        fprintf(stderr, "franja render: --%s is for --frames of one glTF or JSON file (posed per frame)\n",
+                a->fps > 0 ? "fps" : "shutter");
         return 2;
     }
     if (a->resume && a->fresh) {

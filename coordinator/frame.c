@@ -13,6 +13,7 @@
 #include "clock.h"
 #include "compile/compile.h"
 #include "compile/compile_child.h"
+#include "compile/gltf_anim.h"
 #include "fbin.h"
 #include "opt.h"
 #include "protocol.h"
@@ -59,7 +60,8 @@ static int scene_binary(const frame_settings *a, const char *jobdir, char *path,
      * keeps any other compile out of this directory. */
     compile_child_sweep(path);
     /* In a child process, so that Ctrl-C stops a long compile at once. */
-    compile_opts co = {a->camera, print_warning, (void *)"franja", a->allow, a->n_allow, &a->limits, NULL};
+    compile_opts co = {a->camera, print_warning, (void *)"franja", a->allow, a->n_allow, &a->limits, NULL,
+                       a->timed, a->frame, a->fps > 0 ? a->fps : GANIM_FPS, a->timed ? a->shutter : 0.0};
     if (compile_child(a->scene, &co, path, stop, NULL, err))
         return -1;
     return fbin_load(path, sc, err);

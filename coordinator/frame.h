@@ -54,6 +54,10 @@ typedef struct {
     int resume, keep_job, fresh, no_lock;
     const char *frames;        /* --frames LIST, or NULL */
     int overwrite;             /* --overwrite */
+    double fps;                /* --fps, 0 when not given (GANIM_FPS) */
+    double shutter;            /* --shutter, a fraction of a frame; 0 when not given */
+    int timed;                 /* an animation's frame of one scene file: posed at `frame` (set per frame) */
+    uint32_t frame;            /* the frame number, when timed */
     int reproducible;          /* --reproducible: no render time or hosts in the metadata */
     double time_limit;         /* --time-limit, seconds; 0 when not given */
     uint32_t passes;           /* --passes: render passes (passes.h mask) */

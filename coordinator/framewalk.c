@@ -9,6 +9,9 @@
 #include <sys/stat.h>
 
 #include "clock.h"
+#include "compile/compile.h"
+#include "compile/json_keys.h"
+#include "file.h"
 
 /* argv with every string that holds (points into) one of the patterns
  * rewritten for frame f; NULL when out of memory or a name is too long.
@@ -76,6 +79,37 @@ static void free_args(int argc, char **v)
     free(v);
 }
 
+int framewalk_one_scene(const char *scene)
+{
+    size_t n = strlen(scene);
+    if (framelist_is_pattern(scene))
+        return 0;
+    if (compile_is_gltf(scene))
+        return 1;
+    if (n <= 5 || strcmp(scene + n - 5, ".json") != 0)
+        return 0;
+    /* A JSON scene with keyed values or a gltf shape (whose file may be
+     * animated); one that cannot be read counts too, so that its compile
+     * says what is wrong with it. */
+    char *text;
+    size_t len;
+    fr_error err;
+    if (file_read(scene, &text, &len, &err))
+        return 1;
+    cJSON *root = cJSON_ParseWithLength(text, len);
+    free(text);
+    if (!root)
+        return 1;
+    const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
+    int keyed = json_keys_in(cJSON_GetObjectItemCaseSensitive(root, "camera"));
+    for (const cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s && !keyed; s = s->next) {
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(s, "type");
+        keyed = json_keys_in(s) || (cJSON_IsString(t) && !strcmp(t->valuestring, "gltf"));
+    }
+    cJSON_Delete(root);
+    return keyed;
+}
+
 int framewalk_check_plain(const char *scene)
 {
     struct stat st;
@@ -96,7 +130,7 @@ int framewalk_begin(framewalk_iter *it, int argc, char **argv, const framewalk_j
         return 2;
     }
     const char *what = NULL, *name = NULL;
-    if (!framelist_is_pattern(job->scene))
+    if (!framelist_is_pattern(job->scene) && !job->one_scene)
         what = "the scene", name = job->scene;
     else if (!framelist_is_pattern(job->out))
         what = "the output (-o, else named after the scene)", name = job->out;
@@ -104,7 +138,8 @@ int framewalk_begin(framewalk_iter *it, int argc, char **argv, const framewalk_j
         what = "--job", name = job->jobdir;
     if (what) {
         fprintf(stderr, "franja render: --frames: %s '%s' has no # for the frame number (e.g. "
-                "shots/f.####.json -o out/f.####.exr: each frame its own file)\n", what, name);
+                "shots/f.####.json -o out/f.####.exr: each frame its own file; an animated\n"
+                "glTF file, or a JSON scene with keyed values, is one scene for every frame)\n", what, name);
         framelist_free(&it->fl);
         return 2;
     }

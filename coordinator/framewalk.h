@@ -25,6 +25,7 @@ typedef struct {
     const char *list;       /**< the --frames value */
     int overwrite;          /**< --overwrite: render frames whose output exists */
     const char *scene, *out, *jobdir, *preview;
+    int one_scene;          /**< the scene is one animated file, posed per frame: it needs no # */
 } framewalk_job;
 
 /** The exit status of an animation that --time-limit stopped before
@@ -79,6 +80,12 @@ void framewalk_failed(framewalk_iter *it, uint32_t number, const char *scene, co
 
 /** Ends the walk: with rc 0 prints the summary; frees the list; returns rc. */
 int framewalk_end(framewalk_iter *it, int rc);
+
+/** 1 when `scene` is one file for every frame, posed per frame: a glTF
+ * file (its animations) or a JSON scene with keyed values (json_keys.h)
+ * or a gltf shape (or one that cannot be read: its compile says why),
+ * whose name has no #. */
+int framewalk_one_scene(const char *scene);
 
 /** For a render without --frames: 0, or, when scene is a '#' pattern that
  * names no file, prints that --frames is needed and returns 2. */

@@ -139,6 +139,11 @@ static int rf_open(anim_run *fx, sched_frame *next)
         fprintf(stderr, "franja render: %s\n", e.msg);
         rc = 2;
     }
+    if (!rc && fx->it.job.one_scene) {
+        /* One animated file: this frame's pose. */
+        fs->im->a.timed = 1;
+        fs->im->a.frame = fs->one.number;
+    }
     if (!rc) {
         /* The run's limit (fx->deadline), not passes of each frame. */
         fs->im->a.time_limit = 0;
@@ -278,7 +283,8 @@ static int run_reporters(anim_run *fx, const frame_settings *a)
 int render_anim(int argc, char **argv, frame_settings *a, render_anim_parse_fn parse)
 {
     double t_start = clock_now();
-    framewalk_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview};
+    framewalk_job fj = {a->frames, a->overwrite, a->scene, a->out, a->jobdir, a->preview,
+                        framewalk_one_scene(a->scene)};
     anim_run fx;
     memset(&fx, 0, sizeof fx);
     fx.parse = parse;

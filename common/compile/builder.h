@@ -55,6 +55,8 @@ typedef struct {
     fr_array light_nodes;      /**< fr_light_node: the light tree, built by frz_scene */
     int no_light_tree;         /**< 1: no light tree, next-event estimation picks by the power table alone */
     fr_array material_names;   /**< fr_name: the materials' names as far as given (bld_material_name) */
+    fr_motion motion;          /**< what moves while the shutter is open (scene.h); zero: nothing.  frz_scene
+                                    finishes camera_close as it does the camera */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero, no

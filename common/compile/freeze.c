@@ -103,6 +103,8 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     f->table = (fr_array){NULL, 0, 0, sizeof(fr_mesh)};
     if (bld_camera_finish(&b->camera, err) < 0 || bld_drop_unused_vertices(b, err) < 0 || bld_flatten(b, 0, err) < 0)
         return -1;
+    if ((b->motion.flags & FR_MOTION_CAMERA) && bld_camera_finish(&b->motion.camera_close, err) < 0)
+        return -1;
     fr_array mprims = {NULL, 0, 0, sizeof(fr_prim)};
     /* With instances, two levels: a tree per mesh, then the scene's over
      * the other prims and the instances (bld_flatten has dropped meshes
@@ -139,6 +141,7 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     view->volume = b->volume;
     view->tonemap = b->tonemap;
     view->world = b->world;
+    view->motion = b->motion;
     VIEW(distrib, b->distrib);
     VIEW(meshes, f->table); VIEW(instances, b->instances);
     VIEW(mesh_nodes, f->mnodes); VIEW(mesh_leaves, f->mleaves);

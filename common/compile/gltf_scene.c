@@ -11,6 +11,7 @@
 #include "compile/builder_instance.h"
 #include "compile/builder_light.h"
 #include "compile/freeze.h"
+#include "compile/gltf_anim.h"
 #include "compile/gltf_doc.h"
 #include "compile/gltf_mat.h"
 
@@ -81,7 +82,18 @@ typedef struct {
     int counting;              /* the first pass over the nodes: only count the uses of each mesh */
     uint32_t *uses;            /* per glTF mesh: nodes that draw it */
     uint32_t *mesh_of;         /* per glTF mesh drawn more than once: its builder mesh, or FR_NONE */
+    ganim_pose pose;           /* the animated nodes (o->animate), else empty */
+    affine *world;             /* with skins: every node's world transform (from the counting pass) */
+    unsigned char *placed;     /* with skins: which nodes of world are set (in the scene) */
 } imp;
+
+/* A skin as one node uses it: its joints' matrices (joint's world
+ * transform times its inverse bind matrix). */
+typedef struct {
+    affine *joint;
+    uint32_t n;
+    uint32_t skin;             /* its index (messages) */
+} skinning;
 
 /* ---- nodes ------------------------------------------------------------ */
 
@@ -99,6 +111,18 @@ static int local_transform(imp *c, uint32_t n, affine *out, fr_error *err)
         gdoc_numbers(d, o, ptr, "scale", 3, s, &has_s, err) < 0)
         return -1;
     af_identity(out);
+    const ganim_node *an = n < c->pose.n ? &c->pose.node[n] : NULL;
+    if (an && an->set) {
+        if (has_m)
+            return gdoc_fail(d, err, ptr, "matrix: a node animated by /animations/%u/channels/%u must give "
+                             "translation/rotation/scale instead", an->anim, an->channel);
+        if (an->set & GANIM_T)
+            memcpy(t, an->t, sizeof t);
+        if (an->set & GANIM_R)
+            memcpy(q, an->r, sizeof q), has_r = 1;
+        if (an->set & GANIM_S)
+            memcpy(s, an->s, sizeof s);
+    }
     if (has_m) {
         if (has_t || has_r || has_s)
             return gdoc_fail(d, err, ptr, "both matrix and translation/rotation/scale");
@@ -140,7 +164,108 @@ static uint32_t corner(uint32_t mode, uint32_t t, int k)
     return k == 0 ? t + 1 : k == 1 ? t + 2 : 0; /* fan */
 }
 
-static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const affine *w, fr_error *err)
+/* The morph weights a node gives its mesh. */
+typedef struct {
+    double w[GANIM_MAX_WEIGHTS];
+    uint32_t n;                /* 0: none (the base mesh) */
+    char from[64];             /* where they come from (messages) */
+} morph;
+
+/* The morph targets of primitive `ptr` (object p) with nv vertices, as
+ * weights `mw` blend them: the accessors of the targets of non-zero
+ * weight into t[] (*nt of them, their weights in wt[]), NORMAL ones into
+ * tn[] where present. */
+static int morph_targets(imp *c, const cJSON *p, const char *ptr, uint32_t nv, const morph *mw, gdoc_acc *t,
+                         gdoc_acc *tn, int *has_n, double *wt, uint32_t *nt, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    const cJSON *targets = cJSON_GetObjectItemCaseSensitive(p, "targets");
+    *nt = 0;
+    if (!targets)
+        return 0;
+    char tp[112];
+    snprintf(tp, sizeof tp, "%s/targets", ptr);
+    int n = cJSON_GetArraySize(targets);
+    if (!cJSON_IsArray(targets) || n > GANIM_MAX_WEIGHTS)
+        return gdoc_fail(d, err, tp, "expected an array of at most %d targets", GANIM_MAX_WEIGHTS);
+    if (mw->n && mw->n != (uint32_t)n)
+        return gdoc_fail(d, err, tp, "%d targets, but %s gives %u weights", n, mw->from, mw->n);
+    int k = 0;
+    for (const cJSON *o = targets->child; o; o = o->next, k++) {
+        if (!mw->n || mw->w[k] == 0.0)
+            continue;
+        char op[128];
+        snprintf(op, sizeof op, "%s/%d", tp, k);
+        uint32_t ip, in;
+        if (!cJSON_IsObject(o))
+            return gdoc_fail(d, err, op, "expected an object");
+        if (gdoc_index(d, o, op, "POSITION", 0, d->accessors.n, "accessors", &ip, err) < 0 ||
+            gdoc_index(d, o, op, "NORMAL", 0, d->accessors.n, "accessors", &in, err) < 0)
+            return -1;
+        if (ip == UINT32_MAX && in == UINT32_MAX)
+            continue;
+        gdoc_acc *a = &t[*nt], *an = &tn[*nt];
+        memset(a, 0, sizeof *a);
+        memset(an, 0, sizeof *an);
+        if ((ip != UINT32_MAX && gdoc_accessor(d, ip, op, 3, NULL, a, err) < 0) ||
+            (in != UINT32_MAX && gdoc_accessor(d, in, op, 3, NULL, an, err) < 0))
+            return -1;
+        if ((ip != UINT32_MAX && a->count != nv) || (in != UINT32_MAX && an->count != nv))
+            return gdoc_fail(d, err, op, "a target of a different count than POSITION's %u", nv);
+        has_n[*nt] = in != UINT32_MAX;
+        if (ip == UINT32_MAX)
+            a->count = 0;              /* no position offsets: all zeros */
+        wt[(*nt)++] = mw->w[k];
+    }
+    return 0;
+}
+
+/* Vertex i's matrix under skin sk: the joints' matrices weighted by
+ * JOINTS_0 and WEIGHTS_0, in the order of the four components. */
+static void skin_matrix(const skinning *sk, const gdoc_acc *joints, const gdoc_acc *weights, uint32_t i, affine *m)
+{
+    memset(m, 0, sizeof *m);
+    for (uint32_t k = 0; k < 4; k++) {
+        double wk = gdoc_get(weights, i, k);
+        if (wk == 0.0)
+            continue;
+        const affine *j = &sk->joint[(uint32_t)gdoc_get(joints, i, k)];
+        for (int r = 0; r < 3; r++)
+            for (int q = 0; q < 4; q++)
+                m->m[r][q] += wk * j->m[r][q];
+    }
+}
+
+/* JOINTS_0 and WEIGHTS_0 of a skinned primitive (attributes `attrs` at
+ * `ap`, nv vertices), every joint index checked against the skin. */
+static int skin_attributes(imp *c, const cJSON *attrs, const char *ap, uint32_t nv, const skinning *sk,
+                           gdoc_acc *joints, gdoc_acc *weights, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    static const uint32_t jtypes[] = {GDOC_U8, GDOC_U16, 0}, wtypes[] = {GDOC_F32, GDOC_U8, GDOC_U16, 0};
+    uint32_t ij, iw;
+    if (gdoc_index(d, attrs, ap, "JOINTS_0", 1, d->accessors.n, "accessors", &ij, err) < 0 ||
+        gdoc_index(d, attrs, ap, "WEIGHTS_0", 1, d->accessors.n, "accessors", &iw, err) < 0 ||
+        gdoc_accessor(d, ij, ap, 4, jtypes, joints, err) < 0 || gdoc_accessor(d, iw, ap, 4, wtypes, weights, err) < 0)
+        return -1;
+    if (joints->count != nv || weights->count != nv)
+        return gdoc_fail(d, err, ap, "JOINTS_0 and WEIGHTS_0 need %u elements (POSITION's count)", nv);
+    if (cJSON_GetObjectItemCaseSensitive(attrs, "JOINTS_1"))
+        gdoc_warn(d, "joints1", "%s/JOINTS_1: more than four joints a vertex: the first four are used", ap);
+    for (uint32_t i = 0; i < nv; i++)
+        for (uint32_t k = 0; k < 4; k++) {
+            double wk = gdoc_get(weights, i, k);
+            if (!isfinite(wk))
+                return gdoc_fail(d, err, ap, "WEIGHTS_0: element %u is not finite", i);
+            if (wk != 0.0 && gdoc_get(joints, i, k) >= sk->n)
+                return gdoc_fail(d, err, ap, "JOINTS_0: element %u names joint %g; /skins/%u has %u", i,
+                                 gdoc_get(joints, i, k), sk->skin, sk->n);
+        }
+    return 0;
+}
+
+static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const affine *w, const morph *mw,
+                     const skinning *sk, fr_error *err)
 {
     gltf_doc *d = c->d;
     fr_builder *b = c->b;
@@ -168,8 +293,6 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
                   "the UVs of each triangle)", ap);
     if (cJSON_GetObjectItemCaseSensitive(attrs, "COLOR_0"))
         gdoc_warn(d, "color", "%s/COLOR_0: vertex colours are not supported: ignored", ap);
-    if (cJSON_GetObjectItemCaseSensitive(p, "targets"))
-        gdoc_warn(d, "morph", "%s/targets: morph targets are not supported: the base mesh is drawn", ptr);
     if (mode < MODE_TRIANGLES) {
         gdoc_warn(d, "points", "%s/mode: points and lines are not rendered", ptr);
         return 0;
@@ -221,12 +344,22 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
             return gdoc_fail(d, err, ptr, "indices: accessor %u element %u is %u, not below the vertex count %u",
                              iidx, i, v, nv);
     }
+    gdoc_acc joints, weights;
+    if (sk && skin_attributes(c, attrs, ap, nv, sk, &joints, &weights, err) < 0)
+        return -1;
+    gdoc_acc tpos[GANIM_MAX_WEIGHTS], tnrm[GANIM_MAX_WEIGHTS];
+    int tn_has[GANIM_MAX_WEIGHTS];
+    double tw[GANIM_MAX_WEIGHTS];
+    uint32_t nt;
+    if (morph_targets(c, p, ptr, nv, mw, tpos, tnrm, tn_has, tw, &nt, err) < 0)
+        return -1;
     uint32_t mat = c->o->material;
     const double *uvxf = NULL;
     if (mat == FR_NONE && gmat_material(&c->mat, imat, &mat, &uvxf, err) < 0)
         return -1;
 
-    double det = af_det(w), cof[3][3];
+    /* (a skinned mesh: its first joint's orientation decides the winding) */
+    double det = af_det(sk ? &sk->joint[0] : w), cof[3][3];
     af_cofactor(w, cof);
     uint32_t base = b->positions.count;
     int use_n = inrm != UINT32_MAX, use_uv = iuv != UINT32_MAX;
@@ -234,7 +367,21 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
         return gdoc_fail(d, err, ptr, "out of memory");
     for (uint32_t i = 0; i < nv; i++) {
         double in[3] = {gdoc_get(&pos, i, 0), gdoc_get(&pos, i, 1), gdoc_get(&pos, i, 2)}, o[3];
-        af_apply(w, in, 1.0, o);
+        for (uint32_t k = 0; k < nt; k++)          /* morph targets, in the file's order */
+            for (int j = 0; j < 3 && tpos[k].count; j++)
+                in[j] += tw[k] * gdoc_get(&tpos[k], i, (uint32_t)j);
+        affine vm;
+        const affine *pw = w;
+        double vdet = det, vcof[3][3];
+        const double (*cf)[3] = cof;
+        if (sk) {                                  /* skinned: the vertex's own matrix */
+            skin_matrix(sk, &joints, &weights, i, &vm);
+            pw = &vm;
+            vdet = af_det(&vm);
+            af_cofactor(&vm, vcof);
+            cf = vcof;
+        }
+        af_apply(pw, in, 1.0, o);
         vec3 p = v3((float)o[0], (float)o[1], (float)o[2]);
         if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
             return gdoc_fail(d, err, ap, "POSITION: accessor %u element %u is not finite once placed", ipos, i);
@@ -242,8 +389,11 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
             return gdoc_fail(d, err, ptr, "out of memory");
         if (use_n) {
             double nn[3] = {gdoc_get(&nrm, i, 0), gdoc_get(&nrm, i, 1), gdoc_get(&nrm, i, 2)}, m[3];
+            for (uint32_t k = 0; k < nt; k++)
+                for (int j = 0; j < 3 && tn_has[k]; j++)
+                    nn[j] += tw[k] * gdoc_get(&tnrm[k], i, (uint32_t)j);
             for (int k = 0; k < 3; k++)
-                m[k] = (det < 0 ? -1.0 : 1.0) * (cof[k][0] * nn[0] + cof[k][1] * nn[1] + cof[k][2] * nn[2]);
+                m[k] = (vdet < 0 ? -1.0 : 1.0) * (cf[k][0] * nn[0] + cf[k][1] * nn[1] + cf[k][2] * nn[2]);
             double l = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
             vec3 q = l > 0 && isfinite(l) ? v3((float)(m[0] / l), (float)(m[1] / l), (float)(m[2] / l)) : v3s(0);
             if (bld_push(&b->normals, &q) == FR_NONE)
@@ -291,7 +441,7 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
     return 0;
 }
 
-static int mesh_prims(imp *c, uint32_t m, const affine *w, fr_error *err)
+static int mesh_prims(imp *c, uint32_t m, const affine *w, const morph *mw, const skinning *sk, fr_error *err)
 {
     gltf_doc *d = c->d;
     char ptr[48];
@@ -301,25 +451,68 @@ static int mesh_prims(imp *c, uint32_t m, const affine *w, fr_error *err)
         return gdoc_fail(d, err, ptr, "primitives: expected an array");
     uint32_t i = 0;
     for (const cJSON *p = prims->child; p; p = p->next, i++)
-        if (primitive(c, m, i, p, w, err) < 0)
+        if (primitive(c, m, i, p, w, mw, sk, err) < 0)
             return -1;
+    return 0;
+}
+
+/* The morph weights node n gives mesh m: the animations', else the
+ * node's `weights`, else the mesh's; none (n 0) when all are zero. */
+static int morph_weights(imp *c, uint32_t n, uint32_t m, morph *mw, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    const ganim_node *an = n < c->pose.n ? &c->pose.node[n] : NULL;
+    mw->n = 0;
+    if (an && (an->set & GANIM_W)) {
+        mw->n = an->n_weights;
+        memcpy(mw->w, an->w, mw->n * sizeof *mw->w);
+        snprintf(mw->from, sizeof mw->from, "/animations/%u (a weights channel)", an->anim);
+    } else {
+        char ptr[48];
+        const cJSON *o = d->nodes.v[n];
+        snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+        if (!cJSON_GetObjectItemCaseSensitive(o, "weights")) {
+            o = d->meshes.v[m];
+            snprintf(ptr, sizeof ptr, "/meshes/%u", m);
+        }
+        const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, "weights");
+        if (!a)
+            return 0;
+        snprintf(mw->from, sizeof mw->from, "%s/weights", ptr);
+        if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) > GANIM_MAX_WEIGHTS)
+            return gdoc_fail(d, err, mw->from, "expected an array of at most %d numbers", GANIM_MAX_WEIGHTS);
+        for (const cJSON *e = a->child; e; e = e->next) {
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
+                return gdoc_fail(d, err, mw->from, "element %u: expected a finite number", mw->n);
+            mw->w[mw->n++] = e->valuedouble;
+        }
+    }
+    uint32_t nonzero = 0;
+    for (uint32_t i = 0; i < mw->n; i++)
+        nonzero += mw->w[i] != 0.0;
+    if (!nonzero)
+        mw->n = 0;
     return 0;
 }
 
 /* A mesh drawn by one node is placed into the world's triangles; one drawn
  * by several is read once in its own space and placed by an instance per
- * node (builder_instance.h). */
-static int mesh(imp *c, uint32_t m, const affine *w, fr_error *err)
+ * node (builder_instance.h), unless morph weights bend it: then this node's
+ * copy is placed into the world's triangles. */
+static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning *sk, fr_error *err)
 {
-    if (c->uses[m] < 2)
-        return mesh_prims(c, m, w, err);
+    morph mw;
+    if (morph_weights(c, n, m, &mw, err) < 0)
+        return -1;
+    if (c->uses[m] < 2 || mw.n || sk)
+        return mesh_prims(c, m, w, &mw, sk, err);
     if (c->mesh_of[m] == FR_NONE) {
         affine id;
         af_identity(&id);
         uint32_t k = bld_mesh_begin(c->b);
         if (k == FR_NONE)
             return gdoc_fail(c->d, err, NULL, "out of memory");
-        if (mesh_prims(c, m, &id, err) < 0)
+        if (mesh_prims(c, m, &id, &mw, NULL, err) < 0)
             return -1;
         fr_error e;
         if (bld_mesh_end(c->b, k, &e) < 0)
@@ -470,6 +663,65 @@ static int light(imp *c, uint32_t n, const cJSON *ext, const affine *w, fr_error
     return 0;
 }
 
+/* The skin node n names, if any: its joints' matrices into *sk (malloc'd,
+ * the caller frees sk->joint), from their world transforms at the pose
+ * and the inverse bind matrices.  A skinned mesh's vertices are placed
+ * by its joints alone (glTF ignores the node's own transform). */
+static int skin_of(imp *c, uint32_t n, skinning *sk, fr_error *err)
+{
+    gltf_doc *d = c->d;
+    char ptr[48], sp[48], jp[64];
+    snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+    const cJSON *skins = cJSON_GetObjectItemCaseSensitive(d->root, "skins");
+    uint32_t si, ibm;
+    if (gdoc_index(d, d->nodes.v[n], ptr, "skin", 0, (uint32_t)cJSON_GetArraySize(skins), "skins", &si, err) < 0)
+        return -1;
+    if (si == UINT32_MAX)
+        return 0;
+    const cJSON *so = cJSON_GetArrayItem(skins, (int)si);
+    snprintf(sp, sizeof sp, "/skins/%u", si);
+    snprintf(jp, sizeof jp, "%s/joints", sp);
+    const cJSON *joints = cJSON_GetObjectItemCaseSensitive(so, "joints");
+    int nj = cJSON_GetArraySize(joints);
+    if (!cJSON_IsObject(so) || !cJSON_IsArray(joints) || nj < 1)
+        return gdoc_fail(d, err, sp, "expected an object with a non-empty array of joints");
+    if (gdoc_index(d, so, sp, "inverseBindMatrices", 0, d->accessors.n, "accessors", &ibm, err) < 0)
+        return -1;
+    static const uint32_t floats[] = {GDOC_F32, 0};
+    gdoc_acc ib;
+    if (ibm != UINT32_MAX && (gdoc_accessor(d, ibm, sp, 16, floats, &ib, err) < 0))
+        return -1;
+    if (ibm != UINT32_MAX && ib.count != (uint32_t)nj)
+        return gdoc_fail(d, err, sp, "inverseBindMatrices: %u matrices for %d joints", ib.count, nj);
+    if (!c->world)
+        return gdoc_fail(d, err, sp, "internal: no world transforms");
+    if ((sk->joint = malloc((size_t)nj * sizeof *sk->joint)) == NULL)
+        return gdoc_fail(d, err, sp, "out of memory");
+    sk->n = (uint32_t)nj;
+    sk->skin = si;
+    int k = 0;
+    for (const cJSON *e = joints->child; e; e = e->next, k++) {
+        double x = e->valuedouble;
+        if (!cJSON_IsNumber(e) || x != floor(x) || !(x >= 0 && x < d->nodes.n))
+            return gdoc_fail(d, err, jp, "element %d is not a node index (the file has %u nodes)", k, d->nodes.n);
+        uint32_t j = (uint32_t)x;
+        if (!c->placed[j])
+            return gdoc_fail(d, err, jp, "element %d: node %u is not in the scene", k, j);
+        affine inv;
+        af_identity(&inv);
+        for (int r = 0; ibm != UINT32_MAX && r < 4; r++)
+            for (int q = 0; q < 4; q++) {
+                double v = gdoc_get(&ib, (uint32_t)k, (uint32_t)(4 * q + r)); /* column-major */
+                if (!isfinite(v) || (r == 3 && v != (q == 3 ? 1.0 : 0.0)))
+                    return gdoc_fail(d, err, sp, "inverseBindMatrices: matrix %d is not finite and affine", k);
+                if (r < 3)
+                    inv.m[r][q] = v;
+            }
+        af_mul(&sk->joint[k], &c->world[j], &inv);
+    }
+    return 0;
+}
+
 static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
 {
     gltf_doc *d = c->d;
@@ -484,16 +736,20 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
     if (c->counting) {
         if (m != UINT32_MAX)
             c->uses[m]++;
+        if (c->world) {
+            c->world[n] = *w;
+            c->placed[n] = 1;
+        }
         return 0;
     }
     if (ext)
         lp = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
-    if (cJSON_GetObjectItemCaseSensitive(o, "skin"))
-        gdoc_warn(d, "skin", "%s/skin: skinning is not supported: the mesh is drawn in its bind pose", ptr);
-    if (cJSON_GetObjectItemCaseSensitive(o, "weights"))
-        gdoc_warn(d, "morph", "%s/weights: morph targets are not supported: the base mesh is drawn", ptr);
-    if ((m != UINT32_MAX && mesh(c, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
-        (lp && light(c, n, lp, w, err) < 0))
+    skinning sk = {NULL, 0, 0};
+    int rc = 0;
+    if (m != UINT32_MAX && !c->o->camera_only && (rc = skin_of(c, n, &sk, err)) == 0)
+        rc = mesh(c, n, m, w, sk.joint ? &sk : NULL, err);
+    free(sk.joint);
+    if (rc < 0 || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) || (lp && light(c, n, lp, w, err) < 0))
         return -1;
     return 0;
 }
@@ -589,6 +845,18 @@ static int traverse(imp *c, fr_error *err)
     } else {
         for (uint32_t i = 0; i < n; i++)
             c->mesh_of[i] = FR_NONE;
+        /* With skins, the counting pass keeps every node's world transform
+         * for the joints. */
+        uint32_t nn = c->d->nodes.n ? c->d->nodes.n : 1;
+        if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(c->d->root, "skins")) > 0 &&
+            (!(c->world = malloc(nn * sizeof *c->world)) || !(c->placed = calloc(nn, 1)))) {
+            free(c->uses);
+            free(c->mesh_of);
+            free(c->world);
+            c->uses = c->mesh_of = NULL;
+            c->world = NULL;
+            return gdoc_fail(c->d, err, NULL, "out of memory");
+        }
         c->counting = 1;
         rc = walk_nodes(c, err);
         c->counting = 0;
@@ -597,7 +865,11 @@ static int traverse(imp *c, fr_error *err)
     }
     free(c->uses);
     free(c->mesh_of);
+    free(c->world);
+    free(c->placed);
     c->uses = c->mesh_of = NULL;
+    c->world = NULL;
+    c->placed = NULL;
     return rc;
 }
 
@@ -705,15 +977,25 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
                       fr_error *err)
 {
     memset(r, 0, sizeof *r);
-    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0, NULL, NULL};
+    imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0,
+             NULL, NULL, {0}, NULL, NULL};
     gdoc_warn_extensions(d, known_extensions);
-    const cJSON *an = cJSON_GetObjectItemCaseSensitive(d->root, "animations");
-    if (cJSON_GetArraySize(an) > 0)
-        gdoc_warn(d, "animations", "/animations: animations are not supported: the scene is drawn at rest");
-    if (gmat_begin(&c.mat, d, hooks, b, err) < 0)
+    if (o->animate) {
+        if (ganim_eval(d, o->time, &c.pose, err) < 0) {
+            ganim_free(&c.pose);
+            return -1;
+        }
+    } else if (ganim_present(d)) {
+        gdoc_warn(d, "animations", "/animations: not played: the scene is drawn at rest (render with --frames to "
+                  "pose it per frame)");
+    }
+    if (gmat_begin(&c.mat, d, hooks, b, err) < 0) {
+        ganim_free(&c.pose);
         return -1;
+    }
     int rc = traverse(&c, err);
     gmat_end(&c.mat);
+    ganim_free(&c.pose);
     if (rc == 0 && o->take_camera && o->camera && c.cam_node < 0) {
         char names[256];
         camera_names(d, names, sizeof names);
@@ -788,6 +1070,43 @@ static int frame_bounds(fr_builder *b, vec3 lo, vec3 hi, fr_error *err)
     return bld_camera_finish(cm, err);
 }
 
+/* The camera of options o (take_camera) posed at time t into *cam. */
+static int camera_at(const char *path, const void *bytes, size_t len, const gltf_options *o, double t,
+                     fr_camera *cam, fr_error *err)
+{
+    gltf_options oc = *o;
+    oc.camera_only = 1;
+    oc.take_lights = 0;
+    oc.time = t;
+    fr_builder tmp;
+    gltf_result r;
+    bld_init(&tmp);
+    int rc = bytes ? gltf_import_mem(bytes, len, path, NULL, &oc, &tmp, &r, err)
+                   : gltf_import(path, NULL, &oc, &tmp, &r, err);
+    *cam = tmp.camera;
+    bld_free(&tmp);
+    return rc;
+}
+
+/* With a shutter: the camera at shutter open (b->camera) and close
+ * (b->motion), when they differ. */
+static int camera_motion(const char *path, const void *bytes, size_t len, const scene_hooks *hooks,
+                         const gltf_options *o, fr_builder *b, fr_error *err)
+{
+    fr_camera open, close;
+    double f = hooks->frame, h = 0.5 * hooks->shutter;
+    if (camera_at(path, bytes, len, o, ganim_hooks_time(hooks, f - h), &open, err) < 0 ||
+        camera_at(path, bytes, len, o, ganim_hooks_time(hooks, f + h), &close, err) < 0)
+        return -1;
+    b->motion.shutter = (float)(hooks->shutter / hooks->fps);
+    if (!memcmp(&open, &close, sizeof open))
+        return 0;
+    b->camera = open;
+    b->motion.camera_close = close;
+    b->motion.flags |= FR_MOTION_CAMERA;
+    return 0;
+}
+
 int gltf_build_scene(const char *path, const void *bytes, size_t len, const scene_hooks *hooks, const char *camera,
                      uint32_t max_triangles, fr_builder *b, fr_error *err)
 {
@@ -796,6 +1115,8 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scen
     gltf_options_default(&o);
     o.camera = camera;
     o.max_triangles = max_triangles;
+    o.animate = hooks && hooks->timed;
+    o.time = o.animate ? ganim_hooks_time(hooks, hooks->frame) : 0.0;
     int rc = bytes ? gltf_import_mem(bytes, len, path, hooks, &o, b, &r, err) : gltf_import(path, hooks, &o, b, &r, err);
     if (rc < 0)
         return -1;
@@ -818,6 +1139,8 @@ int gltf_build_scene(const char *path, const void *bytes, size_t len, const scen
         lo = v3_vmin(lo, p[i]);
         hi = v3_vmax(hi, p[i]);
     }
+    if (r.camera_found && o.animate && hooks->shutter > 0.0 && camera_motion(path, bytes, len, hooks, &o, b, err) < 0)
+        return -1;
     if (!r.camera_found) {
         warn(hooks, path, "no perspective camera in the scene: one frames it from +Z");
         fr_error e;

@@ -1,8 +1,10 @@
 /** @file gltf_scene.h
  * Importing a glTF 2.0 scene (.gltf or .glb) at compile time: the node
  * hierarchy with its transforms, the meshes' triangles with normals and
- * UVs, materials and textures (gltf_mat.h), the camera and the punctual
- * lights.  The mapping, and what is ignored, is documented in
+ * UVs (bent by their morph targets' weights and their skins' joints),
+ * materials and textures (gltf_mat.h), the camera and the punctual
+ * lights; posed by the file's animations at a time when asked
+ * (gltf_anim.h).  The mapping, and what is ignored, is documented in
  * scenes/README.md.
  *
  * glTF is Y-up, right-handed, in metres; Franja has no fixed up axis, so
@@ -35,10 +37,14 @@ typedef struct {
     const confine *scope;      /**< the file is named by a scene with this scope (confine.h): it, its
                                     buffers and images are read through it; NULL: the file is the scene,
                                     read as named, with its own folder and the hooks' allow list */
+    int animate;               /**< pose the nodes by the file's animations at `time` (gltf_anim.h); 0:
+                                    the nodes' own transforms (a warning says animations are not played) */
+    double time;               /**< seconds, when animate */
+    int camera_only;           /**< take the camera alone: no meshes (nor, with take_lights 0, lights) */
 } gltf_options;
 
 /** Options for a file rendered alone: its first camera, its lights, no
- * placement, its own materials. */
+ * placement, its own materials, at rest. */
 void gltf_options_default(gltf_options *o);
 
 /** What an import found. */
@@ -59,7 +65,10 @@ int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *
 int gltf_import_mem(const void *bytes, size_t len, const char *name, const scene_hooks *hooks, const gltf_options *o,
                     fr_builder *b, gltf_result *r, fr_error *err);
 
-/** A glTF file as a whole scene: default image settings (640 pixels wide,
+/** A glTF file as a whole scene, posed at hooks->time when hooks->timed
+ * (scene_hooks.h), its camera moving across hooks->shutter (seconds,
+ * centred on that time: the camera posed at shutter open and close,
+ * scene.h's fr_motion, when the two poses differ): default image settings (640 pixels wide,
  * the height from the camera's aspect ratio, else 480; 64 samples, 8
  * bounces), the file's camera `camera` (or its first; with none, one
  * framing the scene's bounds from +Z, with a warning) and its lights (with

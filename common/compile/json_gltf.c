@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "compile/gltf_anim.h"
 #include "compile/gltf_scene.h"
 #include "compile/jsonval.h"
 
@@ -122,6 +123,8 @@ int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char
         return fr_fail(err, "%s.camera: the scene has a camera of its own (give one or the other)", where);
     g.take_camera = take_camera && c;
     g.material = material;
+    g.animate = hooks && hooks->timed;
+    g.time = g.animate ? ganim_hooks_time(hooks, hooks->frame) : 0.0;
     gltf_result r;
     fr_error e;
     if (gltf_import(path, hooks, &g, b, &r, &e) < 0)
@@ -133,7 +136,8 @@ int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char
     return 0;
 }
 
-int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const confine *scope, fr_error *err)
+int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const confine *scope,
+                     const scene_hooks *hooks, fr_error *err)
 {
     int i = 0;
     for (const cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s; s = s->next, i++) {
@@ -159,6 +163,8 @@ int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const 
         }
         g.take_camera = 1;
         g.take_lights = 0;
+        g.animate = hooks && hooks->timed;
+        g.time = g.animate ? ganim_hooks_time(hooks, hooks->frame) : 0.0;
         int rc = gltf_import(path, NULL, &g, &tmp, &r, &e);
         if (rc == 0 && !r.camera_found)
             rc = fr_fail(&e, "%s has no perspective camera", path);

@@ -26,8 +26,10 @@ int json_gltf_shape(fr_builder *b, const cJSON *o, const char *where, const char
                    const scene_hooks *hooks, uint32_t material, int take_camera, fr_error *err);
 
 /** The scene's camera from the first gltf shape of array `shapes` with a
- * `camera` field (read through `scope`), for a JSON scene without "camera".  Returns 0, or -1 when
+ * `camera` field (read through `scope`, posed at hooks' time when timed),
+ * for a JSON scene without "camera".  Returns 0, or -1 when
  * there is none (saying so) or the file's camera cannot be taken. */
-int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const confine *scope, fr_error *err);
+int json_gltf_camera(fr_builder *b, const cJSON *shapes, const char *dir, const confine *scope,
+                     const scene_hooks *hooks, fr_error *err);
 
 #endif

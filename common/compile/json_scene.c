@@ -18,6 +18,7 @@
 #include "proto_limits.h"
 #include "compile/json_appear.h"
 #include "compile/json_gltf.h"
+#include "compile/json_keys.h"
 #include "compile/json_light.h"
 #include "compile/json_microfacet.h"
 
@@ -35,6 +36,8 @@ typedef struct {
     int gltf_camera;           /* the camera comes from a gltf shape */
     fr_error *err;
     json_appear *look;          /* textures, media (json_appear.h) */
+    int gltf_moving;           /* the gltf shape's camera moves across the shutter: *gltf_open is b->camera */
+    fr_camera *gltf_open;
 } ctx;
 
 static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
@@ -78,7 +81,7 @@ static int parse_image(ctx *c, const cJSON *o)
 static int parse_camera(ctx *c, const cJSON *o)
 {
     static const char *const fields[] = {"position", "target", "up", "fov", "aperture", "focus", "fstop",
-                                         "focal_length", NULL};
+                                         "focal_length", "shutter", NULL};
     fr_camera *cam = &c->b->camera;
     float fov;
     if (!cJSON_IsObject(o))
@@ -107,14 +110,98 @@ static int parse_camera(ctx *c, const cJSON *o)
     return 0;
 }
 
-/* The top-level camera, or (without one) the camera of a gltf shape. */
+/* Keyed fields (json_keys.h) of the camera and the shapes posed at the
+ * hooks' frame (frame 0, warned, when the scene is not a frame of an
+ * animation); with a shutter (the hooks', else the camera's `shutter`, in
+ * frames), a keyed camera is posed at the shutter's opening and closing
+ * into *open and *close too (new trees, the caller's). */
+static int pose_keys(ctx *c, cJSON *root, cJSON **open, cJSON **close)
+{
+    const scene_hooks *h = c->hooks;
+    cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
+    int cam_keyed = json_keys_in(cam), any = cam_keyed;
+    for (const cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s && !any; s = s->next)
+        any = json_keys_in(s);
+    if (!any)
+        return 0;
+    int timed = h && h->timed;
+    double frame = timed ? h->frame : 0.0, shutter = timed ? h->shutter : 0.0;
+    if (!timed && h && h->warn)
+        h->warn(h->user, "keyed values are posed at frame 0 (render the file with --frames to play them)");
+    const cJSON *sh = cJSON_GetObjectItemCaseSensitive(cam, "shutter");
+    if (sh && (!cJSON_IsNumber(sh) || !(sh->valuedouble >= 0.0 && sh->valuedouble <= 1.0)))
+        return fr_fail(c->err, "camera.shutter: expected the fraction of a frame the shutter is open, in [0, 1]");
+    if (timed && !(shutter > 0.0) && sh)
+        shutter = sh->valuedouble;
+    if (timed && shutter > 0.0 && cam_keyed) {
+        c->b->motion.shutter = (float)(shutter / (h->fps > 0.0 ? h->fps : 24.0));
+        if (!(*open = cJSON_Duplicate(cam, 1)) || !(*close = cJSON_Duplicate(cam, 1)))
+            return fr_fail(c->err, "camera: out of memory");
+        if (json_keys_pose(*open, "camera", frame - 0.5 * shutter, c->err) < 0 ||
+            json_keys_pose(*close, "camera", frame + 0.5 * shutter, c->err) < 0)
+            return -1;
+    }
+    if (json_keys_pose(cam, "camera", frame, c->err) < 0)
+        return -1;
+    int i = 0;
+    for (cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s; s = s->next, i++) {
+        char where[PATHLEN];
+        snprintf(where, sizeof where, "shapes[%d]", i);
+        if (json_keys_pose(s, where, frame, c->err) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* The camera at the shutter's opening (b->camera) and closing (b->motion)
+ * from the posed trees of pose_keys, when they differ. */
+static int camera_motion(ctx *c, const cJSON *open, const cJSON *close)
+{
+    if (parse_camera(c, close) < 0)
+        return -1;
+    fr_camera shut = c->b->camera;
+    if (parse_camera(c, open) < 0)
+        return -1;
+    if (memcmp(&shut, &c->b->camera, sizeof shut) != 0) {
+        c->b->motion.camera_close = shut;
+        c->b->motion.flags |= FR_MOTION_CAMERA;
+    }
+    return 0;
+}
+
+/* The top-level camera, or (without one) the camera of a gltf shape: with
+ * a shutter, the file's camera at the shutter's opening, and at its
+ * closing in b->motion when it moved. */
 static int camera(ctx *c, const cJSON *root)
 {
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
     if (cam)
         return parse_camera(c, cam);
     c->gltf_camera = 1;
-    return json_gltf_camera(c->b, cJSON_GetObjectItemCaseSensitive(root, "shapes"), c->dir, c->scope, c->err);
+    const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
+    const scene_hooks *h = c->hooks;
+    if (json_gltf_camera(c->b, shapes, c->dir, c->scope, h, c->err) < 0)
+        return -1;
+    if (!h || !h->timed || !(h->shutter > 0.0))
+        return 0;
+    scene_hooks at = *h;
+    at.frame = h->frame + 0.5 * h->shutter;
+    if (json_gltf_camera(c->b, shapes, c->dir, c->scope, &at, c->err) < 0)
+        return -1;
+    fr_camera shut = c->b->camera;
+    at.frame = h->frame - 0.5 * h->shutter;
+    if (json_gltf_camera(c->b, shapes, c->dir, c->scope, &at, c->err) < 0)
+        return -1;
+    c->b->motion.shutter = (float)(h->shutter / (h->fps > 0.0 ? h->fps : 24.0));
+    if (memcmp(&shut, &c->b->camera, sizeof shut) != 0) {
+        c->b->motion.camera_close = shut;
+        c->b->motion.flags |= FR_MOTION_CAMERA;
+        /* (the shape takes the camera again, at the frame: undone after) */
+        c->gltf_moving = 1;
+        *c->gltf_open = c->b->camera;
+    }
+    return 0;
 }
 
 #define TYPES "lambert, phong, mirror, glass, mix, conductor, principled, emitter or interface"
@@ -394,13 +481,15 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
     }
     json_appear look;
     memset(&look, 0, sizeof look);
-    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look};
+    fr_camera gltf_open;
+    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look, 0, &gltf_open};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
                                       "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
+    cJSON *cam_open = NULL, *cam_close = NULL;
     if (!cJSON_IsObject(root)) {
         fr_fail(&e, "(top level): expected an object");
-    } else if (jv_only_fields(root, "(top level)", top, &e) == 0 &&
+    } else if (jv_only_fields(root, "(top level)", top, &e) == 0 && pose_keys(&c, root, &cam_open, &cam_close) == 0 &&
                parse_image(&c, cJSON_GetObjectItemCaseSensitive(root, "image")) == 0 &&
                camera(&c, root) == 0 &&
                json_appear_begin(&look, root, dir, &scope, hooks, b, &e) == 0 &&
@@ -432,8 +521,14 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
             }
             if (rc == 0)
                 rc = json_appear_finish(&look, root, &e);
+            if (rc == 0 && cam_open)
+                rc = camera_motion(&c, cam_open, cam_close);
+            if (c.gltf_moving)
+                b->camera = gltf_open;
         }
     }
+    cJSON_Delete(cam_open);
+    cJSON_Delete(cam_close);
     json_appear_free(&look);
     free(c.by_name);
     cJSON_Delete(root);

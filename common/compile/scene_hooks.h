@@ -80,6 +80,16 @@ typedef struct {
      * frz_scene_file: the builder freed before the file is mapped back),
      * or NULL: it is made in memory (frz_scene). */
     const char *fbin;
+    /** When timed: the frame at which animated scenes are posed, at fps
+     * frames per second (glTF animations at ganim_hooks_time: gltf_anim.h;
+     * keyframes of JSON scenes by frame: json_keys.h); otherwise they are
+     * read at rest. */
+    int timed;
+    double frame, fps;
+    /** When timed: how long the shutter is open, in frames, centred on
+     * `frame` (0: no motion blur).  What moves across it is blurred
+     * (scene.h's fr_motion). */
+    double shutter;
 } scene_hooks;
 
 #endif

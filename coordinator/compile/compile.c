@@ -78,7 +78,8 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
     memset(budget.used, 0, sizeof budget.used);
     scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
                          o ? o->allow : NULL, o ? o->n_allow : 0, &budget,
-                         o ? o->fbin : NULL};
+                         o ? o->fbin : NULL, o ? o->timed : 0, o ? o->frame : 0.0, o ? o->fps : 0.0,
+                         o ? o->shutter : 0.0};
     int rc;
     if (compile_is_gltf(path))
         rc = gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);

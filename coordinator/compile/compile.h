@@ -31,6 +31,9 @@ typedef struct {
     const fr_budget *limits;
     const char *fbin;          /**< where the binary scene is written as it is made (scene_hooks.h); NULL:
                                     in memory only */
+    int timed;                 /**< pose animated scenes at `frame` (scene_hooks.h); 0: at rest */
+    double frame, fps;         /**< when timed: the frame, and frames per second (0: GANIM_FPS) */
+    double shutter;            /**< frames the shutter is open around `frame` (motion blur); 0: none */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */

@@ -64,7 +64,7 @@ _franja()
 diffuse_indirect glossy_direct glossy_indirect transmission_direct transmission_indirect material_id crypto_material variance" -- "$cur"))
         return 0 ;;
     -j | --spp | --size | --scale | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
-        --monitor | --crop | --jpeg-quality | --noise-threshold | --frames | --time-limit)
+        --monitor | --crop | --jpeg-quality | --noise-threshold | --frames | --fps | --shutter | --time-limit)
         return 0 ;;
     esac
     if [[ $cur == -* ]]; then

@@ -1,0 +1,68 @@
+#!/bin/sh
+# it_motion_blur.sh -- tests motion blur of a moving camera (--shutter).
+#
+# A camera moving at constant speed past an emissive quad (blur.gltf of
+# tests/support/genanim.py: 12 pixels wide, smeared over 8 pixels by a
+# shutter of half a frame): without --shutter the quad's edges are sharp;
+# with it, each column's mean is the analytic smear, the quad's box
+# convolved with the 8-pixel shutter path and averaged over the pixel (a
+# trapezoid: ramps 8 pixels long, a plateau of 4), within the noise of
+# 64 x 16 samples a column; the total light is the quad's; the frame is
+# byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts,
+# and its pixels the same as a JSON scene's that places the file;
+# the bidirectional integrator refuses the moving camera.
+. "$(dirname "$0")/support/fakehosts.sh"
+need python3 cmp
+fh_init
+cd "$ROOT" || exit 1
+F=bin/franja T=$FH
+python3 tests/support/genanim.py "$T" || bad "genanim.py"
+R="--size 64x16 --spp 64"
+$F render "$T/blur.gltf" --frames 12 -o "$T/sharp.#.pfm" $R -j 2 >/dev/null 2>"$T/err" || bad "sharp: $(cat "$T/err")"
+$F render "$T/blur.gltf" --frames 12 --shutter 0.5 -o "$T/a.#.pfm" $R -j 1 >/dev/null 2>"$T/err" ||
+    bad "blur: $(cat "$T/err")"
+
+# analytic: the quad covers [26, 38) at the frame's time; across the
+# shutter it is shifted by s in [-4, 4] (uniform); pixel x gets the mean
+# over s and over [x, x + 1) of the coverage.
+python3 - "$T/sharp.12.pfm" "$T/a.12.pfm" <<'PY' >"$T/check" || bad "profile check did not run"
+import sys
+sys.path.insert(0, 'tests/support')
+from pfmcols import columns as profile
+def covered(x, s):
+    return max(0.0, min(x + 1, 38 + s) - max(x, 26 + s))
+def smear(x, n=800):
+    return sum(covered(x, -4 + 8 * (k + 0.5) / n) for k in range(n)) / n
+sharp, blur = profile(sys.argv[1]), profile(sys.argv[2])
+worst = max(abs(blur[x] - smear(x)) for x in range(64))
+print("sharp", all(abs(sharp[x] - (1.0 if 26 <= x < 38 else 0.0)) < 1e-6 for x in range(64)))
+print("smear", worst < 0.06, worst)
+print("total", abs(sum(blur) - 12.0) < 0.1, sum(blur))
+print("spread", sum(1 for v in blur if v > 0.01), sum(1 for v in sharp if v > 0.01))
+PY
+grep -q "^sharp True" "$T/check" && ok || bad "without a shutter the quad's edges are not sharp: $(cat "$T/check")"
+grep -q "^smear True" "$T/check" && ok || bad "the smear is not the analytic one: $(cat "$T/check")"
+grep -q "^total True" "$T/check" && ok || bad "the smear does not keep the quad's light: $(cat "$T/check")"
+grep -q "^spread 20 12$" "$T/check" && ok || bad "the smear's width: $(cat "$T/check")"
+
+# split invariance
+$F render "$T/blur.gltf" --frames 12 --shutter 0.5 -o "$T/b.#.pfm" $R -j 2 --slab-rows 5 >/dev/null 2>&1 ||
+    bad "render -j 2 --slab-rows 5"
+cmp -s "$T/a.12.pfm" "$T/b.12.pfm" && ok || bad "-j 1 and -j 2 --slab-rows 5 differ"
+fh_start a 2 2
+fh_start b 3 1
+fr render "$T/blur.gltf" --frames 12 --shutter 0.5 -o "$T/c.#.pfm" $R --hosts "$FH/hosts" --slab-rows 3 \
+    >/dev/null 2>"$T/err" || bad "fake SSH hosts: $(cat "$T/err")"
+cmp -s "$T/a.12.pfm" "$T/c.12.pfm" && ok || bad "fake SSH hosts render a different image"
+
+# the same file as a gltf shape of a JSON scene, its camera taken: the same pixels
+printf '{ "image": { "width": 64, "height": 16, "spp": 64 }, "materials": {},\n  "shapes": [ { "type": "gltf", "file": "blur.gltf", "camera": true } ] }\n' >"$T/jblur.json"
+$F render "$T/jblur.json" --frames 12 --shutter 0.5 -o "$T/j.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "JSON: $(cat "$T/err")"
+tail -c 12288 "$T/a.12.pfm" >"$T/a.px" && tail -c 12288 "$T/j.12.pfm" >"$T/j.px"
+cmp -s "$T/a.px" "$T/j.px" && ok || bad "a gltf shape's moving camera is not blurred as the file's own"
+
+expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
+    $F render "$T/blur.gltf" --frames 12 --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm" $R
+expect_error "--shutter without --frames" "--shutter is for --frames of one glTF or JSON file" \
+    $F render "$T/blur.gltf" --shutter 0.5 -o "$T/e.pfm" $R
+summary
