@@ -1,8 +1,7 @@
 # Franja -- one entry point: build, test, bench, docs, dist.
 #
 #   make            bin/franja-worker and bin/franja
-#   make deps       install the Debian packages the project needs (root)
-#   make bench-deps also Blender, which the benchmarks and refs compare with
+#   make deps       install the Debian packages the project needs, Blender too (root)
 #   make check      build and run every test
 #   make bench      benchmarks (see tests/bench/)
 #   make render     render scenes/cornell.json to cornell.png on this machine
@@ -65,7 +64,7 @@ LIB         = $(B)/libfranja.a
 WORKER_LIBS = $(CJSON_LIBS) $(ZSTD_LIBS) -lm -pthread
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) $(ZSTD_LIBS) -ldl -lm -pthread
 
-.PHONY: all deps bench-deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
+.PHONY: all deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
 all: bin/franja-worker bin/franja $(IIO_PLUGIN)
 
 # The modules a pixel sample runs through are built at -O3 (more inlining
@@ -209,9 +208,6 @@ fuzz: all $(FUZZ_BIN) bin/bench/packbench
 deps:
 	sh tests/install-deps.sh
 
-bench-deps:
-	sh tests/install-deps.sh bench
-
 # make check runs everything: the renderer's and coordinator's tests, then
 # the cross-build tests (Docker images, qemu, mixed clusters; needs root).
 # make test runs the first part alone.
@@ -229,7 +225,7 @@ render: all
 # The small Cycles renders in tests/data that tests/it_conventions.sh,
 # tests/it_envlight.sh, tests/it_cycles_*.sh and tests/it_lightunits.sh
 # compare against (and the glTF files Blender's exporter writes for the
-# last), made again with Debian's blender (make bench-deps installs it and
+# last), made again with Debian's blender (make deps installs it and
 # python3-numpy, which its glTF exporter needs).  The tests read the
 # committed files: only this target and the benchmarks need blender.
 refs:

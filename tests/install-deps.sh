@@ -2,10 +2,10 @@
 # install-deps.sh -- installs the Debian packages to build, test and benchmark.
 #
 # Install the Debian 12 packages Franja needs to build, test and cross-build
-# (make deps); with the argument `bench`, also what the benchmarks and the
-# references compare against: Blender's Cycles, and numpy for Blender's
-# glTF exporter (make bench-deps).  Idempotent; run as root.  Edit only the
-# package lists.
+# (make deps), Blender among them: the tests open render passes in its
+# compositor and export animations with its glTF exporter (which needs
+# numpy), and Cycles, which the benchmarks and references compare with.
+# Idempotent; run as root.  Edit only the package lists.
 set -e
 export DEBIAN_FRONTEND=noninteractive
 apt-get update
@@ -17,7 +17,5 @@ apt-get install -y --no-install-recommends \
     libfuse3-dev fuse3 time python3 \
     slurmctld slurmd slurm-client munge \
     docker.io debootstrap qemu-user-static \
-    gcc-aarch64-linux-gnu libc6-dev-arm64-cross
-if [ "${1:-}" = bench ]; then
-    apt-get install -y --no-install-recommends blender python3-numpy
-fi
+    gcc-aarch64-linux-gnu libc6-dev-arm64-cross \
+    blender python3-numpy
