@@ -14,7 +14,7 @@
  * position the path lands on, and the target is f = luminance(C).  The
  * depth stays fixed along a chain, as in Hachisuka et al.
  *
- * Normalisation (b) and start: a bootstrap of MLT_BOOTSTRAP independent
+ * Normalisation (b) and start: a bootstrap of n independent
  * states (sample i: depth i mod (max_depth + 1), numbers from seed i)
  * gives b_d, the mean of f over depth d's samples, and b = sum of b_d, the
  * integral of f over the whole state space.  Chain k starts from bootstrap
@@ -44,9 +44,10 @@
 #include "error.h"
 #include "scene.h"
 
-/** Bootstrap states of a render (a power of two: every depth gets the same
- * count when max_depth + 1 is one too, nearly the same otherwise). */
+/** Bootstrap states of a render: 4 per pixel, at least 2^14 and at most
+ * MLT_BOOTSTRAP (2^18: b within about 1 % on the Cornell box, 0.2 s). */
 #define MLT_BOOTSTRAP 262144u
+#define MLT_BOOTSTRAP_MIN 16384u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f
 
