@@ -66,8 +66,9 @@ void mlt_step(mlt_chain *c, int force_large)
 
 float mlt_perturb(float u, float a, float b)
 {
-    /* Distance s2 * (s1/s2)^a = s2 * exp(-ln(s2/s1) a): density ~ 1/d on [s1, s2]. */
-    float d = S2 * fm_expf(-fm_logf(S2 / S1) * a);
+    /* Distance s2 * (s1/s2)^a = s2 * exp(-ln(s2/s1) a): density ~ 1/d on
+     * [s1, s2]; ln(s2/s1) = ln 16. */
+    float d = S2 * fm_expf(-2.77258872f * a);
     float v = b < 0.5f ? u + d : u - d;
     if (v >= 1.0f)
         v -= 1.0f;

@@ -14,9 +14,10 @@
  *
  * Mutations are lazy, as Kelemen et al. describe: a number is perturbed
  * only when the path asks for it (mlt_next), by as many small steps as
- * iterations passed since it was last set (at most MLT_LAZY_MAX of them,
- * a fixed function of that count, so the composed step stays symmetric),
- * or drawn afresh when a large step was accepted since.  The value before
+ * iterations passed since it was last set, but at most MLT_LAZY_MAX (a
+ * fixed function of that count, so the composed step stays symmetric;
+ * Kelemen et al. take one per iteration), or drawn afresh when a large
+ * step was accepted since.  The value before
  * the iteration is kept, and mlt_reject puts it back.
  *
  * The numbers are split into interleaved streams (camera and light
@@ -36,8 +37,10 @@
 #include <stdint.h>
 
 #define MLT_MAX_STREAMS 4
-/** Most small steps applied at once to a number left alone for longer. */
-#define MLT_LAZY_MAX 16
+/** Most small steps applied at once to a number left alone for longer
+ * (each costs an exponential: the numbers a strategy reads only now and
+ * then would otherwise take most of a mutation's time). */
+#define MLT_LAZY_MAX 1
 
 typedef struct {
     float value, backup;       /**< the number, and its value before this iteration */

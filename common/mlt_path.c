@@ -288,7 +288,7 @@ int mlt_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uin
     if (mlt_supported(s, err) < 0)
         return -1;
     memset(rgb, 0, (size_t)s->settings.width * (y1 - y0) * 3 * sizeof *rgb);
-    uint64_t n = (uint64_t)s->settings.width * s->settings.height * 4;
+    uint64_t n = (uint64_t)s->settings.width * s->settings.height * 16;
     n = n < MLT_BOOTSTRAP_MIN ? MLT_BOOTSTRAP_MIN : n > MLT_BOOTSTRAP ? MLT_BOOTSTRAP : n;
     mlt_boot bt;
     if (mlt_bootstrap(s, (uint32_t)n, &bt, err) < 0)

@@ -44,10 +44,10 @@
 #include "error.h"
 #include "scene.h"
 
-/** Bootstrap states of a render: 4 per pixel, at least 2^14 and at most
+/** Bootstrap states of a render: 16 per pixel, at least 2^15 and at most
  * MLT_BOOTSTRAP (2^18: b within about 1 % on the Cornell box, 0.2 s). */
 #define MLT_BOOTSTRAP 262144u
-#define MLT_BOOTSTRAP_MIN 16384u
+#define MLT_BOOTSTRAP_MIN 32768u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f
 

@@ -6,7 +6,7 @@
  * images: the bootstrap's b (the integral of the target, the image's mean
  * luminance) against path tracing's mean luminance; the MLT image's mean
  * against b (the chains distribute exactly b over the image); the image's
- * quadrants against path tracing's; and chains [0, K) rendered as one
+ * quadrants against path tracing's (within MLT's noise at this budget); and chains [0, K) rendered as one
  * group against three groups added in another order (fixed-point sums). */
 #include <math.h>
 #include <stdlib.h>
@@ -20,6 +20,7 @@
 
 #define W 24
 #define H 24
+#define K (4 * H)
 
 static double luma(const float *p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
@@ -37,7 +38,10 @@ static double quadrant(const float *rgb, int q)
     return sum / n;
 }
 
-static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_spp)
+/* quad_tol: the relative difference allowed in a quadrant (MLT's noise:
+ * the spheres' caustics make it several times the Cornell box's; over
+ * six seeds their worst quadrant strayed 16 %). */
+static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_spp, double quad_tol)
 {
     fr_scene s;
     fr_error err;
@@ -57,25 +61,27 @@ static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_s
     double pt_mean = quadrant(ref, 4);
     CHECK(fabs(bt.b / pt_mean - 1.0) < 0.02, "%s: b %g, path tracing's mean luminance %g", path, bt.b, pt_mean);
 
-    /* The whole image as franja-worker renders it: H chains of W * spp. */
+    /* The whole image in K = 4H chains of W * spp / 4 mutations (franja-worker
+     * runs H chains of W * spp: more, shorter chains here for less noise in
+     * the quadrants). */
     s.settings.spp = mlt_spp;
     uint64_t *one = calloc((size_t)W * H * 3, sizeof *one), *parts = calloc((size_t)W * H * 3, sizeof *parts),
              *part = calloc((size_t)W * H * 3, sizeof *part);
-    CHECK(mlt_chains(&s, &bt, 0, H, H, (uint64_t)W * mlt_spp, one, &err) == 0, "%s: chains: %s", path, err.msg);
+    CHECK(mlt_chains(&s, &bt, 0, K, K, (uint64_t)W * mlt_spp / 4, one, &err) == 0, "%s: chains: %s", path, err.msg);
     memset(img, 0, sizeof img);
     spl_resolve(img, one, W, 0, H, mlt_spp);
     double mlt_mean = quadrant(img, 4);
     CHECK(fabs(mlt_mean / bt.b - 1.0) < 1e-4, "%s: MLT image's mean luminance %g, b %g", path, mlt_mean, bt.b);
     for (int q = 0; q < 4; q++) {
         double a = quadrant(img, q), r = quadrant(ref, q);
-        CHECK(fabs(a / r - 1.0) < 0.1, "%s: quadrant %d: MLT %g, path tracing %g", path, q, a, r);
+        CHECK(fabs(a / r - 1.0) < quad_tol, "%s: quadrant %d: MLT %g, path tracing %g", path, q, a, r);
     }
 
-    /* Groups [17, 24), [0, 5), [5, 17), added in that order. */
-    const uint32_t cut[][2] = {{17, H}, {0, 5}, {5, 17}};
+    /* Groups [67, 96), [0, 5), [5, 67), added in that order. */
+    const uint32_t cut[][2] = {{67, K}, {0, 5}, {5, 67}};
     for (int g = 0; g < 3; g++) {
         memset(part, 0, (size_t)W * H * 3 * sizeof *part);
-        mlt_chains(&s, &bt, cut[g][0], cut[g][1], H, (uint64_t)W * mlt_spp, part, &err);
+        mlt_chains(&s, &bt, cut[g][0], cut[g][1], K, (uint64_t)W * mlt_spp / 4, part, &err);
         spl_sum(parts, part, (size_t)W * H * 3);
     }
     CHECK(memcmp(one, parts, (size_t)W * H * 3 * sizeof *one) == 0, "%s: chains in three groups differ from one",
@@ -89,7 +95,7 @@ static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_s
 
 int main(void)
 {
-    scene_against_path("scenes/cornell.json", 1024, 256);
-    scene_against_path("scenes/spheres.json", 1024, 256);
+    scene_against_path("scenes/cornell.json", 1024, 512, 0.05);
+    scene_against_path("scenes/spheres.json", 1024, 512, 0.25);
     return check_done();
 }
