@@ -6,10 +6,13 @@
 # (scenes/cornell.json) and the caustic of the BDPT benchmark
 # (tests/bench/scenes/spheres-lamp.json).  On each, BDPT renders at BD_SPP
 # samples per pixel; path tracing and MLT get the samples (mutations) per
-# pixel that take the same CPU time, from the cost of a calibration run at
-# a quarter of that count.  All three are compared with a long reference
-# (BDPT at REF_SPP, the scene's own seed; the runs use seeds 1, 2, ...) by
-# RMSE over the pixels off the light (tests/tools/imgcmp), and MLT's mean
+# pixel that take the same CPU time, from calibration runs at a quarter
+# and a half of that count (a fixed cost, MLT's bootstrap, plus a cost per
+# sample).  All three are compared with a long reference
+# (BDPT at REF_SPP times the box filter's side, the scene's own seed; the runs use seeds 1, 2, ...) by
+# RMSE over the pixels off the light (tests/tools/imgcmp; on the door
+# scene after a 4x4 box filter of both images, which takes the reference's
+# own noise down to below what is measured), and MLT's mean
 # over the whole image against the reference's.  Every render is cut into
 # 2 slabs (--slab-rows H/2) for all integrators alike: each MLT slab runs
 # its own bootstrap.  Goals (issue 34): MLT at least 5x lower RMSE than
@@ -20,7 +23,7 @@
 cd "$(dirname "$0")/../.." || exit 1
 N=$(nproc)
 BD_SPP=${BD_SPP:-32} REF_SPP=${REF_SPP:-1024} RUNS=${RUNS:-1} BIN=${BIN:-bin}
-SCENES=${SCENES:-"tests/bench/scenes/door-ajar.json:128x96 scenes/cornell.json:64x64 tests/bench/scenes/spheres-lamp.json:64x64"}
+SCENES=${SCENES:-"tests/bench/scenes/door-ajar.json:128x96:4 scenes/cornell.json:64x64:1 tests/bench/scenes/spheres-lamp.json:64x64:1"}
 OUT=build/bench
 mkdir -p "$OUT"
 T=$(mktemp -d)
@@ -36,32 +39,38 @@ render() {
         --integrator "$3" -j "$N" --slab-rows $(((h + 1) / 2)) 2>"$T/log" || { tail -n 5 "$T/log" >&2; exit 1; }
     awk '{ printf "%.3f", $1 + $2 }' "$T/time"
 }
-rmse() { "$BIN/tools/imgcmp" "$1" "$2" | sed -n 's/^rmse \([0-9.e+-]*\) over.*/\1/p'; }
+rmse() { "$BIN/tools/imgcmp" "$1" "$2" --down "$down" | sed -n 's/^rmse \([0-9.e+-]*\) over.*/\1/p'; }
 # mean IMAGE: the mean of the three channels' means, as imgcmp prints them.
 mean() { "$BIN/tools/imgcmp" "$1" "$1" | awk '/^channel/ { s += $4 } END { printf "%.6g", s / 3 }'; }
 med() { sort -g | awk '{ v[NR] = $1 } END { print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 for item in $SCENES; do
-    scene=${item%:*} size=${item#*:}
+    scene=${item%%:*} rest=${item#*:}
+    size=${rest%:*} down=${rest#*:}
     name=$(basename "$scene" .json)
-    echo "== $name ($scene, $size): BDPT at $BD_SPP spp, path and MLT at equal CPU time"
+    echo "== $name ($scene, $size, RMSE on images box-filtered by $down): BDPT at $BD_SPP spp, path and MLT at equal CPU time"
     key=$( ("$BIN/franja-worker" --version; cat "$scene") | sha256sum | cut -c1-12)
-    REF="$OUT/mlt-$name-ref-$size-$REF_SPP-$key.pfm"
+    ref_spp=$((REF_SPP * down))
+    REF="$OUT/mlt-$name-ref-$size-$ref_spp-$key.pfm"
     "$BIN/franja" compile "$scene" -o "$T/ref.fbin" >/dev/null 2>&1 || { echo "compile failed"; exit 1; }
     if [ ! -s "$REF" ]; then
-        t=$(render "$T/ref.fbin" "$size" bdpt "$REF_SPP" "$T/ref.pfm") && mv "$T/ref.pfm" "$REF" || exit 1
-        echo "reference (BDPT, $REF_SPP spp): $t CPU s"
+        t=$(render "$T/ref.fbin" "$size" bdpt "$ref_spp" "$T/ref.pfm") && mv "$T/ref.pfm" "$REF" || exit 1
+        echo "reference (BDPT, $ref_spp spp): $t CPU s"
     fi
     : >"$T/runs"
     for r in $(seq 1 "$RUNS"); do
         sed "s/\"seed\": [0-9]*/\"seed\": $r/" "$scene" >"$T/seed.json"
         "$BIN/franja" compile "$T/seed.json" -o "$T/seed.fbin" >/dev/null 2>&1 || exit 1
+        # Two calibration runs each (q and 2q): a fixed cost (start-up, MLT's
+        # bootstrap) and a cost per sample, extrapolated to BDPT's time.
         q=$((BD_SPP / 4))
         t_bd=$(render "$T/seed.fbin" "$size" bdpt "$BD_SPP" "$T/bd.pfm") || exit 1
-        t_pc=$(render "$T/seed.fbin" "$size" path "$q" "$T/pc.pfm") || exit 1
-        t_mc=$(render "$T/seed.fbin" "$size" mlt "$q" "$T/mc.pfm") || exit 1
-        spp_pt=$(awk "BEGIN { s = int($q * $t_bd / $t_pc + 0.5); print s < 1 ? 1 : s }")
-        spp_ml=$(awk "BEGIN { s = int($q * $t_bd / $t_mc + 0.5); print s < 1 ? 1 : s }")
+        t_p1=$(render "$T/seed.fbin" "$size" path "$q" "$T/pc.pfm") || exit 1
+        t_p2=$(render "$T/seed.fbin" "$size" path $((2 * q)) "$T/pc.pfm") || exit 1
+        t_m1=$(render "$T/seed.fbin" "$size" mlt "$q" "$T/mc.pfm") || exit 1
+        t_m2=$(render "$T/seed.fbin" "$size" mlt $((2 * q)) "$T/mc.pfm") || exit 1
+        fit() { awk "BEGIN { k = ($2 - $1) / $q; if (k <= 0) k = $2 / (2 * $q); s = int(2 * $q + ($t_bd - $2) / k + 0.5); print s < 1 ? 1 : s }"; }
+        spp_pt=$(fit "$t_p1" "$t_p2") spp_ml=$(fit "$t_m1" "$t_m2")
         t_pt=$(render "$T/seed.fbin" "$size" path "$spp_pt" "$T/pt.pfm") || exit 1
         t_ml=$(render "$T/seed.fbin" "$size" mlt "$spp_ml" "$T/ml.pfm") || exit 1
         e_pt=$(rmse "$T/pt.pfm" "$REF") e_bd=$(rmse "$T/bd.pfm" "$REF") e_ml=$(rmse "$T/ml.pfm" "$REF")
