@@ -704,8 +704,10 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
 
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
-vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
-               bd_splat_fn splat, void *ctx)
+/* bd_sample, also adding each weighted contribution's luminance to
+ * by_depth[its depth] when by_depth is not NULL. */
+static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
+                   bd_splat_fn splat, void *ctx, double *by_depth)
 {
     fr_sampler cs, ls;
     smp_start(&cs, x, y, index, s->settings.seed);
@@ -734,12 +736,44 @@ vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x,
                 continue;
             if (use_mis)
                 c = v3_scale(c, mis_weight(s, w->cam, w->lgt, &sampled, s_, t));
+            if (by_depth && finite3(c))
+                by_depth[depth] += v3_luma(c);
             if (t > 1)
                 L = v3_add(L, c);
             else if (finite3(c))
                 splat(ctx, (uint32_t)rx, (uint32_t)ry, c.x, c.y, c.z);
         }
     return finite3(L) ? L : v3s(0.0f);
+}
+
+vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
+               bd_splat_fn splat, void *ctx)
+{
+    return sample(s, w, st, x, y, index, splat, ctx, NULL);
+}
+
+static void no_splat(void *ctx, uint32_t x, uint32_t y, float r, float g, float b)
+{
+    (void)ctx, (void)x, (void)y, (void)r, (void)g, (void)b;
+}
+
+int bd_depth_means(const fr_scene *s, uint32_t spp, double *by_depth)
+{
+    bd_work *w = bd_work_new(s);
+    if (!w)
+        return -1;
+    const bd_strategy all = {-1, -1, -1};
+    uint32_t width = s->settings.width, height = s->settings.height;
+    for (uint32_t d = 0; d <= s->settings.max_depth; d++)
+        by_depth[d] = 0.0;
+    for (uint32_t y = 0; y < height; y++)
+        for (uint32_t x = 0; x < width; x++)
+            for (uint32_t i = 0; i < spp; i++)
+                sample(s, w, &all, x, y, i, no_splat, NULL, by_depth);
+    for (uint32_t d = 0; d <= s->settings.max_depth; d++)
+        by_depth[d] /= (double)width * height * spp;
+    bd_work_free(w);
+    return 0;
 }
 
 vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam, const bd_stream *light, float *rx,

@@ -149,14 +149,19 @@ int mlt_bootstrap(const fr_scene *s, uint32_t n, mlt_boot *bt, fr_error *err)
         int d = boot_state(&r, i, n, &st);
         bt->cdf[bt->off[d] + i / nd + 1] = st.f;
     }
-    for (uint32_t d = 0; d < nd; d++) {
-        uint32_t count = bt->off[d + 1] - bt->off[d];
-        double sum = 0.0;
-        for (uint32_t p = bt->off[d]; p < bt->off[d + 1]; p++)
-            sum += bt->cdf[p + 1];
-        bt->bd[d] = count ? sum / count : 0.0;
-        bt->b += bt->bd[d];
+    /* b_d: each depth's mean luminance by bidirectional path tracing over
+     * the image, all strategies MIS-weighted and the pixels stratified (the
+     * states' own mean, one random strategy each, is several times noisier
+     * where light comes through narrow passages). */
+    uint64_t pixels = (uint64_t)s->settings.width * s->settings.height;
+    uint64_t spp = (MLT_BOOTSTRAP_BDPT + pixels - 1) / pixels;
+    if (bd_depth_means(s, spp > 256 ? 256 : (uint32_t)spp, bt->bd) < 0) {
+        runner_close(&r);
+        mlt_boot_free(bt);
+        return fr_fail(err, "out of memory for the Metropolis bootstrap");
     }
+    for (uint32_t d = 0; d < nd; d++)
+        bt->b += bt->bd[d];
     for (uint32_t p = 0; p < n; p++)
         bt->cdf[p + 1] += bt->cdf[p];
     runner_close(&r);

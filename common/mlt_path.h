@@ -14,10 +14,12 @@
  * position the path lands on, and the target is f = luminance(C).  The
  * depth stays fixed along a chain, as in Hachisuka et al.
  *
- * Normalisation (b) and start: a bootstrap of n independent
- * states (sample i: depth i mod (max_depth + 1), numbers from seed i)
- * gives b_d, the mean of f over depth d's samples, and b = sum of b_d, the
- * integral of f over the whole state space.  Chain k starts from bootstrap
+ * Normalisation (b) and start: b_d, the integral of f over depth d's
+ * states, is the mean luminance of depth d's paths over the image, which
+ * bidirectional path tracing estimates (bd_depth_means, about
+ * MLT_BOOTSTRAP_BDPT samples with all strategies); b = sum of b_d.  A
+ * bootstrap of n independent states (state i: depth i mod (max_depth + 1),
+ * numbers from seed i) gives the chains' starts.  Chain k starts from bootstrap
  * sample j picked with probability f_j / sum f (its depth so has
  * probability b_d / b, and its state is distributed about as f is: little
  * start-up bias), and from there mutates with its own generator, seed k.
@@ -48,13 +50,16 @@
  * MLT_BOOTSTRAP (2^18: b within about 1 % on the Cornell box, 0.2 s). */
 #define MLT_BOOTSTRAP 262144u
 #define MLT_BOOTSTRAP_MIN 32768u
+/** Bidirectional samples that estimate b_d (spp = this over the pixels,
+ * rounded up, at most 256). */
+#define MLT_BOOTSTRAP_BDPT 32768u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f
 
 /** The bootstrap: b and the cumulative f of its states. */
 typedef struct {
     double b;                  /**< sum over depths of the mean f: the integral of the target */
-    double *bd;                /**< nd entries: b_d, the mean f of depth d (owned) */
+    double *bd;                /**< nd entries: b_d, the integral of f over depth d (owned) */
     uint32_t nd;               /**< depths, max_depth + 1 */
     uint32_t *off;             /**< nd + 1 entries: depth d's states are cdf positions off[d]..off[d+1]-1 (owned) */
     uint32_t n;                /**< states */
