@@ -757,21 +757,24 @@ static void no_splat(void *ctx, uint32_t x, uint32_t y, float r, float g, float 
     (void)ctx, (void)x, (void)y, (void)r, (void)g, (void)b;
 }
 
-int bd_depth_means(const fr_scene *s, uint32_t spp, double *by_depth)
+int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth)
 {
     bd_work *w = bd_work_new(s);
     if (!w)
         return -1;
     const bd_strategy all = {-1, -1, -1};
-    uint32_t width = s->settings.width, height = s->settings.height;
+    uint64_t width = s->settings.width, pixels = width * s->settings.height;
+    /* Every pixel spp times, or n pixels evenly spread once each. */
+    uint64_t spp = n > pixels ? (n + pixels - 1) / pixels : 1, used = n > pixels ? pixels : (n ? n : 1);
     for (uint32_t d = 0; d <= s->settings.max_depth; d++)
         by_depth[d] = 0.0;
-    for (uint32_t y = 0; y < height; y++)
-        for (uint32_t x = 0; x < width; x++)
-            for (uint32_t i = 0; i < spp; i++)
-                sample(s, w, &all, x, y, i, no_splat, NULL, by_depth);
+    for (uint64_t k = 0; k < used; k++) {
+        uint64_t p = k * pixels / used;
+        for (uint32_t i = 0; i < spp; i++)
+            sample(s, w, &all, (uint32_t)(p % width), (uint32_t)(p / width), i, no_splat, NULL, by_depth);
+    }
     for (uint32_t d = 0; d <= s->settings.max_depth; d++)
-        by_depth[d] /= (double)width * height * spp;
+        by_depth[d] /= (double)used * spp;
     bd_work_free(w);
     return 0;
 }

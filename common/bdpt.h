@@ -102,10 +102,12 @@ vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam,
              float *ry);
 
 /** The mean luminance over the image of the paths of each depth
- * (by_depth: max_depth + 1 entries, caller-owned), from samples 0..spp-1
- * of every pixel with all strategies, splats included: each depth's share
- * of the image.  -1 when out of memory. */
-int bd_depth_means(const fr_scene *s, uint32_t spp, double *by_depth);
+ * (by_depth: max_depth + 1 entries, caller-owned), from about n samples
+ * with all strategies, splats included: each depth's share of the image.
+ * Samples 0..spp-1 of every pixel (spp = n / pixels rounded up) when n is
+ * over the pixel count, else sample 0 of n pixels spread evenly over the
+ * image.  -1 when out of memory. */
+int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth);
 
 /** Render rows [y0, y1) of s->settings' size and spp with all strategies:
  * rgb (3 floats per pixel, row y0 first, width*(y1-y0)*3) receives the

@@ -153,9 +153,7 @@ int mlt_bootstrap(const fr_scene *s, uint32_t n, mlt_boot *bt, fr_error *err)
      * the image, all strategies MIS-weighted and the pixels stratified (the
      * states' own mean, one random strategy each, is several times noisier
      * where light comes through narrow passages). */
-    uint64_t pixels = (uint64_t)s->settings.width * s->settings.height;
-    uint64_t spp = (MLT_BOOTSTRAP_BDPT + pixels - 1) / pixels;
-    if (bd_depth_means(s, spp > 256 ? 256 : (uint32_t)spp, bt->bd) < 0) {
+    if (bd_depth_means(s, MLT_BOOTSTRAP_BDPT, bt->bd) < 0) {
         runner_close(&r);
         mlt_boot_free(bt);
         return fr_fail(err, "out of memory for the Metropolis bootstrap");

@@ -50,8 +50,7 @@
  * MLT_BOOTSTRAP (2^18: b within about 1 % on the Cornell box, 0.2 s). */
 #define MLT_BOOTSTRAP 262144u
 #define MLT_BOOTSTRAP_MIN 32768u
-/** Bidirectional samples that estimate b_d (spp = this over the pixels,
- * rounded up, at most 256). */
+/** Bidirectional samples that estimate b_d (bd_depth_means). */
 #define MLT_BOOTSTRAP_BDPT 32768u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f
