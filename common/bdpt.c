@@ -22,6 +22,32 @@
 
 enum { BD_CAMERA, BD_LIGHT, BD_SURFACE };
 
+/* Where a subpath's numbers come from: a pixel sample's sampler, or a
+ * caller's stream (bd_path, for primary-sample-space Metropolis). */
+typedef struct {
+    fr_sampler *smp;
+    const bd_stream *st;
+} rnd;
+
+static inline void rnd_2d(rnd *r, float *u, float *v)
+{
+    if (r->smp) {
+        smp_2d(r->smp, u, v);
+        return;
+    }
+    *u = r->st->next(r->st->ctx);
+    *v = r->st->next(r->st->ctx);
+}
+
+static inline float rnd_1(rnd *r) { return r->smp ? smp_random(r->smp) : r->st->next(r->st->ctx); }
+
+/* A pair that this subpath does not use (smp_skip); a stream skips nothing. */
+static inline void rnd_skip(rnd *r)
+{
+    if (r->smp)
+        smp_skip(r->smp);
+}
+
 /* A subpath vertex.  pdf_fwd is the area density with which its own
  * subpath reached it, pdf_rev the one with which the other direction
  * would (from the next vertex of its subpath).  A genuine 0 (a direction
@@ -291,11 +317,11 @@ static int set_rev_back(const fr_scene *s, vert *path, int i, const vert *v, flo
  * (the ratio m of their largest channels is what its scattering kept), as
  * pathtrace.c plays it: survival q = min(1, sqrt(m)), survivors reweighted
  * by 1 / q.  Returns 0 when it ends. */
-static int roulette(fr_sampler *smp, uint32_t depth, vec3 beta0, vec3 *beta)
+static int roulette(rnd *smp, uint32_t depth, vec3 beta0, vec3 *beta)
 {
     if (depth < RR_DEPTH)
         return 1;
-    float m = v3_max(*beta) / v3_max(beta0), u = smp_random(smp);
+    float m = v3_max(*beta) / v3_max(beta0), u = rnd_1(smp);
     if (m >= 1.0f)
         return 1;
     float q = sqrtf(m);
@@ -310,7 +336,7 @@ static int roulette(fr_sampler *smp, uint32_t depth, vec3 beta0, vec3 *beta)
  * importance: a light subpath.  A camera subpath that leaves the scene
  * ends on a distant light vertex when the scene has distant lights.
  * Returns the number of vertices. */
-static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float pdf_dir, int importance, vert *path,
+static int walk(const fr_scene *s, rnd *smp, fr_ray ray, vec3 beta, float pdf_dir, int importance, vert *path,
                 int maxv)
 {
     vec3 beta0 = beta;
@@ -369,15 +395,15 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
          * point, direction; light side (lobe, -), direction, lens point. */
         float ulobe, unused, u1, u2, a, b;
         if (importance) {
-            smp_2d(smp, &ulobe, &unused);
-            smp_2d(smp, &u1, &u2);
-            smp_2d(smp, &a, &b);
+            rnd_2d(smp, &ulobe, &unused);
+            rnd_2d(smp, &u1, &u2);
+            rnd_2d(smp, &a, &b);
             v->u[0] = a;
             v->u[1] = b;
         } else {
-            smp_2d(smp, &v->u[0], &ulobe);
-            smp_2d(smp, &v->u[1], &v->u[2]);
-            smp_2d(smp, &u1, &u2);
+            rnd_2d(smp, &v->u[0], &ulobe);
+            rnd_2d(smp, &v->u[1], &v->u[2]);
+            rnd_2d(smp, &u1, &u2);
         }
         if (n >= maxv)
             break;
@@ -418,14 +444,29 @@ static int walk(const fr_scene *s, fr_sampler *smp, fr_ray ray, vec3 beta, float
     return n;
 }
 
-static int camera_subpath(const fr_scene *s, fr_sampler *smp, uint32_t x, uint32_t y, vert *cam, int maxv)
+/* The camera subpath of pixel (x, y); from a stream (smp->st), the first
+ * two numbers place it anywhere in the image instead, and *rx, *ry (when
+ * not NULL) receive its raster position. */
+static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, vert *cam, int maxv, float *rx,
+                          float *ry)
 {
     float px, py, lx = 0.0f, ly = 0.0f, pdf_dir;
-    smp_2d(smp, &px, &py);
+    rnd_2d(smp, &px, &py);
+    if (!smp->smp) {
+        float fx = px * (float)s->settings.width, fy = py * (float)s->settings.height;
+        x = fx < (float)s->settings.width ? (uint32_t)fx : s->settings.width - 1;
+        y = fy < (float)s->settings.height ? (uint32_t)fy : s->settings.height - 1;
+        px = fx - (float)x;
+        py = fy - (float)y;
+        if (rx) {
+            *rx = fx;
+            *ry = fy;
+        }
+    }
     if (s->camera.aperture > 0.0f)
-        smp_2d(smp, &lx, &ly);
+        rnd_2d(smp, &lx, &ly);
     else
-        smp_skip(smp);         /* a pinhole has no lens to sample */
+        rnd_skip(smp);         /* a pinhole has no lens to sample */
     fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
     cam_importance(s, ray.o, ray.d, &pdf_dir, NULL, NULL);
     vert *c = &cam[0];
@@ -440,12 +481,12 @@ static int camera_subpath(const fr_scene *s, fr_sampler *smp, uint32_t x, uint32
     return walk(s, smp, ray, c->beta, pdf_dir, 0, cam, maxv);
 }
 
-static int light_subpath(const fr_scene *s, fr_sampler *smp, vert *lgt, int maxv)
+static int light_subpath(const fr_scene *s, rnd *smp, vert *lgt, int maxv)
 {
     float upick, unused, u1, u2, u3, u4;
-    smp_2d(smp, &upick, &unused);
-    smp_2d(smp, &u1, &u2);
-    smp_2d(smp, &u3, &u4);
+    rnd_2d(smp, &upick, &unused);
+    rnd_2d(smp, &u1, &u2);
+    rnd_2d(smp, &u3, &u4);
     fr_light_emit e;
     if (!lgt_sample_emit(s, upick, u1, u2, u3, u4, &e))
         return 0;
@@ -666,16 +707,19 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
 
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
-vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
-               bd_splat_fn splat, void *ctx)
+/* bd_sample, also adding each weighted contribution's luminance to
+ * by_depth[its depth] when by_depth is not NULL. */
+static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
+                   bd_splat_fn splat, void *ctx, double *by_depth)
 {
     fr_sampler cs, ls;
     smp_start(&cs, x, y, index, s->settings.seed);
     ls = cs;
     ls.dim = LIGHT_DIM;
     int maxd = (int)s->settings.max_depth;
-    int nc = camera_subpath(s, &cs, x, y, w->cam, maxd + 2);
-    int nl = light_subpath(s, &ls, w->lgt, maxd + 1);
+    rnd rc = {&cs, NULL}, rl = {&ls, NULL};
+    int nc = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL);
+    int nl = light_subpath(s, &rl, w->lgt, maxd + 1);
     /* s = 1 samples its own light point: possible even when the light
      * subpath could not start. */
     int smax = nl > 0 ? nl : s->n_lights > 0;
@@ -695,12 +739,75 @@ vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x,
                 continue;
             if (use_mis)
                 c = v3_scale(c, mis_weight(s, w->cam, w->lgt, &sampled, s_, t));
+            if (by_depth && finite3(c))
+                by_depth[depth] += v3_luma(c);
             if (t > 1)
                 L = v3_add(L, c);
             else if (finite3(c))
                 splat(ctx, (uint32_t)rx, (uint32_t)ry, c.x, c.y, c.z);
         }
     return finite3(L) ? L : v3s(0.0f);
+}
+
+vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
+               bd_splat_fn splat, void *ctx)
+{
+    return sample(s, w, st, x, y, index, splat, ctx, NULL);
+}
+
+static void no_splat(void *ctx, uint32_t x, uint32_t y, float r, float g, float b)
+{
+    (void)ctx, (void)x, (void)y, (void)r, (void)g, (void)b;
+}
+
+int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth)
+{
+    bd_work *w = bd_work_new(s);
+    if (!w)
+        return -1;
+    const bd_strategy all = {-1, -1, -1};
+    uint64_t width = s->settings.width, pixels = width * s->settings.height;
+    /* Every pixel spp times, or n pixels evenly spread once each. */
+    uint64_t spp = n > pixels ? (n + pixels - 1) / pixels : 1, used = n > pixels ? pixels : (n ? n : 1);
+    for (uint32_t d = 0; d <= s->settings.max_depth; d++)
+        by_depth[d] = 0.0;
+    for (uint64_t k = 0; k < used; k++) {
+        uint64_t p = k * pixels / used;
+        for (uint32_t i = 0; i < spp; i++)
+            sample(s, w, &all, (uint32_t)(p % width), (uint32_t)(p / width), i, no_splat, NULL, by_depth);
+    }
+    for (uint32_t d = 0; d <= s->settings.max_depth; d++)
+        by_depth[d] /= (double)used * spp;
+    bd_work_free(w);
+    return 0;
+}
+
+vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam, const bd_stream *light, float *rx,
+             float *ry)
+{
+    const vec3 zero = v3s(0.0f);
+    if (t < 1 || s_ < 0 || (s_ == 1 && t == 1) || s_ + t - 2 > (int)s->settings.max_depth || s_ + t < 2)
+        return zero;
+    rnd rc = {NULL, cam}, rl = {NULL, light};
+    float cx = 0.0f, cy = 0.0f;
+    if (camera_subpath(s, &rc, 0, 0, w->cam, t, &cx, &cy) != t)
+        return zero;
+    /* s = 1 samples its light point from the camera vertex's numbers. */
+    if (s_ > 1 && light_subpath(s, &rl, w->lgt, s_) != s_)
+        return zero;
+    if (s_ == 1 && s->n_lights == 0)
+        return zero;
+    vert sampled;
+    float lx = 0.0f, ly = 0.0f;
+    vec3 c = connect(s, w, s_, t, &sampled, &lx, &ly);
+    if (v3_is_zero(c))
+        return zero;
+    c = v3_scale(c, mis_weight(s, w->cam, w->lgt, &sampled, s_, t));
+    if (!finite3(c))
+        return zero;
+    *rx = t == 1 ? lx : cx;
+    *ry = t == 1 ? ly : cy;
+    return c;
 }
 
 typedef struct {

@@ -60,6 +60,13 @@ typedef struct {
  * and the radiance to add to its sum (the pixel's value gains L / spp). */
 typedef void (*bd_splat_fn)(void *ctx, uint32_t x, uint32_t y, float r, float g, float b);
 
+/** A caller's source of numbers in [0, 1) for bd_path: next(ctx) is the
+ * next number of the stream. */
+typedef struct {
+    float (*next)(void *ctx);
+    void *ctx;
+} bd_stream;
+
 /** Working memory for one thread: the two subpaths. */
 typedef struct bd_work bd_work;
 
@@ -78,6 +85,29 @@ void bd_work_free(bd_work *w);
  * splat) the same way everywhere.  The scene must pass bd_supported. */
 vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
                bd_splat_fn splat, void *ctx);
+
+/** One strategy (s_, t) of one path, for primary-sample-space Metropolis
+ * (mlt_path.h): the camera subpath of t vertices from the numbers of cam
+ * (its first two place the camera ray anywhere in the image: raster x =
+ * u0 * width, y = u1 * height, the pixel's lens and subpath numbers after
+ * them in bd_sample's order), the light subpath of s_ vertices from light
+ * (bd_sample's order from dimension pair 65536), joined as bd_sample joins
+ * them.  Returns the contribution times its MIS weight (the one bd_sample
+ * gives it among all strategies), and in *rx, *ry the raster position
+ * (continuous, in [0, width) x [0, height)) where it lands.  0 when the
+ * subpaths end before t or s_ vertices, the strategy is out of range
+ * ((1, 1), a depth s_ + t - 2 beyond max_depth) or the result is not
+ * finite.  The scene must pass bd_supported. */
+vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam, const bd_stream *light, float *rx,
+             float *ry);
+
+/** The mean luminance over the image of the paths of each depth
+ * (by_depth: max_depth + 1 entries, caller-owned), from about n samples
+ * with all strategies, splats included: each depth's share of the image.
+ * Samples 0..spp-1 of every pixel (spp = n / pixels rounded up) when n is
+ * over the pixel count, else sample 0 of n pixels spread evenly over the
+ * image.  -1 when out of memory. */
+int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth);
 
 /** Render rows [y0, y1) of s->settings' size and spp with all strategies:
  * rgb (3 floats per pixel, row y0 first, width*(y1-y0)*3) receives the

@@ -14,7 +14,7 @@
 #include "trace.h"
 
 static const char *const format_names[] = {"pf", "ppm16", "ppm8"};
-static const char *const integrator_names[] = {"path", "bdpt"};
+static const char *const integrator_names[] = {"path", "bdpt", "mlt"};
 
 int proto_integrator_parse(const char *name, int *out)
 {
@@ -181,7 +181,7 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         } else if (!strcmp(a, "--integrator")) {
             int k;
             if (proto_integrator_parse(argv[++i], &k) < 0)
-                return fr_fail(err, "--integrator: expected path or bdpt, got '%s'", argv[i]);
+                return fr_fail(err, "--integrator: expected path, bdpt or mlt, got '%s'", argv[i]);
             r->slab.integrator = 1 + k;
         } else if (!strcmp(a, "-o")) {
             r->slab.out = argv[++i];

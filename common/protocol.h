@@ -85,7 +85,7 @@ typedef struct {
  * "franja-worker: "). */
 int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *err);
 
-/** Parses an integrator name, "path" or "bdpt", into FR_INTEGRATOR_*; -1
+/** Parses an integrator name, "path", "bdpt" or "mlt", into FR_INTEGRATOR_*; -1
  * if it is neither. */
 int proto_integrator_parse(const char *name, int *out);
 

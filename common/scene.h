@@ -26,9 +26,13 @@
 #define FR_NONE 0xffffffffu /**< "no index" for optional uint32 references */
 
 /** How a scene is rendered by default (franja-worker --integrator
- * overrides it): unidirectional path tracing, or bidirectional path
- * tracing (bdpt.h). */
-enum { FR_INTEGRATOR_PATH = 0, FR_INTEGRATOR_BDPT = 1, FR_INTEGRATORS };
+ * overrides it): unidirectional path tracing, bidirectional path tracing
+ * (bdpt.h), or Metropolis light transport (mlt_path.h). */
+enum { FR_INTEGRATOR_PATH = 0, FR_INTEGRATOR_BDPT = 1, FR_INTEGRATOR_MLT = 2, FR_INTEGRATORS };
+
+/** Whether integrator i's partial images carry fixed-point splats over the
+ * whole image (splat.h): bidirectional and Metropolis renders. */
+static inline int fr_integrator_splats(uint32_t i) { return i == FR_INTEGRATOR_BDPT || i == FR_INTEGRATOR_MLT; }
 
 /** Image and sampling settings. */
 typedef struct {

@@ -65,7 +65,7 @@ static const char usage[] =
     "                       (repeatable); without it, a scene reads only files\n"
     "                       in its own folder\n"
     COMPILE_LIMIT_HELP
-    "  --integrator I       path or bdpt (default: the scene's, else path)\n"
+    "  --integrator I       path, bdpt or mlt (default: the scene's, else path)\n"
     "  --noise-threshold E  adaptive sampling (path tracing): each pixel stops once\n"
     "                       the relative error of its mean is below E, in (0, 1]\n"
     "                       (default: the scene's, else off)\n"
@@ -248,7 +248,7 @@ static int parse(int argc, char **argv, frame_settings *a)
             a->preview = v;
             break;
         case OPT_INTEGRATOR: {
-            static const char *const integrators[] = {"path", "bdpt", NULL};
+            static const char *const integrators[] = {"path", "bdpt", "mlt", NULL};
             int k = opt_choice(cmd, "--integrator", v, integrators);
             bad = k < 0 || proto_integrator_parse(v, &k) < 0;
             a->integrator = 1 + k;

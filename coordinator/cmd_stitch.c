@@ -105,7 +105,7 @@ int cmd_stitch(int argc, char **argv)
         goto done;
     }
     int rows = preview_image(dir, &spec, rgb, have, &skipped, &err);
-    if (rows >= 0 && spec.integrator == FR_INTEGRATOR_BDPT) {
+    if (rows >= 0 && fr_integrator_splats(spec.integrator)) {
         /* A bidirectional job: the rows lack the light traced from the
          * lights (every slab's splats over the whole image), so only a
          * complete job, whose every slab checked out, makes an image. */

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "bdpt.h"
+#include "mlt_path.h"
 #include "clock.h"
 #include "compile/compile.h"
 #include "compile/compile_child.h"
@@ -260,27 +261,32 @@ int frame_open(frame_image *im)
         fprintf(stderr, "franja render: --scale: %ux%u is over the largest size, %u pixels a side\n", spec.width,
                 spec.height, PROTO_MAX_SIZE);
         rc = 2;
-    } else if (spec.integrator == FR_INTEGRATOR_BDPT && a->noise_threshold > 0.0f) {
-        fprintf(stderr, "franja render: --noise-threshold: adaptive sampling is for path tracing, not bdpt\n");
+    } else if (fr_integrator_splats(spec.integrator) && a->noise_threshold > 0.0f) {
+        fprintf(stderr, "franja render: --noise-threshold: adaptive sampling is for path tracing, not %s\n",
+                proto_integrator_name((int)spec.integrator));
         rc = 2;
     }
-    if (!rc && spec.integrator == FR_INTEGRATOR_BDPT)
-        spec.noise_threshold = 0.0f; /* bidirectional workers take every sample */
-    if (!rc && spec.passes && spec.integrator == FR_INTEGRATOR_BDPT) {
-        fprintf(stderr, "franja render: %s: render passes are made by the path integrator, not bdpt (use "
-                "--integrator path, or --passes none)\n", a->passes_set ? "--passes" : a->scene);
+    int mlt = spec.integrator == FR_INTEGRATOR_MLT;
+    if (!rc && fr_integrator_splats(spec.integrator))
+        spec.noise_threshold = 0.0f; /* bidirectional and Metropolis workers take every sample */
+    if (!rc && spec.passes && fr_integrator_splats(spec.integrator)) {
+        fprintf(stderr, "franja render: %s: render passes are made by the path integrator, not %s (use "
+                "--integrator path, or --passes none)\n", a->passes_set ? "--passes" : a->scene,
+                proto_integrator_name((int)spec.integrator));
         rc = 2;
     } else if (!rc && spec.passes && a->time_limit > 0) {
         fprintf(stderr, "franja render: --time-limit with render passes: its passes add samples to kept sample "
                 "sums, which slabs with render passes do not keep (use --passes none, or no --time-limit)\n");
         rc = 2;
-    } else if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && bd_supported(&sc, &err)) {
-        fprintf(stderr, "franja render: %s: bidirectional path tracing: %s\n", a->scene, err.msg);
+    } else if (!rc && fr_integrator_splats(spec.integrator) && (mlt ? mlt_supported(&sc, &err) : bd_supported(&sc, &err))) {
+        fprintf(stderr, "franja render: %s: %s: %s\n", a->scene,
+                mlt ? "Metropolis light transport" : "bidirectional path tracing", err.msg);
         rc = a->integrator ? 2 : 1;
     } else if (!rc && a->time_limit > 0 && !job_sums(&spec)) {
         fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
                 "only path tracing without adaptive sampling keeps (this render %s)\n",
                 spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"
+                : mlt                                   ? "is Metropolis light transport"
                 : a->noise_threshold > 0.0f       ? "has --noise-threshold"
                                                   : "has the scene's noise_threshold");
         rc = 2;
@@ -294,8 +300,11 @@ int frame_open(frame_image *im)
     }
     /* A crop renders the window's rows only, except bidirectionally: light
      * paths started from every pixel of the image reach the window. */
-    int crop_rows = im->crop_rows = a->crop && spec.integrator != FR_INTEGRATOR_BDPT;
-    if (a->crop && !crop_rows)
+    int crop_rows = im->crop_rows = a->crop && !fr_integrator_splats(spec.integrator);
+    if (a->crop && mlt)
+        fprintf(stderr, "franja: --crop with --integrator mlt renders every row (every chain splats over the whole "
+                "image)\n");
+    else if (a->crop && !crop_rows)
         fprintf(stderr, "franja: --crop with --integrator bdpt renders every row (light traced from the whole "
                 "image reaches the window)\n");
     uint32_t asked = spec.spp;

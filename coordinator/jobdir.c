@@ -42,7 +42,7 @@ static int check_slab(const unsigned char *buf, size_t len, const job_spec *spec
                        spec->height);
     if (info.y0 != y0 || info.y1 != y1)
         return fr_fail(err, "rows %u:%u, expected %u:%u", info.y0, info.y1, y0, y1);
-    uint64_t paths = spec->integrator == FR_INTEGRATOR_BDPT ? (uint64_t)spec->width * (y1 - y0) * info.spp : 0;
+    uint64_t paths = fr_integrator_splats(spec->integrator) ? (uint64_t)spec->width * (y1 - y0) * info.spp : 0;
     if (info.splat_paths != paths)
         return paths ? fr_fail(err, "%llu light subpaths splatted, expected %llu (one per pixel sample of its rows)",
                                (unsigned long long)info.splat_paths, (unsigned long long)paths)
@@ -88,7 +88,7 @@ size_t job_max_partial(const job_spec *spec, uint32_t y0, uint32_t y1)
     size_t n = 4096 + (size_t)spec->width * (y1 - y0) * 12;
     if (job_sums(spec))
         n += (size_t)spec->width * (y1 - y0) * 24;
-    if (spec->integrator == FR_INTEGRATOR_BDPT)
+    if (fr_integrator_splats(spec->integrator))
         n += (size_t)spec->width * spec->height * 24;
     n += (size_t)spec->width * (y1 - y0) * pass_channels(spec->passes) * 4 + 512;
     return n;
@@ -105,7 +105,9 @@ static void spec_text(const job_spec *s, char *out, size_t cap)
         snprintf(passes, sizeof passes, "passes=%s\n", names);
     }
     snprintf(out, cap, "franja job\nscene=%016llx\nsize=%ux%u\nspp=%u\n%s%s%s", (unsigned long long)s->hash,
-             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT ? "integrator=bdpt\n" : "", noise,
+             s->width, s->height, s->spp, s->integrator == FR_INTEGRATOR_BDPT  ? "integrator=bdpt\n"
+             : s->integrator == FR_INTEGRATOR_MLT ? "integrator=mlt\n"
+                                                  : "", noise,
              passes);
 }
 
@@ -220,9 +222,10 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
                 fr_fail(err, "%s: holds a render with %u samples per pixel; %s cannot be continued to %u "
                         "exactly (only path tracing without --noise-threshold or render passes keeps each "
                         "pixel's sample sums): render with --fresh, or with --spp %u", dir, old.spp,
-                        spec->integrator == FR_INTEGRATOR_BDPT ? "a bidirectional render"
-                        : spec->passes                         ? "a render with passes"
-                                                               : "an adaptive render",
+                        spec->integrator == FR_INTEGRATOR_BDPT  ? "a bidirectional render"
+                        : spec->integrator == FR_INTEGRATOR_MLT ? "a Metropolis render"
+                        : spec->passes                          ? "a render with passes"
+                                                                : "an adaptive render",
                         spec->spp, old.spp);
                 return JOB_REFUSED;
             }
@@ -694,7 +697,7 @@ int job_stitch_passes(const char *dir, const job_spec *spec, float *rgb, float *
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, NULL, spec->integrator == FR_INTEGRATOR_BDPT ? NULL : rgb, passes, 0, notes, STITCH, 0};
+    scan_ctx c = {spec, have, NULL, fr_integrator_splats(spec->integrator) ? NULL : rgb, passes, 0, notes, STITCH, 0};
     int rc = each_slab(dir, scan_one, &c, err);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];
@@ -702,7 +705,7 @@ int job_stitch_passes(const char *dir, const job_spec *spec, float *rgb, float *
         rc = fr_fail(err, "rows %s are missing from %s; the image was not written", missing, dir);
     }
     free(have);
-    if (rc == 0 && spec->integrator == FR_INTEGRATOR_BDPT)
+    if (rc == 0 && fr_integrator_splats(spec->integrator))
         rc = stitch_splats(dir, spec, rgb, err);
     return rc;
 }
@@ -750,6 +753,9 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
         if (ok && !strncmp(copy + n, "integrator=bdpt\n", 16)) {
             bdpt = 1;
             n += 16;
+        } else if (ok && !strncmp(copy + n, "integrator=mlt\n", 15)) {
+            bdpt = 2;
+            n += 15;
         }
         if (ok && n < (int)len && !strncmp(copy + n, "noise_threshold=", 16)) {
             int m = -1;
@@ -771,12 +777,12 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
     free(text);
     if (!ok || w == 0 || h == 0 || w > PROTO_MAX_SIZE || h > PROTO_MAX_SIZE || spp == 0 || spp > PROTO_MAX_SPP)
         return fr_fail(err, "%s: not a job file of franja (expected scene=, size=WxH and spp= lines, maybe integrator=bdpt "
-                       "or noise_threshold=E in (0, 1] and passes=NAMES, sizes in 1..%u)", path, PROTO_MAX_SIZE);
+                       "or mlt, noise_threshold=E in (0, 1] and passes=NAMES, sizes in 1..%u)", path, PROTO_MAX_SIZE);
     spec->hash = hash;
     spec->width = w;
     spec->height = h;
     spec->spp = spp;
-    spec->integrator = bdpt ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH;
+    spec->integrator = bdpt == 2 ? FR_INTEGRATOR_MLT : bdpt ? FR_INTEGRATOR_BDPT : FR_INTEGRATOR_PATH;
     spec->noise_threshold = noise;
     spec->passes = passes;
     return 0;

@@ -10,7 +10,7 @@ static const char usage[] =
     "usage: franja render SCENE [-o OUT] [--hosts FILE | --slurm [--worker PATH]\n"
     "                     [--workdir DIR | --shared-workdir DIR]] [-j N] [--spp N]\n"
     "                     [--size WxH | --scale S] [--crop X0:Y0:X1:Y1 [--crop-output]]\n"
-    "                     [--camera NAME] [--allow-path DIR]... [--integrator path|bdpt]\n"
+    "                     [--camera NAME] [--allow-path DIR]... [--integrator path|bdpt|mlt]\n"
     "                     [--noise-threshold E] [--passes LIST]\n"
     "                     [--exposure E] [--tonemap none|filmic] [--exr-half]\n"
     "                     [--exr-compression C] [--jpeg-quality Q] [--reproducible]\n"

@@ -19,7 +19,7 @@ int preview_image(const char *dir, const job_spec *spec, float *rgb, unsigned ch
         return -1;
     /* A whole bidirectional job: the rows with every slab's splats added,
      * as the render's own image has them. */
-    if (spec->integrator == FR_INTEGRATOR_BDPT && (uint32_t)rows == spec->height && !bad)
+    if (fr_integrator_splats(spec->integrator) && (uint32_t)rows == spec->height && !bad)
         return job_stitch(dir, spec, rgb, NULL, err) ? -1 : rows;
     for (uint32_t y = 0; y < spec->height; y++) {
         if (have[y])

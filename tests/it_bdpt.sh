@@ -108,7 +108,7 @@ check "because light tracing adds light to every row" grep -q "needs the whole i
 check "the whole image in sRGB is fine" test -s whole.ppm
 "$WORKER" --scene scene.fbin --rows 0:5 $SIZE --integrator bogus -o x.pf 2>e2
 check "an unknown integrator is refused (status 2)" test $? -eq 2
-check "and named" grep -q "expected path or bdpt, got 'bogus'" e2
+check "and named" grep -q "expected path, bdpt or mlt, got 'bogus'" e2
 "$FRANJA" compile "$ROOT/scenes/fog-room.json" -o fog.fbin 2>/dev/null
 "$WORKER" --scene fog.fbin --rows 0:4 --size 8x8 --spp 1 $B -o f.pf 2>e3
 check "a scene with media is refused by the worker (status 2)" test $? -eq 2

@@ -94,7 +94,7 @@ cp scenes/spheres.json "$T/here/-dash.json"
 expect_error "--spp 0" "--spp: '0' is not an integer in 1..1048576" "$F" render scenes/spheres.json --spp 0
 expect_error "--spp=x" "--spp: 'x' is not an integer in 1..1048576" "$F" render scenes/spheres.json --spp=x
 expect_error "--tonemap aces" "--tonemap: 'aces' is not one of: none, filmic" "$F" render scenes/spheres.json --tonemap aces
-expect_error "--integrator" "--integrator: 'bidir' is not one of: path, bdpt" "$F" render scenes/spheres.json --integrator=bidir
+expect_error "--integrator" "--integrator: 'bidir' is not one of: path, bdpt, mlt" "$F" render scenes/spheres.json --integrator=bidir
 expect_error "--size 64" "--size: '64' is not WxH" "$F" render scenes/spheres.json --size 64
 expect_error "-j 0" "-j: '0' is not an integer in 1..4096" "$F" render scenes/spheres.json -j 0
 expect_error "--exposure x" "--exposure: 'x' is not a number in -64..64" "$F" render scenes/spheres.json --exposure x

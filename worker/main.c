@@ -15,6 +15,7 @@
 #include "image.h"
 #include "lifeline.h"
 #include "passes.h"
+#include "mlt_path.h"
 #include "pathtrace.h"
 #include "protocol.h"
 #include "quick.h"
@@ -27,7 +28,7 @@
 
 static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
-    "                     [--integrator path|bdpt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
+    "                     [--integrator path|bdpt|mlt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
     "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE] [--passes LIST]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --unpack FILE --scene FILE\n"
@@ -43,7 +44,8 @@ static const char usage[] =
     "  --noise-threshold E  adaptive sampling: each pixel stops once its relative\n"
     "                 error estimate is below E, in (0, 1] (default: the scene's)\n"
     "  --size WxH     image size (default: the scene's)\n"
-    "  --integrator I path or bdpt (default: the scene's)\n"
+    "  --integrator I path, bdpt or mlt (default: the scene's); mlt renders\n"
+    "                 chain y for row y (Metropolis chains splat anywhere)\n"
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
@@ -175,16 +177,19 @@ int main(int argc, char **argv)
         return 2;
     }
     uint32_t width = scene.settings.width, height = scene.settings.height, spp = scene.settings.spp;
-    int bdpt = (sl->integrator ? sl->integrator - 1 : (int)scene.settings.integrator) == FR_INTEGRATOR_BDPT;
-    if (bdpt && bd_supported(&scene, &err) < 0) {
-        fprintf(stderr, "franja-worker: bidirectional path tracing: %s\n", err.msg);
+    uint32_t integ = sl->integrator ? (uint32_t)sl->integrator - 1 : scene.settings.integrator;
+    int bdpt = fr_integrator_splats(integ), mlt = integ == FR_INTEGRATOR_MLT;
+    if (bdpt && (mlt ? mlt_supported(&scene, &err) : bd_supported(&scene, &err)) < 0) {
+        fprintf(stderr, "franja-worker: %s: %s\n", mlt ? "Metropolis light transport" : "bidirectional path tracing",
+                err.msg);
         scn_free(&scene);
         return sl->integrator ? 2 : 1;
     }
     if (bdpt && sl->format != IMG_PF && (y0 != 0 || y1 != height)) {
-        fprintf(stderr, "franja-worker: --format %s with the bdpt integrator needs the whole image (--rows 0:%u): "
-                        "light tracing adds light to every row; use --format pf for a slab\n",
-                sl->format == IMG_PPM16 ? "ppm16" : "ppm8", height);
+        fprintf(stderr, "franja-worker: --format %s with the %s integrator needs the whole image (--rows 0:%u): "
+                        "%s adds light to every row; use --format pf for a slab\n",
+                sl->format == IMG_PPM16 ? "ppm16" : "ppm8", mlt ? "mlt" : "bdpt", height,
+                mlt ? "every Metropolis chain" : "light tracing");
         scn_free(&scene);
         return 2;
     }
@@ -199,7 +204,7 @@ int main(int argc, char **argv)
     if (passes && (bdpt || keep_sums || sl->format != IMG_PF)) {
         fprintf(stderr, "franja-worker: --passes needs the path integrator and --format pf, without --sums or "
                         "--continue (this render %s)\n",
-                bdpt ? "is bidirectional" : keep_sums ? "keeps sample sums" : "is not --format pf");
+                mlt ? "is Metropolis" : bdpt ? "is bidirectional" : keep_sums ? "keeps sample sums" : "is not --format pf");
         scn_free(&scene);
         return 2;
     }
@@ -231,7 +236,8 @@ int main(int argc, char **argv)
     }
     img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0, 0, passes, 0};
     if (bdpt) {
-        if (bd_render_rows(&scene, y0, y1, rgb, splat, &err) < 0) {
+        if ((mlt ? mlt_render_rows(&scene, y0, y1, rgb, splat, &err) : bd_render_rows(&scene, y0, y1, rgb, splat, &err)) <
+            0) {
             fprintf(stderr, "franja-worker: %s\n", err.msg);
             free(rgb);
             free(splat);

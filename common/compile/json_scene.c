@@ -46,7 +46,7 @@ static int parse_image(ctx *c, const cJSON *o)
 {
     static const char *const fields[] = {"width", "height", "spp", "max_depth", "seed", "integrator",
                                          "noise_threshold", "light_sampling", "passes", NULL};
-    static const char *const integrators[] = {"path", "bdpt", NULL};
+    static const char *const integrators[] = {"path", "bdpt", "mlt", NULL};
     static const char *const light_samplings[] = {"tree", "power", NULL};
     fr_settings *s = &c->b->settings;
     int integrator, light_sampling;

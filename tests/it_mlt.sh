@@ -1,0 +1,82 @@
+#!/bin/sh
+# it_mlt.sh -- tests Metropolis renders are the same bytes for any split.
+#
+# Metropolis light transport through the band renderer: row y of the image
+# stands for chain y, so a slab is a range of chains whose splats cover the
+# whole image.  The stitched image is byte-identical for any slab height,
+# any number of worker processes, local or over fake SSH hosts; a resumed
+# job renders only the lost chains, to the same bytes; franja stitch adds
+# a kept job's splats; what MLT cannot do is refused with the reason.
+. "$(dirname "$0")/support/fakehosts.sh"
+fh_init
+cd "$FH" || exit 1
+W=24 H=21
+SIZE="--size ${W}x$H --spp 8"
+M="--integrator mlt"
+"$FRANJA" compile "$ROOT/scenes/spheres.json" -o scene.fbin 2>/dev/null
+check "the spheres scene compiles" test -s scene.fbin
+
+"$FRANJA" render scene.fbin -o one.pfm $SIZE $M -j 1 --slab-rows $H 2>log1
+check "one slab: a Metropolis render succeeds" test -s one.pfm
+check "one slab: 1 slab" grep -q "; 1 slabs" log1
+for n in 2 7; do
+    rows=$(((H + n - 1) / n))
+    "$FRANJA" render scene.fbin -o s$n.pfm $SIZE $M -j 2 --slab-rows $rows 2>log$n
+    check "$n slabs: $n slabs were rendered" grep -q "; $n slabs" log$n
+    check "$n slabs give the bytes of one" cmp -s s$n.pfm one.pfm
+done
+"$FRANJA" render scene.fbin -o bd.pfm $SIZE --integrator bdpt -j 2 2>/dev/null
+check "bdpt gives another image" sh -c "! cmp -s bd.pfm one.pfm"
+
+# Over fake SSH hosts, the slabs finishing in whatever order.
+fh_start a 2 2
+fh_start b 3 3
+for rows in 3 8; do
+    fr render scene.fbin -o ssh$rows.pfm --hosts hosts $SIZE $M --slab-rows $rows 2>logs$rows
+    check "$rows-row slabs over 2 SSH hosts give the same bytes" cmp -s ssh$rows.pfm one.pfm
+done
+
+# The partial image: its rows (black: all light is splatted), then the
+# splats of its chains over the whole image.
+"$WORKER" --scene scene.fbin --rows 5:9 $SIZE $M -o part.pf
+check "the header counts the slab's mutations and hashes the splats" \
+    sh -c "head -n 2 part.pf | grep -Eq '^# franja scene=[0-9a-f]{16} rows=5:9 spp=8 size=${W}x$H splat=$((W * 4 * 8)):[0-9a-f]{16}\$'"
+
+# A job interrupted (slabs lost), resumed with another slab height: only
+# the lost chains are rendered, to the bytes of the uninterrupted render.
+"$FRANJA" render scene.fbin -o keep.pfm $SIZE $M -j 2 --slab-rows 7 --job kj --keep-job 2>/dev/null
+check "a kept job gives the same bytes" cmp -s keep.pfm one.pfm
+check "its job file names the integrator" grep -q "integrator=mlt" kj/job
+rm -f kj/rows-00007-00014.pf
+"$FRANJA" render scene.fbin -o keep2.pfm $SIZE $M -j 2 --slab-rows 2 --job kj --resume --keep-job 2>logk
+check "a resume with 2-row slabs renders only the lost chains" grep -q "; 4 slabs" logk
+check "and gives the bytes of the uninterrupted render" cmp -s keep2.pfm one.pfm
+"$FRANJA" stitch kj -o st.pfm >/dev/null 2>logst
+check "franja stitch of a complete Metropolis job: the same bytes" cmp -s st.pfm one.pfm
+"$FRANJA" render scene.fbin -o other.pfm $SIZE --integrator bdpt -j 2 --job kj --resume 2>logo
+check "a Metropolis job directory is not resumed by a bidirectional render" grep -q "belongs to another render" logo
+
+# What MLT cannot do is refused, with the reason.
+"$WORKER" --scene scene.fbin --rows 0:5 $SIZE $M --format ppm8 -o x.ppm 2>e1
+check "an sRGB slab of a Metropolis render is refused (status 2)" test $? -eq 2
+check "because every chain adds light to every row" grep -q "every Metropolis chain" e1
+"$FRANJA" compile "$ROOT/scenes/fog-room.json" -o fog.fbin 2>/dev/null
+"$WORKER" --scene fog.fbin --rows 0:4 --size 8x8 --spp 1 $M -o f.pf 2>e3
+check "a scene with media is refused by the worker (status 2)" test $? -eq 2
+check "with the reason" grep -q "Metropolis light transport.*participating media" e3
+"$FRANJA" render fog.fbin -o f.png --size 8x8 --spp 1 $M 2>e4
+check "and by franja render (status 2)" test $? -eq 2
+check "before rendering anything" sh -c "grep -q 'participating media' e4 && ! grep -q Msamples e4"
+"$FRANJA" render scene.fbin -o t.pfm $SIZE $M --time-limit 10 2>e5
+check "--time-limit is refused (status 2)" test $? -eq 2
+check "naming Metropolis light transport" grep -q "is Metropolis light transport" e5
+"$FRANJA" render scene.fbin -o t.pfm $SIZE $M --noise-threshold 0.1 2>e6
+check "--noise-threshold is refused (status 2)" test $? -eq 2
+check "as adaptive sampling is for path tracing" grep -q "not mlt" e6
+sed 's/"max_depth": 8,/"max_depth": 8, "integrator": "mlt",/' "$ROOT/scenes/spheres.json" >sm.json
+"$FRANJA" render sm.json -o sm.pfm $SIZE -j 2 2>/dev/null
+pixels=$((W * H * 12))
+check "image.integrator mlt renders as --integrator mlt" \
+    sh -c "tail -c $pixels sm.pfm | cmp -s - \$0" "$(tail -c $pixels one.pfm >one.px; echo one.px)"
+
+summary

@@ -1,0 +1,101 @@
+/* test_mlt_path.c -- Metropolis light transport over bidirectional paths
+ * renders path tracing's image, normalised by its bootstrap, the same bits
+ * for any grouping of chains.
+ *
+ * On the Cornell box and the glass-and-mirror spheres (scenes/), small
+ * images: the bootstrap's b (the integral of the target, the image's mean
+ * luminance) against path tracing's mean luminance; the MLT image's mean
+ * against b (the chains distribute exactly b over the image); the image's
+ * quadrants against path tracing's (within MLT's noise at this budget); and chains [0, K) rendered as one
+ * group against three groups added in another order (fixed-point sums). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "compile/json_scene.h"
+#include "mlt_path.h"
+#include "pathtrace.h"
+#include "splat.h"
+
+#define W 24
+#define H 24
+#define K (4 * H)
+
+static double luma(const float *p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+/* Mean luminance of quadrant q (0..3; 4: the whole image) of a W x H image. */
+static double quadrant(const float *rgb, int q)
+{
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            if (q == 4 || (x >= W / 2) + 2 * (y >= H / 2) == q) {
+                sum += luma(rgb + ((size_t)y * W + x) * 3);
+                n++;
+            }
+    return sum / n;
+}
+
+/* quad_tol: the relative difference allowed in a quadrant (MLT's noise:
+ * the spheres' caustics make it several times the Cornell box's; over
+ * six seeds their worst quadrant strayed 16 %). */
+static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_spp, double quad_tol)
+{
+    fr_scene s;
+    fr_error err;
+    if (json_scene_load(path, NULL, &s, &err) < 0) {
+        CHECK(0, "%s", err.msg);
+        return;
+    }
+    s.settings.width = W;
+    s.settings.height = H;
+    s.settings.noise_threshold = 0.0f;
+    static float ref[W * H * 3], img[W * H * 3];
+    s.settings.spp = pt_spp;
+    pt_render_rows(&s, PT_MIS, 0, H, ref);
+
+    mlt_boot bt;
+    CHECK(mlt_bootstrap(&s, MLT_BOOTSTRAP, &bt, &err) == 0, "%s: bootstrap: %s", path, err.msg);
+    double pt_mean = quadrant(ref, 4);
+    CHECK(fabs(bt.b / pt_mean - 1.0) < 0.02, "%s: b %g, path tracing's mean luminance %g", path, bt.b, pt_mean);
+
+    /* The whole image in K = 4H chains of W * spp / 4 mutations (franja-worker
+     * runs H chains of W * spp: more, shorter chains here for less noise in
+     * the quadrants). */
+    s.settings.spp = mlt_spp;
+    uint64_t *one = calloc((size_t)W * H * 3, sizeof *one), *parts = calloc((size_t)W * H * 3, sizeof *parts),
+             *part = calloc((size_t)W * H * 3, sizeof *part);
+    CHECK(mlt_chains(&s, &bt, 0, K, K, (uint64_t)W * mlt_spp / 4, one, &err) == 0, "%s: chains: %s", path, err.msg);
+    memset(img, 0, sizeof img);
+    spl_resolve(img, one, W, 0, H, mlt_spp);
+    double mlt_mean = quadrant(img, 4);
+    CHECK(fabs(mlt_mean / bt.b - 1.0) < 1e-4, "%s: MLT image's mean luminance %g, b %g", path, mlt_mean, bt.b);
+    for (int q = 0; q < 4; q++) {
+        double a = quadrant(img, q), r = quadrant(ref, q);
+        CHECK(fabs(a / r - 1.0) < quad_tol, "%s: quadrant %d: MLT %g, path tracing %g", path, q, a, r);
+    }
+
+    /* Groups [67, 96), [0, 5), [5, 67), added in that order. */
+    const uint32_t cut[][2] = {{67, K}, {0, 5}, {5, 67}};
+    for (int g = 0; g < 3; g++) {
+        memset(part, 0, (size_t)W * H * 3 * sizeof *part);
+        mlt_chains(&s, &bt, cut[g][0], cut[g][1], K, (uint64_t)W * mlt_spp / 4, part, &err);
+        spl_sum(parts, part, (size_t)W * H * 3);
+    }
+    CHECK(memcmp(one, parts, (size_t)W * H * 3 * sizeof *one) == 0, "%s: chains in three groups differ from one",
+          path);
+    free(one);
+    free(parts);
+    free(part);
+    mlt_boot_free(&bt);
+    scn_free(&s);
+}
+
+int main(void)
+{
+    scene_against_path("scenes/cornell.json", 1024, 512, 0.05);
+    scene_against_path("scenes/spheres.json", 1024, 512, 0.25);
+    return check_done();
+}
