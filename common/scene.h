@@ -419,6 +419,11 @@ typedef struct {
     const fr_bvh_leaf *mesh_leaves; uint32_t n_mesh_leaves;
     const fr_light_node *light_nodes; uint32_t n_light_nodes;
     const fr_name *material_names; uint32_t n_material_names; /**< 0, or one per material */
+    /** 0, or the object of each prim, then of each plane, then of each
+     * instance (an index into object_names; a prim of an instanced mesh
+     * takes its instance's). */
+    const uint32_t *objects; uint32_t n_objects;
+    const fr_name *object_names; uint32_t n_object_names; /**< the objects' names */
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

@@ -9,6 +9,7 @@
 
 #include "fmath.h"
 #include "compile/builder_instance.h"
+#include "compile/builder_object.h"
 #include "compile/builder_light.h"
 #include "compile/freeze.h"
 #include "compile/gltf_doc.h"
@@ -492,6 +493,15 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
         gdoc_warn(d, "skin", "%s/skin: skinning is not supported: the mesh is drawn in its bind pose", ptr);
     if (cJSON_GetObjectItemCaseSensitive(o, "weights"))
         gdoc_warn(d, "morph", "%s/weights: morph targets are not supported: the base mesh is drawn", ptr);
+    if (m != UINT32_MAX) {
+        /* The node is an object (builder_object.h), by its name. */
+        char dflt[24];
+        const char *name = name_of(o);
+        snprintf(dflt, sizeof dflt, "node%u", n);
+        fr_error e;
+        if (bld_object(c->b, name ? name : dflt, &e) < 0)
+            return gdoc_fail(d, err, ptr, "%s", e.msg);
+    }
     if ((m != UINT32_MAX && mesh(c, m, w, err) < 0) || (cam != UINT32_MAX && camera(c, n, cam, w, err) < 0) ||
         (lp && light(c, n, lp, w, err) < 0))
         return -1;

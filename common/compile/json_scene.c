@@ -20,6 +20,7 @@
 #include "compile/json_gltf.h"
 #include "compile/json_light.h"
 #include "compile/json_microfacet.h"
+#include "compile/builder_object.h"
 
 #define PATHLEN 160
 
@@ -280,10 +281,31 @@ static int parse_box(fr_builder *b, const cJSON *o, const char *where, uint32_t 
     return 0;
 }
 
+static int parse_shape_fields(ctx *c, const cJSON *o, const char *where);
+
+/* A shape: an object (builder_object.h) named by its optional "name" key,
+ * else by where it is ("shapes[3]"); the key is set aside while the
+ * shape's own fields are read. */
 static int parse_shape(ctx *c, const cJSON *o, const char *where)
 {
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "%s: expected an object", where);
+    cJSON *name = cJSON_DetachItemFromObjectCaseSensitive((cJSON *)o, "name");
+    int rc = 0;
+    if (name && (!cJSON_IsString(name) || !name->valuestring[0]))
+        rc = fr_fail(c->err, "%s.name: expected a non-empty string", where);
+    if (rc == 0)
+        rc = bld_object(c->b, name ? name->valuestring : where, c->err);
+    if (rc == 0)
+        rc = parse_shape_fields(c, o, where);
+    if (name)
+        cJSON_AddItemToObject((cJSON *)o, "name", name);
+    return rc;
+}
+
+/* A shape's fields but its name. */
+static int parse_shape_fields(ctx *c, const cJSON *o, const char *where)
+{
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
         return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle, box, mesh or gltf)", where);
