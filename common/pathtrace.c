@@ -182,7 +182,8 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             pass_light(ps, depth + 1, v3_sub(L, before));
             if (depth == 0 && (kind == VTX_SURFACE || kind == VTX_MEDIUM))
                 pass_first_hit(ps, kind == VTX_SURFACE ? v.sf.p : v.p,
-                               kind == VTX_SURFACE ? v.sf.material : FR_NONE, camera);
+                               kind == VTX_SURFACE ? v.sf.material : FR_NONE,
+                               kind == VTX_SURFACE ? pass_object(s, &v.sf) : 0, camera);
         }
         if (kind == VTX_ESCAPED) {
             vec3 e = escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta);

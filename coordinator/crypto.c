@@ -60,7 +60,7 @@ void crypto_name(const crypto_names *names, uint32_t index, char *out)
     if (index < names->n && names->v[index].name[0])
         snprintf(out, 64, "%s", names->v[index].name);
     else
-        snprintf(out, 64, "material%u", index);
+        snprintf(out, 64, "%s%u", names->prefix ? names->prefix : "material", index);
 }
 
 /* The Cryptomatte id of material index. */

@@ -109,6 +109,8 @@ typedef struct {
     float *passes;             /* the render passes (passes.h) once stitched, or NULL */
     fr_name *mat_names;        /* the materials' names (n_mat_names, 0 or n_materials), for the passes' metadata */
     uint32_t n_mat_names, n_materials;
+    fr_name *obj_names;        /* the objects' names (n_obj_names), for the passes' metadata */
+    uint32_t n_obj_names;
     frame_passes ps;
     int rows_job, rows_have;
     double t0;

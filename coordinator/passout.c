@@ -23,7 +23,8 @@ static void pass_file(const char *path, const char *name, char *out, size_t cap)
  * interleaved in *passes itself (grown), so that the passes are not held
  * twice. */
 static int write_exr(const char *path, const float *rgb, float **passes, const job_spec *spec,
-                     const iio_options *o, const crypto_names *cn, uint32_t n_materials, fr_error *err)
+                     const iio_options *o, const crypto_names *cn, uint32_t n_materials, const crypto_names *on,
+                     fr_error *err)
 {
     uint32_t nch = pass_channels(spec->passes), all = 4 + nch;
     size_t npx = (size_t)spec->width * spec->height;
@@ -49,15 +50,18 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
     uint32_t c = 0;
     for (; c < 4; c++)
         snprintf(names[c], sizeof names[c], "ViewLayer.Combined.%c", rgba[c]);
-    uint32_t crypto_at = 0;
+    uint32_t crypto_at = 0, crypto_obj_at = 0;
     for (int i = 0; i < PASS_COUNT; i++) {
         if (!(spec->passes >> i & 1u))
             continue;
         const pass_info *p = pass_get(i);
+        int crypto = i == PASS_CRYPTO_MATERIAL || i == PASS_CRYPTO_OBJECT;
         if (i == PASS_CRYPTO_MATERIAL)
             crypto_at = c;
+        if (i == PASS_CRYPTO_OBJECT)
+            crypto_obj_at = c;
         for (const char *ch = p->channels; *ch; ch++, c++)
-            if (i == PASS_CRYPTO_MATERIAL) /* Cryptomatte's ranks: ViewLayer.CryptoMaterial00.R ... 02.A */
+            if (crypto) /* Cryptomatte's ranks: ViewLayer.CryptoMaterial00.R ... 02.A */
                 snprintf(names[c], sizeof names[c], "ViewLayer.%s%02u.%c", p->layer,
                          (unsigned)(ch - p->channels) / 4, *ch);
             else
@@ -65,6 +69,8 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
     }
     if (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)
         crypto_ids(px + crypto_at, npx, all, cn);
+    if (spec->passes >> PASS_CRYPTO_OBJECT & 1u)
+        crypto_ids(px + crypto_obj_at, npx, all, on);
     for (c = 0; c < all; c++)
         ptrs[c] = names[c];
     /* The caller's attributes and franja:passes. */
@@ -72,18 +78,27 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
     pass_format(spec->passes, list, sizeof list);
     const char *attrs[64];
     size_t k = 0;
-    for (const char *const *a = o ? o->attrs : NULL; a && a[0] && a[1] && k + 16 < 64; a += 2)
+    for (const char *const *a = o ? o->attrs : NULL; a && a[0] && a[1] && k + 24 < 64; a += 2)
         attrs[k++] = a[0], attrs[k++] = a[1];
     attrs[k++] = "franja:passes", attrs[k++] = list;
-    char *table = NULL, *crypto = NULL;
+    char *table = NULL, *crypto = NULL, *otable = NULL, *ocrypto = NULL;
     int rc = 0;
     if (spec->passes & (1u << PASS_MATERIAL_ID | 1u << PASS_CRYPTO_MATERIAL)) {
         rc = crypto_name_table(cn, n_materials, &table, err);
         if (rc == 0)
             attrs[k++] = "franja:materials", attrs[k++] = table;
     }
+    if (rc == 0 && (spec->passes & (1u << PASS_OBJECT_ID | 1u << PASS_CRYPTO_OBJECT))) {
+        rc = crypto_name_table(on, on->n, &otable, err);
+        if (rc == 0)
+            attrs[k++] = "franja:objects", attrs[k++] = otable;
+    }
     if (rc == 0 && (spec->passes >> PASS_CRYPTO_MATERIAL & 1u)) {
         rc = crypto_metadata("ViewLayer.CryptoMaterial", cn, n_materials, attrs + k, &crypto, err);
+        k += 8;
+    }
+    if (rc == 0 && (spec->passes >> PASS_CRYPTO_OBJECT & 1u)) {
+        rc = crypto_metadata("ViewLayer.CryptoObject", on, on->n, attrs + k, &ocrypto, err);
         k += 8;
     }
     attrs[k] = NULL;
@@ -95,6 +110,8 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
         rc = out_write_with(path, px, spec, NULL, &with, err);
     free(table);
     free(crypto);
+    free(otable);
+    free(ocrypto);
     free(names);
     free(ptrs);
     return rc;
@@ -102,7 +119,7 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
 
 /* Pass i of the passes as an RGB image for a file of its own: one-channel
  * passes grey; for LDR files the normal as 0.5 + 0.5 n and the depth and
- * material_id over their largest value (a depth of nothing hit as 1). */
+ * material_id and object_id over their largest value (a depth of nothing hit as 1). */
 static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, size_t npx, int ldr, float *out)
 {
     const pass_info *p = pass_get(i);
@@ -118,7 +135,7 @@ static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, si
             float v = passes[j * nch + at + (k == 3 ? (uint32_t)c : 0)];
             if (ldr && i == PASS_NORMAL)
                 v = 0.5f + 0.5f * v;
-            else if (ldr && (i == PASS_DEPTH || i == PASS_MATERIAL_ID))
+            else if (ldr && (i == PASS_DEPTH || i == PASS_MATERIAL_ID || i == PASS_OBJECT_ID))
                 v = v >= PASS_DEPTH_NONE ? 1.0f : top > 0.0f ? v / top : 0.0f;
             out[j * 3 + c] = v;
         }
@@ -126,13 +143,13 @@ static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, si
 
 int passout_write(const char *path, const float *rgb, float **pass_buf, const job_spec *spec,
                   const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
-                  fr_error *err)
+                  const crypto_names *objects, fr_error *err)
 {
     const float *passes = pass_buf ? *pass_buf : NULL;
     if (!passes || !spec->passes)
         return out_write_with(path, rgb, spec, tm, o, err);
     if (out_has_ext(path, "exr"))
-        return write_exr(path, rgb, pass_buf, spec, o, names, n_materials, err);
+        return write_exr(path, rgb, pass_buf, spec, o, names, n_materials, objects, err);
     if (out_write_with(path, rgb, spec, tm, o, err))
         return -1;
     size_t npx = (size_t)spec->width * spec->height;
@@ -148,7 +165,7 @@ int passout_write(const char *path, const float *rgb, float **pass_buf, const jo
         if (!(spec->passes >> i & 1u))
             continue;
         const pass_info *p = pass_get(i);
-        if (i == PASS_CRYPTO_MATERIAL) { /* OpenEXR only (frame.c says so) */
+        if (i == PASS_CRYPTO_MATERIAL || i == PASS_CRYPTO_OBJECT) { /* OpenEXR only (frame.c says so) */
             at += (uint32_t)strlen(p->channels);
             continue;
         }

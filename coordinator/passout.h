@@ -39,10 +39,11 @@
  * reallocated (*passes updated; its values are then the file's), so the
  * passes are not held twice.
  * o: the writer's options (NULL: none); names: the materials' names
- * (n_materials of them), for the metadata.  Fails naming the file not
- * written (files written before it stay). */
+ * (n_materials of them), objects: the objects' names (objects->n of
+ * them), for the metadata.  Fails naming the file not written (files
+ * written before it stay). */
 int passout_write(const char *path, const float *rgb, float **passes, const job_spec *spec,
                   const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
-                  fr_error *err);
+                  const crypto_names *objects, fr_error *err);
 
 #endif

@@ -33,14 +33,18 @@ for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Alb
     "ViewLayer.Denoising Normal.Z" "ViewLayer.Depth.Z" "ViewLayer.Position.X" "ViewLayer.Emit.B" \
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
     "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "ViewLayer.CryptoMaterial00.R" \
-    "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B"; do
+    "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B" "ViewLayer.IndexOB.X" "ViewLayer.CryptoObject00.R" \
+    "ViewLayer.CryptoObject02.A"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
-check "the EXR has 51 channels" grep -q "51 channel" info
+check "the EXR has 64 channels" grep -q "64 channel" info
 check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoMaterial"' info
 check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
 check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info
 check "the EXR names its passes" grep -q 'franja:passes: "albedo,normal,depth' info
+check "the EXR has the objects' Cryptomatte metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoObject"' info
+check "the object manifest names the shapes" grep -q 'manifest: "{"shapes\[0\]":"[0-9a-f]\{8\}","shapes\[1\]"' info
+check "the object_id name table" grep -q 'franja:objects: "\["shapes\[0\]","shapes\[1\]",' info
 
 # Blender opens the file as a multilayer EXR: its compositor's Image node
 # offers every pass.
@@ -54,7 +58,7 @@ print("PASSES |" + "|".join(o.name for o in node.outputs) + "|")
 PY
 blender -b --factory-startup --python open.py -- j1.exr >blender.log 2>&1
 for p in Combined "Denoising Albedo" "Denoising Normal" Depth Position Emit DiffDir DiffInd GlossDir GlossInd \
-    TransDir TransInd IndexMA CryptoMaterial00 CryptoMaterial02 Variance; do
+    TransDir TransInd IndexMA CryptoMaterial00 CryptoMaterial02 Variance IndexOB CryptoObject00 CryptoObject02; do
     check "Blender's Image node offers $p" grep -q "^PASSES .*|$p|" blender.log
 done
 
@@ -63,7 +67,8 @@ done
 "$FRANJA" render "$SCENE" -o plain.pfm $SIZE -j 2 2>log4
 "$FRANJA" render "$SCENE" -o with.pfm $SIZE -j 2 --passes all 2>log5
 check "the image keeps its bytes with passes" cmp -s plain.pfm with.pfm
-for p in albedo normal depth position emission diffuse_direct glossy_indirect transmission_indirect material_id; do
+for p in albedo normal depth position emission diffuse_direct glossy_indirect transmission_indirect material_id \
+    object_id; do
     check "PFM output: with.$p.pfm written" test -s "with.$p.pfm"
 done
 
