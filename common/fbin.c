@@ -32,7 +32,8 @@ enum {
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
     SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE, SEC_NAMES,
-    SEC_OBJECTS, SEC_OBJECT_NAMES, SEC_COUNT = SEC_OBJECT_NAMES
+    SEC_OBJECTS, SEC_OBJECT_NAMES,
+    SEC_LIGHT_GROUPS, SEC_GROUP_NAMES, SEC_COUNT = SEC_GROUP_NAMES
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -75,6 +76,8 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_NAMES, "material_names", material_names, fr_name),
     ARR(SEC_OBJECTS, "objects", objects, uint32_t),
     ARR(SEC_OBJECT_NAMES, "object_names", object_names, fr_name),
+    ARR(SEC_LIGHT_GROUPS, "light_groups", light_groups, uint32_t),
+    ARR(SEC_GROUP_NAMES, "group_names", group_names, fr_name),
 };
 #undef ARR
 
@@ -557,6 +560,16 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
         if (s->objects[i] >= s->n_object_names)
             return fr_fail(err, "section objects, byte %zu: object %u of %u names", AT(&s->objects[i]),
                            s->objects[i], s->n_object_names);
+    if (names_validate("group_names", s->group_names, s->n_group_names, base, err) < 0)
+        return -1;
+    if (s->n_group_names > PASS_LIGHT_GROUPS || (s->n_light_groups && s->n_light_groups != s->n_lights))
+        return fr_fail(err, "section light_groups: %u entries for %u lights, %u groups (expected 0 or one per "
+                       "light, at most %d groups)", s->n_light_groups, s->n_lights, s->n_group_names,
+                       PASS_LIGHT_GROUPS);
+    for (uint32_t i = 0; i < s->n_light_groups; i++)
+        if (s->light_groups[i] >= s->n_group_names)
+            return fr_fail(err, "section light_groups, byte %zu: group %u of %u names", AT(&s->light_groups[i]),
+                           s->light_groups[i], s->n_group_names);
     if (validate_instances(s, base, err) < 0)
         return -1;
     uint32_t top = s->n_meshes ? s->meshes[0].prim_first : s->n_prims;

@@ -27,6 +27,7 @@ static const pass_info passes[PASS_COUNT] = {
     [PASS_VARIANCE] = {"variance", "Variance", "RGB"},
     [PASS_OBJECT_ID] = {"object_id", "IndexOB", "X"},
     [PASS_CRYPTO_OBJECT] = {"crypto_object", "CryptoObject", "RGBARGBARGBA"},
+    [PASS_LIGHTGROUP] = {"light_groups", "Combined_", "RGBRGBRGBRGBRGBRGBRGBRGB"},
 };
 
 const pass_info *pass_get(int i) { return &passes[i]; }
@@ -117,6 +118,12 @@ void pass_light(pass_sample *p, uint32_t bounces, vec3 L)
     p->light[k] = v3_add(p->light[k], L);
 }
 
+void pass_group(pass_sample *p, const fr_scene *s, uint32_t light, vec3 L)
+{
+    uint32_t g = light < s->n_light_groups ? s->light_groups[light] : 0;
+    p->group[g] = v3_add(p->group[g], L);
+}
+
 /* A material's reflectance for the albedo pass (passes.h). */
 static vec3 material_albedo(const fr_material *m)
 {
@@ -182,6 +189,8 @@ void pass_drop_light(pass_sample *p)
 {
     for (int k = 0; k < 7; k++)
         p->light[k] = v3s(0.0f);
+    for (int k = 0; k < PASS_LIGHT_GROUPS; k++)
+        p->group[k] = v3s(0.0f);
 }
 
 /* Channels of pass i, with the pass's values in sample p (up to 3). */
@@ -268,6 +277,12 @@ void pass_accumulate(double *acc, uint32_t mask, const pass_sample *p, uint32_t 
                     acc[3 + c] += v * v;
                 }
             acc += acc_width(i);
+            continue;
+        }
+        if (i == PASS_LIGHTGROUP) {
+            for (int k = 0; k < 3 * PASS_LIGHT_GROUPS; k++)
+                acc[k] += v3_get(p->group[k / 3], k % 3);
+            acc += 3 * PASS_LIGHT_GROUPS;
             continue;
         }
         float v[3];

@@ -62,6 +62,15 @@
  *   nothing is hit or the scene has no objects.
  * - crypto_object (12 channels): the Cryptomatte ranking of the objects
  *   first hit, as crypto_material's (ids 1 + the object's index).
+ * - light_groups (PASS_LIGHT_GROUPS x RGB): the beauty split by the light
+ *   group of the light it came from (the scene's group_names, group 0
+ *   "default": lights without a group, and every light of a scene that
+ *   names none; groups past the scene's are 0).  An emitter hit by a ray
+ *   (the camera's or a scattered one) gives its own group, next-event
+ *   estimation the group of the light sampled, the environment and suns
+ *   seen by an escaping ray theirs; light that media scatter toward a ray
+ *   by equiangular sampling (vertex.h) goes to group 0.  The groups sum
+ *   to the beauty (within float rounding).
  *
  * Every value is finite.  Light passes and albedo are means over the
  * pixel's samples like the beauty, so any split of rows gives the same
@@ -95,6 +104,7 @@ enum {
     PASS_VARIANCE,
     PASS_OBJECT_ID,
     PASS_CRYPTO_OBJECT,
+    PASS_LIGHTGROUP,
     PASS_COUNT
 };
 
@@ -102,7 +112,10 @@ enum {
 #define PASS_ALL ((1u << PASS_COUNT) - 1u)
 
 /** Most channels a pixel's passes have (all of them). */
-#define PASS_MAX_CHANNELS 60
+#define PASS_MAX_CHANNELS 84
+
+/** Light groups a scene may have (the default one included). */
+#define PASS_LIGHT_GROUPS 8
 
 /** Ranks of the Cryptomatte pass (each an id and its coverage). */
 #define PASS_CRYPTO_RANKS 6
@@ -151,6 +164,7 @@ typedef struct {
     int kind;                  /**< the first scattering's kind: 0 diffuse, 1 glossy, 2 transmission; -1 none yet */
     vec3 light[7];             /**< emission, then diffuse, glossy, transmission each direct and indirect */
     vec3 beauty;               /**< the sample's radiance, as the image adds it (variance) */
+    vec3 group[PASS_LIGHT_GROUPS]; /**< the radiance by light group */
 } pass_sample;
 
 /** A sample's passes before its camera ray is traced. */
@@ -169,6 +183,10 @@ uint32_t pass_object(const fr_scene *s, const fr_surface *sf);
  * directly): to emission, or to the direct or indirect pass of the first
  * scattering's kind (diffuse when none was set). */
 void pass_light(pass_sample *p, uint32_t bounces, vec3 L);
+
+/** Light L from light `light` (an index into s->lights; FR_NONE: group
+ * 0) to its light group. */
+void pass_group(pass_sample *p, const fr_scene *s, uint32_t light, vec3 L);
 
 /** Light L from light sampling at the first scattering vertex (surface sf
  * of material m, seen along wo, the light along wi): split between the

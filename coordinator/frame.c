@@ -312,6 +312,8 @@ int frame_open(frame_image *im)
         memcpy(im->mat_names, sc.material_names, (im->n_mat_names = sc.n_material_names) * sizeof *im->mat_names);
     if (spec.passes && sc.n_object_names && (im->obj_names = malloc(sc.n_object_names * sizeof *im->obj_names)))
         memcpy(im->obj_names, sc.object_names, (im->n_obj_names = sc.n_object_names) * sizeof *im->obj_names);
+    if (spec.passes && sc.n_group_names && (im->group_names = malloc(sc.n_group_names * sizeof *im->group_names)))
+        memcpy(im->group_names, sc.group_names, (im->n_group_names = sc.n_group_names) * sizeof *im->group_names);
     scn_free(&sc);
     im->spec = spec;
     if ((spec.passes & (1u << PASS_CRYPTO_MATERIAL | 1u << PASS_CRYPTO_OBJECT)) && !out_has_ext(a->out, "exr"))
@@ -443,9 +445,10 @@ int frame_write(frame_image *im, const char *used)
     if (a->reproducible)
         out_meta_set_time(&meta, reproducible_epoch());
     a->io.attrs = meta.attrs;
-    crypto_names names = {im->mat_names, im->n_mat_names, NULL}, objects = {im->obj_names, im->n_obj_names, "object"};
+    crypto_names names = {im->mat_names, im->n_mat_names, NULL}, objects = {im->obj_names, im->n_obj_names, "object"},
+                 groups = {im->group_names, im->n_group_names, "group"};
     if (passout_write(a->out, rgb, &im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &objects,
-                      &err)) {
+                      &groups, &err)) {
         /* Said only once checked: the rows are still there. */
         if (job_rows_present(im->jobdir) >= im->rows_job) {
             fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
@@ -488,6 +491,7 @@ void frame_close(frame_image *im, int rc)
     free(im->passes);
     free(im->mat_names);
     free(im->obj_names);
+    free(im->group_names);
     free(im);
 }
 

@@ -19,12 +19,51 @@ static void pass_file(const char *path, const char *name, char *out, size_t cap)
     snprintf(out, cap, "%.*s.%s%s", (int)stem, path, name, dot ? dot : "");
 }
 
+/* The number of light groups of the scene (at least the default one). */
+static uint32_t group_count(const crypto_names *groups)
+{
+    return groups && groups->n ? (groups->n < PASS_LIGHT_GROUPS ? groups->n : PASS_LIGHT_GROUPS) : 1;
+}
+
+/* The name of light group g: the scene's, "default" for group 0 of a
+ * scene that names none. */
+static void group_name(const crypto_names *groups, uint32_t g, char *out)
+{
+    if (groups && g < groups->n)
+        crypto_name(groups, g, out);
+    else
+        snprintf(out, 64, "default");
+}
+
+/* The EXR name of channel k of the light_groups pass into out[64], "" for
+ * a group past the scene's. */
+static void group_channel(const crypto_names *groups, uint32_t k, char *out)
+{
+    static const char rgb[] = "RGB";
+    char name[64];
+    if (k / 3 >= group_count(groups)) {
+        out[0] = 0;
+        return;
+    }
+    group_name(groups, k / 3, name);
+    snprintf(out, 64, "ViewLayer.Combined_%.40s.%c", name, rgb[k % 3]);
+}
+
+/* Whether EXR channel `at` (the beauty's 4, then the passes') is written. */
+static int channel_kept(uint32_t mask, const crypto_names *groups, uint32_t at)
+{
+    if (at < 4 || !(mask >> PASS_LIGHTGROUP & 1u))
+        return 1;
+    uint32_t before = 4 + pass_channels(mask & ((1u << PASS_LIGHTGROUP) - 1u));
+    return at < before || at >= before + 3 * PASS_LIGHT_GROUPS || (at - before) / 3 < group_count(groups);
+}
+
 /* The multilayer OpenEXR: the beauty in RGBA, then the passes' channels,
  * interleaved in *passes itself (grown), so that the passes are not held
  * twice. */
 static int write_exr(const char *path, const float *rgb, float **passes, const job_spec *spec,
                      const iio_options *o, const crypto_names *cn, uint32_t n_materials, const crypto_names *on,
-                     fr_error *err)
+                     const crypto_names *groups, fr_error *err)
 {
     uint32_t nch = pass_channels(spec->passes), all = 4 + nch;
     size_t npx = (size_t)spec->width * spec->height;
@@ -61,7 +100,9 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
         if (i == PASS_CRYPTO_OBJECT)
             crypto_obj_at = c;
         for (const char *ch = p->channels; *ch; ch++, c++)
-            if (crypto) /* Cryptomatte's ranks: ViewLayer.CryptoMaterial00.R ... 02.A */
+            if (i == PASS_LIGHTGROUP) /* ViewLayer.Combined_NAME.R ..., "" past the scene's groups */
+                group_channel(groups, (uint32_t)(ch - p->channels), names[c]);
+            else if (crypto) /* Cryptomatte's ranks: ViewLayer.CryptoMaterial00.R ... 02.A */
                 snprintf(names[c], sizeof names[c], "ViewLayer.%s%02u.%c", p->layer,
                          (unsigned)(ch - p->channels) / 4, *ch);
             else
@@ -71,6 +112,21 @@ static int write_exr(const char *path, const float *rgb, float **passes, const j
         crypto_ids(px + crypto_at, npx, all, cn);
     if (spec->passes >> PASS_CRYPTO_OBJECT & 1u)
         crypto_ids(px + crypto_obj_at, npx, all, on);
+    /* The light groups the scene lacks leave the file. */
+    uint32_t kept = 0;
+    for (c = 0; c < all; c++)
+        if (names[c][0])
+            memmove(names[kept++], names[c], sizeof names[c]);
+    if (kept < all) {
+        uint32_t from_of[4 + PASS_MAX_CHANNELS];
+        for (uint32_t from = 0, to = 0; from < all; from++)
+            if (channel_kept(spec->passes, groups, from))
+                from_of[to++] = from;
+        for (size_t i = 0; i < npx; i++)
+            for (uint32_t to = 0; to < kept; to++)
+                px[i * kept + to] = px[i * all + from_of[to]];
+        all = kept;
+    }
     for (c = 0; c < all; c++)
         ptrs[c] = names[c];
     /* The caller's attributes and franja:passes. */
@@ -143,13 +199,13 @@ static void pass_image(const float *passes, uint32_t nch, uint32_t at, int i, si
 
 int passout_write(const char *path, const float *rgb, float **pass_buf, const job_spec *spec,
                   const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
-                  const crypto_names *objects, fr_error *err)
+                  const crypto_names *objects, const crypto_names *groups, fr_error *err)
 {
     const float *passes = pass_buf ? *pass_buf : NULL;
     if (!passes || !spec->passes)
         return out_write_with(path, rgb, spec, tm, o, err);
     if (out_has_ext(path, "exr"))
-        return write_exr(path, rgb, pass_buf, spec, o, names, n_materials, objects, err);
+        return write_exr(path, rgb, pass_buf, spec, o, names, n_materials, objects, groups, err);
     if (out_write_with(path, rgb, spec, tm, o, err))
         return -1;
     size_t npx = (size_t)spec->width * spec->height;
@@ -170,6 +226,20 @@ int passout_write(const char *path, const float *rgb, float **pass_buf, const jo
             continue;
         }
         char file[4200];
+        if (i == PASS_LIGHTGROUP) { /* one file a group: OUT.Combined_NAME.png */
+            for (uint32_t g = 0; g < group_count(groups) && rc == 0; g++) {
+                char name[64], what[80];
+                group_name(groups, g, name);
+                snprintf(what, sizeof what, "Combined_%.64s", name);
+                pass_file(path, what, file, sizeof file);
+                for (size_t j = 0; j < npx; j++)
+                    for (int c = 0; c < 3; c++)
+                        img[j * 3 + c] = passes[j * nch + at + 3 * g + (uint32_t)c];
+                rc = out_write_with(file, img, spec, tm, o, err);
+            }
+            at += (uint32_t)strlen(p->channels);
+            continue;
+        }
         pass_file(path, p->name, file, sizeof file);
         pass_image(passes, nch, at, i, npx, ldr, img);
         int light = i >= PASS_EMISSION && i <= PASS_TRANSMISSION_INDIRECT;

@@ -163,7 +163,7 @@ static void test_table(void)
     rehash(p, n);
     REFUSE("section id", p, n, "byte 256", "id 9");
     memcpy(p, good.blob, n);
-    put64(p + 64 + 8, 1 << 12);   /* settings: count must be 1 */
+    put64(p + 64 + 16, 2);   /* settings: count must be 1 */
     rehash(p, n);
     REFUSE("settings count", p, n, "settings");
     free(p);

@@ -35,6 +35,10 @@ void bld_init(fr_builder *b)
     array_init(&b->object_names, sizeof(fr_name));
     array_init(&b->object_runs, sizeof(bld_object_run));
     array_init(&b->inst_objects, sizeof(uint32_t));
+    array_init(&b->group_names, sizeof(fr_name));
+    array_init(&b->given_groups, sizeof(uint32_t));
+    array_init(&b->material_groups, sizeof(uint32_t));
+    array_init(&b->light_groups, sizeof(uint32_t));
     b->world.env_light = b->world.env_texture = FR_NONE;
     b->world.rot_cos = 1.0f;
 }
@@ -45,7 +49,8 @@ void bld_free(fr_builder *b)
                        &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
                        &b->textures, &b->texels, &b->media, &b->distrib, &b->meshes, &b->instances,
                        &b->light_nodes, &b->material_names,
-                       &b->object_names, &b->object_runs, &b->inst_objects};
+                       &b->object_names, &b->object_runs, &b->inst_objects, &b->group_names,
+                       &b->given_groups, &b->material_groups, &b->light_groups};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->data);
     memset(b, 0, sizeof *b);

@@ -66,6 +66,10 @@ typedef struct {
     fr_array object_names;     /**< fr_name: the objects begun (builder_object.h) */
     fr_array object_runs;      /**< bld_object_run: where each object's geometry starts (builder_object.h) */
     fr_array inst_objects;     /**< uint32_t: each instance's object, once bld_flatten has set it */
+    fr_array group_names;      /**< fr_name: the light groups (builder_group.h), "default" first */
+    fr_array given_groups;     /**< uint32_t: the group of each light the readers added, as far as given */
+    fr_array material_groups;  /**< uint32_t: the group of each emissive material, as far as given */
+    fr_array light_groups;     /**< uint32_t: each light's group in the frozen light table (frz_lights) */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero, no

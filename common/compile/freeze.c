@@ -151,6 +151,9 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     VIEW(light_nodes, b->light_nodes);
     VIEW(material_names, b->material_names);
     VIEW(objects, f->objects);
+    VIEW(light_groups, b->light_groups);
+    if (b->light_groups.count)
+        VIEW(group_names, b->group_names);
     if (f->objects.count)
         VIEW(object_names, b->object_names);
 #undef VIEW

@@ -20,6 +20,7 @@
 #include "compile/json_gltf.h"
 #include "compile/json_light.h"
 #include "compile/json_microfacet.h"
+#include "compile/builder_group.h"
 #include "compile/builder_object.h"
 
 #define PATHLEN 160
@@ -199,11 +200,20 @@ static int parse_materials(ctx *c, const cJSON *o)
         char where[PATHLEN];
         snprintf(where, sizeof where, "materials.%s", m->string);
         fr_material mat;
-        if (parse_material(c, m, where, &mat) < 0)
+        /* A light_group is set aside while the material's fields are read. */
+        cJSON *g = cJSON_IsObject(m) ? cJSON_DetachItemFromObjectCaseSensitive((cJSON *)m, "light_group") : NULL;
+        int rc = g && (!cJSON_IsString(g) || !g->valuestring[0])
+                     ? fr_fail(c->err, "%s.light_group: expected a non-empty string", where)
+                     : parse_material(c, m, where, &mat);
+        uint32_t k = rc < 0 ? 0 : bld_push(&c->b->materials, &mat);
+        if (rc == 0 && (k == FR_NONE || bld_material_name(c->b, k, m->string) < 0))
+            rc = fr_fail(c->err, "%s: out of memory", where);
+        if (rc == 0 && g)
+            rc = bld_material_group(c->b, k, g->valuestring, where, c->err);
+        if (g)
+            cJSON_AddItemToObject((cJSON *)m, "light_group", g);
+        if (rc < 0)
             return -1;
-        uint32_t k = bld_push(&c->b->materials, &mat);
-        if (k == FR_NONE || bld_material_name(c->b, k, m->string) < 0)
-            return fr_fail(c->err, "%s: out of memory", where);
     }
     c->materials = o;
     uint32_t n = 0;
