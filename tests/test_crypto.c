@@ -13,12 +13,11 @@
 #include <string.h>
 
 #include "check.h"
-#include "compile/builder.h"
-#include "compile/freeze.h"
 #include "compile/json_scene.h"
 #include "crypto.h"
 #include "passes.h"
 #include "pathtrace.h"
+#include "scenes.h"
 
 #define W 40
 #define H 30
@@ -161,18 +160,8 @@ static void check_objects(void)
         " {\"type\": \"quad\", \"name\": \"right quad\", \"material\": \"m\","
         "  \"vertices\": [[0.5, -1, 0], [2, -1, 0], [2, 1, 0], [0.5, 1, 0]]}],"
         " \"lights\": [{\"type\": \"point\", \"position\": [0, 3, -3], \"intensity\": [5, 5, 5]}]}";
-    fr_builder b;
     fr_scene s;
-    fr_error err;
-    bld_init(&b);
-    int rc = json_scene_parse(json, "(objects)", NULL, &b, &err);
-    if (rc == 0)
-        rc = frz_scene(&b, &s, &err);
-    bld_free(&b);
-    if (rc < 0) {
-        CHECK(0, "the objects scene: %s", err.msg);
-        return;
-    }
+    test_scene(json, &s);
     CHECK(s.n_object_names == 3 && !strcmp(s.object_names[0].name, "shapes[0]") &&
               !strcmp(s.object_names[1].name, "left ball") && !strcmp(s.object_names[2].name, "right quad"),
           "objects: shapes[0], left ball, right quad (%u names)", s.n_object_names);
@@ -190,11 +179,8 @@ static void check_objects(void)
                               " \"materials\": {\"m\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]}},"
                               " \"shapes\": [{\"type\": \"sphere\", \"name\": 3, \"center\": [0, 0, 0],"
                               " \"radius\": 1, \"material\": \"m\"}]}";
-    bld_init(&b);
-    rc = json_scene_parse(bad, "(bad)", NULL, &b, &err);
-    CHECK(rc < 0 && strstr(err.msg, "shapes[0].name"), "a name that is not a string is refused: %s",
-          rc < 0 ? err.msg : "accepted");
-    bld_free(&b);
+    const char *msg;
+    CHECK(test_scene_refused(bad, "shapes[0].name", &msg), "a name that is not a string is refused: %s", msg);
     scn_free(&s);
 }
 

@@ -12,12 +12,11 @@
 #include <string.h>
 
 #include "check.h"
-#include "compile/builder.h"
-#include "compile/freeze.h"
 #include "compile/json_scene.h"
 #include "image.h"
 #include "passes.h"
 #include "pathtrace.h"
+#include "scenes.h"
 
 #define W 40
 #define H 30
@@ -115,18 +114,8 @@ static void check_groups(void)
         "   \"light_group\": \"key\"},"
         "  {\"type\": \"point\", \"position\": [-3, 2, -2], \"intensity\": [2, 2, 2]}],"
         " \"environment\": {\"color\": [0.1, 0.1, 0.15], \"light_group\": \"sky\"}}";
-    fr_builder b;
     fr_scene s;
-    fr_error err;
-    bld_init(&b);
-    int rc = json_scene_parse(json, "(groups)", NULL, &b, &err);
-    if (rc == 0)
-        rc = frz_scene(&b, &s, &err);
-    bld_free(&b);
-    if (rc < 0) {
-        CHECK(0, "the light groups scene: %s", err.msg);
-        return;
-    }
+    test_scene(json, &s);
     CHECK(s.n_group_names == 4 && !strcmp(s.group_names[0].name, "default") && s.n_light_groups == s.n_lights,
           "groups: default and three named (%u), one per light (%u of %u)", s.n_group_names, s.n_light_groups,
           s.n_lights);
@@ -151,11 +140,8 @@ static void check_groups(void)
         k += snprintf(many + k, sizeof many - (size_t)k, "%s{\"type\": \"point\", \"position\": [0, 3, 0],"
                       " \"intensity\": [1, 1, 1], \"light_group\": \"g%d\"}", i ? ", " : "", i);
     snprintf(many + k, sizeof many - (size_t)k, "]}");
-    bld_init(&b);
-    rc = json_scene_parse(many, "(many)", NULL, &b, &err);
-    CHECK(rc < 0 && strstr(err.msg, "lights[7].light_group"), "a ninth light group is refused: %s",
-          rc < 0 ? err.msg : "accepted");
-    bld_free(&b);
+    const char *msg;
+    CHECK(test_scene_refused(many, "lights[7].light_group", &msg), "a ninth light group is refused: %s", msg);
 }
 
 static void check_passes(const char *path, fr_scene *sp, unsigned want_seen, double *group)
