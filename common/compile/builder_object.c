@@ -23,6 +23,11 @@ int bld_object(fr_builder *b, const char *name, fr_error *err)
 {
     fr_name n;
     bld_name_set(&n, name);
+    /* The same name as the object before: the same object (a JSON scene's
+     * triangles of one mesh, each a shape of that name). */
+    uint32_t last = b->object_names.count;
+    if (last && !strcmp(((const fr_name *)b->object_names.data)[last - 1].name, n.name))
+        return push_run(b, last - 1, err);
     uint32_t k = bld_push(&b->object_names, &n);
     if (k == FR_NONE)
         return fr_fail(err, "out of memory for the objects' names");

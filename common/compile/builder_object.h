@@ -14,8 +14,9 @@
 
 #include "compile/builder.h"
 
-/** Begin object `name` (cut to 63 bytes as bld_name_set does).  0, or -1
- * with *err set when memory runs out. */
+/** Begin object `name` (cut to 63 bytes as bld_name_set does); the same
+ * name as the last object's goes on with that object.  0, or -1 with
+ * *err set when memory runs out. */
 int bld_object(fr_builder *b, const char *name, fr_error *err);
 
 /** bld_flatten's part: the triangles added from now on are object's

@@ -294,8 +294,8 @@ static int parse_box(fr_builder *b, const cJSON *o, const char *where, uint32_t 
 static int parse_shape_fields(ctx *c, const cJSON *o, const char *where);
 
 /* A shape: an object (builder_object.h) named by its optional "name" key,
- * else by where it is ("shapes[3]"); the key is set aside while the
- * shape's own fields are read. */
+ * else by where it is ("shapes[3]"), but a glTF file (its nodes are); the
+ * key is set aside while the shape's own fields are read. */
 static int parse_shape(ctx *c, const cJSON *o, const char *where)
 {
     if (!cJSON_IsObject(o))
@@ -304,7 +304,9 @@ static int parse_shape(ctx *c, const cJSON *o, const char *where)
     int rc = 0;
     if (name && (!cJSON_IsString(name) || !name->valuestring[0]))
         rc = fr_fail(c->err, "%s.name: expected a non-empty string", where);
-    if (rc == 0)
+    /* A glTF file's nodes are objects of their own (gltf_scene.c). */
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
+    if (rc == 0 && !(cJSON_IsString(t) && !strcmp(t->valuestring, "gltf")))
         rc = bld_object(c->b, name ? name->valuestring : where, c->err);
     if (rc == 0)
         rc = parse_shape_fields(c, o, where);
