@@ -32,7 +32,8 @@ enum {
     SEC_TRIANGLES, SEC_POSITIONS, SEC_NORMALS, SEC_UVS, SEC_PLANES, SEC_LIGHTS, SEC_NODES, SEC_LEAVES,
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
     SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE, SEC_NAMES, SEC_MOTION,
-    SEC_COUNT = SEC_MOTION
+    SEC_OBJECTS, SEC_OBJECT_NAMES,
+    SEC_LIGHT_GROUPS, SEC_GROUP_NAMES, SEC_COUNT = SEC_GROUP_NAMES
 };
 
 /* Where each section lives in an fr_scene, so serialize and open share one
@@ -74,6 +75,10 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_LIGHTTREE, "lighttree", light_nodes, fr_light_node),
     ARR(SEC_NAMES, "material_names", material_names, fr_name),
     [SEC_MOTION] = {"motion", sizeof(fr_motion), offsetof(fr_scene, motion), 0},
+    ARR(SEC_OBJECTS, "objects", objects, uint32_t),
+    ARR(SEC_OBJECT_NAMES, "object_names", object_names, fr_name),
+    ARR(SEC_LIGHT_GROUPS, "light_groups", light_groups, uint32_t),
+    ARR(SEC_GROUP_NAMES, "group_names", group_names, fr_name),
 };
 #undef ARR
 
@@ -496,6 +501,23 @@ static int validate_light_tree(const fr_scene *s, const void *base, fr_error *er
 }
 
 /* Check every cross-reference so that rendering can index without checks. */
+/* A names section (material_names, object_names): each entry
+ * NUL-terminated within its 64 bytes, no control character. */
+static int names_validate(const char *what, const fr_name *v, uint32_t n, const void *base, fr_error *err)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        const char *t = v[i].name;
+        size_t k = strnlen(t, sizeof v[i].name);
+        int ok = k < sizeof v[i].name;
+        for (size_t j = 0; ok && j < k; j++)
+            ok = (unsigned char)t[j] >= 0x20 && t[j] != 0x7f;
+        if (!ok)
+            return fr_fail(err, "section %s, byte %zu: name %u: not NUL-terminated text of at most 63 bytes "
+                           "without control characters", what, (size_t)((const char *)t - (const char *)base), i);
+    }
+    return 0;
+}
+
 static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr_error *err)
 {
     const fr_settings *st = &s->settings;
@@ -541,16 +563,27 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     if (s->n_material_names && s->n_material_names != s->n_materials)
         return fr_fail(err, "section material_names: %u names for %u materials (expected 0 or one each)",
                        s->n_material_names, s->n_materials);
-    for (uint32_t i = 0; i < s->n_material_names; i++) {
-        const char *n = s->material_names[i].name;
-        size_t k = strnlen(n, sizeof s->material_names[i].name);
-        int ok = k < sizeof s->material_names[i].name;
-        for (size_t j = 0; ok && j < k; j++)
-            ok = (unsigned char)n[j] >= 0x20 && n[j] != 0x7f;
-        if (!ok)
-            return fr_fail(err, "section material_names, byte %zu: name %u: not NUL-terminated text of at most 63 "
-                           "bytes without control characters", AT(n), i);
-    }
+    if (names_validate("material_names", s->material_names, s->n_material_names, base, err) < 0 ||
+        names_validate("object_names", s->object_names, s->n_object_names, base, err) < 0)
+        return -1;
+    uint64_t n_obj = (uint64_t)s->n_prims + s->n_planes + s->n_instances;
+    if (s->n_objects && s->n_objects != n_obj)
+        return fr_fail(err, "section objects: %u entries for %llu primitives, planes and instances (expected 0 or "
+                       "one each)", s->n_objects, (unsigned long long)n_obj);
+    for (uint32_t i = 0; i < s->n_objects; i++)
+        if (s->objects[i] >= s->n_object_names)
+            return fr_fail(err, "section objects, byte %zu: object %u of %u names", AT(&s->objects[i]),
+                           s->objects[i], s->n_object_names);
+    if (names_validate("group_names", s->group_names, s->n_group_names, base, err) < 0)
+        return -1;
+    if (s->n_group_names > PASS_LIGHT_GROUPS || (s->n_light_groups && s->n_light_groups != s->n_lights))
+        return fr_fail(err, "section light_groups: %u entries for %u lights, %u groups (expected 0 or one per "
+                       "light, at most %d groups)", s->n_light_groups, s->n_lights, s->n_group_names,
+                       PASS_LIGHT_GROUPS);
+    for (uint32_t i = 0; i < s->n_light_groups; i++)
+        if (s->light_groups[i] >= s->n_group_names)
+            return fr_fail(err, "section light_groups, byte %zu: group %u of %u names", AT(&s->light_groups[i]),
+                           s->light_groups[i], s->n_group_names);
     if (validate_instances(s, base, err) < 0)
         return -1;
     uint32_t top = s->n_meshes ? s->meshes[0].prim_first : s->n_prims;

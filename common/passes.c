@@ -25,6 +25,9 @@ static const pass_info passes[PASS_COUNT] = {
     [PASS_MATERIAL_ID] = {"material_id", "IndexMA", "X"},
     [PASS_CRYPTO_MATERIAL] = {"crypto_material", "CryptoMaterial", "RGBARGBARGBA"},
     [PASS_VARIANCE] = {"variance", "Variance", "RGB"},
+    [PASS_OBJECT_ID] = {"object_id", "IndexOB", "X"},
+    [PASS_CRYPTO_OBJECT] = {"crypto_object", "CryptoObject", "RGBARGBARGBA"},
+    [PASS_LIGHTGROUP] = {"light_groups", "Combined_", "RGBRGBRGBRGBRGBRGBRGBRGB"},
 };
 
 const pass_info *pass_get(int i) { return &passes[i]; }
@@ -96,17 +99,29 @@ void pass_start(pass_sample *p)
     p->kind = -1;
 }
 
-void pass_first_hit(pass_sample *p, vec3 at, uint32_t material, vec3 from)
+void pass_first_hit(pass_sample *p, vec3 at, uint32_t material, uint32_t object, vec3 from)
 {
     p->depth = v3_len(v3_sub(at, from));
     p->position = at;
     p->material = material == FR_NONE ? 0 : material + 1;
+    p->object = object;
+}
+
+uint32_t pass_object(const fr_scene *s, const fr_surface *sf)
+{
+    return sf->element < s->n_objects ? s->objects[sf->element] + 1 : 0;
 }
 
 void pass_light(pass_sample *p, uint32_t bounces, vec3 L)
 {
     int k = bounces == 0 ? 0 : 1 + 2 * (p->kind < 0 ? 0 : p->kind) + (bounces > 1);
     p->light[k] = v3_add(p->light[k], L);
+}
+
+void pass_group(pass_sample *p, const fr_scene *s, uint32_t light, vec3 L)
+{
+    uint32_t g = light < s->n_light_groups ? s->light_groups[light] : 0;
+    p->group[g] = v3_add(p->group[g], L);
 }
 
 /* A material's reflectance for the albedo pass (passes.h). */
@@ -174,6 +189,8 @@ void pass_drop_light(pass_sample *p)
 {
     for (int k = 0; k < 7; k++)
         p->light[k] = v3s(0.0f);
+    for (int k = 0; k < PASS_LIGHT_GROUPS; k++)
+        p->group[k] = v3s(0.0f);
 }
 
 /* Channels of pass i, with the pass's values in sample p (up to 3). */
@@ -186,6 +203,7 @@ static int values(const pass_sample *p, int i, float *v)
     case PASS_POSITION: c = p->position; break;
     case PASS_DEPTH: v[0] = p->depth; return 1;
     case PASS_MATERIAL_ID: v[0] = (float)p->material; return 1;
+    case PASS_OBJECT_ID: v[0] = (float)p->object; return 1;
     default: c = p->light[i - PASS_EMISSION]; break;
     }
     v[0] = c.x, v[1] = c.y, v[2] = c.z;
@@ -193,12 +211,18 @@ static int values(const pass_sample *p, int i, float *v)
 }
 
 /* Whether pass i keeps sample 0's value rather than the mean. */
-static int first_only(int i) { return i == PASS_DEPTH || i == PASS_POSITION || i == PASS_MATERIAL_ID; }
+static int first_only(int i)
+{
+    return i == PASS_DEPTH || i == PASS_POSITION || i == PASS_MATERIAL_ID || i == PASS_OBJECT_ID;
+}
+
+/* Whether pass i is a Cryptomatte ranking. */
+static int is_crypto(int i) { return i == PASS_CRYPTO_MATERIAL || i == PASS_CRYPTO_OBJECT; }
 
 /* Doubles pass_accumulate keeps for pass i. */
 static int acc_width(int i)
 {
-    return i == PASS_CRYPTO_MATERIAL ? 2 * PASS_CRYPTO_SLOTS : i == PASS_VARIANCE ? 6 : (int)strlen(passes[i].channels);
+    return is_crypto(i) ? 2 * PASS_CRYPTO_SLOTS : i == PASS_VARIANCE ? 6 : (int)strlen(passes[i].channels);
 }
 
 /* The Cryptomatte slots (id + 1, samples): one more sample on material id
@@ -243,9 +267,9 @@ void pass_accumulate(double *acc, uint32_t mask, const pass_sample *p, uint32_t 
     for (int i = 0; i < PASS_COUNT; i++) {
         if (!(mask >> i & 1u))
             continue;
-        if (i == PASS_CRYPTO_MATERIAL || i == PASS_VARIANCE) {
-            if (i == PASS_CRYPTO_MATERIAL)
-                crypto_count(acc, p->material);
+        if (is_crypto(i) || i == PASS_VARIANCE) {
+            if (is_crypto(i))
+                crypto_count(acc, i == PASS_CRYPTO_MATERIAL ? p->material : p->object);
             else
                 for (int c = 0; c < 3; c++) {
                     double v = v3_get(p->beauty, c);
@@ -253,6 +277,12 @@ void pass_accumulate(double *acc, uint32_t mask, const pass_sample *p, uint32_t 
                     acc[3 + c] += v * v;
                 }
             acc += acc_width(i);
+            continue;
+        }
+        if (i == PASS_LIGHTGROUP) {
+            for (int k = 0; k < 3 * PASS_LIGHT_GROUPS; k++)
+                acc[k] += v3_get(p->group[k / 3], k % 3);
+            acc += 3 * PASS_LIGHT_GROUPS;
             continue;
         }
         float v[3];
@@ -273,7 +303,7 @@ void pass_finish(const double *acc, uint32_t mask, uint32_t n, float *out)
         if (!(mask >> i & 1u))
             continue;
         int k = (int)strlen(passes[i].channels);
-        if (i == PASS_CRYPTO_MATERIAL)
+        if (is_crypto(i))
             crypto_rank(acc, n, out);
         else if (i == PASS_VARIANCE)
             for (int c = 0; c < 3; c++) {

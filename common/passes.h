@@ -56,6 +56,22 @@
  *   dropped sample as 0) over their number; 0 for a single sample.  What
  *   a denoiser or the adaptive sampler's user weighs the pixel by.
  *
+ * - object_id (X): 1 + the index of the object first hit (sample 0), in
+ *   the order of the scene's object_names (a JSON shape, a glTF node with
+ *   a mesh; an instance is its placing shape's or node's object); 0 where
+ *   nothing is hit or the scene has no objects.
+ * - crypto_object (12 channels): the Cryptomatte ranking of the objects
+ *   first hit, as crypto_material's (ids 1 + the object's index).
+ * - light_groups (PASS_LIGHT_GROUPS x RGB): the beauty split by the light
+ *   group of the light it came from (the scene's group_names, group 0
+ *   "default": lights without a group, and every light of a scene that
+ *   names none; groups past the scene's are 0).  An emitter hit by a ray
+ *   (the camera's or a scattered one) gives its own group, next-event
+ *   estimation the group of the light sampled, the environment and suns
+ *   seen by an escaping ray theirs; light that media scatter toward a ray
+ *   by equiangular sampling (vertex.h) goes to group 0.  The groups sum
+ *   to the beauty (within float rounding).
+ *
  * Every value is finite.  Light passes and albedo are means over the
  * pixel's samples like the beauty, so any split of rows gives the same
  * bits.
@@ -86,6 +102,9 @@ enum {
     PASS_MATERIAL_ID,
     PASS_CRYPTO_MATERIAL,
     PASS_VARIANCE,
+    PASS_OBJECT_ID,
+    PASS_CRYPTO_OBJECT,
+    PASS_LIGHTGROUP,
     PASS_COUNT
 };
 
@@ -93,7 +112,10 @@ enum {
 #define PASS_ALL ((1u << PASS_COUNT) - 1u)
 
 /** Most channels a pixel's passes have (all of them). */
-#define PASS_MAX_CHANNELS 47
+#define PASS_MAX_CHANNELS 84
+
+/** Light groups a scene may have (the default one included). */
+#define PASS_LIGHT_GROUPS 8
 
 /** Ranks of the Cryptomatte pass (each an id and its coverage). */
 #define PASS_CRYPTO_RANKS 6
@@ -103,7 +125,7 @@ enum {
 #define PASS_CRYPTO_SLOTS 16
 
 /** Most doubles pass_accumulate keeps for a pixel (all the passes). */
-#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 2 * PASS_CRYPTO_RANKS + 2 * PASS_CRYPTO_SLOTS + 3)
+#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 4 * PASS_CRYPTO_RANKS + 4 * PASS_CRYPTO_SLOTS + 3)
 
 /** Depth where the camera ray hits nothing. */
 #define PASS_DEPTH_NONE 1e10f
@@ -138,22 +160,33 @@ typedef struct {
     float depth;
     vec3 position;
     uint32_t material;         /**< 1 + index, 0: none */
+    uint32_t object;           /**< 1 + index into object_names, 0: none */
     int kind;                  /**< the first scattering's kind: 0 diffuse, 1 glossy, 2 transmission; -1 none yet */
     vec3 light[7];             /**< emission, then diffuse, glossy, transmission each direct and indirect */
     vec3 beauty;               /**< the sample's radiance, as the image adds it (variance) */
+    vec3 group[PASS_LIGHT_GROUPS]; /**< the radiance by light group */
 } pass_sample;
 
 /** A sample's passes before its camera ray is traced. */
 void pass_start(pass_sample *p);
 
 /** The camera ray's first hit: point `at`, material index (FR_NONE: a
- * point in a medium), the ray's origin `from`. */
-void pass_first_hit(pass_sample *p, vec3 at, uint32_t material, vec3 from);
+ * point in a medium), object (1 + index, 0: none; pass_object), the
+ * ray's origin `from`. */
+void pass_first_hit(pass_sample *p, vec3 at, uint32_t material, uint32_t object, vec3 from);
+
+/** The object of surface sf (1 + its index into s->object_names), 0 when
+ * the scene has no objects. */
+uint32_t pass_object(const fr_scene *s, const fr_surface *sf);
 
 /** Light L that reaches the camera after `bounces` scatterings (0: seen
  * directly): to emission, or to the direct or indirect pass of the first
  * scattering's kind (diffuse when none was set). */
 void pass_light(pass_sample *p, uint32_t bounces, vec3 L);
+
+/** Light L from light `light` (an index into s->lights; FR_NONE: group
+ * 0) to its light group. */
+void pass_group(pass_sample *p, const fr_scene *s, uint32_t light, vec3 L);
 
 /** Light L from light sampling at the first scattering vertex (surface sf
  * of material m, seen along wo, the light along wi): split between the

@@ -120,8 +120,10 @@ static vec3 emission(const fr_scene *s, pt_strategy strategy, vtx_mis mis, const
 
 /* Light from the distant lights (sun disks, environment) that a ray
  * leaving the scene along unit dir sees, times beta, each weighted against
- * light sampling from the previous vertex as emission() weighs hits. */
-static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta, float prev_pdf, int prev_delta)
+ * light sampling from the previous vertex as emission() weighs hits; each
+ * light's share to its light group in ps when ps is not NULL. */
+static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta, float prev_pdf, int prev_delta,
+                    pass_sample *ps)
 {
     vec3 L = v3s(0.0f);
     uint32_t n = lgt_n_distant(s);
@@ -137,7 +139,10 @@ static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta
             else if (strategy != PT_BSDF_ONLY)
                 w = vtx_power_heuristic(prev_pdf, pdf);
         }
-        L = v3_add(L, v3_scale(v3_mul(beta, le), w));
+        vec3 e = v3_scale(v3_mul(beta, le), w);
+        L = v3_add(L, e);
+        if (ps)
+            pass_group(ps, s, i, e);
     }
     return L;
 }
@@ -197,12 +202,14 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
         if (ps) {
             /* Light scattered in a medium on the way: one more bounce. */
             pass_light(ps, depth + 1, v3_sub(L, before));
+            pass_group(ps, s, FR_NONE, v3_sub(L, before));
             if (depth == 0 && (kind == VTX_SURFACE || kind == VTX_MEDIUM))
                 pass_first_hit(ps, kind == VTX_SURFACE ? v.sf.p : v.p,
-                               kind == VTX_SURFACE ? v.sf.material : FR_NONE, camera);
+                               kind == VTX_SURFACE ? v.sf.material : FR_NONE,
+                               kind == VTX_SURFACE ? pass_object(s, &v.sf) : 0, camera);
         }
         if (kind == VTX_ESCAPED) {
-            vec3 e = escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta);
+            vec3 e = escaped(s, strategy, ray.d, beta, prev_pdf, prev_delta, ps);
             L = v3_add(L, e);
             if (ps)
                 pass_light(ps, depth, e);
@@ -223,8 +230,10 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             smp_2d(&smp, &v1, &v2);
             if (vtx_direct_medium(s, &v, medium, beta, mis, light, pick, u1, u2, &d)) {
                 L = v3_add(L, d.L);
-                if (ps)
+                if (ps) {
                     pass_light(ps, depth + 1, d.L);
+                    pass_group(ps, s, light, d.L);
+                }
             }
             vtx_scatter_medium(s, &v, medium, v1, v2, &ray, &prev_pdf);
             if (ps && depth == 0)
@@ -250,8 +259,10 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
                 vec3 e = emission(s, strategy, mis, m, &v.sf, wo, beta, prev_pdf, prev_delta, prev_p, prev_n, &prev_v,
                                   prev_medium);
                 L = v3_add(L, e);
-                if (ps)
+                if (ps) {
                     pass_light(ps, depth, e);
+                    pass_group(ps, s, v.sf.light, e);
+                }
             }
             if (depth >= max_depth)
                 break;
@@ -268,6 +279,8 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
                     pass_light_first(ps, m, &v.sf, wo, d.ls.wi, d.L);
                 else if (ps)
                     pass_light(ps, depth + 1, d.L);
+                if (ps)
+                    pass_group(ps, s, light, d.L);
             }
             fr_bsdf_sample bs;
             if (!vtx_scatter_surface(s, m, &v.sf, wo, ulobe, v1, v2, &org, &bs, &ray, &medium))

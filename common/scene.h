@@ -439,6 +439,15 @@ typedef struct {
     const fr_light_node *light_nodes; uint32_t n_light_nodes;
     const fr_name *material_names; uint32_t n_material_names; /**< 0, or one per material */
     fr_motion motion;
+    /** 0, or the object of each prim, then of each plane, then of each
+     * instance (an index into object_names; a prim of an instanced mesh
+     * takes its instance's). */
+    const uint32_t *objects; uint32_t n_objects;
+    const fr_name *object_names; uint32_t n_object_names; /**< the objects' names */
+    /** 0, or each light's group (an index into group_names; 0 is
+     * "default"), for the light_groups pass. */
+    const uint32_t *light_groups; uint32_t n_light_groups;
+    const fr_name *group_names; uint32_t n_group_names; /**< the light groups' names */
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

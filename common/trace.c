@@ -339,10 +339,12 @@ static inline __attribute__((always_inline)) void surface(const fr_scene *s, con
     out->footprint = 0.0f;
     if (__builtin_expect(hit->inst != 0, 0)) {
         instance_surface(s, r, hit, out, uv);
+        out->element = s->n_prims + s->n_planes + hit->inst - 1;
         return;
     }
     if (hit->prim == FR_NONE) {
         const fr_plane *pl = &s->planes[hit->plane];
+        out->element = s->n_prims + hit->plane;
         out->p = geo_plane_point(pl, r, hit->t, &out->perr);
         out->ng = out->ns = pl->normal;
         out->material = pl->material;
@@ -362,6 +364,7 @@ static inline __attribute__((always_inline)) void surface(const fr_scene *s, con
     const fr_prim *p = &s->prims[hit->prim];
     out->material = p->material;
     out->light = p->light;
+    out->element = hit->prim;
     if (p->kind == FR_PRIM_SPHERE) {
         const fr_sphere *sp = &s->spheres[p->index];
         vec3 n = v3_scale(v3_sub(v3_madd(r->o, r->d, hit->t), sp->center), 1.0f / sp->radius);

@@ -32,6 +32,10 @@ typedef struct {
     vec3 dpdu, dpdv;           /**< how p moves with u and v (tangents for bump and normal maps) */
     uint32_t material;
     uint32_t light;            /**< FR_NONE unless an area light */
+    /** What was hit, as an index into the scene's objects section: the
+     * prim, n_prims + the plane, or n_prims + n_planes + the instance
+     * (trace_surface* set it; the object_id passes read it). */
+    uint32_t element;
     /** Width (scene units) of the ray's footprint on the surface, from
      * which image lookups pick a mip level (texture.h); 0 (as every
      * trace_surface* leaves it): the finest level. */

@@ -60,7 +60,7 @@ void crypto_name(const crypto_names *names, uint32_t index, char *out)
     if (index < names->n && names->v[index].name[0])
         snprintf(out, 64, "%s", names->v[index].name);
     else
-        snprintf(out, 64, "material%u", index);
+        snprintf(out, 64, "%s%u", names->prefix ? names->prefix : "material", index);
 }
 
 /* The Cryptomatte id of material index. */
@@ -73,12 +73,20 @@ static float material_id(const crypto_names *names, uint32_t index)
 
 void crypto_ids(float *pass, size_t npx, uint32_t stride, const crypto_names *names)
 {
+    /* The ids of the named entries once each (a pixel's names are
+     * hashed again only past them, or when memory runs out). */
+    float *known = names->n ? malloc(names->n * sizeof *known) : NULL;
+    for (uint32_t k = 0; known && k < names->n; k++)
+        known[k] = material_id(names, k);
     for (size_t i = 0; i < npx; i++)
         for (int r = 0; r < PASS_CRYPTO_RANKS; r++) {
             float *id = pass + i * stride + 2 * r;
-            if (*id >= 1.0f)
-                *id = material_id(names, (uint32_t)*id - 1);
+            if (*id < 1.0f)
+                continue;
+            uint32_t k = (uint32_t)*id - 1;
+            *id = known && k < names->n ? known[k] : material_id(names, k);
         }
+    free(known);
 }
 
 /* A growing string. */

@@ -15,7 +15,9 @@
  *
  * A material's name is the scene file's (the material_names section of
  * the binary scene); one without a name is called "material" and its
- * index ("material3").
+ * index ("material3").  The crypto_object pass (layer
+ * "ViewLayer.CryptoObject") and object_id are the same with the objects'
+ * names (the object_names section).
  */
 #ifndef FRANJA_CRYPTO_H
 #define FRANJA_CRYPTO_H
@@ -26,10 +28,13 @@
 #include "error.h"
 #include "scene.h"
 
-/** The materials' names of a scene: n entries (0: none known). */
+/** The materials' (or objects') names of a scene: n entries (0: none
+ * known); one without a name is called prefix and its index (prefix NULL:
+ * "material"). */
 typedef struct {
     const fr_name *v;
     uint32_t n;
+    const char *prefix;
 } crypto_names;
 
 /** MurmurHash3_x86_32 of len bytes at key with seed. */

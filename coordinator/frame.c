@@ -321,11 +321,15 @@ int frame_open(frame_image *im)
     im->n_materials = sc.n_materials;
     if (spec.passes && sc.n_material_names && (im->mat_names = malloc(sc.n_material_names * sizeof *im->mat_names)))
         memcpy(im->mat_names, sc.material_names, (im->n_mat_names = sc.n_material_names) * sizeof *im->mat_names);
+    if (spec.passes && sc.n_object_names && (im->obj_names = malloc(sc.n_object_names * sizeof *im->obj_names)))
+        memcpy(im->obj_names, sc.object_names, (im->n_obj_names = sc.n_object_names) * sizeof *im->obj_names);
+    if (spec.passes && sc.n_group_names && (im->group_names = malloc(sc.n_group_names * sizeof *im->group_names)))
+        memcpy(im->group_names, sc.group_names, (im->n_group_names = sc.n_group_names) * sizeof *im->group_names);
     scn_free(&sc);
     im->spec = spec;
-    if ((spec.passes >> PASS_CRYPTO_MATERIAL & 1u) && !out_has_ext(a->out, "exr"))
-        fprintf(stderr, "franja render: warning: crypto_material is written to .exr outputs only; %s gets the "
-                "other passes\n", a->out);
+    if ((spec.passes & (1u << PASS_CRYPTO_MATERIAL | 1u << PASS_CRYPTO_OBJECT)) && !out_has_ext(a->out, "exr"))
+        fprintf(stderr, "franja render: warning: crypto_material and crypto_object are written to .exr outputs "
+                "only; %s gets the other passes\n", a->out);
 
     im->have = calloc(spec.height, 1);
     im->base = calloc(spec.height, sizeof *im->base);
@@ -452,8 +456,10 @@ int frame_write(frame_image *im, const char *used)
     if (a->reproducible)
         out_meta_set_time(&meta, reproducible_epoch());
     a->io.attrs = meta.attrs;
-    crypto_names names = {im->mat_names, im->n_mat_names};
-    if (passout_write(a->out, rgb, &im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &err)) {
+    crypto_names names = {im->mat_names, im->n_mat_names, NULL}, objects = {im->obj_names, im->n_obj_names, "object"},
+                 groups = {im->group_names, im->n_group_names, "group"};
+    if (passout_write(a->out, rgb, &im->passes, &out_spec, &im->tm, &a->io, &names, im->n_materials, &objects,
+                      &groups, &err)) {
         /* Said only once checked: the rows are still there. */
         if (job_rows_present(im->jobdir) >= im->rows_job) {
             fprintf(stderr, "franja render: %s\nfranja render: the rendered rows stay in %s: rerun with --resume "
@@ -495,6 +501,8 @@ void frame_close(frame_image *im, int rc)
     free(im->rgb);
     free(im->passes);
     free(im->mat_names);
+    free(im->obj_names);
+    free(im->group_names);
     free(im);
 }
 

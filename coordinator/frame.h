@@ -113,6 +113,10 @@ typedef struct {
     float *passes;             /* the render passes (passes.h) once stitched, or NULL */
     fr_name *mat_names;        /* the materials' names (n_mat_names, 0 or n_materials), for the passes' metadata */
     uint32_t n_mat_names, n_materials;
+    fr_name *obj_names;        /* the objects' names (n_obj_names), for the passes' metadata */
+    uint32_t n_obj_names;
+    fr_name *group_names;      /* the light groups' names (n_group_names), for the passes' layers */
+    uint32_t n_group_names;
     frame_passes ps;
     int rows_job, rows_have;
     double t0;

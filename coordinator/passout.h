@@ -39,10 +39,13 @@
  * reallocated (*passes updated; its values are then the file's), so the
  * passes are not held twice.
  * o: the writer's options (NULL: none); names: the materials' names
- * (n_materials of them), for the metadata.  Fails naming the file not
- * written (files written before it stay). */
+ * (n_materials of them), objects: the objects' names (objects->n of
+ * them), for the metadata; groups: the light groups' names (groups->n,
+ * 0: the one "default" group), whose layers are written
+ * (ViewLayer.Combined_NAME; PNG ...: OUT.Combined_NAME.png).  Fails naming the file not written (files
+ * written before it stay). */
 int passout_write(const char *path, const float *rgb, float **passes, const job_spec *spec,
                   const fr_tonemap *tm, const iio_options *o, const crypto_names *names, uint32_t n_materials,
-                  fr_error *err);
+                  const crypto_names *objects, const crypto_names *groups, fr_error *err);
 
 #endif

@@ -33,14 +33,18 @@ for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Alb
     "ViewLayer.Denoising Normal.Z" "ViewLayer.Depth.Z" "ViewLayer.Position.X" "ViewLayer.Emit.B" \
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
     "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "ViewLayer.CryptoMaterial00.R" \
-    "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B"; do
+    "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B" "ViewLayer.IndexOB.X" "ViewLayer.CryptoObject00.R" \
+    "ViewLayer.CryptoObject02.A" "ViewLayer.Combined_default.B"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
-check "the EXR has 51 channels" grep -q "51 channel" info
+check "the EXR has 67 channels" grep -q "67 channel" info
 check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoMaterial"' info
 check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
 check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info
 check "the EXR names its passes" grep -q 'franja:passes: "albedo,normal,depth' info
+check "the EXR has the objects' Cryptomatte metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoObject"' info
+check "the object manifest names the shapes" grep -q 'manifest: "{"shapes\[0\]":"[0-9a-f]\{8\}","shapes\[1\]"' info
+check "the object_id name table" grep -q 'franja:objects: "\["shapes\[0\]","shapes\[1\]",' info
 
 # Blender opens the file as a multilayer EXR: its compositor's Image node
 # offers every pass.
@@ -54,16 +58,59 @@ print("PASSES |" + "|".join(o.name for o in node.outputs) + "|")
 PY
 blender -b --factory-startup --python open.py -- j1.exr >blender.log 2>&1
 for p in Combined "Denoising Albedo" "Denoising Normal" Depth Position Emit DiffDir DiffInd GlossDir GlossInd \
-    TransDir TransInd IndexMA CryptoMaterial00 CryptoMaterial02 Variance; do
+    TransDir TransInd IndexMA CryptoMaterial00 CryptoMaterial02 Variance IndexOB CryptoObject00 CryptoObject02 \
+    Combined_default; do
     check "Blender's Image node offers $p" grep -q "^PASSES .*|$p|" blender.log
 done
+
+# Light groups: a layer each, summing to the image, the same bytes on
+# every split and host.
+cat >groups.json <<'EOF'
+{
+  "image": {"width": 40, "height": 30, "spp": 4, "max_depth": 4},
+  "camera": {"position": [0, 1, -6], "target": [0, 1, 0], "fov": 45},
+  "materials": {
+    "wall": {"type": "lambert", "albedo": [0.7, 0.7, 0.7]},
+    "lamp": {"type": "emitter", "emission": [4, 4, 4], "light_group": "panel"}
+  },
+  "shapes": [
+    {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "material": "wall"},
+    {"type": "sphere", "name": "ball", "center": [-1, 1, 0], "radius": 1, "material": "wall"},
+    {"type": "rect", "origin": [-1, 3, -1], "edge_u": [2, 0, 0], "edge_v": [0, 0, 2], "material": "lamp"}
+  ],
+  "lights": [
+    {"type": "point", "position": [2, 3, -2], "intensity": [5, 5, 5], "light_group": "key"},
+    {"type": "point", "position": [-3, 2, -2], "intensity": [2, 2, 2]}
+  ],
+  "environment": {"color": [0.1, 0.1, 0.15], "light_group": "sky"}
+}
+EOF
+GP="--passes light_groups,object_id,crypto_object --reproducible"
+"$FRANJA" render groups.json -o g1.exr -j 1 $GP 2>logg1
+check "light groups render (-j 1)" test $? -eq 0
+"$FRANJA" render groups.json -o g2.exr -j 2 --slab-rows 5 $GP 2>logg2
+check "light groups: -j 2 --slab-rows 5 gives the bytes of -j 1" cmp -s g1.exr g2.exr
+fr render groups.json -o gssh.exr --hosts hosts $GP 2>logg3
+check "light groups: SSH hosts give the bytes of -j 1" cmp -s g1.exr gssh.exr
+oiiotool --info -v g1.exr >ginfo 2>&1
+for ch in default key panel sky; do
+    check "light group layer ViewLayer.Combined_$ch" grep -q "ViewLayer.Combined_$ch.R" ginfo
+    oiiotool g1.exr --ch "ViewLayer.Combined_$ch.R,ViewLayer.Combined_$ch.G,ViewLayer.Combined_$ch.B" -o "l_$ch.exr"
+done
+check "the object manifest names the ball" grep -q 'manifest: "{.*"ball":"[0-9a-f]\{8\}"' ginfo
+oiiotool g1.exr --ch "ViewLayer.Combined.R,ViewLayer.Combined.G,ViewLayer.Combined.B" -o beauty.exr
+oiiotool l_default.exr l_key.exr --add l_panel.exr --add l_sky.exr --add -o lsum.exr
+check "the light group layers sum to the image" sh -c 'oiiotool --fail 1e-5 --diff lsum.exr beauty.exr | grep -q PASS'
+"$FRANJA" render groups.json -o g.png -j 2 --passes light_groups 2>logg4
+check "PNG output: a file per light group" sh -c 'test -s g.Combined_key.png && test -s g.Combined_default.png'
 
 # The image is the same bytes with and without passes (PFM: Franja's own
 # writer, so the bytes are the pixels and the header).
 "$FRANJA" render "$SCENE" -o plain.pfm $SIZE -j 2 2>log4
 "$FRANJA" render "$SCENE" -o with.pfm $SIZE -j 2 --passes all 2>log5
 check "the image keeps its bytes with passes" cmp -s plain.pfm with.pfm
-for p in albedo normal depth position emission diffuse_direct glossy_indirect transmission_indirect material_id; do
+for p in albedo normal depth position emission diffuse_direct glossy_indirect transmission_indirect material_id \
+    object_id; do
     check "PFM output: with.$p.pfm written" test -s "with.$p.pfm"
 done
 

@@ -163,7 +163,7 @@ static void test_table(void)
     rehash(p, n);
     REFUSE("section id", p, n, "byte 256", "id 9");
     memcpy(p, good.blob, n);
-    put64(p + 64 + 8, 1 << 12);   /* settings: count must be 1 */
+    put64(p + 64 + 16, 2);   /* settings: count must be 1 */
     rehash(p, n);
     REFUSE("settings count", p, n, "settings");
     free(p);
@@ -635,6 +635,45 @@ static void test_light_tree(void)
         poke_at("leaf's parent a leaf", t + 56, 1, "section lighttree", t + 56);
 }
 
+/* The objects and light group sections (28 to 31): an object or group
+ * past the names, or a count that is not one per element, is refused. */
+static void test_objects_groups(void)
+{
+    fr_scene g;
+    test_scene("{\"image\": {\"width\": 8, \"height\": 8}, \"camera\": {\"position\": [0, 0, -5],"
+               " \"target\": [0, 0, 0], \"fov\": 40}, \"materials\": {\"g\": {\"type\": \"lambert\","
+               " \"albedo\": [0.5, 0.5, 0.5]}}, \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0],"
+               " \"intensity\": [5, 5, 5], \"light_group\": \"key\"}],"
+               " \"shapes\": [{\"type\": \"sphere\", \"name\": \"ball\", \"center\": [0, 0, 0], \"radius\": 1,"
+               " \"material\": \"g\"}, {\"type\": \"plane\", \"point\": [0, -1, 0], \"normal\": [0, 1, 0],"
+               " \"material\": \"g\"}]}",
+               &g);
+    CHECK(g.n_objects == 2 && g.n_object_names == 2 && !strcmp(g.object_names[0].name, "ball") &&
+              g.n_light_groups == 1 && g.n_group_names == 2 && !strcmp(g.group_names[1].name, "key"),
+          "objects %u (2), names %u (2), light groups %u (1), names %u (2)", g.n_objects, g.n_object_names,
+          g.n_light_groups, g.n_group_names);
+    size_t n = g.blob_size;
+    unsigned char *p = aligned_alloc(64, (n + 63) / 64 * 64);
+    memcpy(p, g.blob, n);
+    put32(p + section(p, 28) + 4, 2);   /* the plane's object: past the two names */
+    rehash(p, n);
+    REFUSE("object past the names", p, n, "section objects", "object 2 of 2 names");
+    memcpy(p, g.blob, n);
+    put32(p + section(p, 30), 5);
+    rehash(p, n);
+    REFUSE("group past the names", p, n, "section light_groups", "group 5 of 2 names");
+    memcpy(p, g.blob, n);
+    put64(p + 64 + 32 * 27 + 16, 1);    /* objects: one entry for a prim and a plane */
+    rehash(p, n);
+    REFUSE("objects count", p, n, "section objects");
+    memcpy(p, g.blob, n);
+    p[section(p, 29) + 70] = 0x07;      /* a control character in the second name */
+    rehash(p, n);
+    REFUSE("object name", p, n, "section object_names", "name 1");
+    free(p);
+    scn_free(&g);
+}
+
 int main(void)
 {
     test_scene(scene_json, &good);
@@ -647,6 +686,7 @@ int main(void)
     test_texture_sizes();
     test_lights();
     test_light_tree();
+    test_objects_groups();
     scn_free(&good);
     return check_done();
 }

@@ -20,6 +20,7 @@
 #include <xxhash.h>
 
 #include "check.h"
+#include "passes.h"
 #include "compile/builder_instance.h"
 #include "compile/freeze.h"
 #include "compile/gltf_scene.h"
@@ -438,6 +439,29 @@ static void test_gltf(void)
         differ += ha != hc || (ha && fabsf(a.t - c.t) > 1e-5f * c.t);
     }
     CHECK(differ <= 4, "%d of 4000 rays hit the shared mesh and its copies differently", differ);
+    /* Objects (the object_id pass): each node is one, by the instance it
+     * places or the copy it owns, the same either way. */
+    CHECK(shared.n_object_names == 12 && copies.n_object_names == 12 && !strcmp(shared.object_names[0].name, "node0")
+              && !strcmp(shared.object_names[11].name, "node11"),
+          "12 nodes, 12 objects node0..node11 (%u, %u)", shared.n_object_names, copies.n_object_names);
+    int other = 0, hits = 0;
+    unsigned seen = 0;
+    for (int k = 0; k < 4000; k++) {
+        fr_ray r = {v3(rnd() * 8.0f - 1.0f, 2.0f, rnd() * 6.0f - 1.0f), v3_norm(v3(rnd() - 0.5f, -1.0f, rnd() - 0.5f))};
+        fr_hit a, c;
+        if (!trace_closest(&shared, &r, INFINITY, &a) || !trace_closest(&copies, &r, INFINITY, &c))
+            continue;
+        fr_surface sa, sc;
+        trace_surface(&shared, &r, &a, &sa);
+        trace_surface(&copies, &r, &c, &sc);
+        uint32_t oa = pass_object(&shared, &sa), oc = pass_object(&copies, &sc);
+        other += oa != oc;
+        hits++;
+        if (oa > 0 && oa <= 32)
+            seen |= 1u << (oa - 1);
+    }
+    CHECK(hits > 500 && other <= 4 && seen == 0xfffu,
+          "objects: %d of %d hits differ between instances and copies; nodes hit %#x (want 0xfff)", other, hits, seen);
     scn_free(&one);
     scn_free(&shared);
     scn_free(&copies);

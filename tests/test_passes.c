@@ -16,6 +16,7 @@
 #include "image.h"
 #include "passes.h"
 #include "pathtrace.h"
+#include "scenes.h"
 
 #define W 40
 #define H 30
@@ -24,7 +25,7 @@
 /* Offsets of the passes' channels with every pass on (passes.h order). */
 enum {
     C_ALBEDO = 0, C_NORMAL = 3, C_DEPTH = 6, C_POSITION = 7, C_EMISSION = 10, C_LIGHT = 13, C_MATERIAL = 31,
-    C_CRYPTO = 32, C_VARIANCE = 44, C_ALL = 47
+    C_CRYPTO = 32, C_VARIANCE = 44, C_OBJECT = 47, C_CRYPTO_OBJECT = 48, C_GROUPS = 60, C_ALL = 84
 };
 
 static int load(const char *path, fr_scene *s)
@@ -62,9 +63,24 @@ static void check_sum(const char *name, const float *rgb, const float *pass, uns
     }
     CHECK(worst < 1e-5, "%s: the light passes sum to the beauty within %g (relative), want < 1e-5", name, worst);
     CHECK(bad == 0, "%s: %d negative light pass values", name, bad);
+    /* The light groups too. */
+    worst = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++)
+        for (int c = 0; c < 3; c++) {
+            double sum = 0;
+            for (int g = 0; g < PASS_LIGHT_GROUPS; g++)
+                sum += pass[i * C_ALL + C_GROUPS + 3 * g + c];
+            double b = rgb[i * 3 + c], e = fabs(sum - b) / (b > 1e-3 ? b : 1e-3);
+            worst = e > worst ? e : worst;
+        }
+    CHECK(worst < 1e-5, "%s: the light groups sum to the beauty within %g (relative), want < 1e-5", name, worst);
 }
 
-/* Every pass of a scene: the beauty's bits, the sum, split invariance. */
+/* Every pass of scene s: the beauty's bits, the sum, split invariance;
+ * the light per group into group[PASS_LIGHT_GROUPS] (the sum of the
+ * pixels' channels) when group is not NULL. */
+static void check_passes(const char *path, fr_scene *s, unsigned want_seen, double *group);
+
 static void check_scene(const char *path, unsigned want_seen)
 {
     fr_scene s;
@@ -72,6 +88,65 @@ static void check_scene(const char *path, unsigned want_seen)
         CHECK(0, "%s loads", path);
         return;
     }
+    check_passes(path, &s, want_seen, NULL);
+    scn_free(&s);
+}
+
+/* Light groups: lights, an emissive material and the environment in
+ * groups of their own, a light left in "default"; each group gets light
+ * and the groups past the scene's none (the sum: check_sum). */
+static void check_groups(void)
+{
+    static const char json[] =
+        "{\"image\": {\"width\": 40, \"height\": 30, \"spp\": 16, \"max_depth\": 4},"
+        " \"camera\": {\"position\": [0, 1, -6], \"target\": [0, 1, 0], \"fov\": 45},"
+        " \"materials\": {\"wall\": {\"type\": \"lambert\", \"albedo\": [0.7, 0.7, 0.7]},"
+        "  \"shiny\": {\"type\": \"phong\", \"diffuse\": [0.3, 0.3, 0.3], \"glossy\": [0.5, 0.5, 0.5],"
+        "   \"exponent\": 40},"
+        "  \"glass\": {\"type\": \"glass\", \"ior\": 1.5},"
+        "  \"lamp\": {\"type\": \"emitter\", \"emission\": [4, 4, 4], \"light_group\": \"panel\"}},"
+        " \"shapes\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"wall\"},"
+        "  {\"type\": \"sphere\", \"center\": [-1, 1, 0], \"radius\": 1, \"material\": \"shiny\"},"
+        "  {\"type\": \"sphere\", \"center\": [1.2, 0.8, -0.5], \"radius\": 0.8, \"material\": \"glass\"},"
+        "  {\"type\": \"rect\", \"origin\": [-1, 3, -1], \"edge_u\": [2, 0, 0], \"edge_v\": [0, 0, 2],"
+        "   \"material\": \"lamp\"}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [2, 3, -2], \"intensity\": [5, 5, 5],"
+        "   \"light_group\": \"key\"},"
+        "  {\"type\": \"point\", \"position\": [-3, 2, -2], \"intensity\": [2, 2, 2]}],"
+        " \"environment\": {\"color\": [0.1, 0.1, 0.15], \"light_group\": \"sky\"}}";
+    fr_scene s;
+    test_scene(json, &s);
+    CHECK(s.n_group_names == 4 && !strcmp(s.group_names[0].name, "default") && s.n_light_groups == s.n_lights,
+          "groups: default and three named (%u), one per light (%u of %u)", s.n_group_names, s.n_light_groups,
+          s.n_lights);
+    double group[PASS_LIGHT_GROUPS] = {0};
+    check_passes("(groups)", &s, 1u << 1 | 1u << 3, group);
+    int lit = 0, dark = 1;
+    for (uint32_t g = 0; g < PASS_LIGHT_GROUPS; g++)
+        if (g < s.n_group_names)
+            lit += group[g] > 0.0;
+        else
+            dark &= group[g] == 0.0;
+    CHECK(lit == 4 && dark, "every group of the scene has light (%d of 4), the others none", lit);
+    scn_free(&s);
+    /* A ninth group is refused, naming it. */
+    char many[2048];
+    int k = snprintf(many, sizeof many, "{\"image\": {\"width\": 4, \"height\": 4},"
+                     " \"camera\": {\"position\": [0, 0, -5], \"target\": [0, 0, 0], \"fov\": 50},"
+                     " \"materials\": {\"m\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]}},"
+                     " \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"}],"
+                     " \"lights\": [");
+    for (int i = 0; i < PASS_LIGHT_GROUPS; i++)
+        k += snprintf(many + k, sizeof many - (size_t)k, "%s{\"type\": \"point\", \"position\": [0, 3, 0],"
+                      " \"intensity\": [1, 1, 1], \"light_group\": \"g%d\"}", i ? ", " : "", i);
+    snprintf(many + k, sizeof many - (size_t)k, "]}");
+    const char *msg;
+    CHECK(test_scene_refused(many, "lights[7].light_group", &msg), "a ninth light group is refused: %s", msg);
+}
+
+static void check_passes(const char *path, fr_scene *sp, unsigned want_seen, double *group)
+{
+    fr_scene s = *sp;
     size_t n = (size_t)W * H;
     float *plain = malloc(n * 3 * sizeof *plain), *rgb = malloc(n * 3 * sizeof *rgb);
     float *pass = malloc(n * C_ALL * sizeof *pass), *split = malloc(n * C_ALL * sizeof *split);
@@ -101,13 +176,15 @@ static void check_scene(const char *path, unsigned want_seen)
     for (size_t i = 0; i < n * C_ALL; i++)
         finite &= isfinite(pass[i]);
     CHECK(finite, "%s: every pass value is finite", path);
+    for (size_t i = 0; group && i < n; i++)
+        for (int k = 0; k < 3 * PASS_LIGHT_GROUPS; k++)
+            group[k / 3] += pass[i * C_ALL + C_GROUPS + k];
     free(sub);
     free(plain);
     free(rgb);
     free(rgb2);
     free(pass);
     free(split);
-    scn_free(&s);
 }
 
 /* The Cornell box: pixels whose 3x3 neighbourhood sees one material (by
@@ -254,7 +331,7 @@ static void check_names(void)
     fr_error err;
     CHECK(pass_parse("albedo,normal", &m, &err) == 0 && m == (1u << PASS_ALBEDO | 1u << PASS_NORMAL),
           "albedo,normal parses");
-    CHECK(pass_parse("all", &m, &err) == 0 && m == PASS_ALL && pass_channels(m) == 47, "all: every pass, 47 channels");
+    CHECK(pass_parse("all", &m, &err) == 0 && m == PASS_ALL && pass_channels(m) == C_ALL, "all: every pass, %d channels", C_ALL);
     CHECK(pass_parse("none", &m, &err) == 0 && m == 0, "none parses to no pass");
     CHECK(pass_parse("albedo,nromal", &m, &err) < 0 && strstr(err.msg, "nromal"), "a misspelt pass is named: %s",
           err.msg);
@@ -275,5 +352,6 @@ int main(void)
     check_scene("scenes/spheres.json", 0x7f & ~(1u << 5));
     check_scene("scenes/metals.json", 1u << 3 | 1u << 4);
     check_scene("scenes/fog-room.json", 1u << 1);
+    check_groups();
     return check_done();
 }

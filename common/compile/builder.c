@@ -32,6 +32,13 @@ void bld_init(fr_builder *b)
     array_init(&b->instances, sizeof(fr_instance));
     array_init(&b->light_nodes, sizeof(fr_light_node));
     array_init(&b->material_names, sizeof(fr_name));
+    array_init(&b->object_names, sizeof(fr_name));
+    array_init(&b->object_runs, sizeof(bld_object_run));
+    array_init(&b->inst_objects, sizeof(uint32_t));
+    array_init(&b->group_names, sizeof(fr_name));
+    array_init(&b->given_groups, sizeof(uint32_t));
+    array_init(&b->material_groups, sizeof(uint32_t));
+    array_init(&b->light_groups, sizeof(uint32_t));
     b->world.env_light = b->world.env_texture = FR_NONE;
     b->world.rot_cos = 1.0f;
 }
@@ -41,7 +48,9 @@ void bld_free(fr_builder *b)
     fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
                        &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
                        &b->textures, &b->texels, &b->media, &b->distrib, &b->meshes, &b->instances,
-                       &b->light_nodes, &b->material_names};
+                       &b->light_nodes, &b->material_names,
+                       &b->object_names, &b->object_runs, &b->inst_objects, &b->group_names,
+                       &b->given_groups, &b->material_groups, &b->light_groups};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]->data);
     memset(b, 0, sizeof *b);
@@ -54,7 +63,12 @@ int bld_material_name(fr_builder *b, uint32_t material, const char *name)
     while (b->material_names.count <= material)
         if (bld_push(&b->material_names, &empty) == FR_NONE)
             return -1;
-    fr_name *n = (fr_name *)b->material_names.data + material;
+    bld_name_set((fr_name *)b->material_names.data + material, name);
+    return 0;
+}
+
+void bld_name_set(fr_name *n, const char *name)
+{
     size_t k = strlen(name);
     if (k > sizeof n->name - 1) {
         k = sizeof n->name - 1;
@@ -66,7 +80,6 @@ int bld_material_name(fr_builder *b, uint32_t material, const char *name)
         unsigned char ch = (unsigned char)name[i];
         n->name[i] = ch < 0x20 || ch == 0x7f ? '?' : (char)ch;
     }
-    return 0;
 }
 
 uint32_t bld_push(fr_array *a, const void *elem)

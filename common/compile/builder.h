@@ -32,6 +32,14 @@ typedef struct {
     vec3 lo, hi;               /**< bounds of its vertices (set by bld_mesh_end) */
 } bld_mesh;
 
+/** Where an object's geometry starts (builder_object.h): the counts of
+ * triangles, spheres, rects and instances (indexed by FR_PRIM_*) and of
+ * planes (index FR_PRIM_KINDS) when it began. */
+typedef struct {
+    uint32_t object;           /**< index into object_names */
+    uint32_t start[FR_PRIM_KINDS + 1];
+} bld_object_run;
+
 /** A scene under construction: the sections of fr_scene as growable
  * arrays, in the same element types. */
 typedef struct {
@@ -57,6 +65,13 @@ typedef struct {
     fr_array material_names;   /**< fr_name: the materials' names as far as given (bld_material_name) */
     fr_motion motion;          /**< what moves while the shutter is open (scene.h); zero: nothing.  frz_scene
                                     finishes camera_close as it does the camera */
+    fr_array object_names;     /**< fr_name: the objects begun (builder_object.h) */
+    fr_array object_runs;      /**< bld_object_run: where each object's geometry starts (builder_object.h) */
+    fr_array inst_objects;     /**< uint32_t: each instance's object, once bld_flatten has set it */
+    fr_array group_names;      /**< fr_name: the light groups (builder_group.h), "default" first */
+    fr_array given_groups;     /**< uint32_t: the group of each light the readers added, as far as given */
+    fr_array material_groups;  /**< uint32_t: the group of each emissive material, as far as given */
+    fr_array light_groups;     /**< uint32_t: each light's group in the frozen light table (frz_lights) */
 } fr_builder;
 
 /** An empty builder: every array empty, settings and camera zero, no
@@ -69,6 +84,10 @@ void bld_free(fr_builder *b);
  * 63 bytes at a character boundary, control characters as '?'; materials
  * not named are "".  -1 when memory runs out. */
 int bld_material_name(fr_builder *b, uint32_t material, const char *name);
+
+/** Sets *n to name, cut to 63 bytes at a character boundary, control
+ * characters as '?', the rest zeros. */
+void bld_name_set(fr_name *n, const char *name);
 
 /** Append one element (copied); return its index, or FR_NONE when memory or
  * the 32-bit index space runs out. */

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compile/builder_object.h"
+
 uint32_t bld_mesh_begin(fr_builder *b)
 {
     bld_mesh m = {b->prims.count, 0, v3s(INFINITY), v3s(-INFINITY)};
@@ -197,6 +199,8 @@ int bld_flatten(fr_builder *b, int all, fr_error *err)
         rc = fr_fail(err, "out of memory flattening instances");
         goto done;
     }
+    if ((rc = bld_object_instances(b, err)) < 0)
+        goto done;
     const fr_prim *prims = b->prims.data;
     for (uint32_t i = 0; i < b->prims.count; i++)
         owner[i] = FR_NONE;
@@ -237,7 +241,10 @@ int bld_flatten(fr_builder *b, int all, fr_error *err)
         } else if (p.kind == FR_PRIM_INSTANCE) {
             uint32_t k = p.index;
             if (inst_to[k] == FR_NONE) {
-                rc = place_copy(b, &meshes[inst[k].mesh], b->prims.data, &inst[k], &out, err);
+                uint32_t *io = b->inst_objects.data;
+                rc = io ? bld_object_continue(b, io[k], err) : 0;
+                if (rc == 0)
+                    rc = place_copy(b, &meshes[inst[k].mesh], b->prims.data, &inst[k], &out, err);
                 continue;
             }
             p.index = inst_to[k];
@@ -251,8 +258,12 @@ int bld_flatten(fr_builder *b, int all, fr_error *err)
                 fr_instance x = inst[i];
                 x.mesh = mesh_to[x.mesh];
                 inst[inst_to[i]] = x;
+                if (b->inst_objects.count)
+                    ((uint32_t *)b->inst_objects.data)[inst_to[i]] = ((uint32_t *)b->inst_objects.data)[i];
             }
         b->instances.count = kept;
+        if (b->inst_objects.count)
+            b->inst_objects.count = kept;
         for (uint32_t k = 0; k < nm; k++)
             if (mesh_to[k] != FR_NONE)
                 meshes[mesh_to[k]] = meshes[k];

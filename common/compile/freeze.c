@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "compile/builder_instance.h"
+#include "compile/builder_object.h"
 #include "compile/bvh_build.h"
 #include "fbin.h"
 #include "compile/freeze_light.h"
@@ -81,6 +82,7 @@ static int build_meshes(fr_builder *b, fr_array *mp, fr_array *mnodes, fr_array 
 /* The arrays freezing makes beside the builder's. */
 typedef struct {
     fr_array nodes, leaves, mnodes, mleaves, table;
+    fr_array objects;          /* uint32_t: the objects section (builder_object.h) */
 } frozen;
 
 static void frozen_free(frozen *f)
@@ -90,6 +92,7 @@ static void frozen_free(frozen *f)
     free(f->mnodes.data);
     free(f->mleaves.data);
     free(f->table.data);
+    free(f->objects.data);
 }
 
 /* Everything but the bytes: camera, BVH, lights; *view points at the
@@ -101,6 +104,7 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     f->mnodes = (fr_array){NULL, 0, 0, sizeof(fr_bvh_node)};
     f->mleaves = (fr_array){NULL, 0, 0, sizeof(fr_bvh_leaf)};
     f->table = (fr_array){NULL, 0, 0, sizeof(fr_mesh)};
+    f->objects = (fr_array){NULL, 0, 0, sizeof(uint32_t)};
     if (bld_camera_finish(&b->camera, err) < 0 || bld_drop_unused_vertices(b, err) < 0 || bld_flatten(b, 0, err) < 0)
         return -1;
     if ((b->motion.flags & FR_MOTION_CAMERA) && bld_camera_finish(&b->motion.camera_close, err) < 0)
@@ -129,6 +133,8 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     while (rc == 0 && b->material_names.count && b->material_names.count < b->materials.count)
         if (bld_push(&b->material_names, &unnamed) == FR_NONE)
             rc = fr_fail(err, "out of memory for the materials' names");
+    if (rc == 0)
+        rc = bld_object_table(b, &f->objects, err);
     memset(view, 0, sizeof *view);
     view->settings = b->settings;
     view->camera = b->camera;
@@ -147,6 +153,12 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     VIEW(mesh_nodes, f->mnodes); VIEW(mesh_leaves, f->mleaves);
     VIEW(light_nodes, b->light_nodes);
     VIEW(material_names, b->material_names);
+    VIEW(objects, f->objects);
+    VIEW(light_groups, b->light_groups);
+    if (b->light_groups.count)
+        VIEW(group_names, b->group_names);
+    if (f->objects.count)
+        VIEW(object_names, b->object_names);
 #undef VIEW
     return rc;
 }

@@ -11,6 +11,7 @@
 #include "compile/freeze_lighttree.h"
 #include "fmath.h"
 #include "compile/builder_instance.h"
+#include "compile/builder_group.h"
 #include "texture.h"
 
 /* |a x b| in double: edges of coordinates up to 1e18 (jsonval.h) have
@@ -334,6 +335,17 @@ static double frz_light_power(emit_ctx *c, const fr_builder *b, const fr_light *
     }
 }
 
+/* The next light of the table's group (builder_group.h), when the scene
+ * names groups: given, the light as the readers added it, or FR_NONE for
+ * an area light of `material`.  FR_NONE when memory runs out. */
+static uint32_t group(fr_builder *b, uint32_t given, uint32_t material)
+{
+    if (!b->group_names.count)
+        return 0;
+    uint32_t g = bld_group_of(b, given, material);
+    return bld_push(&b->light_groups, &g);
+}
+
 /* Rank of a light kind in the table: distant lights first. */
 static int rank(uint32_t kind) { return kind == FR_LIGHT_ENV ? 0 : kind == FR_LIGHT_SUN ? 1 : 2; }
 
@@ -343,6 +355,7 @@ int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
     /* Order what the readers added (stable), then append the area lights. */
     fr_array given = b->lights;
     b->lights = (fr_array){NULL, 0, 0, sizeof(fr_light)};
+    b->light_groups.count = 0;
     b->world.env_light = FR_NONE;
     int rc = 0;
     for (int r = 0; r < 3 && rc == 0; r++)
@@ -355,7 +368,7 @@ int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
                              "is infinite, so no distant light reaches it); put the fog inside a shape instead "
                              "(a box whose material has \"medium\")");
             uint32_t at = rc < 0 ? 0 : bld_push(&b->lights, l);
-            if (at == FR_NONE)
+            if (at == FR_NONE || (rc == 0 && group(b, i, 0) == FR_NONE))
                 rc = fr_fail(err, "out of memory for lights");
             if (l->kind == FR_LIGHT_ENV)
                 b->world.env_light = at;
@@ -380,7 +393,7 @@ int frz_lights(fr_builder *b, const uint32_t *placed, fr_error *err)
             return fr_fail(err, "primitive %u: an emitter of area %g, too large for single precision", k, area);
         l.area = (float)area;
         uint32_t li = bld_push(&b->lights, &l);
-        if (li == FR_NONE)
+        if (li == FR_NONE || group(b, FR_NONE, prims[i].material) == FR_NONE)
             return fr_fail(err, "out of memory for lights");
         prims[i].light = li;
     }

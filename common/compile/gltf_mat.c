@@ -409,7 +409,10 @@ int gmat_material(gmat_ctx *c, uint32_t index, uint32_t *out, const double **uvx
             }
         }
         gmat_to_franja(c, &v, &m);
-        if ((c->mat_of[slot] = bld_push(&c->b->materials, &m)) == FR_NONE)
+        const cJSON *name = index == UINT32_MAX ? NULL
+                                                : cJSON_GetObjectItemCaseSensitive(c->doc->materials.v[index], "name");
+        if ((c->mat_of[slot] = bld_push(&c->b->materials, &m)) == FR_NONE ||
+            (cJSON_IsString(name) && bld_material_name(c->b, c->mat_of[slot], name->valuestring) < 0))
             return gdoc_fail(c->doc, err, NULL, "out of memory");
     }
     *out = c->mat_of[slot];

@@ -9,6 +9,7 @@
 
 #include "fmath.h"
 #include "compile/builder_instance.h"
+#include "compile/builder_object.h"
 #include "compile/builder_light.h"
 #include "compile/freeze.h"
 #include "compile/gltf_anim.h"
@@ -744,6 +745,15 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
     }
     if (ext)
         lp = cJSON_GetObjectItemCaseSensitive(ext, "KHR_lights_punctual");
+    if (m != UINT32_MAX && !c->o->camera_only) {
+        /* The node is an object (builder_object.h), by its name. */
+        char dflt[24];
+        const char *name = name_of(o);
+        snprintf(dflt, sizeof dflt, "node%u", n);
+        fr_error e;
+        if (bld_object(c->b, name ? name : dflt, &e) < 0)
+            return gdoc_fail(d, err, ptr, "%s", e.msg);
+    }
     skinning sk = {NULL, 0, 0};
     int rc = 0;
     if (m != UINT32_MAX && !c->o->camera_only && (rc = skin_of(c, n, &sk, err)) == 0)

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "compile/builder_group.h"
 #include "compile/builder_light.h"
 #include "fmath.h"
 #include "compile/jsonval.h"
@@ -73,6 +74,26 @@ static int parse_light(json_appear *a, const cJSON *o, const char *where, fr_err
     return located(bld_sun_light(a->b, dir, col, angle * DEG, &e), where, &e, err);
 }
 
+/* parse(a, o, where, err) with o's optional "light_group" key set aside
+ * while it reads o's other fields: the light it adds is in that group
+ * (builder_group.h). */
+static int grouped(json_appear *a, const cJSON *o, const char *where,
+                   int (*parse)(json_appear *, const cJSON *, const char *, fr_error *), fr_error *err)
+{
+    cJSON *g = cJSON_IsObject(o) ? cJSON_DetachItemFromObjectCaseSensitive((cJSON *)o, "light_group") : NULL;
+    uint32_t before = a->b->lights.count;
+    int rc = 0;
+    if (g && (!cJSON_IsString(g) || !g->valuestring[0]))
+        rc = fr_fail(err, "%s.light_group: expected a non-empty string", where);
+    if (rc == 0)
+        rc = parse(a, o, where, err);
+    if (rc == 0 && g && a->b->lights.count > before)
+        rc = bld_light_group(a->b, before, g->valuestring, where, err);
+    if (g)
+        cJSON_AddItemToObject((cJSON *)o, "light_group", g);
+    return rc;
+}
+
 int json_lights(json_appear *a, const cJSON *lights, fr_error *err)
 {
     if (!lights)
@@ -83,17 +104,24 @@ int json_lights(json_appear *a, const cJSON *lights, fr_error *err)
     for (const cJSON *o = lights->child; o; o = o->next, i++) {
         char where[PATHLEN];
         snprintf(where, sizeof where, "lights[%d]", i);
-        if (parse_light(a, o, where, err) < 0)
+        if (grouped(a, o, where, parse_light, err) < 0)
             return -1;
     }
     return 0;
 }
 
+static int environment(json_appear *a, const cJSON *env, const char *where, fr_error *err);
+
 int json_environment(json_appear *a, const cJSON *env, fr_error *err)
 {
+    return env ? grouped(a, env, "environment", environment, err) : 0;
+}
+
+/* The environment object but its light_group. */
+static int environment(json_appear *a, const cJSON *env, const char *where, fr_error *err)
+{
     static const char *const fields[] = {"color", "strength", "rotation", NULL};
-    if (!env)
-        return 0;
+    (void)where;
     if (!cJSON_IsObject(env))
         return fr_fail(err, "environment: expected an object");
     vec3 color;

@@ -21,6 +21,8 @@
 #include "compile/json_keys.h"
 #include "compile/json_light.h"
 #include "compile/json_microfacet.h"
+#include "compile/builder_group.h"
+#include "compile/builder_object.h"
 
 #define PATHLEN 160
 
@@ -285,11 +287,20 @@ static int parse_materials(ctx *c, const cJSON *o)
         char where[PATHLEN];
         snprintf(where, sizeof where, "materials.%s", m->string);
         fr_material mat;
-        if (parse_material(c, m, where, &mat) < 0)
+        /* A light_group is set aside while the material's fields are read. */
+        cJSON *g = cJSON_IsObject(m) ? cJSON_DetachItemFromObjectCaseSensitive((cJSON *)m, "light_group") : NULL;
+        int rc = g && (!cJSON_IsString(g) || !g->valuestring[0])
+                     ? fr_fail(c->err, "%s.light_group: expected a non-empty string", where)
+                     : parse_material(c, m, where, &mat);
+        uint32_t k = rc < 0 ? 0 : bld_push(&c->b->materials, &mat);
+        if (rc == 0 && (k == FR_NONE || bld_material_name(c->b, k, m->string) < 0))
+            rc = fr_fail(c->err, "%s: out of memory", where);
+        if (rc == 0 && g)
+            rc = bld_material_group(c->b, k, g->valuestring, where, c->err);
+        if (g)
+            cJSON_AddItemToObject((cJSON *)m, "light_group", g);
+        if (rc < 0)
             return -1;
-        uint32_t k = bld_push(&c->b->materials, &mat);
-        if (k == FR_NONE || bld_material_name(c->b, k, m->string) < 0)
-            return fr_fail(c->err, "%s: out of memory", where);
     }
     c->materials = o;
     uint32_t n = 0;
@@ -367,10 +378,33 @@ static int parse_box(fr_builder *b, const cJSON *o, const char *where, uint32_t 
     return 0;
 }
 
+static int parse_shape_fields(ctx *c, const cJSON *o, const char *where);
+
+/* A shape: an object (builder_object.h) named by its optional "name" key,
+ * else by where it is ("shapes[3]"), but a glTF file (its nodes are); the
+ * key is set aside while the shape's own fields are read. */
 static int parse_shape(ctx *c, const cJSON *o, const char *where)
 {
     if (!cJSON_IsObject(o))
         return fr_fail(c->err, "%s: expected an object", where);
+    cJSON *name = cJSON_DetachItemFromObjectCaseSensitive((cJSON *)o, "name");
+    int rc = 0;
+    if (name && (!cJSON_IsString(name) || !name->valuestring[0]))
+        rc = fr_fail(c->err, "%s.name: expected a non-empty string", where);
+    /* A glTF file's nodes are objects of their own (gltf_scene.c). */
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
+    if (rc == 0 && !(cJSON_IsString(t) && !strcmp(t->valuestring, "gltf")))
+        rc = bld_object(c->b, name ? name->valuestring : where, c->err);
+    if (rc == 0)
+        rc = parse_shape_fields(c, o, where);
+    if (name)
+        cJSON_AddItemToObject((cJSON *)o, "name", name);
+    return rc;
+}
+
+/* A shape's fields but its name. */
+static int parse_shape_fields(ctx *c, const cJSON *o, const char *where)
+{
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "type");
     if (!cJSON_IsString(t))
         return fr_fail(c->err, "%s.type: missing (expected sphere, plane, rect, quad, triangle, box, mesh or gltf)", where);

@@ -61,7 +61,7 @@ _franja()
     --worker) _franja_files "$cur" ""; return 0 ;;
     --passes)
         COMPREPLY=($(compgen -W "all light denoise none albedo normal depth position emission diffuse_direct \
-diffuse_indirect glossy_direct glossy_indirect transmission_direct transmission_indirect material_id crypto_material variance" -- "$cur"))
+diffuse_indirect glossy_direct glossy_indirect transmission_direct transmission_indirect material_id crypto_material variance object_id crypto_object light_groups" -- "$cur"))
         return 0 ;;
     -j | --spp | --size | --scale | --exposure | --slab-rows | --retries | --timeout | --camera | --preview-every | \
         --monitor | --crop | --jpeg-quality | --noise-threshold | --frames | --fps | --shutter | --time-limit)

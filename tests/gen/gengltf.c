@@ -300,12 +300,12 @@ static void quad_tris(tri *t, const float a[3], const float b[3], const float c[
             memcpy(t[k].p + 3 * v, q[k][v], 3 * sizeof(float));
 }
 
-static void json_tris(str *j, const tri *t, int n, const char *mat)
+static void json_tris(str *j, const tri *t, int n, const char *mat, const char *name)
 {
     for (int i = 0; i < n; i++)
-        addf(j, ",\n    {\"type\": \"triangle\", \"material\": \"%s\", \"vertices\": [[%.9g, %.9g, %.9g], "
-             "[%.9g, %.9g, %.9g], [%.9g, %.9g, %.9g]]}", mat, t[i].p[0], t[i].p[1], t[i].p[2], t[i].p[3], t[i].p[4],
-             t[i].p[5], t[i].p[6], t[i].p[7], t[i].p[8]);
+        addf(j, ",\n    {\"type\": \"triangle\", \"name\": \"%s\", \"material\": \"%s\", \"vertices\": "
+             "[[%.9g, %.9g, %.9g], [%.9g, %.9g, %.9g], [%.9g, %.9g, %.9g]]}", name, mat, t[i].p[0], t[i].p[1],
+             t[i].p[2], t[i].p[3], t[i].p[4], t[i].p[5], t[i].p[6], t[i].p[7], t[i].p[8]);
 }
 
 static void gen_scene(const char *dir)
@@ -357,9 +357,9 @@ static void gen_scene(const char *dir)
              "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 2], \"intensity\": [20, 20, 20]}],\n"
              "  \"shapes\": [");
     str t = {0};
-    json_tris(&t, floor, 2, "grey");
-    json_tris(&t, wall, 2, "blue");
-    json_tris(&t, prism, 4, "red");
+    json_tris(&t, floor, 2, "grey", "floor");
+    json_tris(&t, wall, 2, "blue", "wall");
+    json_tris(&t, prism, 4, "red", "prism");
     addf(&j, "%s\n  ]\n}\n", t.s + 1);
     save(dir, "scene.json", j.s, j.n);
     free(j.s);

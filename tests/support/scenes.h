@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "compile/freeze.h"
 #include "compile/json_scene.h"
@@ -25,5 +26,19 @@ static inline void test_scene_with(const char *json, const char *file, const sce
 
 /* Parse and freeze a scene from JSON text (no asset loaders). */
 static inline void test_scene(const char *json, fr_scene *out) { test_scene_with(json, "(test)", NULL, out); }
+
+/* Whether a scene's JSON text is refused with a message containing
+ * `want`; the message (or "accepted") into *msg, which stays valid until
+ * the next call. */
+static inline int test_scene_refused(const char *json, const char *want, const char **msg)
+{
+    static fr_error err;
+    fr_builder b;
+    bld_init(&b);
+    int rc = json_scene_parse(json, "(test)", NULL, &b, &err);
+    bld_free(&b);
+    *msg = rc < 0 ? err.msg : "accepted";
+    return rc < 0 && strstr(err.msg, want) != NULL;
+}
 
 #endif
