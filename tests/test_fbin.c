@@ -635,7 +635,7 @@ static void test_light_tree(void)
         poke_at("leaf's parent a leaf", t + 56, 1, "section lighttree", t + 56);
 }
 
-/* The objects and light group sections (28 to 31): an object or group
+/* The objects and light group sections (29 to 32): an object or group
  * past the names, or a count that is not one per element, is refused. */
 static void test_objects_groups(void)
 {
@@ -655,19 +655,19 @@ static void test_objects_groups(void)
     size_t n = g.blob_size;
     unsigned char *p = aligned_alloc(64, (n + 63) / 64 * 64);
     memcpy(p, g.blob, n);
-    put32(p + section(p, 28) + 4, 2);   /* the plane's object: past the two names */
+    put32(p + section(p, 29) + 4, 2);   /* the plane's object: past the two names */
     rehash(p, n);
     REFUSE("object past the names", p, n, "section objects", "object 2 of 2 names");
     memcpy(p, g.blob, n);
-    put32(p + section(p, 30), 5);
+    put32(p + section(p, 31), 5);
     rehash(p, n);
     REFUSE("group past the names", p, n, "section light_groups", "group 5 of 2 names");
     memcpy(p, g.blob, n);
-    put64(p + 64 + 32 * 27 + 16, 1);    /* objects: one entry for a prim and a plane */
+    put64(p + 64 + 32 * 28 + 16, 1);    /* objects: one entry for a prim and a plane */
     rehash(p, n);
     REFUSE("objects count", p, n, "section objects");
     memcpy(p, g.blob, n);
-    p[section(p, 29) + 70] = 0x07;      /* a control character in the second name */
+    p[section(p, 30) + 70] = 0x07;      /* a control character in the second name */
     rehash(p, n);
     REFUSE("object name", p, n, "section object_names", "name 1");
     free(p);
