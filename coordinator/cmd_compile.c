@@ -123,9 +123,13 @@ int cmd_compile(int argc, char **argv)
     }
     /* A scene written to a device or a pipe (/dev/stdout) is not mixed
      * with the summary. */
+    char placed[64] = "";
+    if (st.instances)
+        snprintf(placed, sizeof placed, ", %u instances of %u meshes", st.instances, st.meshes);
     fprintf(file_out_in_place(out) ? stderr : stdout,
-            "%s: scene %s, %llu bytes: %u primitives (%u triangles), %u materials, %u lights, "
+            "%s: scene %s, %llu bytes: %u primitives (%u triangles)%s, %u materials, %u lights, "
             "%u BVH nodes, %u leaf blocks; compiled in %.3f s\n",
-            out, st.hash, st.bytes, st.prims, st.triangles, st.materials, st.lights, st.nodes, st.leaves, st.seconds);
+            out, st.hash, st.bytes, st.prims, st.triangles, placed, st.materials, st.lights, st.nodes, st.leaves,
+            st.seconds);
     return 0;
 }

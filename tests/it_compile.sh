@@ -98,6 +98,10 @@ out=$($F compile "$T/m/a.json" -o "$T/a.fbin") && echo "$out" | grep -q '2 primi
 scene "$T/m/b.json" '{"type": "mesh", "file": "quad.obj", "material": "grey", "scale": [2, 1, -1], "rotate": [0, 45, 0], "translate": [0, 1, 0]}'
 out=$($F compile "$T/m/b.json" -o "$T/b.fbin") && echo "$out" | grep -q '2 triangles), 1 materials, 1 lights' &&
     ok || bad "material override with a mirroring transform: $out"
+# a mesh placed three times: the summary counts the placements
+scene "$T/m/i.json" '{"type": "mesh", "file": "quad.obj", "material": "grey", "instances": [{"translate": [0, 1, 0]}, {"translate": [2, 1, 0]}, {"translate": [4, 1, 0]}]}'
+out=$($F compile "$T/m/i.json" -o "$T/i.fbin") && echo "$out" | grep -q '(2 triangles), 3 instances of 1 meshes, 1 materials' &&
+    ok || bad "instances in the summary: $out"
 scene "$T/m/c.json" '{"type": "mesh", "file": "quad.obj", "matrix": [0,0,1,2, 0,1,0,0, -1,0,0,0, 0,0,0,1]}'
 $F compile "$T/m/c.json" -o "$T/c.fbin" >/dev/null && ok || bad "matrix transform"
 printf 'solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n' >"$T/m/t.stl"

@@ -65,6 +65,8 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
         a.st.lights = s.n_lights;
         a.st.nodes = s.n_nodes;
         a.st.leaves = s.n_leaves;
+        a.st.instances = s.n_instances;
+        a.st.meshes = s.n_meshes;
         scn_free(&s);
     }
     const char *p = (const char *)&a;

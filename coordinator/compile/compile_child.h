@@ -37,6 +37,7 @@ typedef struct {
     char hash[17];          /**< the scene hash in hex */
     unsigned long long bytes; /**< size of the .fbin */
     unsigned prims, triangles, materials, lights, nodes, leaves;
+    unsigned instances, meshes; /**< placements of meshes, and the meshes they place */
     double seconds;         /**< compile time, without writing the file */
 } compile_child_stats;
 
