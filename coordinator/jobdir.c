@@ -300,11 +300,12 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     if (!bad && info.spp != c->spec->spp) {
         /* Another sample count: more is never this render's (the slab is
          * left alone); fewer is a base to add samples to, when it has its
-         * sums, or a row of the image so far. */
+         * sums, or a row of the image so far.  A render that keeps no sums
+         * (render passes' --time-limit) leaves fewer alone too. */
         int use = 0;
         if (info.spp < c->spec->spp && c->mode == GATHER) {
             use = 1;
-        } else if (info.spp < c->spec->spp && c->mode == SCAN && !info.sums_offset) {
+        } else if (info.spp < c->spec->spp && c->mode == SCAN && !info.sums_offset && job_sums(c->spec)) {
             bad = 1;
             snprintf(e.msg, sizeof e.msg, "%u samples per pixel, expected %u, and no sample sums to add to",
                      info.spp, c->spec->spp);
