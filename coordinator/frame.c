@@ -271,10 +271,18 @@ int frame_open(frame_image *im)
     int mlt = spec.integrator == FR_INTEGRATOR_MLT;
     if (!rc && fr_integrator_splats(spec.integrator))
         spec.noise_threshold = 0.0f; /* bidirectional and Metropolis workers take every sample */
-    if (!rc && spec.passes && fr_integrator_splats(spec.integrator)) {
-        fprintf(stderr, "franja render: %s: render passes are made by the path integrator, not %s (use "
-                "--integrator path, or --passes none)\n", a->passes_set ? "--passes" : a->scene,
+    if (!rc && spec.passes && mlt) {
+        fprintf(stderr, "franja render: %s: render passes are made by the path integrator and bdpt, not %s (use "
+                "--integrator path or bdpt, or --passes none)\n", a->passes_set ? "--passes" : a->scene,
                 proto_integrator_name((int)spec.integrator));
+        rc = 2;
+    } else if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && (spec.passes & ~BD_PASSES)) {
+        char names[400];
+        pass_format(spec.passes & ~BD_PASSES, names, sizeof names);
+        fprintf(stderr, "franja render: %s: bdpt fills the passes of its camera subpaths (albedo, normal, depth, "
+                "position, material_id, crypto_material, object_id, crypto_object), not %s: light tracing's "
+                "splats land on other pixels (use --integrator path for them)\n",
+                a->passes_set ? "--passes" : a->scene, names);
         rc = 2;
     } else if (!rc && fr_integrator_splats(spec.integrator) && (mlt ? mlt_supported(&sc, &err) : bd_supported(&sc, &err))) {
         fprintf(stderr, "franja render: %s: %s: %s\n", a->scene,

@@ -286,7 +286,7 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
             free(rows);
             rows = NULL;
         }
-        if (!bad && c->rgb && c->passes && nch) {
+        if (!bad && c->passes && nch) {
             prows = malloc((size_t)c->spec->width * (y1 - y0) * nch * sizeof *prows);
             if (!prows) {
                 bad = 1;

@@ -7,7 +7,8 @@
 # do not change with passes; PNG and
 # PFM outputs get one file per pass; the scene's "passes" key is read;
 # --crop, --resume, --time-limit and adaptive sampling work with passes;
-# bdpt is refused with a message.
+# bdpt fills the passes of its camera subpaths, the same bytes on every
+# split; its light passes and mlt are refused with a message.
 . "$(dirname "$0")/support/fakehosts.sh"
 need oiiotool blender
 fh_init
@@ -170,14 +171,42 @@ N=$(sed -n 's/.*time limit of 1 s reached: \([0-9]*\) samples.*/\1/p' log18)
 check "--time-limit with passes, stopped: the bytes of a render with its ${N:-0} samples" cmp -s ts.exr tn.exr
 check "--time-limit with passes: no slab discarded" sh -c '! grep -q discarded log14 log18'
 
+# BDPT: the passes of its camera subpaths, the same bytes on every split
+# and host; its image keeps its bytes; on the Cornell box's Lambertian
+# walls its first-hit passes are the path tracer's.
+BP="--integrator bdpt --passes denoise,depth,position,material_id,object_id,crypto_material,crypto_object --reproducible"
+CORNELL="$ROOT/scenes/cornell.json"
+"$FRANJA" render "$CORNELL" -o bd1.exr $SIZE -j 1 $BP 2>log21
+check "bdpt with its passes (-j 1)" test $? -eq 0
+"$FRANJA" render "$CORNELL" -o bd2.exr $SIZE -j 2 --slab-rows 5 $BP 2>log22
+check "bdpt with passes: -j 2 --slab-rows 5 gives the bytes of -j 1" cmp -s bd1.exr bd2.exr
+fr render "$CORNELL" -o bdssh.exr --hosts hosts $BP $SIZE 2>log23
+check "bdpt with passes: SSH hosts give the bytes of -j 1" cmp -s bd1.exr bdssh.exr
+oiiotool --info -v bd1.exr >bdinfo 2>&1
+check "bdpt's EXR has 4 + 36 channels" grep -q "40 channel" bdinfo
+"$FRANJA" render "$CORNELL" -o bdplain.pfm $SIZE -j 2 --integrator bdpt 2>log24
+"$FRANJA" render "$CORNELL" -o bdwith.pfm $SIZE -j 2 --integrator bdpt --passes denoise,depth 2>log25
+check "bdpt's image keeps its bytes with passes" cmp -s bdplain.pfm bdwith.pfm
+check "bdpt: PFM files of its passes" sh -c 'test -s bdwith.albedo.pfm && test -s bdwith.depth.pfm'
+"$FRANJA" render "$CORNELL" -o pt1.exr $SIZE -j 2 --passes denoise,depth,material_id --reproducible 2>log26
+for ch in "ViewLayer.Depth.Z" "ViewLayer.IndexMA.X" \
+    "ViewLayer.Denoising Albedo.R,ViewLayer.Denoising Albedo.G,ViewLayer.Denoising Albedo.B"; do
+    oiiotool bd1.exr --ch "$ch" -o bdch.exr
+    oiiotool pt1.exr --ch "$ch" -o ptch.exr
+    check "bdpt's $ch is the path tracer's on the Cornell box" sh -c 'oiiotool --fail 0 --diff bdch.exr ptch.exr | grep -q PASS'
+done
+
 # Adaptive sampling with passes.
 "$FRANJA" render "$SCENE" -o adapt.exr --size 40x30 --spp 64 --noise-threshold 0.5 -j 2 --passes light 2>log12
 check "adaptive sampling with passes" test $? -eq 0
 
 # Refusals, with a message.
-"$FRANJA" render "$SCENE" -o b.png $SIZE --passes albedo --integrator bdpt 2>log13
-check "bdpt with passes: status 2" test $? -eq 2
-check "bdpt with passes: said" grep -q "path integrator, not bdpt" log13
+"$FRANJA" render "$SCENE" -o b.png $SIZE --passes albedo,emission --integrator bdpt 2>log13
+check "bdpt with light passes: status 2" test $? -eq 2
+check "bdpt with light passes: said, naming them" grep -q "camera subpaths .*, not emission: light tracing" log13
+"$FRANJA" render "$SCENE" -o m.png $SIZE --passes albedo --integrator mlt 2>log20
+check "mlt with passes: status 2" test $? -eq 2
+check "mlt with passes: said" grep -q "path integrator and bdpt, not mlt" log20
 "$FRANJA" render "$SCENE" -o t.png $SIZE --passes albedo,nrm 2>log15
 check "an unknown pass: status 2" test $? -eq 2
 check "an unknown pass is named" grep -q "unknown pass 'nrm'" log15
