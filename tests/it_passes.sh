@@ -35,10 +35,10 @@ for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Alb
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
     "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "ViewLayer.CryptoMaterial00.R" \
     "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B" "ViewLayer.IndexOB.X" "ViewLayer.CryptoObject00.R" \
-    "ViewLayer.CryptoObject02.A" "ViewLayer.Combined_default.B"; do
+    "ViewLayer.CryptoObject02.A" "ViewLayer.Combined_default.B" "ViewLayer.Shadow.G"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
-check "the EXR has 67 channels" grep -q "67 channel" info
+check "the EXR has 70 channels" grep -q "70 channel" info
 check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoMaterial"' info
 check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
 check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info

@@ -66,7 +66,7 @@ static const char usage[] =
     "                 emission, diffuse_direct, diffuse_indirect, glossy_direct,\n"
     "                 glossy_indirect, transmission_direct, transmission_indirect,\n"
     "                 material_id, crypto_material, variance, object_id,\n"
-    "                 crypto_object, light_groups; or all, light,\n"
+    "                 crypto_object, light_groups, shadow; or all, light,\n"
     "                 denoise, none\n"
     "\n"
     "Writing to a pipe (-o -), the worker ends itself when the pipe's reader is\n"
