@@ -288,7 +288,8 @@ int frame_open(frame_image *im)
         fprintf(stderr, "franja render: %s: %s: %s\n", a->scene,
                 mlt ? "Metropolis light transport" : "bidirectional path tracing", err.msg);
         rc = a->integrator ? 2 : 1;
-    } else if (!rc && a->time_limit > 0 && !job_sums(&spec) && !spec.passes) {
+    } else if (!rc && a->time_limit > 0 && !job_sums(&spec) &&
+               !(spec.passes && spec.integrator == FR_INTEGRATOR_PATH)) {
         fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
                 "only path tracing without adaptive sampling keeps (this render %s)\n",
                 spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"

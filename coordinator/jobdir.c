@@ -768,7 +768,7 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
             /* "passes=<names>\n", the last line. */
             char *nl = strchr(copy + n, '\n');
             fr_error e2;
-            ok = !strncmp(copy + n, "passes=", 7) && nl && nl + 1 == copy + len && !bdpt;
+            ok = !strncmp(copy + n, "passes=", 7) && nl && nl + 1 == copy + len && bdpt != 2;
             if (ok) {
                 *nl = 0;
                 ok = pass_parse(copy + n + 7, &passes, &e2) == 0 && passes;

@@ -188,6 +188,12 @@ check "bdpt's EXR has 4 + 36 channels" grep -q "40 channel" bdinfo
 "$FRANJA" render "$CORNELL" -o bdwith.pfm $SIZE -j 2 --integrator bdpt --passes denoise,depth 2>log25
 check "bdpt's image keeps its bytes with passes" cmp -s bdplain.pfm bdwith.pfm
 check "bdpt: PFM files of its passes" sh -c 'test -s bdwith.albedo.pfm && test -s bdwith.depth.pfm'
+"$FRANJA" render "$CORNELL" -o bdk.exr $SIZE -j 2 $BP --keep-job 2>log27
+"$FRANJA" render "$CORNELL" -o bdk.exr $SIZE -j 2 $BP --resume 2>log28
+check "bdpt with passes: --resume writes the same bytes" cmp -s bdk.exr bd1.exr
+check "bdpt with passes: --resume rendered nothing again" grep -q "30 of 30 rows already done" log28
+"$FRANJA" render "$CORNELL" -o bdc.exr $SIZE -j 2 $BP --crop 5:7:29:23 2>log29
+check "bdpt with passes and --crop" test $? -eq 0
 "$FRANJA" render "$CORNELL" -o pt1.exr $SIZE -j 2 --passes denoise,depth,material_id --reproducible 2>log26
 for ch in "ViewLayer.Depth.Z" "ViewLayer.IndexMA.X" \
     "ViewLayer.Denoising Albedo.R,ViewLayer.Denoising Albedo.G,ViewLayer.Denoising Albedo.B"; do
