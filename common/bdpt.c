@@ -87,6 +87,7 @@ typedef struct {
     float pdf_fwd, pdf_rev;
     uint32_t light;            /* light: index into lights; surface: its area light or FR_NONE */
     float u[3];                /* camera subpath: light pick and point for s = 1; light subpath: lens point */
+    vec3 weight;               /* surface: the weight of the bounce that left it (the render passes' albedo) */
     fr_surface sf;
     fr_material m;             /* as textured at sf */
 } vert;
@@ -94,6 +95,7 @@ typedef struct {
 struct bd_work {
     uint32_t cap;
     vert *cam, *lgt;
+    int ncam;                  /* the vertices of the last sample's camera subpath */
 };
 
 int bd_supported(const fr_scene *s, fr_error *err)
@@ -424,6 +426,7 @@ static int walk(const fr_scene *s, rnd *smp, fr_ray ray, vec3 beta, float pdf_di
                 weight = v3_scale(f, fabsf(v3_dot(bs.wi, v->sf.ns)) * fix / bs.pdf);
             }
         }
+        v->weight = weight;
         beta = v3_mul(beta, weight);
         v->delta = delta_in = bs.delta;
         pdf_dir = bs.pdf;
@@ -718,7 +721,7 @@ static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_
     ls.dim = LIGHT_DIM;
     int maxd = (int)s->settings.max_depth;
     rnd rc = {&cs, NULL}, rl = {&ls, NULL};
-    int nc = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL);
+    int nc = w->ncam = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL);
     int nl = light_subpath(s, &rl, w->lgt, maxd + 1);
     /* s = 1 samples its own light point: possible even when the light
      * subpath could not start. */
@@ -824,8 +827,32 @@ static void add_fixed(void *ctx, uint32_t x, uint32_t y, float r, float g, float
     spl_add(&p[2], spl_fixed(b));
 }
 
+/* The passes of one sample from its camera subpath cam[0..n) (passes.h;
+ * bdpt.h says which): the first hit, and albedo and normal at the first
+ * surface that is not a perfect mirror or smooth glass. */
+static void camera_passes(const fr_scene *s, const vert *cam, int n, pass_sample *p)
+{
+    pass_start(p);
+    if (n < 2 || cam[1].type != BD_SURFACE)
+        return;
+    pass_first_hit(p, cam[1].p, cam[1].sf.material, pass_object(s, &cam[1].sf), cam[0].p);
+    for (int i = 1; i < n && cam[i].type == BD_SURFACE && !p->albedo_done; i++) {
+        pass_albedo_at(p, &cam[i].m, &cam[i].sf, v3_neg(cam[i].wo));
+        if (!p->albedo_done && i + 1 < n)
+            pass_albedo_through(p, cam[i].weight);
+    }
+}
+
 int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err)
 {
+    return bd_render_rows_passes(s, y0, y1, rgb, splat, 0, NULL, err);
+}
+
+int bd_render_rows_passes(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, uint32_t passes,
+                          float *out, fr_error *err)
+{
+    if (passes & ~BD_PASSES)
+        return fr_fail(err, "bidirectional path tracing does not fill render passes beyond the camera subpath's");
     if (bd_supported(s, err) < 0)
         return -1;
     bd_work *w = bd_work_new(s);
@@ -834,17 +861,25 @@ int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint
     const bd_strategy all = {-1, -1, -1};
     fixed_splats f = {splat, s->settings.width};
     uint32_t width = s->settings.width, spp = s->settings.spp;
+    uint32_t nch = pass_channels(passes);
+    pass_sample ps;
     for (uint32_t y = y0; y < y1; y++)
         for (uint32_t x = 0; x < width; x++) {
-            double acc[3] = {0, 0, 0};
+            double acc[3] = {0, 0, 0}, pacc[PASS_MAX_ACC] = {0};
             for (uint32_t i = 0; i < spp; i++) {
                 vec3 c = bd_sample(s, w, &all, x, y, i, add_fixed, &f);
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
+                if (passes) {
+                    camera_passes(s, w->cam, w->ncam, &ps);
+                    pass_accumulate(pacc, passes, &ps, i);
+                }
             }
             float *px = rgb + ((size_t)(y - y0) * width + x) * 3;
             px[0] = (float)(acc[0] / spp);
             px[1] = (float)(acc[1] / spp);
             px[2] = (float)(acc[2] / spp);
+            if (passes)
+                pass_finish(pacc, passes, spp, out + ((size_t)(y - y0) * width + x) * nch);
         }
     bd_work_free(w);
     return 0;

@@ -45,6 +45,7 @@
 #define FRANJA_BDPT_H
 
 #include "error.h"
+#include "passes.h"
 #include "scene.h"
 
 /** Which strategies to use.  {-1, -1, -1}: all of them with MIS weights
@@ -117,5 +118,23 @@ int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth);
  * rgb plus spl_resolve of the splats of every slab.  Returns -1 with err
  * set when the scene is not supported or memory runs out. */
 int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err);
+
+/** The render passes bidirectional path tracing fills (passes.h), from
+ * each sample's camera subpath: the first hit's depth, position,
+ * material_id, object_id and Cryptomatte, and albedo and normal at the
+ * first surface that is not a perfect mirror or smooth glass (through
+ * those, as the path tracer).  The light passes, light groups and
+ * variance are not filled: light tracing's splats land on other pixels
+ * than the sample's own. */
+#define BD_PASSES                                                                                                  \
+    (1u << PASS_ALBEDO | 1u << PASS_NORMAL | 1u << PASS_DEPTH | 1u << PASS_POSITION | 1u << PASS_MATERIAL_ID |     \
+     1u << PASS_CRYPTO_MATERIAL | 1u << PASS_OBJECT_ID | 1u << PASS_CRYPTO_OBJECT)
+
+/** bd_render_rows, with the render passes `passes` (a subset of
+ * BD_PASSES, else -1 with err set) of the rows into out
+ * (width*(y1-y0)*pass_channels(passes) floats, top row first; NULL when
+ * passes is 0). */
+int bd_render_rows_passes(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, uint32_t passes,
+                          float *out, fr_error *err);
 
 #endif

@@ -94,20 +94,23 @@ static int write_image(FILE *f, img_format fmt, const img_partial_info *info, co
                        const uint64_t *splat, size_t nsplat, int sums, const float *pass, fr_error *err)
 {
     uint32_t w = info->width, rows = info->y1 - info->y0;
-    char tail[512] = "";
+    char tail[512] = "", ptail[460] = "";
     unsigned char *tmp = NULL, *pb = NULL;
     size_t pblen = 0;
     if (pass && fmt != IMG_PF)
         return fr_fail(err, "render passes need the PF format");
-    if (pass && pass_bytes(info, pass, &pb, &pblen, tail, sizeof tail) < 0)
+    if (pass && pass_bytes(info, pass, &pb, &pblen, ptail, sizeof ptail) < 0)
         return fr_fail(err, "out of memory writing the image");
     if (splat) {
-        if (fmt != IMG_PF)
+        if (fmt != IMG_PF) {
+            free(pb);
             return fr_fail(err, "%s need the PF format", sums ? "sample sums" : "light-tracing splats");
+        }
         tmp = malloc(SPLAT_CHUNK * 8);
         XXH3_state_t *st = XXH3_createState();
         if (!tmp || !st || XXH3_64bits_reset(st) != XXH_OK || splat_bytes(splat, nsplat, tmp, hash_chunk, st) < 0) {
             free(tmp);
+            free(pb);
             XXH3_freeState(st);
             return fr_fail(err, "out of memory writing the image");
         }
@@ -118,9 +121,10 @@ static int write_image(FILE *f, img_format fmt, const img_partial_info *info, co
                      (uint64_t)XXH3_64bits_digest(st));
         XXH3_freeState(st);
     }
-    fprintf(f, "%s\n# franja scene=%016" PRIx64 " rows=%u:%u spp=%u size=%ux%u%s\n%u %u\n%s\n",
+    /* Splats and passes (bidirectional): the splat block, then the passes'. */
+    fprintf(f, "%s\n# franja scene=%016" PRIx64 " rows=%u:%u spp=%u size=%ux%u%s%s\n%u %u\n%s\n",
             fmt == IMG_PF ? "PF" : "P6", info->scene, info->y0, info->y1, info->spp, info->width,
-            info->height, tail, w, rows, fmt == IMG_PF ? "-1.0" : fmt == IMG_PPM16 ? "65535" : "255");
+            info->height, tail, ptail, w, rows, fmt == IMG_PF ? "-1.0" : fmt == IMG_PPM16 ? "65535" : "255");
     size_t rowbytes = (size_t)w * 3 * (fmt == IMG_PF ? 4 : fmt == IMG_PPM16 ? 2 : 1);
     unsigned char *line = malloc(rowbytes ? rowbytes : 1);
     if (!line) {
@@ -171,6 +175,34 @@ int img_write(FILE *f, img_format fmt, const img_partial_info *info, const float
 int img_write_passes(FILE *f, const img_partial_info *info, const float *rgb, const float *passes, fr_error *err)
 {
     return write_image(f, IMG_PF, info, rgb, NULL, 0, 0, info->passes ? passes : NULL, err);
+}
+
+int img_write_splat_passes(FILE *f, const img_partial_info *info, const float *rgb, const uint64_t *splat,
+                           const float *passes, fr_error *err)
+{
+    return write_image(f, IMG_PF, info, rgb, splat, (size_t)info->width * info->height * 3, 0,
+                       info->passes ? passes : NULL, err);
+}
+
+/* " passes=<names>:<16 hex>" at rest (to its end) into *passes and *hash;
+ * at: the header's byte offset, for the message. */
+static int parse_passes(const char *rest, size_t at, uint32_t *passes, unsigned long long *hash, fr_error *err)
+{
+    char names[400];
+    const char *colon = strrchr(rest, ':');
+    size_t k = colon ? (size_t)(colon - (rest + 8)) : 0;
+    fr_error e2;
+    if (!colon || k == 0 || k >= sizeof names || strlen(colon + 1) != 16 ||
+        strspn(colon + 1, "0123456789abcdef") != 16)
+        return fr_fail(err, "byte %zu: malformed franja header comment (expected passes=<names>:<16 hex digits>)",
+                       at);
+    memcpy(names, rest + 8, k);
+    names[k] = 0;
+    *passes = 0;
+    if (pass_parse(names, passes, &e2) < 0 || !*passes)
+        return fr_fail(err, "byte %zu: franja header comment: passes=: %s", at, *passes ? e2.msg : "no pass");
+    *hash = strtoull(colon + 1, NULL, 16);
+    return 0;
 }
 
 int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, const double *sums, fr_error *err)
@@ -257,28 +289,20 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
         sums = 1;
     } else if (!strncmp(rest, " passes=", 8)) {
         /* " passes=<names>:<16 hex>": the render passes follow the pixels. */
-        char names[400];
-        const char *colon = strrchr(rest, ':');
-        size_t k = colon ? (size_t)(colon - (rest + 8)) : 0;
-        fr_error e2;
-        if (!colon || k == 0 || k >= sizeof names || strlen(colon + 1) != 16 ||
-            strspn(colon + 1, "0123456789abcdef") != 16)
-            return fr_fail(err, "byte %zu: malformed franja header comment (expected passes=<names>:<16 hex digits>)",
-                           at);
-        memcpy(names, rest + 8, k);
-        names[k] = 0;
-        if (pass_parse(names, &passes, &e2) < 0 || !passes)
-            return fr_fail(err, "byte %zu: franja header comment: passes=: %s", at, passes ? e2.msg : "no pass");
-        phash = strtoull(colon + 1, NULL, 16);
+        if (parse_passes(rest, at, &passes, &phash, err))
+            return -1;
     } else if (*rest) {
-        /* " splat=<paths>:<16 hex>": a positive count, a whole hash. */
+        /* " splat=<paths>:<16 hex>": a positive count, a whole hash; then
+         * maybe the passes, whose block follows the splats'. */
         int e2 = -1;
         const char *colon = strchr(rest, ':');
         if (strncmp(rest, " splat=", 7) != 0 || rest[7] < '1' || rest[7] > '9' || !colon ||
-            sscanf(rest, " splat=%llu:%16llx%n", &paths, &hash, &e2) != 2 || e2 < 0 || rest[e2] != 0 ||
-            strlen(colon + 1) != 16)
+            sscanf(rest, " splat=%llu:%16llx%n", &paths, &hash, &e2) != 2 || e2 < 0 ||
+            (rest[e2] != 0 && strncmp(rest + e2, " passes=", 8) != 0) || rest + e2 - (colon + 1) != 16)
             return fr_fail(err, "byte %zu: malformed franja header comment (after size=: expected nothing, "
                                 "sums=<16 hex digits>, splat=<paths>:<16 hex digits> or passes=<names>:<16 hex digits>)", at);
+        if (rest[e2] && parse_passes(rest + e2, at, &passes, &phash, err))
+            return -1;
     }
     at = pos;
     unsigned w, h;
@@ -296,15 +320,16 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
         return fr_fail(err, "byte %zu: %zu bytes of pixels%s, expected %zu", pos, len - pos,
                        paths ? " and splats" : sums ? " and sums" : passes ? " and passes" : "",
                        n * 4 + nsplat * 8 + npass * 4);
-    if (passes && XXH3_64bits(buf + pos + n * 4, npass * 4) != phash)
-        return fr_fail(err, "byte %zu: the passes block does not match its hash %016llx", pos + n * 4, phash);
+    size_t poff = pos + n * 4 + nsplat * 8;
+    if (passes && XXH3_64bits(buf + poff, npass * 4) != phash)
+        return fr_fail(err, "byte %zu: the passes block does not match its hash %016llx", poff, phash);
     for (size_t i = 0; i < npass; i++) {
-        const unsigned char *p = buf + pos + n * 4 + i * 4;
+        const unsigned char *p = buf + poff + i * 4;
         uint32_t bits = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
         float v;
         memcpy(&v, &bits, 4);
         if (!isfinite(v))
-            return fr_fail(err, "byte %zu: a render pass value is not finite", pos + n * 4 + i * 4);
+            return fr_fail(err, "byte %zu: a render pass value is not finite", poff + i * 4);
     }
     if (paths && XXH3_64bits(buf + pos + n * 4, nsplat * 8) != hash)
         return fr_fail(err, "byte %zu: the splat block does not match its hash %016llx", pos + n * 4, hash);
@@ -348,7 +373,7 @@ int img_read_partial(const unsigned char *buf, size_t len, img_partial_info *inf
     info->splat_offset = paths ? pos + n * 4 : 0;
     info->sums_offset = sums ? pos + n * 4 : 0;
     info->passes = passes;
-    info->passes_offset = passes ? pos + n * 4 : 0;
+    info->passes_offset = passes ? poff : 0;
     *rgb = out;
     return 0;
 }

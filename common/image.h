@@ -32,6 +32,11 @@
  * PFM pixels), each pixel's C channels (pass_channels) in pass order.
  * The reader checks the hash and that every value is finite (normals and
  * positions may be negative).
+ *
+ * A bidirectional PF partial may carry both: the comment line ends with
+ * " splat=<paths>:<16 hex> passes=<names>:<16 hex>", and the splat block
+ * follows the pixels, the passes block the splat block (the passes
+ * bidirectional path tracing fills, bdpt.h BD_PASSES).
  */
 #ifndef FRANJA_IMAGE_H
 #define FRANJA_IMAGE_H
@@ -75,6 +80,12 @@ int img_write_sums(FILE *f, const img_partial_info *info, const float *rgb, cons
  * the pixels: passes holds width*(y1-y0)*pass_channels(info->passes)
  * floats, top row first.  Returns -1 with err set if writing fails. */
 int img_write_passes(FILE *f, const img_partial_info *info, const float *rgb, const float *passes, fr_error *err);
+
+/** Write a bidirectional PF partial with its splat block (as img_write)
+ * and then the render passes info->passes (as img_write_passes).
+ * Returns -1 with err set if writing fails. */
+int img_write_splat_passes(FILE *f, const img_partial_info *info, const float *rgb, const uint64_t *splat,
+                           const float *passes, fr_error *err);
 
 /** Copies the passes block of a partial that img_read_partial accepted with
  * passes != 0 into out (width*(y1-y0)*pass_channels(passes) floats, the

@@ -28,6 +28,7 @@ static const pass_info passes[PASS_COUNT] = {
     [PASS_OBJECT_ID] = {"object_id", "IndexOB", "X"},
     [PASS_CRYPTO_OBJECT] = {"crypto_object", "CryptoObject", "RGBARGBARGBA"},
     [PASS_LIGHTGROUP] = {"light_groups", "Combined_", "RGBRGBRGBRGBRGBRGBRGBRGB"},
+    [PASS_SHADOW] = {"shadow", "Shadow", "RGB"},
 };
 
 const pass_info *pass_get(int i) { return &passes[i]; }
@@ -180,6 +181,12 @@ void pass_albedo_at(pass_sample *p, const fr_material *m, const fr_surface *sf, 
     p->albedo_done = 1;
 }
 
+void pass_shadow(pass_sample *p, vec3 L, vec3 free)
+{
+    p->lit = v3_add(p->lit, L);
+    p->unshadowed = v3_add(p->unshadowed, free);
+}
+
 void pass_albedo_through(pass_sample *p, vec3 w)
 {
     p->albedo_beta = v3_mul(p->albedo_beta, w);
@@ -222,7 +229,8 @@ static int is_crypto(int i) { return i == PASS_CRYPTO_MATERIAL || i == PASS_CRYP
 /* Doubles pass_accumulate keeps for pass i. */
 static int acc_width(int i)
 {
-    return is_crypto(i) ? 2 * PASS_CRYPTO_SLOTS : i == PASS_VARIANCE ? 6 : (int)strlen(passes[i].channels);
+    return is_crypto(i) ? 2 * PASS_CRYPTO_SLOTS : i == PASS_VARIANCE || i == PASS_SHADOW ? 6
+                                                                           : (int)strlen(passes[i].channels);
 }
 
 /* The Cryptomatte slots (id + 1, samples): one more sample on material id
@@ -279,6 +287,14 @@ void pass_accumulate(double *acc, uint32_t mask, const pass_sample *p, uint32_t 
             acc += acc_width(i);
             continue;
         }
+        if (i == PASS_SHADOW) {
+            for (int c = 0; c < 3; c++) {
+                acc[c] += v3_get(p->lit, c);
+                acc[3 + c] += v3_get(p->unshadowed, c);
+            }
+            acc += 6;
+            continue;
+        }
         if (i == PASS_LIGHTGROUP) {
             for (int k = 0; k < 3 * PASS_LIGHT_GROUPS; k++)
                 acc[k] += v3_get(p->group[k / 3], k % 3);
@@ -309,6 +325,11 @@ void pass_finish(const double *acc, uint32_t mask, uint32_t n, float *out)
             for (int c = 0; c < 3; c++) {
                 double var = n > 1 ? (acc[3 + c] - acc[c] * acc[c] / n) / (n - 1) / n : 0.0;
                 out[c] = var > 0.0 ? (float)var : 0.0f;
+            }
+        else if (i == PASS_SHADOW)
+            for (int c = 0; c < 3; c++) {
+                double r = acc[3 + c] > 0.0 && isfinite(acc[3 + c]) && isfinite(acc[c]) ? acc[c] / acc[3 + c] : 1.0;
+                out[c] = (float)(r < 1.0 ? r : 1.0);
             }
         else
             for (int c = 0; c < k; c++)

@@ -71,6 +71,13 @@
  *   seen by an escaping ray theirs; light that media scatter toward a ray
  *   by equiangular sampling (vertex.h) goes to group 0.  The groups sum
  *   to the beauty (within float rounding).
+ * - shadow (RGB): how much of the direct light at the first hit is not
+ *   shadowed, per channel: the sum over the pixel's samples of the light
+ *   that next-event estimation at the camera ray's first surface brings
+ *   (shadow rays tested), over the sum of what it would bring with every
+ *   shadow ray unblocked (and no medium's attenuation); 1 fully lit, 0
+ *   fully in shadow, 1 where no light could reach (Cycles' Shadow pass,
+ *   one light sample a vertex).
  *
  * Every value is finite.  Light passes and albedo are means over the
  * pixel's samples like the beauty, so any split of rows gives the same
@@ -105,6 +112,7 @@ enum {
     PASS_OBJECT_ID,
     PASS_CRYPTO_OBJECT,
     PASS_LIGHTGROUP,
+    PASS_SHADOW,
     PASS_COUNT
 };
 
@@ -112,7 +120,7 @@ enum {
 #define PASS_ALL ((1u << PASS_COUNT) - 1u)
 
 /** Most channels a pixel's passes have (all of them). */
-#define PASS_MAX_CHANNELS 84
+#define PASS_MAX_CHANNELS 87
 
 /** Light groups a scene may have (the default one included). */
 #define PASS_LIGHT_GROUPS 8
@@ -125,7 +133,7 @@ enum {
 #define PASS_CRYPTO_SLOTS 16
 
 /** Most doubles pass_accumulate keeps for a pixel (all the passes). */
-#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 4 * PASS_CRYPTO_RANKS + 4 * PASS_CRYPTO_SLOTS + 3)
+#define PASS_MAX_ACC (PASS_MAX_CHANNELS - 4 * PASS_CRYPTO_RANKS + 4 * PASS_CRYPTO_SLOTS + 3 + 3)
 
 /** Depth where the camera ray hits nothing. */
 #define PASS_DEPTH_NONE 1e10f
@@ -165,6 +173,7 @@ typedef struct {
     vec3 light[7];             /**< emission, then diffuse, glossy, transmission each direct and indirect */
     vec3 beauty;               /**< the sample's radiance, as the image adds it (variance) */
     vec3 group[PASS_LIGHT_GROUPS]; /**< the radiance by light group */
+    vec3 lit, unshadowed;      /**< direct light at the first surface, and the same with no shadow (shadow) */
 } pass_sample;
 
 /** A sample's passes before its camera ray is traced. */
@@ -202,6 +211,10 @@ void pass_first_kind(pass_sample *p, const fr_material *m, const fr_surface *sf,
  * found: records albedo and normal there unless m has delta lobes only
  * (then pass_albedo_through follows its sampled bounce). */
 void pass_albedo_at(pass_sample *p, const fr_material *m, const fr_surface *sf, vec3 d);
+
+/** Next-event estimation at the first surface: L what it brought (0 when
+ * shadowed), free what it would bring unshadowed (the shadow pass). */
+void pass_shadow(pass_sample *p, vec3 L, vec3 free);
 
 /** Albedo search goes on through a delta bounce of weight w. */
 void pass_albedo_through(pass_sample *p, vec3 w);

@@ -273,7 +273,10 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
             light_numbers(s, v.sf.p, v.sf.ns, light_sampling && bsdf_has_smooth(m), &smp, &light, &pick, &u1, &u2);
             smp_2d(&smp, &v1, &v2);
             vtx_origin org = vtx_origin_at(&v.sf, wo);
-            if (vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, light, pick, u1, u2, &org, &d)) {
+            int lit = vtx_direct_surface(s, m, &v.sf, wo, medium, beta, mis, light, pick, u1, u2, &org, &d);
+            if (ps && depth == 0)
+                pass_shadow(ps, lit ? d.L : v3s(0.0f), d.unshadowed);
+            if (lit) {
                 L = v3_add(L, d.L);
                 if (ps && depth == 0)
                     pass_light_first(ps, m, &v.sf, wo, d.ls.wi, d.L);

@@ -164,6 +164,7 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
                        vtx_direct *out)
 {
     fr_light_sample *ls = &out->ls;
+    out->unshadowed = v3s(0.0f);
     if (light == FR_NONE || !bsdf_has_smooth(m) || !lgt_sample_chosen(s, light, pick, sf->p, u1, u2, ls))
         return 0;
     vec3 f = bsdf_eval(m, sf, wo, ls->wi, &out->scatter_pdf);
@@ -171,13 +172,15 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
         return 0;
     fr_ray shadow = {origin(org, sf, ls->wi), ls->wi};
     float tmax = ls->distant ? INFINITY : v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
+    out->weight = (ls->delta || !mis.area) ? 1.0f : vtx_power_heuristic(ls->pdf, out->scatter_pdf);
+    float cosi = fabsf(v3_dot(ls->wi, sf->ns));
+    if (tmax > 0.0f)
+        out->unshadowed = v3_scale(v3_mul(beta, v3_mul(f, ls->radiance)), out->weight * cosi / ls->pdf);
     vec3 tr = v3s(1.0f);
     if (s->n_media && tmax > 0.0f)
         tr = med_shadow(s, med_after(s, medium, m, sf->ng, ls->wi), &shadow, tmax, ls->prim);
     if (!(tmax > 0.0f) || v3_is_zero(tr) || (!s->n_media && trace_occluded(s, &shadow, tmax, ls->prim)))
         return 0;
-    out->weight = (ls->delta || !mis.area) ? 1.0f : vtx_power_heuristic(ls->pdf, out->scatter_pdf);
-    float cosi = fabsf(v3_dot(ls->wi, sf->ns));
     out->L = v3_scale(v3_mul(beta, v3_mul(v3_mul(tr, f), ls->radiance)), out->weight * cosi / ls->pdf);
     return 1;
 }

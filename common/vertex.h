@@ -92,6 +92,8 @@ typedef struct {
     float weight;              /**< MIS weight of the light sample */
     vec3 L;                    /**< beta * f * Tr * Le * weight / ls.pdf, f with |cos| at a surface or the
                                     phase function in a medium (0 when the shadow ray is blocked) */
+    vec3 unshadowed;           /**< vtx_direct_surface: L with the shadow ray unblocked and Tr 1 (set even
+                                    when it returns 0; 0 when no light was sampled) */
 } vtx_direct;
 
 /** Next-event estimation at surface vertex sf, of material m (as textured

@@ -158,6 +158,8 @@ int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err)
     *spp = 0;
     if (lo >= ps->cap)
         return 0;
+    if (!job_sums(&ps->spec))
+        lo = hi = ps->reached; /* slabs with render passes: each pass renders from the first sample */
     uint32_t twice = lo == 0 ? 1 : lo > ps->cap / 2 ? ps->cap : 2 * lo;
     *spp = twice > hi ? twice : hi;
     return 0;
@@ -167,8 +169,8 @@ int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err)
 int frame_pass_image(frame_passes *ps, fr_error *err)
 {
     if (ps->crop_rows)
-        return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, NULL, ps->scratch, err);
-    return job_stitch(ps->jobdir, &ps->spec, ps->rgb, &ps->a->tr.notes, err);
+        return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->passes, ps->scratch, err);
+    return job_stitch_passes(ps->jobdir, &ps->spec, ps->rgb, ps->passes, &ps->a->tr.notes, err);
 }
 
 
@@ -269,20 +271,25 @@ int frame_open(frame_image *im)
     int mlt = spec.integrator == FR_INTEGRATOR_MLT;
     if (!rc && fr_integrator_splats(spec.integrator))
         spec.noise_threshold = 0.0f; /* bidirectional and Metropolis workers take every sample */
-    if (!rc && spec.passes && fr_integrator_splats(spec.integrator)) {
-        fprintf(stderr, "franja render: %s: render passes are made by the path integrator, not %s (use "
-                "--integrator path, or --passes none)\n", a->passes_set ? "--passes" : a->scene,
+    if (!rc && spec.passes && mlt) {
+        fprintf(stderr, "franja render: %s: render passes are made by the path integrator and bdpt, not %s (use "
+                "--integrator path or bdpt, or --passes none)\n", a->passes_set ? "--passes" : a->scene,
                 proto_integrator_name((int)spec.integrator));
         rc = 2;
-    } else if (!rc && spec.passes && a->time_limit > 0) {
-        fprintf(stderr, "franja render: --time-limit with render passes: its passes add samples to kept sample "
-                "sums, which slabs with render passes do not keep (use --passes none, or no --time-limit)\n");
+    } else if (!rc && spec.integrator == FR_INTEGRATOR_BDPT && (spec.passes & ~BD_PASSES)) {
+        char names[400];
+        pass_format(spec.passes & ~BD_PASSES, names, sizeof names);
+        fprintf(stderr, "franja render: %s: bdpt fills the passes of its camera subpaths (albedo, normal, depth, "
+                "position, material_id, crypto_material, object_id, crypto_object), not %s: light tracing's "
+                "splats land on other pixels (use --integrator path for them)\n",
+                a->passes_set ? "--passes" : a->scene, names);
         rc = 2;
     } else if (!rc && fr_integrator_splats(spec.integrator) && (mlt ? mlt_supported(&sc, &err) : bd_supported(&sc, &err))) {
         fprintf(stderr, "franja render: %s: %s: %s\n", a->scene,
                 mlt ? "Metropolis light transport" : "bidirectional path tracing", err.msg);
         rc = a->integrator ? 2 : 1;
-    } else if (!rc && a->time_limit > 0 && !job_sums(&spec)) {
+    } else if (!rc && a->time_limit > 0 && !job_sums(&spec) &&
+               !(spec.passes && spec.integrator == FR_INTEGRATOR_PATH)) {
         fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
                 "only path tracing without adaptive sampling keeps (this render %s)\n",
                 spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"
@@ -337,7 +344,12 @@ int frame_open(frame_image *im)
     frame_passes *ps = &im->ps;
     *ps = (frame_passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
                    .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL};
-    if (!im->have || !im->base || !im->rgb || !(ps->scratch = calloc(spec.height, 1))) {
+    /* --time-limit keeps the passes of its last complete pass beside rgb. */
+    if (spec.passes && a->time_limit > 0)
+        im->passes = ps->passes = calloc((size_t)spec.width * spec.height * pass_channels(spec.passes),
+                                         sizeof *im->passes);
+    if (!im->have || !im->base || !im->rgb || !(ps->scratch = calloc(spec.height, 1)) ||
+        (spec.passes && a->time_limit > 0 && !im->passes)) {
         fprintf(stderr, "franja render: out of memory for a %ux%u image\n", spec.width, spec.height);
         return 1;
     }
@@ -412,7 +424,7 @@ int frame_write(frame_image *im, const char *used)
                     a->time_limit, ps->reached, ps->stopped);
         else
             fprintf(stderr, "franja: every %u samples per pixel within the time limit\n", ps->reached);
-    } else if (spec.passes && !(im->passes = malloc((size_t)spec.width * spec.height *
+    } else if (spec.passes && !im->passes && !(im->passes = malloc((size_t)spec.width * spec.height *
                                                     pass_channels(spec.passes) * sizeof *im->passes))) {
         fprintf(stderr, "franja render: out of memory for the render passes of a %ux%u image\n", spec.width,
                 spec.height);
@@ -445,7 +457,7 @@ int frame_write(frame_image *im, const char *used)
             if (wp) {
                 crop_extract_n(&a->win, im->passes, spec.width, nch, wp);
                 free(im->passes);
-                im->passes = wp;
+                im->passes = ps->passes = wp;
             }
             out_spec.width = a->win.x1 - a->win.x0;
             out_spec.height = a->win.y1 - a->win.y0;
@@ -514,7 +526,7 @@ void frame_shrink(frame_image *im)
     free(im->ps.scratch);
     free(im->rgb);
     free(im->passes);
-    im->passes = NULL;
+    im->passes = im->ps.passes = NULL;
     im->have = NULL;
     im->base = NULL;
     im->ps.scratch = NULL;

@@ -72,7 +72,10 @@ typedef struct {
  * to twice the fewest samples kept for a row (1 at first; never fewer than
  * the most kept for a row; at most the samples asked for), adding samples
  * to the kept sums, and the image of each complete pass is kept in memory:
- * when the limit stops a pass, that image is written. */
+ * when the limit stops a pass, that image is written.  Slabs with render
+ * passes keep no sums: each pass then renders its rows from the first
+ * sample, to twice the samples of the last complete pass, and its passes
+ * are kept in memory with its image. */
 typedef struct {
     const frame_settings *a;
     const char *jobdir;
@@ -85,6 +88,7 @@ typedef struct {
     int rows_kept;             /* rows the job directory holds at spec.spp, needed or not */
     double deadline;           /* clock_now() time of --time-limit; 0 = none */
     float *rgb;                /* --time-limit: the image of the last complete pass */
+    float *passes;             /* --time-limit: its render passes (the frame_image's), or NULL */
     unsigned char *scratch;    /* height bytes */
     uint32_t reached;          /* the samples per pixel of rgb; 0 = none yet */
     int npass;                 /* passes run */

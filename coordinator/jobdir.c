@@ -286,7 +286,7 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
             free(rows);
             rows = NULL;
         }
-        if (!bad && c->rgb && c->passes && nch) {
+        if (!bad && c->passes && nch) {
             prows = malloc((size_t)c->spec->width * (y1 - y0) * nch * sizeof *prows);
             if (!prows) {
                 bad = 1;
@@ -300,11 +300,12 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     if (!bad && info.spp != c->spec->spp) {
         /* Another sample count: more is never this render's (the slab is
          * left alone); fewer is a base to add samples to, when it has its
-         * sums, or a row of the image so far. */
+         * sums, or a row of the image so far.  A render that keeps no sums
+         * (render passes' --time-limit) leaves fewer alone too. */
         int use = 0;
         if (info.spp < c->spec->spp && c->mode == GATHER) {
             use = 1;
-        } else if (info.spp < c->spec->spp && c->mode == SCAN && !info.sums_offset) {
+        } else if (info.spp < c->spec->spp && c->mode == SCAN && !info.sums_offset && job_sums(c->spec)) {
             bad = 1;
             snprintf(e.msg, sizeof e.msg, "%u samples per pixel, expected %u, and no sample sums to add to",
                      info.spp, c->spec->spp);
@@ -767,7 +768,7 @@ int job_read_spec(const char *dir, job_spec *spec, fr_error *err)
             /* "passes=<names>\n", the last line. */
             char *nl = strchr(copy + n, '\n');
             fr_error e2;
-            ok = !strncmp(copy + n, "passes=", 7) && nl && nl + 1 == copy + len && !bdpt;
+            ok = !strncmp(copy + n, "passes=", 7) && nl && nl + 1 == copy + len && bdpt != 2;
             if (ok) {
                 *nl = 0;
                 ok = pass_parse(copy + n + 7, &passes, &e2) == 0 && passes;

@@ -6,8 +6,9 @@
 # Blender's names and Blender's compositor offers them; the image's bytes
 # do not change with passes; PNG and
 # PFM outputs get one file per pass; the scene's "passes" key is read;
-# --crop, --resume and adaptive sampling work with passes; bdpt and
-# --time-limit are refused with a message.
+# --crop, --resume, --time-limit and adaptive sampling work with passes;
+# bdpt fills the passes of its camera subpaths, the same bytes on every
+# split; its light passes and mlt are refused with a message.
 . "$(dirname "$0")/support/fakehosts.sh"
 need oiiotool blender
 fh_init
@@ -34,10 +35,10 @@ for ch in "ViewLayer.Combined.R" "ViewLayer.Combined.A" "ViewLayer.Denoising Alb
     "ViewLayer.DiffDir.R" "ViewLayer.DiffInd.R" "ViewLayer.GlossDir.R" "ViewLayer.GlossInd.R" \
     "ViewLayer.TransDir.R" "ViewLayer.TransInd.R" "ViewLayer.IndexMA.X" "ViewLayer.CryptoMaterial00.R" \
     "ViewLayer.CryptoMaterial02.A" "ViewLayer.Variance.B" "ViewLayer.IndexOB.X" "ViewLayer.CryptoObject00.R" \
-    "ViewLayer.CryptoObject02.A" "ViewLayer.Combined_default.B"; do
+    "ViewLayer.CryptoObject02.A" "ViewLayer.Combined_default.B" "ViewLayer.Shadow.G"; do
     check "oiiotool --info -v lists $ch" grep -q "$ch" info
 done
-check "the EXR has 67 channels" grep -q "67 channel" info
+check "the EXR has 70 channels" grep -q "70 channel" info
 check "the EXR has Cryptomatte's metadata" grep -q 'cryptomatte/[0-9a-f]*/name: "ViewLayer.CryptoMaterial"' info
 check "the manifest names the scene's materials" grep -q 'manifest: "{"white":"[0-9a-f]\{8\}","red"' info
 check "the material_id name table" grep -q 'franja:materials: "\["white","red","green","light","mirror","glass","phong"\]"' info
@@ -154,17 +155,64 @@ for f in 0001 0002; do
     check "frame $f has its albedo pass" sh -c "oiiotool --info -v anim/f.$f.exr | grep -q 'Denoising Albedo.R'"
 done
 
+# --time-limit with passes: each pass renders from the first sample; the
+# last complete pass is written with its passes, the bytes of a render
+# with that many samples, whatever the split.
+"$FRANJA" render "$SCENE" -o tl.exr $SIZE -j 2 --slab-rows 5 --passes all --reproducible --time-limit 1h 2>log14
+check "--time-limit with passes, every pass within it" test $? -eq 0
+check "--time-limit with passes: the 4 samples' bytes" cmp -s tl.exr j1.exr
+check "--time-limit with passes: passes of 1, 2, 4 samples" grep -q "pass 3 done: 4 samples" log14
+"$FRANJA" render "$SCENE" -o ts.exr --size 40x30 --spp 1000000 -j 2 --slab-rows 5 --passes denoise,object_id \
+    --reproducible --time-limit 1s 2>log18
+check "--time-limit with passes, stopped" grep -q "time limit of 1 s reached" log18
+N=$(sed -n 's/.*time limit of 1 s reached: \([0-9]*\) samples.*/\1/p' log18)
+"$FRANJA" render "$SCENE" -o tn.exr --size 40x30 --spp "${N:-0}" -j 1 --passes denoise,object_id --reproducible \
+    2>log19
+check "--time-limit with passes, stopped: the bytes of a render with its ${N:-0} samples" cmp -s ts.exr tn.exr
+check "--time-limit with passes: no slab discarded" sh -c '! grep -q discarded log14 log18'
+
+# BDPT: the passes of its camera subpaths, the same bytes on every split
+# and host; its image keeps its bytes; on the Cornell box's Lambertian
+# walls its first-hit passes are the path tracer's.
+BP="--integrator bdpt --passes denoise,depth,position,material_id,object_id,crypto_material,crypto_object --reproducible"
+CORNELL="$ROOT/scenes/cornell.json"
+"$FRANJA" render "$CORNELL" -o bd1.exr $SIZE -j 1 $BP 2>log21
+check "bdpt with its passes (-j 1)" test $? -eq 0
+"$FRANJA" render "$CORNELL" -o bd2.exr $SIZE -j 2 --slab-rows 5 $BP 2>log22
+check "bdpt with passes: -j 2 --slab-rows 5 gives the bytes of -j 1" cmp -s bd1.exr bd2.exr
+fr render "$CORNELL" -o bdssh.exr --hosts hosts $BP $SIZE 2>log23
+check "bdpt with passes: SSH hosts give the bytes of -j 1" cmp -s bd1.exr bdssh.exr
+oiiotool --info -v bd1.exr >bdinfo 2>&1
+check "bdpt's EXR has 4 + 36 channels" grep -q "40 channel" bdinfo
+"$FRANJA" render "$CORNELL" -o bdplain.pfm $SIZE -j 2 --integrator bdpt 2>log24
+"$FRANJA" render "$CORNELL" -o bdwith.pfm $SIZE -j 2 --integrator bdpt --passes denoise,depth 2>log25
+check "bdpt's image keeps its bytes with passes" cmp -s bdplain.pfm bdwith.pfm
+check "bdpt: PFM files of its passes" sh -c 'test -s bdwith.albedo.pfm && test -s bdwith.depth.pfm'
+"$FRANJA" render "$CORNELL" -o bdk.exr $SIZE -j 2 $BP --keep-job 2>log27
+"$FRANJA" render "$CORNELL" -o bdk.exr $SIZE -j 2 $BP --resume 2>log28
+check "bdpt with passes: --resume writes the same bytes" cmp -s bdk.exr bd1.exr
+check "bdpt with passes: --resume rendered nothing again" grep -q "30 of 30 rows already done" log28
+"$FRANJA" render "$CORNELL" -o bdc.exr $SIZE -j 2 $BP --crop 5:7:29:23 2>log29
+check "bdpt with passes and --crop" test $? -eq 0
+"$FRANJA" render "$CORNELL" -o pt1.exr $SIZE -j 2 --passes denoise,depth,material_id --reproducible 2>log26
+for ch in "ViewLayer.Depth.Z" "ViewLayer.IndexMA.X" \
+    "ViewLayer.Denoising Albedo.R,ViewLayer.Denoising Albedo.G,ViewLayer.Denoising Albedo.B"; do
+    oiiotool bd1.exr --ch "$ch" -o bdch.exr
+    oiiotool pt1.exr --ch "$ch" -o ptch.exr
+    check "bdpt's $ch is the path tracer's on the Cornell box" sh -c 'oiiotool --fail 0 --diff bdch.exr ptch.exr | grep -q PASS'
+done
+
 # Adaptive sampling with passes.
 "$FRANJA" render "$SCENE" -o adapt.exr --size 40x30 --spp 64 --noise-threshold 0.5 -j 2 --passes light 2>log12
 check "adaptive sampling with passes" test $? -eq 0
 
 # Refusals, with a message.
-"$FRANJA" render "$SCENE" -o b.png $SIZE --passes albedo --integrator bdpt 2>log13
-check "bdpt with passes: status 2" test $? -eq 2
-check "bdpt with passes: said" grep -q "path integrator, not bdpt" log13
-"$FRANJA" render "$SCENE" -o t.png $SIZE --passes albedo --time-limit 10s 2>log14
-check "--time-limit with passes: status 2" test $? -eq 2
-check "--time-limit with passes: said" grep -q "time-limit with render passes" log14
+"$FRANJA" render "$SCENE" -o b.png $SIZE --passes albedo,emission --integrator bdpt 2>log13
+check "bdpt with light passes: status 2" test $? -eq 2
+check "bdpt with light passes: said, naming them" grep -q "camera subpaths .*, not emission: light tracing" log13
+"$FRANJA" render "$SCENE" -o m.png $SIZE --passes albedo --integrator mlt 2>log20
+check "mlt with passes: status 2" test $? -eq 2
+check "mlt with passes: said" grep -q "path integrator and bdpt, not mlt" log20
 "$FRANJA" render "$SCENE" -o t.png $SIZE --passes albedo,nrm 2>log15
 check "an unknown pass: status 2" test $? -eq 2
 check "an unknown pass is named" grep -q "unknown pass 'nrm'" log15

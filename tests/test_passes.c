@@ -25,7 +25,7 @@
 /* Offsets of the passes' channels with every pass on (passes.h order). */
 enum {
     C_ALBEDO = 0, C_NORMAL = 3, C_DEPTH = 6, C_POSITION = 7, C_EMISSION = 10, C_LIGHT = 13, C_MATERIAL = 31,
-    C_CRYPTO = 32, C_VARIANCE = 44, C_OBJECT = 47, C_CRYPTO_OBJECT = 48, C_GROUPS = 60, C_ALL = 84
+    C_CRYPTO = 32, C_VARIANCE = 44, C_OBJECT = 47, C_CRYPTO_OBJECT = 48, C_GROUPS = 60, C_SHADOW = 84, C_ALL = 87
 };
 
 static int load(const char *path, fr_scene *s)
@@ -325,6 +325,58 @@ static void check_partial(void)
     free(buf);
 }
 
+/* The shadow pass under a point light and a sphere over a floor: floor
+ * points whose way to the light the sphere clearly blocks are 0, those it
+ * clearly leaves free 1. */
+static void check_shadow(void)
+{
+    static const char json[] =
+        "{\"image\": {\"width\": 40, \"height\": 30, \"spp\": 4, \"max_depth\": 2},"
+        " \"camera\": {\"position\": [0, 6, -8], \"target\": [0, 0, 0], \"fov\": 50},"
+        " \"materials\": {\"floor\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]},"
+        "  \"ball\": {\"type\": \"lambert\", \"albedo\": [0.5, 0.5, 0.5]}},"
+        " \"shapes\": [{\"type\": \"plane\", \"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": \"floor\"},"
+        "  {\"type\": \"sphere\", \"center\": [0, 2, 0], \"radius\": 1, \"material\": \"ball\"}],"
+        " \"lights\": [{\"type\": \"point\", \"position\": [0.5, 5, 0.5], \"intensity\": [20, 20, 20]}]}";
+    fr_scene s;
+    test_scene(json, &s);
+    uint32_t mask = 1u << PASS_POSITION | 1u << PASS_MATERIAL_ID | 1u << PASS_SHADOW, nch = pass_channels(mask);
+    size_t n = (size_t)W * H;
+    float *rgb = malloc(n * 3 * sizeof *rgb), *pass = malloc(n * nch * sizeof *pass);
+    pt_render_rows_passes(&s, PT_MIS, 0, H, rgb, mask, pass);
+    vec3 light = v3(0.5f, 5.0f, 0.5f), centre = v3(0.0f, 2.0f, 0.0f);
+    int dark = 0, dark_bad = 0, lit = 0, lit_bad = 0, range_bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        const float *p = pass + i * nch; /* position, material_id, shadow */
+        for (int c = 0; c < 3; c++)
+            range_bad += !(p[4 + c] >= 0.0f && p[4 + c] <= 1.0f);
+        /* The floor, away from the ball's outline (its samples are the floor's). */
+        int x = (int)(i % W), y = (int)(i / W), floor = x > 0 && y > 0 && x < W - 1 && y < H - 1;
+        for (int dy = -1; dy <= 1 && floor; dy++)
+            for (int dx = -1; dx <= 1; dx++)
+                floor &= pass[((size_t)(y + dy) * W + (size_t)(x + dx)) * nch + 3] == 1.0f;
+        if (!floor)
+            continue;
+        vec3 at = v3(p[0], p[1], p[2]), seg = v3_sub(light, at);
+        float t = v3_dot(v3_sub(centre, at), seg) / v3_dot(seg, seg);
+        t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+        float d = v3_len(v3_sub(v3_add(at, v3_scale(seg, t)), centre));
+        if (d < 0.8f) {
+            dark++;
+            dark_bad += p[4] != 0.0f || p[5] != 0.0f || p[6] != 0.0f;
+        } else if (d > 1.3f) {
+            lit++;
+            lit_bad += p[4] != 1.0f || p[5] != 1.0f || p[6] != 1.0f;
+        }
+    }
+    CHECK(range_bad == 0, "shadow: %d values outside [0, 1]", range_bad);
+    CHECK(dark > 10 && dark_bad == 0, "shadow: %d of %d floor pixels behind the ball are not 0", dark_bad, dark);
+    CHECK(lit > 100 && lit_bad == 0, "shadow: %d of %d floor pixels in the open are not 1", lit_bad, lit);
+    free(rgb);
+    free(pass);
+    scn_free(&s);
+}
+
 static void check_names(void)
 {
     uint32_t m = 0;
@@ -353,5 +405,6 @@ int main(void)
     check_scene("scenes/metals.json", 1u << 3 | 1u << 4);
     check_scene("scenes/fog-room.json", 1u << 1);
     check_groups();
+    check_shadow();
     return check_done();
 }

@@ -60,12 +60,13 @@ static const char usage[] =
     "  --continue FILE  start from the sums in FILE, a --sums image of the same\n"
     "                 rows with fewer samples: only the samples it lacks are\n"
     "                 rendered, to the bits of a render of them all\n"
-    "  --passes LIST  append render passes to the PF image (path integrator, not\n"
-    "                 with sums): comma-separated albedo, normal, depth, position,\n"
+    "  --passes LIST  append render passes to the PF image (path integrator, or\n"
+    "                 bdpt's camera-subpath ones; not with sums): comma-separated\n"
+    "                 albedo, normal, depth, position,\n"
     "                 emission, diffuse_direct, diffuse_indirect, glossy_direct,\n"
     "                 glossy_indirect, transmission_direct, transmission_indirect,\n"
     "                 material_id, crypto_material, variance, object_id,\n"
-    "                 crypto_object, light_groups; or all, light,\n"
+    "                 crypto_object, light_groups, shadow; or all, light,\n"
     "                 denoise, none\n"
     "\n"
     "Writing to a pipe (-o -), the worker ends itself when the pipe's reader is\n"
@@ -202,10 +203,11 @@ int main(int argc, char **argv)
         return 2;
     }
     uint32_t passes = sl->passes;
-    if (passes && (bdpt || keep_sums || sl->format != IMG_PF)) {
-        fprintf(stderr, "franja-worker: --passes needs the path integrator and --format pf, without --sums or "
-                        "--continue (this render %s)\n",
-                mlt ? "is Metropolis" : bdpt ? "is bidirectional" : keep_sums ? "keeps sample sums" : "is not --format pf");
+    if (passes && (mlt || (bdpt && (passes & ~BD_PASSES)) || keep_sums || sl->format != IMG_PF)) {
+        fprintf(stderr, "franja-worker: --passes needs the path integrator (or bdpt, for the passes of its camera "
+                        "subpaths) and --format pf, without --sums or --continue (this render %s)\n",
+                mlt ? "is Metropolis" : bdpt ? "is bidirectional, with light passes" : keep_sums ? "keeps sample sums"
+                                                                                      : "is not --format pf");
         scn_free(&scene);
         return 2;
     }
@@ -237,11 +239,12 @@ int main(int argc, char **argv)
     }
     img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0, 0, passes, 0};
     if (bdpt) {
-        if ((mlt ? mlt_render_rows(&scene, y0, y1, rgb, splat, &err) : bd_render_rows(&scene, y0, y1, rgb, splat, &err)) <
-            0) {
+        if ((mlt ? mlt_render_rows(&scene, y0, y1, rgb, splat, &err)
+                 : bd_render_rows_passes(&scene, y0, y1, rgb, splat, passes, pass, &err)) < 0) {
             fprintf(stderr, "franja-worker: %s\n", err.msg);
             free(rgb);
             free(splat);
+            free(pass);
             lifeline_stop();
             scn_free(&scene);
             return 1;
@@ -283,6 +286,7 @@ int main(int argc, char **argv)
         }
     }
     if (f && (sl->sums     ? img_write_sums(f, &info, rgb, sums, &err)
+              : passes && splat ? img_write_splat_passes(f, &info, rgb, splat, pass, &err)
               : passes ? img_write_passes(f, &info, rgb, pass, &err)
                        : img_write(f, sl->format, &info, rgb, splat, &err)) < 0) {
         fprintf(stderr, "franja-worker: %s: %s\n", to_stdout ? "standard output" : out, err.msg);
