@@ -4,8 +4,8 @@
 # franja render --slurm and franja hosts check --slurm on a real Slurm
 # cluster of three nodes on this machine (tests/support/slurm_cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process
-# render whatever the node count; the scene is broadcast once per node,
-# found cached later and sent again when the cached copy is damaged; a
+# render whatever the node count, render passes included; the scene is
+# broadcast once per node, found cached later and sent again when the cached copy is damaged; a
 # straggling node's slabs get second copies elsewhere; progress in a batch
 # job is a plain line every 10 s;
 # a node killed or set down mid-render loses only its slabs, a drained one
@@ -124,6 +124,16 @@ check "no step is left after the animation" no_leftovers
 render logb -N3 -n6 "$FRANJA" render scene.fbin -o b3.pfm $SIZE --integrator bdpt --slurm --workdir "$WD" --slab-rows 4
 check "a bidirectional 3-node render is byte-identical to one process ($(tail -n 3 logb))" cmp -s b3.pfm bref.pfm
 check "and differs from path tracing" sh -c "! cmp -s b3.pfm ref.pfm"
+
+# Render passes travel in the partials: the image and each pass file have
+# the bytes of a one-process render's.
+"$FRANJA" render scene.fbin -o pref.pfm $SIZE --passes albedo,normal,depth,material_id -j 1 2>/dev/null
+render logp -N3 -n6 "$FRANJA" render scene.fbin -o p3.pfm $SIZE --passes albedo,normal,depth,material_id --slurm \
+    --workdir "$WD" --slab-rows 4
+for s in "" .albedo .normal .depth .material_id; do
+    check "with --passes over 3 nodes, p3$s.pfm is byte-identical to one process ($(tail -n 2 logp))" \
+        cmp -s "p3$s.pfm" "pref$s.pfm"
+done
 render log2 -N2 -n3 "$FRANJA" render scene.fbin -o n2.pfm $SIZE --slurm --workdir "$WD" --slab-rows 3
 check "2 nodes (2 + 1 CPUs) give the same bytes" cmp -s n2.pfm ref.pfm
 check "the second render finds the scene cached on both nodes" test "$(grep -c "scene already there" log2)" -eq 2
