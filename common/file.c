@@ -59,13 +59,20 @@ int file_write_all(int fd, const void *buf, size_t n)
     return 0;
 }
 
+static int read_stream(FILE *f, const char *path, size_t max, char **text, size_t *len, fr_error *err);
+
 int file_read(const char *path, char **text, size_t *len, fr_error *err)
+{
+    return file_read_max(path, FILE_READ_MAX, text, len, err);
+}
+
+int file_read_max(const char *path, size_t max, char **text, size_t *len, fr_error *err)
 {
     int fd;
     size_t size;
     *text = NULL;
     *len = 0;
-    if (file_open_regular(path, FILE_READ_MAX, &fd, &size, err) < 0)
+    if (file_open_regular(path, max, &fd, &size, err) < 0)
         return -1;
     FILE *f = fdopen(fd, "rb");
     if (!f) {
@@ -73,10 +80,11 @@ int file_read(const char *path, char **text, size_t *len, fr_error *err)
         close(fd);
         return fr_fail(err, "%s: %s", path, strerror(e));
     }
-    return file_read_stream(f, path, text, len, err);
+    return read_stream(f, path, max, text, len, err);
 }
 
-int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_error *err)
+/* file_read_stream with a limit of max bytes. */
+static int read_stream(FILE *f, const char *path, size_t max, char **text, size_t *len, fr_error *err)
 {
     *text = NULL;
     *len = 0;
@@ -85,12 +93,12 @@ int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_err
      * pipe or a /proc file (size 0) grows as it is read, up to one byte
      * past the limit (which shows that the limit was passed). */
     struct stat st;
-    size_t cap = 4096, top = FILE_READ_MAX + 2;
+    size_t cap = 4096, top = max + 2;
     if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && (uintmax_t)st.st_size + 2 > cap)
         cap = (uintmax_t)st.st_size + 2 < top ? (size_t)st.st_size + 2 : top;
     size_t n = 0;
     char *buf = malloc(cap);
-    while (buf && n <= FILE_READ_MAX) {
+    while (buf && n <= max) {
         size_t got = fread(buf + n, 1, cap - n - 1, f);
         n += got;
         if (got == 0)
@@ -108,9 +116,9 @@ int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_err
     fclose(f);
     if (!buf)
         return fr_fail(err, "%s: out of memory", path);
-    if (n > FILE_READ_MAX) {
+    if (n > max) {
         free(buf);
-        return fr_fail(err, "%s: more than the %zu bytes this reader takes", path, FILE_READ_MAX);
+        return fr_fail(err, "%s: more than the %zu bytes this reader takes", path, max);
     }
     if (bad) {
         free(buf);
@@ -120,6 +128,11 @@ int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_err
     *text = buf;
     *len = n;
     return 0;
+}
+
+int file_read_stream(FILE *f, const char *path, char **text, size_t *len, fr_error *err)
+{
+    return read_stream(f, path, FILE_READ_MAX, text, len, err);
 }
 
 void file_dir(const char *path, char *dir, size_t cap)

@@ -43,6 +43,10 @@ int file_write_all(int fd, const void *buf, size_t n);
  * out of memory"; *text is then NULL. */
 int file_read(const char *path, char **text, size_t *len, fr_error *err);
 
+/** file_read for a file of at most max bytes, which may be more than
+ * FILE_READ_MAX (a partial image whose size its job bounds). */
+int file_read_max(const char *path, size_t max, char **text, size_t *len, fr_error *err);
+
 /** The same for a stream the caller opened (to word its own open error):
  * reads f to its end, at most FILE_READ_MAX bytes, and closes it, whatever
  * happens; path names it in errors. */

@@ -279,7 +279,8 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     img_partial_info info;
     float *rows = NULL, *prows = NULL;
     size_t nch = pass_channels(c->spec->passes);
-    int bad = file_read(path, &text, &len, &e);
+    /* A slab with every render pass can pass FILE_READ_MAX: its job bounds it. */
+    int bad = file_read_max(path, job_max_partial(c->spec, y0, y1), &text, &len, &e);
     if (!bad) {
         bad = read_slab((const unsigned char *)text, len, c->spec, y0, y1, &info, &rows, &e);
         if (!c->rgb) {
@@ -485,7 +486,7 @@ static int cont_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     char *text;
     size_t len;
     fr_error e;
-    if (file_read(path, &text, &len, &e))
+    if (file_read_max(path, job_max_partial(c->spec, y0, y1), &text, &len, &e))
         return 0;
     const unsigned char *buf = (const unsigned char *)text;
     img_partial_info info;
@@ -662,7 +663,7 @@ static int stitch_splats(const char *dir, const job_spec *spec, float *rgb, fr_e
         size_t len;
         img_partial_info info;
         float *rows;
-        if (file_read(path, &text, &len, err))
+        if (file_read_max(path, job_max_partial(spec, sf->y0, sf->y1), &text, &len, err))
             goto out;
         const unsigned char *buf = (const unsigned char *)text;
         if (job_check_partial(buf, len, spec, sf->y0, sf->y1, 0, err) ||

@@ -287,6 +287,24 @@ static void test_devices(void)
     rmdir(sub);
 }
 
+/* file_read_max takes a file of exactly its limit and refuses one byte
+ * more, naming the limit (a job's partial images can pass FILE_READ_MAX). */
+static void test_read_max(void)
+{
+    char path[128];
+    snprintf(path, sizeof path, "%s/max.bin", dir);
+    fr_error err;
+    CHECK(file_write_atomic(path, "0123456789", 10, &err) == 0, "write: %s", err.msg);
+    char *text;
+    size_t len;
+    CHECK(file_read_max(path, 10, &text, &len, &err) == 0 && len == 10 && !memcmp(text, "0123456789", 10),
+          "a file of exactly the limit: %s", err.msg);
+    free(text);
+    CHECK(file_read_max(path, 9, &text, &len, &err) < 0 && !text && strstr(err.msg, "more than the 9"),
+          "a file one byte past the limit: %s", err.msg);
+    unlink(path);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "/tmp/franja-file.XXXXXX");
@@ -295,6 +313,7 @@ int main(void)
         return 1;
     }
     test_write_and_replace();
+    test_read_max();
     test_temporary_name();
     test_planted_links();
     test_processes();
