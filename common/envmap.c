@@ -26,44 +26,47 @@ vec2 env_uv(const fr_scene *s, vec3 dir)
     return r;
 }
 
-static vec3 texel(const fr_scene *s, const fr_texture *t, int64_t i, int64_t j)
+/* Column i wrapped into [0, w) (i within one width of it: the lookup's
+ * columns are -1 to w), row j clamped into [0, h). */
+static int64_t wrap_column(int64_t i, int64_t w)
 {
-    int64_t w = t->width, h = t->height;
-    i %= w;
-    if (i < 0)
-        i += w;
-    j = j < 0 ? 0 : j >= h ? h - 1 : j;
-    float p[3];
-    tex_texel(s->texels, t, 0, (uint32_t)i, (uint32_t)j, p);
+    i = i < 0 ? i + w : i;
+    return i >= w ? i - w : i;
+}
+
+static int64_t clamp_row(int64_t j, int64_t h) { return j < 0 ? 0 : j >= h ? h - 1 : j; }
+
+static vec3 rgb(const fr_texture *t, const float p[3])
+{
     return t->channels == 3 ? v3(p[0], p[1], p[2]) : v3s(p[0]);
 }
 
-/* The map's value at (u, v), v = 1 on the top row. */
+/* The map's value at (u, v) in [0, 1]^2, v = 1 on the top row. */
 static vec3 lookup(const fr_scene *s, vec2 uv)
 {
     const fr_texture *t = &s->textures[s->world.env_texture];
+    int64_t w = t->width, h = t->height;
     float x = uv.u * (float)t->width, y = (1.0f - uv.v) * (float)t->height;
     vec3 c;
+    float p[4][3];
     if (t->filter == FR_FILTER_NEAREST) {
-        c = texel(s, t, (int64_t)floorf(x), (int64_t)floorf(y));
+        int64_t i = wrap_column((int64_t)floorf(x), w), j = clamp_row((int64_t)floorf(y), h);
+        tex_texel(s->texels, t, 0, (uint32_t)i, (uint32_t)j, p[0]);
+        c = rgb(t, p[0]);
     } else {
         x -= 0.5f;
         y -= 0.5f;
         float fx = floorf(x), fy = floorf(y), ax = x - fx, ay = y - fy;
         int64_t i = (int64_t)fx, j = (int64_t)fy;
-        vec3 top = v3_add(v3_scale(texel(s, t, i, j), 1.0f - ax), v3_scale(texel(s, t, i + 1, j), ax));
-        vec3 bot = v3_add(v3_scale(texel(s, t, i, j + 1), 1.0f - ax), v3_scale(texel(s, t, i + 1, j + 1), ax));
+        int64_t i0 = wrap_column(i, w), i1 = wrap_column(i + 1, w);
+        int64_t j0 = clamp_row(j, h) * w, j1 = clamp_row(j + 1, h) * w;
+        size_t at[4] = {(size_t)(j0 + i0), (size_t)(j0 + i1), (size_t)(j1 + i0), (size_t)(j1 + i1)};
+        tex_texels4(s->texels, t, 0, at, p);
+        vec3 top = v3_add(v3_scale(rgb(t, p[0]), 1.0f - ax), v3_scale(rgb(t, p[1]), ax));
+        vec3 bot = v3_add(v3_scale(rgb(t, p[2]), 1.0f - ax), v3_scale(rgb(t, p[3]), ax));
         c = v3_add(v3_scale(top, 1.0f - ay), v3_scale(bot, ay));
     }
     return v3_vmax(c, v3s(0.0f));
-}
-
-vec3 env_radiance(const fr_scene *s, vec3 dir)
-{
-    const fr_world *w = &s->world;
-    if (w->env != FR_ENV_MAP)
-        return w->env_color;
-    return v3_mul(w->env_color, lookup(s, env_uv(s, dir)));
 }
 
 /* The sampling tables of a w x h map. */
@@ -81,20 +84,45 @@ static tables get_tables(const fr_scene *s)
     return tb;
 }
 
-float env_pdf(const fr_scene *s, vec3 dir)
+/* The density of a map's sampling at dir, whose coordinates are uv. */
+static float density(const fr_scene *s, vec3 dir, vec2 uv)
 {
-    if (s->world.env != FR_ENV_MAP)
-        return 1.0f / (4.0f * FM_PI);
     tables tb = get_tables(s);
     vec3 d = turn(&s->world, dir);
     float sin_t = sqrtf(d.x * d.x + d.z * d.z);
     if (!(sin_t > 0.0f))
         return 0.0f;
-    vec2 uv = env_uv(s, dir);
     uint32_t i = (uint32_t)(uv.u * (float)tb.w), j = (uint32_t)((1.0f - uv.v) * (float)tb.h);
     i = i < tb.w ? i : tb.w - 1;
     j = j < tb.h ? j : tb.h - 1;
     return tb.pdf[(size_t)j * tb.w + i] / (TWO_PI2 * sin_t);
+}
+
+vec3 env_radiance(const fr_scene *s, vec3 dir)
+{
+    const fr_world *w = &s->world;
+    if (w->env != FR_ENV_MAP)
+        return w->env_color;
+    return v3_mul(w->env_color, lookup(s, env_uv(s, dir)));
+}
+
+float env_pdf(const fr_scene *s, vec3 dir)
+{
+    if (s->world.env != FR_ENV_MAP)
+        return 1.0f / (4.0f * FM_PI);
+    return density(s, dir, env_uv(s, dir));
+}
+
+vec3 env_eval(const fr_scene *s, vec3 dir, float *pdf)
+{
+    const fr_world *w = &s->world;
+    if (w->env != FR_ENV_MAP) {
+        *pdf = 1.0f / (4.0f * FM_PI);
+        return w->env_color;
+    }
+    vec2 uv = env_uv(s, dir);
+    *pdf = density(s, dir, uv);
+    return v3_mul(w->env_color, lookup(s, uv));
 }
 
 /* The cell of cumulative table c (n + 1 entries, 0 to 1) that u falls in:

@@ -23,6 +23,10 @@ vec3 env_radiance(const fr_scene *s, vec3 dir);
  * is black all around, and at the poles of a map). */
 float env_pdf(const fr_scene *s, vec3 dir);
 
+/** env_radiance and env_pdf of `dir` at once (its map coordinates found
+ * once): the radiance, and the density in *pdf. */
+vec3 env_eval(const fr_scene *s, vec3 dir, float *pdf);
+
 /** A direction from two uniform numbers in [0, 1), with its solid-angle
  * density in *pdf (0 when the sample is unusable: leave it) and the
  * radiance arriving from it in *radiance. */

@@ -289,8 +289,10 @@ vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf)
     const fr_light *l = &s->lights[light];
     *pdf = 0.0f;
     if (l->kind == FR_LIGHT_ENV) {
-        *pdf = l->pick * env_pdf(s, dir);
-        return env_radiance(s, dir);
+        float d;
+        vec3 le = env_eval(s, dir, &d);
+        *pdf = l->pick * d;
+        return le;
     }
     if (l->kind != FR_LIGHT_SUN || l->cone_aux == 0.0f || !in_cone(dir, l->axis, l->cone_aux))
         return v3s(0.0f);

@@ -48,22 +48,23 @@ static const float srgb8[256] = {
 #include "texture_srgb8.inc"
 };
 
-float tex_half_to_float(uint16_t h)
+/* The bits of half h as a float: the exponent rebased from 15 to 127 (to
+ * 255 for infinities and NaNs, whose payload moves with the mantissa);
+ * subnormals (exponent 0) as m 2^-24, exactly.  Selects, no branches. */
+static inline float half_to_float(uint16_t h)
 {
-    uint32_t sign = (uint32_t)(h >> 15) << 31, e = (h >> 10) & 31u, m = h & 1023u;
-    float v;
-    if (e == 0) {
-        v = (float)m * 0x1p-24f;                 /* subnormal (or zero): exact */
-    } else {
-        uint32_t bits = e == 31 ? 0x7f800000u | m << 13 : (e + 112u) << 23 | m << 13;
-        memcpy(&v, &bits, sizeof v);
-    }
-    uint32_t b;
-    memcpy(&b, &v, sizeof b);
-    b |= sign;
-    memcpy(&v, &b, sizeof v);
+    uint32_t em = h & 0x7fffu;
+    uint32_t bits = (em << 13) + (112u << 23) + (em >= 0x7c00u ? 112u << 23 : 0u);
+    float v, sub = (float)em * 0x1p-24f;
+    memcpy(&v, &bits, sizeof v);
+    v = em < 0x0400u ? sub : v;
+    memcpy(&bits, &v, sizeof bits);
+    bits |= (uint32_t)(h >> 15) << 31;
+    memcpy(&v, &bits, sizeof v);
     return v;
 }
+
+float tex_half_to_float(uint16_t h) { return half_to_float(h); }
 
 static inline uint32_t format_bytes(uint32_t format)
 {
@@ -101,7 +102,7 @@ static inline float decode(uint32_t format, const unsigned char *p, uint32_t c)
         return tex_srgb_to_linear((float)h / 65535.0f);
     case FR_TEXEL_F16:
         memcpy(&h, p + 2 * c, 2);
-        return tex_half_to_float(h);
+        return half_to_float(h);
     default:
         memcpy(&f, p + 4 * c, 4);
         return f;
@@ -135,6 +136,42 @@ void tex_texel(const uint32_t *texels, const fr_texture *t, uint32_t level, uint
     fetch((const unsigned char *)(texels + t->first[level]), t->format, t->channels, (size_t)y * w + x, out);
 }
 
+/* The four texels i[0..3] of a level starting at byte lv, fetched with the
+ * format (and, for three channels, the count) known to the compiler, so
+ * that decode's choices are made once, not per value. */
+static inline __attribute__((always_inline)) void fetch4(const unsigned char *lv, uint32_t format, uint32_t n,
+                                                         const size_t i[4], float out[4][3])
+{
+    for (int k = 0; k < 4; k++)
+        fetch(lv, format, n, i[k], out[k]);
+}
+
+#define FETCH4_CASE(f) \
+    case f: \
+        if (n == 3) \
+            fetch4(lv, f, 3, i, out); \
+        else \
+            fetch4(lv, f, n, i, out); \
+        break
+
+static void quad(const unsigned char *lv, uint32_t format, uint32_t n, const size_t i[4], float out[4][3])
+{
+    switch (format) {
+    FETCH4_CASE(FR_TEXEL_U8_SRGB);
+    FETCH4_CASE(FR_TEXEL_U8);
+    FETCH4_CASE(FR_TEXEL_U16);
+    FETCH4_CASE(FR_TEXEL_U16_SRGB);
+    FETCH4_CASE(FR_TEXEL_F16);
+    default:
+        fetch4(lv, FR_TEXEL_F32, n, i, out);
+    }
+}
+
+void tex_texels4(const uint32_t *texels, const fr_texture *t, uint32_t level, const size_t i[4], float out[4][3])
+{
+    quad((const unsigned char *)(texels + t->first[level]), t->format, t->channels, i, out);
+}
+
 /* Image lookup of level `level` at texture-space (u, v), channels into
  * out[0..channels). */
 static void level_eval(const fr_scene *s, const fr_texture *t, uint32_t level, float u, float v, float out[3])
@@ -156,13 +193,11 @@ static void level_eval(const fr_scene *s, const fr_texture *t, uint32_t level, f
     long x0 = (long)x0f, y0 = (long)y0f;
     size_t xa = wrap_index(x0, w, t->wrap), xb = wrap_index(x0 + 1, w, t->wrap);
     size_t ya = (size_t)wrap_index(y0, h, t->wrap) * w, yb = (size_t)wrap_index(y0 + 1, h, t->wrap) * w;
-    float p00[3], p10[3], p01[3], p11[3];
-    fetch(lv, f, n, ya + xa, p00);
-    fetch(lv, f, n, ya + xb, p10);
-    fetch(lv, f, n, yb + xa, p01);
-    fetch(lv, f, n, yb + xb, p11);
+    size_t at[4] = {ya + xa, ya + xb, yb + xa, yb + xb};
+    float p[4][3];
+    quad(lv, f, n, at, p);
     for (uint32_t c = 0; c < n; c++)
-        out[c] = lerp(lerp(p00[c], p10[c], fx), lerp(p01[c], p11[c], fx), fy);
+        out[c] = lerp(lerp(p[0][c], p[1][c], fx), lerp(p[2][c], p[3][c], fx), fy);
 }
 
 /* Image lookup at texture-space (u, v) and level of detail lod (0: level

@@ -45,6 +45,10 @@ float tex_lod(const fr_scene *s, uint32_t t, const fr_surface *sf);
  * of image texture t, whose words are `texels`: out[0..t->channels). */
 void tex_texel(const uint32_t *texels, const fr_texture *t, uint32_t level, uint32_t x, uint32_t y, float out[3]);
 
+/** tex_texel of four texels at once: texel i[k] (row-major index, in
+ * range) of level `level` into out[k][0..t->channels), k = 0..3. */
+void tex_texels4(const uint32_t *texels, const fr_texture *t, uint32_t level, const size_t i[4], float out[4][3]);
+
 /** Width and height of mip level `level` of t: max(1, size >> level). */
 void tex_level_size(const fr_texture *t, uint32_t level, uint32_t *w, uint32_t *h);
 

@@ -1,25 +1,28 @@
 #!/bin/sh
-# profile.sh -- counts a Cornell box sample's instructions by part (callgrind).
+# profile.sh -- counts a scene's instructions a sample by part (callgrind).
 #
-# Where a Cornell box sample's time goes, in instructions (callgrind counts
-# them exactly, whatever else loads the machine): scenes/cornell.json at
-# 64x64 and 16 spp in one worker process, the cost of each function (with
+# Where a sample's time goes, in instructions (callgrind counts them
+# exactly, whatever else loads the machine): SCENE (scenes/cornell.json by
+# default; scenes/metals.json and scenes/sky-spheres.json are the other two
+# of the speed goal) at 64x64 and 16 spp in one worker process, the cost of each function (with
 # the code inlined into it) summed by part and divided by the number of
 # samples, the branch mispredictions of callgrind's branch simulator per
 # sample beside it, and the rays a sample traces (calls of trace_closest and
 # trace_occluded, or of the walks they call where they are inlined).  WORKER=path profiles another build of the worker (the
-# one before a change, say); SIZE and SPP change the slab.
+# one before a change, say); SIZE and SPP change the slab; CG=path keeps the
+# raw profile there (for callgrind_annotate).
 cd "$(dirname "$0")/../.." || exit 1
 command -v valgrind >/dev/null || { echo "profile: valgrind is not installed" >&2; exit 1; }
-W=${WORKER:-bin/franja-worker} SIZE=${SIZE:-64} SPP=${SPP:-16}
+W=${WORKER:-bin/franja-worker} SIZE=${SIZE:-64} SPP=${SPP:-16} SCENE=${SCENE:-scenes/cornell.json}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-bin/franja compile scenes/cornell.json -o "$T/cornell.fbin" >/dev/null || exit 1
-valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$T/cg" "$W" --scene "$T/cornell.fbin" \
+bin/franja compile "$SCENE" -o "$T/scene.fbin" >/dev/null || exit 1
+valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$T/cg" "$W" --scene "$T/scene.fbin" \
     --size "${SIZE}x$SIZE" --spp "$SPP" --rows "0:$SIZE" -o /dev/null 2>"$T/log" || { cat "$T/log" >&2; exit 1; }
 N=$((SIZE * SIZE * SPP))
-echo "== profile: scenes/cornell.json ${SIZE}x$SIZE, $SPP spp, $W (callgrind, $N samples)"
-echo "reproduce: WORKER=$W sh tests/bench/profile.sh"
+[ -z "$CG" ] || cp "$T/cg" "$CG"
+echo "== profile: $SCENE ${SIZE}x$SIZE, $SPP spp, $W (callgrind, $N samples)"
+echo "reproduce: SCENE=$SCENE WORKER=$W sh tests/bench/profile.sh"
 # Exclusive cost per function: Ir, then the branch columns (Bc Bcm Bi Bim),
 # a '.' where a count is 0; the function is the first field naming a file.
 callgrind_annotate --auto=no --threshold=100 "$T/cg" 2>/dev/null | awk -v n=$N '
@@ -30,6 +33,7 @@ BEGIN {
     L = "4|light sampling (light.c, vtx_direct_*)"
     I = "5|integrator and camera (pathtrace.c, vtx_next, vtx_scatter_*)"
     M = "6|own math (fmath.c)"
+    E = "7|environment map (envmap.c)"
 }
 /PROGRAM TOTALS/ { t = $1; gsub(",", "", t); total = t; next }
 /^ *[0-9,]+ \(/ {
@@ -51,13 +55,15 @@ BEGIN {
         p = M
     else if (file == "light.c")
         p = L
+    else if (file == "envmap.c" || fn ~ /^(env_|lookup|density)/)
+        p = E
     else if (file ~ /^(bsdf|microfacet|geom|texture|medium)\.c$/)
         p = H
     else if (file ~ /^(pathtrace|camera)\.c$/)
         p = I
     else if (fn ~ /^(trace_closest|trace_occluded|ray_setup|walk|node_hits|leaf_test|block_test|closest_|occluded_)/)
         p = T
-    else if (fn ~ /^(trace_surface|geo_|push|bsdf_|mf_|smooth_eval|micro_|tex_|med_)/)
+    else if (fn ~ /^(trace_surface|geo_|push|bsdf_|mf_|smooth_eval|micro_|tex_|med_|quad)/)
         p = H
     else if (fn ~ /^smp_/)
         p = S
@@ -70,7 +76,7 @@ BEGIN {
     else if (fn ~ /^fm_/)
         p = M
     else
-        p = "7|start-up, output and the rest"
+        p = "8|start-up, output and the rest"
     ins[p] += ir; mis[p] += bm; all += bm
 }
 END {
