@@ -7,7 +7,9 @@
 
 #include "simd4.h"
 
-float geo_sphere(const fr_sphere *s, const fr_ray *r, float tmax)
+/* Inlined where it is called (always_inline: the walk's leaves test
+ * spheres without a call). */
+__attribute__((always_inline)) inline float geo_sphere(const fr_sphere *s, const fr_ray *r, float tmax)
 {
     /* With f = o - c, the discriminant is computed as r^2 - |f - (f.d/d.d) d|^2,
      * which keeps its precision when the sphere is small and far away
