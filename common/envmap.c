@@ -129,14 +129,19 @@ vec3 env_eval(const fr_scene *s, vec3 dir, float *pdf)
  * the first k with u < c[k + 1]; *frac is u's place inside it. */
 static uint32_t find(const float *c, uint32_t n, float u, float *frac)
 {
-    uint32_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (u < c[mid + 1])
-            hi = mid;
-        else
-            lo = mid + 1;
+    /* Halving by selects, not branches (a branch on u goes either way at
+     * random): b ends at the last entry of c[1..n] that is <= u, or at
+     * c[1], and the cell is the one after it, n - 1 at most.  The table is
+     * non-decreasing (the loader checks it) and u is a number in [0, 1),
+     * so this is the cell a plain binary search finds. */
+    const float *b = c + 1;
+    for (uint32_t len = n; len > 1;) {
+        uint32_t half = len / 2;
+        b = b[half] <= u ? b + half : b;
+        len -= half;
     }
+    uint32_t lo = (uint32_t)(b - (c + 1)) + (b[0] <= u);
+    lo = lo < n ? lo : n - 1;
     float width = c[lo + 1] - c[lo];
     float f = width > 0.0f ? (u - c[lo]) / width : 0.5f;
     *frac = f < 0.0f ? 0.0f : f < 1.0f ? f : 0.99999994f;
