@@ -5,6 +5,7 @@
 
 #include "bsdf.h"
 #include "fmath.h"
+#include "simd4.h"
 
 #include <string.h>
 
@@ -65,6 +66,36 @@ static inline float half_to_float(uint16_t h)
 }
 
 float tex_half_to_float(uint16_t h) { return half_to_float(h); }
+
+typedef uint32_t u4 __attribute__((vector_size(16)));
+
+/* half_to_float of four halves (zero-extended in h) at once: the same
+ * operations lane by lane, so the same bits. */
+static inline f4 half_to_float4(u4 h)
+{
+    u4 em = h & 0x7fffu;
+    u4 bits = (em << 13) + (112u << 23) + ((u4)(em >= 0x7c00u) & (112u << 23));
+    f4 sub = __builtin_convertvector((i4)em, f4) * 0x1p-24f;   /* em < 2^15: signed is exact */
+    u4 small = (u4)(em < 0x0400u);
+    u4 r = (small & (u4)sub) | (~small & bits);
+    return (f4)(r | (h >> 15) << 31);
+}
+
+/* The four three-channel half texels i[0..3] of a level starting at byte
+ * lv, decoded twelve values as three vectors of four. */
+static inline void quad_half3(const unsigned char *lv, const size_t i[4], float out[4][3])
+{
+    uint16_t h[12];
+    for (int k = 0; k < 4; k++)
+        memcpy(h + 3 * k, lv + i[k] * 6, 6);
+    float v[12];
+    for (int q = 0; q < 3; q++) {
+        u4 x = {h[4 * q], h[4 * q + 1], h[4 * q + 2], h[4 * q + 3]};
+        f4 f = half_to_float4(x);
+        memcpy(v + 4 * q, &f, sizeof f);
+    }
+    memcpy(out, v, sizeof v);
+}
 
 static inline uint32_t format_bytes(uint32_t format)
 {
@@ -161,7 +192,12 @@ static void quad(const unsigned char *lv, uint32_t format, uint32_t n, const siz
     FETCH4_CASE(FR_TEXEL_U8);
     FETCH4_CASE(FR_TEXEL_U16);
     FETCH4_CASE(FR_TEXEL_U16_SRGB);
-    FETCH4_CASE(FR_TEXEL_F16);
+    case FR_TEXEL_F16:
+        if (n == 3)
+            quad_half3(lv, i, out);
+        else
+            fetch4(lv, FR_TEXEL_F16, n, i, out);
+        break;
     default:
         fetch4(lv, FR_TEXEL_F32, n, i, out);
     }

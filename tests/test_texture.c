@@ -4,7 +4,8 @@
  * Textures, UVs, bump and normal maps: lookups against hand-computed
  * values, UV round trips on every primitive, an emissive textured quad
  * seen head-on, a flat bump map that changes nothing, and shading normals
- * that never let light through a surface. */
+ * that never let light through a surface; four-texel fetches that decode
+ * every format, and every half-float value, to the bits of one-texel ones. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -534,10 +535,43 @@ static void sizes_and_nan(void)
     scn_free(&s);
 }
 
+/* tex_texels4 against tex_texel, bit for bit: every format at one and three
+ * channels over bytes that count up (so every 8- and 16-bit value, every
+ * half float among them, NaNs and subnormals included, is decoded). */
+static void texels4_match(void)
+{
+    enum { W = 65536 / 3 + 1 };
+    uint32_t *words = calloc((size_t)W * 3 * 4 / 4 + 4, sizeof *words);
+    unsigned char *bytes = (unsigned char *)words;
+    for (size_t i = 0; i < (size_t)W * 3 * 4; i++)
+        bytes[i] = (unsigned char)(i % 2 ? i / 512 : i / 2);   /* 16-bit values 0, 1, 2... little-endian */
+    int bad = 0, tried = 0;
+    for (uint32_t format = 0; format < FR_TEXEL_FORMATS; format++) {
+        for (uint32_t channels = 1; channels <= 3; channels += 2) {
+            fr_texture t = {.kind = FR_TEX_IMAGE, .channels = channels, .format = format, .levels = 1};
+            t.width = (uint32_t)((size_t)W * 3 * 4 / (channels * tex_format_bytes(format)));
+            t.height = 1;
+            for (uint32_t x = 0; x + 3 < t.width; x += 4) {
+                size_t at[4] = {x + 2, x, x + 3, x + 1};
+                float four[4][3], one[3];
+                tex_texels4(words, &t, 0, at, four);
+                for (int k = 0; k < 4; k++) {
+                    tex_texel(words, &t, 0, (uint32_t)at[k], 0, one);
+                    bad += memcmp(four[k], one, channels * sizeof(float)) != 0;
+                    tried++;
+                }
+            }
+        }
+    }
+    CHECK(bad == 0, "tex_texels4 differs from tex_texel in %d of %d texels", bad, tried);
+    free(words);
+}
+
 int main(void)
 {
     make_files();
     srgb_curve();
+    texels4_match();
     lookups();
     uv_round_trips();
     textured_quad();
