@@ -4,6 +4,7 @@
 #   make deps       install the Debian packages the project needs, Blender too (root)
 #   make check      build and run every test
 #   make bench      benchmarks (see tests/bench/)
+#   make pgo        bin/franja-worker again with profile feedback (same bits, faster)
 #   make render     render scenes/cornell.json to cornell.png on this machine
 #   make install    bin/, man pages and bash completion under PREFIX (DESTDIR)
 #   make docs       the user guide and the API documentation (HTML) in build/docs
@@ -64,7 +65,7 @@ LIB         = $(B)/libfranja.a
 WORKER_LIBS = $(CJSON_LIBS) $(ZSTD_LIBS) -lm -pthread
 COORD_LIBS  = $(CJSON_LIBS) $(SSH_LIBS) $(ASSIMP_LIBS) $(MHD_LIBS) $(ZSTD_LIBS) -ldl -lm -pthread
 
-.PHONY: all deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall
+.PHONY: all deps check test bench render clean docs guide fuzz static dist check-cross refs install uninstall pgo
 all: bin/franja-worker bin/franja $(IIO_PLUGIN)
 
 # The modules a pixel sample runs through are built at -O3 (more inlining
@@ -88,7 +89,10 @@ LTO     ?= -flto=auto
 LTO_OBJ  = $(if $(LTO),$(LTO) -ffat-lto-objects)
 LTO_LINK = $(if $(LTO),$(LTO) $(FPFLAGS))
 NO_LTO   = $(if $(LTO),-fno-lto)
-$(HOT_SRC:%.c=$(B)/%.o): HOT = -O3 $(LTO_OBJ)
+# PGO: GCC's profile flags for the render-path modules and the link
+# (`make pgo` below sets them; empty otherwise).
+PGO     ?=
+$(HOT_SRC:%.c=$(B)/%.o): HOT = -O3 $(LTO_OBJ) $(PGO)
 
 $(B)/%.o: %.c
 	@mkdir -p $(dir $@)
@@ -112,7 +116,28 @@ $(LIB): $(COMMON_OBJ)
 
 bin/franja-worker: $(WORKER_OBJ) $(LIB)
 	@mkdir -p bin
-	$(CC) $(CFLAGS) $(LTO_LINK) -o $@ $(WORKER_OBJ) $(LIB) $(WORKER_LIBS)
+	$(CC) $(CFLAGS) $(LTO_LINK) $(PGO) -o $@ $(WORKER_OBJ) $(LIB) $(WORKER_LIBS)
+
+# make pgo: bin/franja-worker built again with GCC's profile feedback, its
+# render-path modules laid out and inlined by where a training render
+# spends (the Cornell box, the rough metals and the sky scene, small).
+# The same bits as the plain build (only code placement and inlining
+# change; -ffp-contract=off and no fast-math still fix every rounding),
+# some 5 % less CPU time on this project's benches (tests/bench/README.md,
+# "Profile feedback").  Its objects live in $(B)/pgo; a later plain `make`
+# keeps this worker until a source changes.
+PGO_SCENES = scenes/cornell.json scenes/metals.json scenes/sky-spheres.json
+pgo: bin/franja
+	rm -rf $(B)/pgo
+	$(MAKE) --no-print-directory B=$(B)/pgo PGO='-fprofile-generate -fprofile-update=atomic' bin/franja-worker
+	for f in $(PGO_SCENES); do \
+	    bin/franja compile $$f -o $(B)/pgo/train.fbin >/dev/null && \
+	    bin/franja-worker --scene $(B)/pgo/train.fbin --size 96x96 --spp 16 --rows 0:96 -o /dev/null || exit 1; \
+	done
+	find $(B)/pgo -name '*.o' -delete
+	rm -f $(B)/pgo/libfranja.a bin/franja-worker
+	$(MAKE) --no-print-directory B=$(B)/pgo PGO='-fprofile-use -fprofile-partial-training -Wno-missing-profile' \
+	    bin/franja-worker
 
 $(COORD_LIB): $(COORD_LIB_OBJ)
 	@mkdir -p $(dir $@)
