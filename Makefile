@@ -123,7 +123,7 @@ bin/franja-worker: $(WORKER_OBJ) $(LIB)
 # spends (the Cornell box, the rough metals and the sky scene, small).
 # The same bits as the plain build (only code placement and inlining
 # change; -ffp-contract=off and no fast-math still fix every rounding),
-# some 5 % less CPU time on this project's benches (tests/bench/README.md,
+# 3-6 % less CPU time on this project's benches (tests/bench/README.md,
 # "Profile feedback").  Its objects live in $(B)/pgo; a later plain `make`
 # keeps this worker until a source changes.
 PGO_SCENES = scenes/cornell.json scenes/metals.json scenes/sky-spheres.json
