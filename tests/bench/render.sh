@@ -20,6 +20,7 @@
 # after this build's render, so both see the same load, and the medians and
 # their ratio are reported side by side.
 cd "$(dirname "$0")/../.." || exit 1
+[ -x bin/tools/imgcmp ] || { echo "$0: bin/tools/imgcmp is missing: run make bench (it builds the tools)" >&2; exit 1; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 N=$(nproc)

@@ -31,6 +31,7 @@
 #     an upper bound of what it needs for Cycles' RMSE).
 # Needs blender; without it, only Franja's figures.
 cd "$(dirname "$0")/../.." || exit 1
+[ -x bin/tools/imgcmp ] || { echo "$0: bin/tools/imgcmp is missing: run make bench (it builds the tools)" >&2; exit 1; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 SPP=${SPP:-64} FREF_SPP=${FREF_SPP:-8192} CREF_SPP=${CREF_SPP:-2048} RUNS=${RUNS:-3} PCT=${PCT:-99.9} N=$(nproc)
