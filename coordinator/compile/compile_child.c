@@ -48,6 +48,7 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
     else
         memset(&co, 0, sizeof co);
     co.fbin = file;
+    co.mesh_key = &a.st.mesh_key;
     double t0 = clock_now();
     a.rc = compile_scene(scene, &co, &s, &a.err);
     if (a.rc && strstr(a.err.msg, "out of memory")) {

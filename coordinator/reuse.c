@@ -1,0 +1,139 @@
+/* reuse.c -- the frames of an animation compiled and sent as what changed
+ * since the frame before (see reuse.h). */
+#include "reuse.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "clock.h"
+#include "compile/compile_child.h"
+#include "fbin.h"
+#include "file.h"
+#include "fpatch.h"
+
+/* A patch is sent instead of the scene when it is under this fraction. */
+enum { PATCH_FRACTION = 4 };
+
+/* The frame's scene made of the frame before's full scene and the
+ * sections its skeleton changed, into `out`: 1 when made, 0 when the
+ * frame needs a full compile (a changed section the meshes add to), -1
+ * with err on a write error or memory. */
+static int splice(const reuse_state *st, const fr_scene *skel, const char *out, fr_error *err)
+{
+    fpatch_sect full[FPATCH_SECTIONS + 1], was[FPATCH_SECTIONS + 1], now[FPATCH_SECTIONS + 1];
+    fr_error e;
+    if (fpatch_sections(st->full.blob, st->full.blob_size, full, &e) < 0 ||
+        fpatch_sections(st->skel.blob, st->skel.blob_size, was, &e) < 0 ||
+        fpatch_sections(skel->blob, skel->blob_size, now, &e) < 0)
+        return fr_fail(err, "%s: %s", out, e.msg);
+    for (int id = 1; id <= FPATCH_SECTIONS; id++) {
+        if (fpatch_same(&was[id], &now[id]))
+            continue;
+        if (!fpatch_same(&was[id], &full[id]))
+            return 0;
+        full[id] = now[id];
+    }
+    void *blob;
+    size_t size;
+    uint64_t hash;
+    if (fpatch_assemble(full, &blob, &size, &hash, err) < 0)
+        return -1;
+    int rc = file_write_atomic(out, blob, size, err);
+    free(blob);
+    return rc < 0 ? -1 : 1;
+}
+
+/* The skeleton of the frame (JSON scenes) into *skel, mapped; its file
+ * goes once mapped. */
+static int skeleton(const char *scene, const compile_opts *co, const char *out, volatile sig_atomic_t *stop,
+                    fr_scene *skel, uint64_t *key, fr_error *err)
+{
+    char path[4400];
+    snprintf(path, sizeof path, "%s.skeleton", out);
+    compile_opts so = *co;
+    so.skeleton = 1;
+    compile_child_stats cs;
+    if (compile_child(scene, &so, path, stop, &cs, err) < 0)
+        return -1;
+    *key = cs.mesh_key;
+    int rc = fbin_load(path, skel, err);
+    unlink(path);
+    return rc;
+}
+
+/* The patch from the frame before's scene to `now` into `patch` when it
+ * is small enough (r->base, r->patch_bytes), else no patch file. */
+static int write_patch(const reuse_state *st, const fr_scene *now, const char *patch, reuse_result *r,
+                       fr_error *err)
+{
+    unlink(patch);
+    if (!st->have)
+        return 0;
+    void *p;
+    size_t n;
+    uint32_t changed;
+    if (fpatch_make(st->full.blob, st->full.blob_size, now->blob, now->blob_size, &p, &n, &changed, err) < 0)
+        return -1;
+    int rc = 0;
+    if (n < now->blob_size / PATCH_FRACTION && (rc = file_write_atomic(patch, p, n, err)) == 0) {
+        r->base = st->full.hash;
+        r->patch_bytes = n;
+    }
+    free(p);
+    return rc;
+}
+
+int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out, const char *patch,
+                  volatile sig_atomic_t *stop, reuse_result *r, fr_error *err)
+{
+    memset(r, 0, sizeof *r);
+    double t0 = clock_now();
+    fr_scene skel = {0}, now = {0};
+    uint64_t key = 0;
+    int json = !compile_is_gltf(scene);
+    /* A skeleton that does not compile leaves the frame to a full compile,
+     * which says what is wrong. */
+    fr_error ignored;
+    if (json && skeleton(scene, co, out, stop, &skel, &key, &ignored) < 0) {
+        if (stop && *stop)
+            return fr_fail(err, "%s: compile interrupted", scene);
+        json = 0;
+    }
+    int made = 0;
+    if (json && st->have && st->skel.blob && key == st->key && (made = splice(st, &skel, out, err)) < 0) {
+        scn_free(&skel);
+        return -1;
+    }
+    compile_child_stats cs = {0};
+    if (!made && compile_child(scene, co, out, stop, &cs, err) < 0) {
+        scn_free(&skel);
+        return -1;
+    }
+    if (fbin_load(out, &now, err) < 0 || write_patch(st, &now, patch, r, err) < 0) {
+        scn_free(&skel);
+        scn_free(&now);
+        return -1;
+    }
+    r->reused = made;
+    r->seconds = clock_now() - t0;
+    st->reused += made;
+    /* The skeleton stands for the full scene only when both read the same meshes. */
+    if (json && !made && cs.mesh_key != key)
+        scn_free(&skel);
+    scn_free(&st->full);
+    scn_free(&st->skel);
+    st->full = now;
+    st->skel = skel;
+    st->key = key;
+    st->have = 1;
+    return 0;
+}
+
+void reuse_free(reuse_state *st)
+{
+    scn_free(&st->full);
+    scn_free(&st->skel);
+    memset(st, 0, sizeof *st);
+}

@@ -1,0 +1,63 @@
+/** @file reuse.h
+ * The frames of an animation compiled and sent as what changed since the
+ * frame before.
+ *
+ * Compile once: a frame of a JSON scene is first compiled as a skeleton
+ * (compile.h: its meshes left out and their files not read, only a key of
+ * what they would read: mesh.h's mesh_key).  When the key is the one of
+ * the frame before, the frame's scene is the last full compile with the
+ * sections that differ between the two skeletons replaced by this
+ * skeleton's, provided each of those sections was, in the frame before,
+ * the same in the skeleton as in the full scene (the meshes added nothing
+ * to it: the camera, the settings, the camera's motion, a sphere's place
+ * but not the BVH over it).  Anything else (a mesh that moves, a section
+ * the meshes add to) compiles the frame whole.  The result is byte for
+ * byte the scene a full compile of the frame makes (tests/it_anim_reuse.sh).
+ * glTF scenes and compiled .fbin frames are compiled (or loaded) whole.
+ *
+ * Send a delta: for every frame after the first, a scene patch (fpatch.h)
+ * from the frame before's scene is written beside the frame's scene when
+ * it is under a quarter of its size; stage_scene sends it to hosts that
+ * hold the frame before's scene (transport/stage.h).
+ *
+ * One per animation run; the frames are opened one after the other.
+ */
+#ifndef FRANJA_REUSE_H
+#define FRANJA_REUSE_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "compile/compile.h"
+#include "error.h"
+#include "scene.h"
+
+/** What the run keeps of the frame before. */
+typedef struct {
+    fr_scene full;             /**< its scene, mapped (the mapping outlives its job directory) */
+    fr_scene skel;             /**< its skeleton (JSON scenes; else empty) */
+    uint64_t key;              /**< its meshes' key */
+    int have;                  /**< 1 once a frame was compiled */
+    int reused;                /**< frames made from the frame before's sections (for the log) */
+} reuse_state;
+
+/** What reuse_compile did for one frame. */
+typedef struct {
+    int reused;                /**< 1: made from the frame before's sections (no full compile) */
+    double seconds;            /**< the compile's time, skeleton included */
+    uint64_t base;             /**< the patch's base scene hash (the frame before's); 0: no patch */
+    uint64_t patch_bytes;      /**< the patch's size */
+} reuse_result;
+
+/** Compiles the frame `scene` (a JSON or glTF scene) with options co into
+ * the .fbin file `out` as described above; writes `patch` (a path) when a
+ * patch from the frame before is worth sending (r->base not 0), else
+ * removes it.  stop as compile_child's.  Returns 0, or -1 with err (the
+ * compiler's, or a write error). */
+int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out, const char *patch,
+                  volatile sig_atomic_t *stop, reuse_result *r, fr_error *err);
+
+/** Lets go of what st keeps. */
+void reuse_free(reuse_state *st);
+
+#endif
