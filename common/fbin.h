@@ -42,6 +42,11 @@ int fbin_load(const char *path, fr_scene *out, fr_error *err);
 /** Write a scene's blob to `path` atomically (temporary name, then rename). */
 int fbin_write(const fr_scene *s, const char *path, fr_error *err);
 
+/** The header's first 32 bytes of a scene of `size` bytes into head:
+ * magic, version, byte-order mark, header size, section count, size (the
+ * hash and the reserved bytes are the caller's). */
+void fbin_put_header(unsigned char *head, uint64_t size);
+
 /** The 16 lowercase hex digits of a hash, NUL-terminated, into buf[17]. */
 void fbin_hash_hex(uint64_t hash, char buf[17]);
 

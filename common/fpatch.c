@@ -68,12 +68,7 @@ int fpatch_assemble(const fpatch_sect s[FPATCH_SECTIONS + 1], void **blob, size_
     unsigned char *p = calloc(1, n);
     if (!p)
         return fr_fail(err, "out of memory assembling a scene of %zu bytes", n);
-    memcpy(p, scn_magic, 8);
-    wr32(p + 8, FBIN_VERSION);
-    wr32(p + 12, 0x01020304u);
-    wr32(p + 16, SCN_HEADER);
-    wr32(p + 20, FPATCH_SECTIONS);
-    wr64(p + 24, n);
+    fbin_put_header(p, n);
     for (int id = 1; id <= FPATCH_SECTIONS; id++) {
         unsigned char *e = p + SCN_HEADER + (size_t)SCN_ENTRY * (id - 1);
         size_t bytes = (size_t)(s[id].count * s[id].elem);

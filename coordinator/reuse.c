@@ -52,8 +52,10 @@ static int skeleton(const char *scene, const compile_opts *co, const char *out, 
 {
     char path[4400];
     snprintf(path, sizeof path, "%s.skeleton", out);
+    compile_child_sweep(path); /* what a compile killed with its render left */
     compile_opts so = *co;
     so.skeleton = 1;
+    so.warn = NULL; /* the full compile of the first frame says them */
     compile_child_stats cs;
     if (compile_child(scene, &so, path, stop, &cs, err) < 0)
         return -1;
