@@ -9,7 +9,10 @@
 # for frames 2 and 3 instead of the whole scene, and its cached scenes are
 # the .fbin files.  A patch damaged on the way, or naming a base the host
 # no longer holds, is refused by the worker and the whole scene is sent;
-# a worker without the patch-1 feature gets whole scenes.
+# a worker without the patch-1 feature gets whole scenes.  A camera that
+# moves into a mesh holding a medium (which medium the camera sits in
+# depends on both) compiles each frame whole, to the bytes of the frame
+# alone.
 . "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
@@ -90,4 +93,23 @@ check "c: the missing base is named" grep -q "^franja: c (.*did not unpack (.*it
 s2=$(sent log-d d 2)
 check "d: a worker without patches gets the whole scene ($s2 bytes)" test "${s2:-0}" -gt 100000
 check "d: and is offered no patch" sh -c "! grep -q 'scene patch' log-d"
+
+# A camera moving into a closed mesh with an interior medium.
+"$ROOT/bin/gen/genmesh" sphere --tris 2000 -o ball.obj >/dev/null || bad "genmesh sphere"
+cat >inside.json <<'JSON'
+{ "image": { "width": 16, "height": 12, "spp": 1 },
+  "camera": { "position": { "keys": [[1, [0, 0, -4]], [3, [0, 0, 0]]] }, "target": [0, 0, 1], "fov": 40 },
+  "media": { "cloud": { "sigma_a": 0.1, "sigma_s": 0.5 } },
+  "materials": { "cloud": { "type": "interface", "medium": "cloud" },
+                 "w": { "type": "lambert", "albedo": [0.6, 0.6, 0.6] } },
+  "lights": [ { "type": "point", "position": [0, 0, 0.5], "intensity": [5, 5, 5] } ],
+  "shapes": [ { "type": "mesh", "file": "ball.obj", "material": "cloud" },
+              { "type": "plane", "point": [0, -3, 0], "normal": [0, 1, 0], "material": "w" } ] }
+JSON
+"$FRANJA" render inside.json --frames 1-3 -o "in/f.#.pfm" --keep-job 2>log-in || bad "inside: $(cat log-in)"
+"$FRANJA" render inside.json --frames 3 -o "in3/f.#.pfm" --keep-job 2>/dev/null || bad "inside, frame 3 alone"
+check "inside: frame 3 compiled whole" grep -q "frame 3: scene compiled" log-in
+check "inside: frame 3's scene is the full compile's" \
+    cmp -s "in/f.3.pfm.franja-job/scene.fbin" "in3/f.3.pfm.franja-job/scene.fbin"
+check "inside: frame 3 equals the frame rendered alone" cmp -s "in/f.3.pfm" "in3/f.3.pfm"
 summary

@@ -267,10 +267,13 @@ int mesh_key(const fr_builder *b, const cJSON *o, const char *where, const char 
         fold(key, paths[i], strlen(paths[i]) + 1);
         fold(key, id, sizeof id);
     }
-    if (levels > 1) {
-        /* The level is chosen by the mesh's size on screen. */
-        float cam[6] = {b->camera.position.x, b->camera.position.y, b->camera.position.z, b->camera.tan_half,
-                        (float)b->settings.width, (float)b->settings.height};
+    /* The level is chosen by the mesh's size on screen; a mesh with an
+     * interior medium may hold the camera (fr_volume.camera_medium). */
+    const fr_material *mats = b->materials.data;
+    if (levels > 1 || (material != FR_NONE && material < b->materials.count && mats[material].medium)) {
+        const fr_camera *c = &b->camera;
+        float cam[12] = {c->position.x, c->position.y, c->position.z, c->target.x, c->target.y, c->target.z,
+                         c->up.x, c->up.y, c->up.z, c->tan_half, (float)b->settings.width, (float)b->settings.height};
         fold(key, cam, sizeof cam);
     }
     return 0;

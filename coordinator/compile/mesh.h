@@ -32,7 +32,8 @@ int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *di
  * names relative to `dir`, material `material`), folded into *key (a
  * hash): the shape's JSON as posed, its files' names and their identity
  * on disk (device, inode, size, modification time), and for a shape with
- * levels of detail the camera and image size that choose one.  Two
+ * levels of detail (chosen by its size on screen) or a material with an
+ * interior medium (which may hold the camera) the camera and image size.  Two
  * compiles that fold the same keys read the same meshes (unless a file
  * the mesh file names, such as an MTL, changed by itself).  Fails like
  * mesh_add on a shape without files. */
