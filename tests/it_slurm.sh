@@ -101,9 +101,11 @@ check "it lies in the nodes' cache under its content hash" \
 check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
 check "no step is left after the render" no_leftovers
 
-# An animation in one allocation: every frame equals its own render.
+# An animation in one allocation: every frame equals its own render.  The
+# camera moves (so that frame 2 can travel as a patch of frame 1's scene).
 for i in 1 2; do
-    sed "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [$((150 * i + 100)), 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+    sed -e "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [250, 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+        -e "s/\"position\": \[278, 273, -800\]/\"position\": [$((218 + 60 * i)), 273, -800]/" \
         "$ROOT/scenes/cornell.json" >"f.000$i.json"
     "$FRANJA" render "f.000$i.json" -o "fref$i.pfm" $SIZE -j 1 2>/dev/null
 done
@@ -116,6 +118,16 @@ check "the frames run over one set of steps: each node probed once" \
     test "$(grep -c ': Linux .* slots, franja-worker' logf)" -eq 3
 check "each frame's scene staged on each node" \
     test "$(grep -Ec 'host n[123]: frame [12]: scene (uploaded|already there)' logf)" -eq 6
+# A node that holds frame 1's scene gets frame 2's as a patch of it
+# (common/fpatch.h), rebuilt by a step on that node.
+patched=0
+for n in n1 n2 n3; do
+    s1=$(sed -n "s/^franja: host $n: frame 1: scene .*, \([0-9]*\) bytes sent).*/\1/p" logf)
+    s2=$(sed -n "s/^franja: host $n: frame 2: scene .*, \([0-9]*\) bytes sent).*/\1/p" logf)
+    [ -n "$s1" ] && [ -n "$s2" ] && [ "$s2" -gt 0 ] && [ $((s2 * 4)) -lt "$s1" ] && patched=$((patched + 1))
+done
+check "frame 2 reaches a node as a patch of frame 1's scene ($patched nodes)" test "$patched" -ge 1
+check "no patch failed" sh -c "! grep -q 'did not unpack' logf"
 check "no step is left after the animation" no_leftovers
 
 # Bidirectional: every step's partial carries its splats over the whole
