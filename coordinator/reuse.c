@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "clock.h"
@@ -12,6 +13,9 @@
 #include "fbin.h"
 #include "file.h"
 #include "fpatch.h"
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
 
 /* A patch is sent instead of the scene when it is under this fraction. */
 enum { PATCH_FRACTION = 4 };
@@ -87,6 +91,19 @@ static int write_patch(const reuse_state *st, const fr_scene *now, const char *p
     return rc;
 }
 
+/* The meshes' key of a compile of `scene`: a glTF file's meshes lie in the
+ * file (or buffers beside it), so its identity on disk goes in too; a JSON
+ * scene's mesh files are in the key already (mesh.h). */
+static uint64_t with_file(const char *scene, uint64_t key)
+{
+    struct stat st;
+    uint64_t id[5] = {0};
+    if (compile_is_gltf(scene) && stat(scene, &st) == 0)
+        id[0] = (uint64_t)st.st_dev, id[1] = (uint64_t)st.st_ino, id[2] = (uint64_t)st.st_size,
+        id[3] = (uint64_t)st.st_mtim.tv_sec, id[4] = (uint64_t)st.st_mtim.tv_nsec;
+    return XXH3_64bits_withSeed(id, sizeof id, key);
+}
+
 int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out, const char *patch,
                   volatile sig_atomic_t *stop, reuse_result *r, fr_error *err)
 {
@@ -94,17 +111,15 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     double t0 = clock_now();
     fr_scene skel = {0}, now = {0};
     uint64_t key = 0;
-    int json = !compile_is_gltf(scene);
     /* A skeleton that does not compile leaves the frame to a full compile,
      * which says what is wrong. */
     fr_error ignored;
-    if (json && skeleton(scene, co, out, stop, &skel, &key, &ignored) < 0) {
-        if (stop && *stop)
-            return fr_fail(err, "%s: compile interrupted", scene);
-        json = 0;
-    }
+    int have_skel = skeleton(scene, co, out, stop, &skel, &key, &ignored) == 0;
+    if (!have_skel && stop && *stop)
+        return fr_fail(err, "%s: compile interrupted", scene);
+    key = with_file(scene, key);
     int made = 0;
-    if (json && st->have && st->skel.blob && key == st->key && (made = splice(st, &skel, out, err)) < 0) {
+    if (have_skel && st->have && st->skel.blob && key == st->key && (made = splice(st, &skel, out, err)) < 0) {
         scn_free(&skel);
         return -1;
     }
@@ -122,7 +137,7 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     r->seconds = clock_now() - t0;
     st->reused += made;
     /* The skeleton stands for the full scene only when both read the same meshes. */
-    if (json && !made && cs.mesh_key != key)
+    if (have_skel && !made && with_file(scene, cs.mesh_key) != key)
         scn_free(&skel);
     scn_free(&st->full);
     scn_free(&st->skel);

@@ -2,18 +2,20 @@
  * The frames of an animation compiled and sent as what changed since the
  * frame before.
  *
- * Compile once: a frame of a JSON scene is first compiled as a skeleton
- * (compile.h: its meshes left out and their files not read, only a key of
- * what they would read: mesh.h's mesh_key).  When the key is the one of
+ * Compile once: a frame is first compiled as a skeleton (compile.h: a
+ * JSON scene's meshes left out and their files not read, only a key of
+ * what they would read, mesh.h's mesh_key; a glTF scene's meshes each a
+ * stand-in triangle, keyed by what places and shapes them, and the file's
+ * identity on disk).  When the key is the one of
  * the frame before, the frame's scene is the last full compile with the
  * sections that differ between the two skeletons replaced by this
  * skeleton's, provided each of those sections was, in the frame before,
  * the same in the skeleton as in the full scene (the meshes added nothing
- * to it: the camera, the settings, the camera's motion, a sphere's place
- * but not the BVH over it).  Anything else (a mesh that moves, a section
- * the meshes add to) compiles the frame whole.  The result is byte for
- * byte the scene a full compile of the frame makes (tests/it_anim_reuse.sh).
- * glTF scenes and compiled .fbin frames are compiled (or loaded) whole.
+ * to it: the camera, the settings, the camera's motion).  Anything else
+ * (a mesh that moves, a section the meshes add to: the BVH, the lights)
+ * compiles the frame whole.  The result is byte for byte the scene a full
+ * compile of the frame makes (tests/it_anim_reuse.sh).  Compiled .fbin
+ * frames are loaded as they are.
  *
  * Send a delta: for every frame after the first, a scene patch (fpatch.h)
  * from the frame before's scene is written beside the frame's scene when

@@ -12,7 +12,9 @@
 # a worker without the patch-1 feature gets whole scenes.  A camera that
 # moves into a mesh holding a medium (which medium the camera sits in
 # depends on both) compiles each frame whole, to the bytes of the frame
-# alone.
+# alone.  glTF animations (tests/support/genanim.py): a camera move is made
+# of the frame before's sections, a moving box compiles whole; with a
+# shutter too, every frame is the bytes of the frame alone.
 . "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
@@ -112,4 +114,21 @@ check "inside: frame 3 compiled whole" grep -q "frame 3: scene compiled" log-in
 check "inside: frame 3's scene is the full compile's" \
     cmp -s "in/f.3.pfm.franja-job/scene.fbin" "in3/f.3.pfm.franja-job/scene.fbin"
 check "inside: frame 3 equals the frame rendered alone" cmp -s "in/f.3.pfm" "in3/f.3.pfm"
+
+# glTF: blur.gltf's camera moves before a still quad; anim.gltf's box moves.
+mkdir -p ga && python3 "$ROOT/tests/support/genanim.py" ga >/dev/null || bad "genanim.py"
+for sc in blur anim; do
+    for sh in 0 0.5; do
+        "$FRANJA" render "ga/$sc.gltf" --frames 0-2 --shutter $sh -o "g-$sc-$sh/f.#.pfm" --size 32x16 --spp 1 \
+            --keep-job 2>"log-$sc-$sh" || bad "$sc.gltf: $(cat "log-$sc-$sh")"
+        "$FRANJA" render "ga/$sc.gltf" --frames 2 --shutter $sh -o "g1-$sc-$sh/f.#.pfm" --size 32x16 --spp 1 \
+            --keep-job 2>/dev/null || bad "$sc.gltf, frame 2 alone"
+        check "$sc.gltf (shutter $sh): frame 2's scene is the full compile's" \
+            cmp -s "g-$sc-$sh/f.2.pfm.franja-job/scene.fbin" "g1-$sc-$sh/f.2.pfm.franja-job/scene.fbin"
+        check "$sc.gltf (shutter $sh): frame 2 equals the frame rendered alone" \
+            cmp -s "g-$sc-$sh/f.2.pfm" "g1-$sc-$sh/f.2.pfm"
+    done
+done
+check "blur.gltf: frames 1 and 2 made of the frame before's" test "$(grep -c "scene made of" log-blur-0.5)" -eq 2
+check "anim.gltf: the moving box compiles every frame" test "$(grep -c "scene compiled" log-anim-0.5)" -eq 3
 summary
