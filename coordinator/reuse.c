@@ -5,7 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "clock.h"
@@ -13,9 +12,6 @@
 #include "fbin.h"
 #include "file.h"
 #include "fpatch.h"
-
-#define XXH_INLINE_ALL
-#include <xxhash.h>
 
 /* A patch is sent instead of the scene when it is under this fraction. */
 enum { PATCH_FRACTION = 4 };
@@ -91,19 +87,6 @@ static int write_patch(const reuse_state *st, const fr_scene *now, const char *p
     return rc;
 }
 
-/* The meshes' key of a compile of `scene`: a glTF file's meshes lie in the
- * file (or buffers beside it), so its identity on disk goes in too; a JSON
- * scene's mesh files are in the key already (mesh.h). */
-static uint64_t with_file(const char *scene, uint64_t key)
-{
-    struct stat st;
-    uint64_t id[5] = {0};
-    if (compile_is_gltf(scene) && stat(scene, &st) == 0)
-        id[0] = (uint64_t)st.st_dev, id[1] = (uint64_t)st.st_ino, id[2] = (uint64_t)st.st_size,
-        id[3] = (uint64_t)st.st_mtim.tv_sec, id[4] = (uint64_t)st.st_mtim.tv_nsec;
-    return XXH3_64bits_withSeed(id, sizeof id, key);
-}
-
 int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out, const char *patch,
                   volatile sig_atomic_t *stop, reuse_result *r, fr_error *err)
 {
@@ -117,7 +100,6 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     int have_skel = skeleton(scene, co, out, stop, &skel, &key, &ignored) == 0;
     if (!have_skel && stop && *stop)
         return fr_fail(err, "%s: compile interrupted", scene);
-    key = with_file(scene, key);
     int made = 0;
     if (have_skel && st->have && st->skel.blob && key == st->key && (made = splice(st, &skel, out, err)) < 0) {
         scn_free(&skel);
@@ -137,7 +119,7 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     r->seconds = clock_now() - t0;
     st->reused += made;
     /* The skeleton stands for the full scene only when both read the same meshes. */
-    if (have_skel && !made && with_file(scene, cs.mesh_key) != key)
+    if (have_skel && !made && cs.mesh_key != key)
         scn_free(&skel);
     scn_free(&st->full);
     scn_free(&st->skel);

@@ -5,8 +5,8 @@
  * Compile once: a frame is first compiled as a skeleton (compile.h: a
  * JSON scene's meshes left out and their files not read, only a key of
  * what they would read, mesh.h's mesh_key; a glTF scene's meshes each a
- * stand-in triangle, keyed by what places and shapes them, and the file's
- * identity on disk).  When the key is the one of
+ * stand-in triangle, keyed by what places and shapes them and by the
+ * file's identity on disk: scene_hooks.h).  When the key is the one of
  * the frame before, the frame's scene is the last full compile with the
  * sections that differ between the two skeletons replaced by this
  * skeleton's, provided each of those sections was, in the frame before,

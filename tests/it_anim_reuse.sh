@@ -14,7 +14,9 @@
 # depends on both) compiles each frame whole, to the bytes of the frame
 # alone.  glTF animations (tests/support/genanim.py): a camera move is made
 # of the frame before's sections, a moving box compiles whole; with a
-# shutter too, every frame is the bytes of the frame alone.
+# shutter too, every frame is the bytes of the frame alone.  JSON frames
+# placing two glTF files of the same nodes but other vertices compile
+# whole.
 . "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
@@ -131,4 +133,19 @@ for sc in blur anim; do
 done
 check "blur.gltf: frames 1 and 2 made of the frame before's" test "$(grep -c "scene made of" log-blur-0.5)" -eq 2
 check "anim.gltf: the moving box compiles every frame" test "$(grep -c "scene compiled" log-anim-0.5)" -eq 3
+
+# f.000N.json places ga/morphN.gltf: the same nodes, other vertices.
+for i in 1 2; do
+    cat >"ga/m.000$i.json" <<JSON
+{ "image": { "width": 16, "height": 12, "spp": 1 },
+  "camera": { "position": [0, 0, 4], "target": [0, 0, 0], "fov": 60 },
+  "materials": {},
+  "lights": [ { "type": "point", "position": [0, 0, 3], "intensity": [5, 5, 5] } ],
+  "shapes": [ { "type": "gltf", "file": "morph$i.gltf" } ] }
+JSON
+done
+"$FRANJA" render 'ga/m.####.json' --frames 1-2 -o "gm/f.#.pfm" 2>log-gm || bad "glTF shapes: $(cat log-gm)"
+"$FRANJA" render ga/m.0002.json -o gm2.pfm 2>/dev/null || bad "ga/m.0002.json alone"
+check "another glTF file under the same nodes compiles whole" grep -q "frame 2: scene compiled" log-gm
+check "and renders as the frame alone" cmp -s gm/f.2.pfm gm2.pfm
 summary

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define XXH_INLINE_ALL
 #include <xxhash.h>
@@ -1049,10 +1050,28 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
     return rc;
 }
 
+/* The file's name and identity on disk (device, inode, size, time),
+ * folded into the hooks' mesh key: another file, or this one rewritten,
+ * may hold other meshes under the same nodes. */
+static void file_key(const char *path, const scene_hooks *hooks)
+{
+    uint64_t *k = hooks ? hooks->mesh_key : NULL;
+    struct stat st;
+    uint64_t id[5] = {0};
+    if (!k)
+        return;
+    if (stat(path, &st) == 0)
+        id[0] = (uint64_t)st.st_dev, id[1] = (uint64_t)st.st_ino, id[2] = (uint64_t)st.st_size,
+        id[3] = (uint64_t)st.st_mtim.tv_sec, id[4] = (uint64_t)st.st_mtim.tv_nsec;
+    *k = XXH3_64bits_withSeed(path, strlen(path) + 1, *k);
+    *k = XXH3_64bits_withSeed(id, sizeof id, *k);
+}
+
 int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *o, fr_builder *b, gltf_result *r,
                 fr_error *err)
 {
     gltf_doc d;
+    file_key(path, hooks);
     confine own;
     const confine *scope = o->scope;
     if (!scope) {

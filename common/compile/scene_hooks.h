@@ -94,9 +94,10 @@ typedef struct {
      * node's mesh stands as one triangle of the default material; the
      * mesh shapes of JSON scenes are the mesh hook's to leave out. */
     int skeleton;
-    /** When not NULL, every glTF mesh a node draws folds what places and
-     * shapes it (node, mesh, world transform, morph weights, joints) into
-     * *mesh_key, in a skeleton or not alike. */
+    /** When not NULL, every glTF file read folds its name and identity on
+     * disk, and every mesh a node draws what places and shapes it (node,
+     * mesh, world transform, morph weights, joints), into *mesh_key, in a
+     * skeleton or not alike. */
     uint64_t *mesh_key;
 } scene_hooks;
 
