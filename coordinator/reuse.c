@@ -65,6 +65,29 @@ static int skeleton(const char *scene, const compile_opts *co, const char *out, 
     return rc;
 }
 
+/* What moves while a shutter is open may be blurred, and a shutter is
+ * open at most a frame (--shutter, a camera's `shutter`): the meshes' keys
+ * half a frame before and after (skeletons posed there, without a
+ * shutter) are folded into *key too, so that a mesh moving around one
+ * frame and not around the frame before is seen. */
+static int shutter_keys(const char *scene, const compile_opts *co, const char *out, volatile sig_atomic_t *stop,
+                        uint64_t *key)
+{
+    for (int side = -1; side <= 1; side += 2) {
+        compile_opts at = *co;
+        at.frame = co->frame + 0.5 * side;
+        at.shutter = 0.0;
+        fr_scene s;
+        uint64_t k = 0;
+        fr_error ignored;
+        if (skeleton(scene, &at, out, stop, &s, &k, &ignored) < 0)
+            return -1;
+        scn_free(&s);
+        *key = *key * 0x9e3779b97f4a7c15ull ^ k;
+    }
+    return 0;
+}
+
 /* The patch from the frame before's scene to `now` into `patch` when it
  * is small enough (r->base, r->patch_bytes), else no patch file. */
 static int write_patch(const reuse_state *st, const fr_scene *now, const char *patch, reuse_result *r,
@@ -98,6 +121,11 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
      * which says what is wrong. */
     fr_error ignored;
     int have_skel = skeleton(scene, co, out, stop, &skel, &key, &ignored) == 0;
+    uint64_t key_now = key; /* the frame's own, as its full compile's */
+    if (have_skel && co->timed && shutter_keys(scene, co, out, stop, &key) < 0) {
+        scn_free(&skel);
+        have_skel = 0;
+    }
     if (!have_skel && stop && *stop)
         return fr_fail(err, "%s: compile interrupted", scene);
     int made = 0;
@@ -118,8 +146,9 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     r->reused = made;
     r->seconds = clock_now() - t0;
     st->reused += made;
-    /* The skeleton stands for the full scene only when both read the same meshes. */
-    if (have_skel && !made && cs.mesh_key != key)
+    /* The skeleton stands for the full scene only when both read the same
+     * meshes (key_now: the frame's key without the shutter's). */
+    if (have_skel && !made && cs.mesh_key != key_now)
         scn_free(&skel);
     scn_free(&st->full);
     scn_free(&st->skel);

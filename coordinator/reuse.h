@@ -6,7 +6,9 @@
  * JSON scene's meshes left out and their files not read, only a key of
  * what they would read, mesh.h's mesh_key; a glTF scene's meshes each a
  * stand-in triangle, keyed by what places and shapes them and by the
- * file's identity on disk: scene_hooks.h).  When the key is the one of
+ * file's identity on disk: scene_hooks.h; for one animated file, also
+ * the keys of skeletons posed half a frame before and after, the most a
+ * shutter is open).  When the key is the one of
  * the frame before, the frame's scene is the last full compile with the
  * sections that differ between the two skeletons replaced by this
  * skeleton's, provided each of those sections was, in the frame before,

@@ -16,7 +16,9 @@
 # of the frame before's sections, a moving box compiles whole; with a
 # shutter too, every frame is the bytes of the frame alone.  JSON frames
 # placing two glTF files of the same nodes but other vertices compile
-# whole.
+# whole.  A mesh that moves within half a frame of frame 2 (the most a
+# shutter is open), not at frame 2 itself, compiles frame 2 whole, so that
+# what a blur of it needs is never taken from frame 1.
 . "$(dirname "$0")/support/fakehosts.sh"
 fh_init
 cd "$FH" || exit 1
@@ -116,6 +118,17 @@ check "inside: frame 3 compiled whole" grep -q "frame 3: scene compiled" log-in
 check "inside: frame 3's scene is the full compile's" \
     cmp -s "in/f.3.pfm.franja-job/scene.fbin" "in3/f.3.pfm.franja-job/scene.fbin"
 check "inside: frame 3 equals the frame rendered alone" cmp -s "in/f.3.pfm" "in3/f.3.pfm"
+
+# A step key at frame 2.2: frames 1 and 2 have the mesh in one place, frame
+# 2's shutter closes (2.25) with it moved.
+sed -e 's|"camera": { "position": { "keys": \[\[1, \[0, 0, -4\]\], \[3, \[0, 0, 0\]\]\] }|"camera": { "position": [0, 0, -4], "shutter": 0.5|' \
+    -e 's|"file": "ball.obj", "material": "cloud"|"file": "ball.obj", "material": "w", "translate": { "keys": [[1, [0, 0, 0]], [2.2, [1, 0, 0]]], "interpolation": "step" }|' \
+    inside.json >step.json
+"$FRANJA" render step.json --frames 1-2 -o "st/f.#.pfm" --keep-job 2>log-st || bad "step: $(cat log-st)"
+"$FRANJA" render step.json --frames 2 -o "st2/f.#.pfm" --keep-job 2>/dev/null || bad "step, frame 2 alone"
+check "step: the key folds the shutter (frame 2 compiled whole)" grep -q "frame 2: scene compiled" log-st
+check "step: frame 2's scene is the full compile's" \
+    cmp -s "st/f.2.pfm.franja-job/scene.fbin" "st2/f.2.pfm.franja-job/scene.fbin"
 
 # glTF: blur.gltf's camera moves before a still quad; anim.gltf's box moves.
 mkdir -p ga && python3 "$ROOT/tests/support/genanim.py" ga >/dev/null || bad "genanim.py"
