@@ -57,6 +57,16 @@ static int scene_binary(frame_image *im, char *path, size_t cap, fr_scene *sc, f
         if (a->camera)
             return fr_fail(err, "%s: --camera applies to glTF scenes (a compiled scene has its camera)", a->scene);
         snprintf(path, cap, "%s", a->scene);
+        if (im->reuse) {
+            /* The patch goes into the job directory, made for it. */
+            if (mkdir(jobdir, 0755) && errno != EEXIST)
+                return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
+            snprintf(im->patch, sizeof im->patch, "%s/scene.patch", jobdir);
+            if (reuse_loaded(im->reuse, path, im->patch, &im->reused, err))
+                return -1;
+            if (!im->reused.base)
+                im->patch[0] = 0;
+        }
         return fbin_load(path, sc, err);
     }
     if (mkdir(jobdir, 0755) && errno != EEXIST)

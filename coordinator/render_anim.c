@@ -155,13 +155,16 @@ static int rf_open(anim_run *fx, sched_frame *next)
         fs->im->reuse = &fx->reuse;
         rc = frame_open(fs->im);
     }
-    if (!rc && fs->im->reused.seconds > 0) {
-        const reuse_result *r = &fs->im->reused;
+    const reuse_result *rr = fs->im ? &fs->im->reused : NULL;
+    if (!rc && (rr->seconds > 0 || rr->base)) {
         render_run_clear_line();
-        fprintf(stderr, "franja: %s: scene %s in %.3f s%s", fs->label,
-                r->reused ? "made of the frame before's" : "compiled", r->seconds, r->base ? "" : "\n");
-        if (r->base)
-            fprintf(stderr, "; a patch of %llu bytes from the frame before's\n", (unsigned long long)r->patch_bytes);
+        fprintf(stderr, "franja: %s: ", fs->label);
+        if (rr->seconds > 0)
+            fprintf(stderr, "scene %s in %.3f s%s", rr->reused ? "made of the frame before's" : "compiled",
+                    rr->seconds, rr->base ? "; " : "");
+        if (rr->base)
+            fprintf(stderr, "a patch of %llu bytes from the frame before's", (unsigned long long)rr->patch_bytes);
+        fputc('\n', stderr);
     }
     if (!rc)
         rc = frame_reporters(fx, fs);

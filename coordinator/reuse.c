@@ -159,6 +159,24 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     return 0;
 }
 
+int reuse_loaded(reuse_state *st, const char *path, const char *patch, reuse_result *r, fr_error *err)
+{
+    memset(r, 0, sizeof *r);
+    fr_scene now;
+    if (fbin_load(path, &now, err) < 0)
+        return -1;
+    if (write_patch(st, &now, patch, r, err) < 0) {
+        scn_free(&now);
+        return -1;
+    }
+    scn_free(&st->full);
+    scn_free(&st->skel); /* a compiled scene has no skeleton: the next frame compiles whole */
+    st->full = now;
+    st->key = 0;
+    st->have = 1;
+    return 0;
+}
+
 void reuse_free(reuse_state *st)
 {
     scn_free(&st->full);

@@ -17,11 +17,11 @@
  * (a mesh that moves, a section the meshes add to: the BVH, the lights)
  * compiles the frame whole.  The result is byte for byte the scene a full
  * compile of the frame makes (tests/it_anim_reuse.sh).  Compiled .fbin
- * frames are loaded as they are.
+ * frames are taken as they are (reuse_loaded).
  *
  * Send a delta: for every frame after the first, a scene patch (fpatch.h)
- * from the frame before's scene is written beside the frame's scene when
- * it is under a quarter of its size; stage_scene sends it to hosts that
+ * from the frame before's scene is written into the frame's job directory
+ * when it is under a quarter of the scene's size; stage_scene sends it to hosts that
  * hold the frame before's scene (transport/stage.h).
  *
  * One per animation run; the frames are opened one after the other.
@@ -60,6 +60,13 @@ typedef struct {
  * compiler's, or a write error). */
 int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out, const char *patch,
                   volatile sig_atomic_t *stop, reuse_result *r, fr_error *err);
+
+/** A frame given as a compiled scene (`path`, an .fbin): a patch to it
+ * from the frame before's scene written to `patch` as reuse_compile does
+ * (r->base, r->patch_bytes; r->seconds 0), and the scene kept for the next
+ * frame.  Returns 0, or -1 with err (a scene that does not load, a write
+ * error). */
+int reuse_loaded(reuse_state *st, const char *path, const char *patch, reuse_result *r, fr_error *err);
 
 /** Lets go of what st keeps. */
 void reuse_free(reuse_state *st);

@@ -9,7 +9,8 @@
 # for frames 2 and 3 instead of the whole scene, and its cached scenes are
 # the .fbin files.  A patch damaged on the way, or naming a base the host
 # no longer holds, is refused by the worker and the whole scene is sent;
-# a worker without the patch-1 feature gets whole scenes.  A camera that
+# a worker without the patch-1 feature gets whole scenes.  Compiled .fbin
+# frames travel as patches too.  A camera that
 # moves into a mesh holding a medium (which medium the camera sits in
 # depends on both) compiles each frame whole, to the bytes of the frame
 # alone.  glTF animations (tests/support/genanim.py): a camera move is made
@@ -83,6 +84,13 @@ done
 s1=$(sent log-a a 1) s2=$(sent log-a a 2) s3=$(sent log-a a 3)
 check "a: frame 1 sends the scene ($s1 bytes)" test "${s1:-0}" -gt 100000
 check "a: frames 2 and 3 send a patch ($s2, $s3 bytes)" test -n "$s2" -a "${s2:-99999}" -lt 4096 -a "${s3:-99999}" -lt 4096
+# The frames as compiled scenes: patches all the same.
+mkdir -p fb
+for f in 1 2 3; do cp "still/f.$f.pfm.franja-job/scene.fbin" "fb/f.$f.fbin"; done
+fr render 'fb/f.#.fbin' --frames 1-3 -o "fbo/f.#.pfm" --hosts hosts.a 2>log-fb || bad "fbin frames: $(cat log-fb)"
+s2=$(sent log-fb a 2) s3=$(sent log-fb a 3)
+check "a: .fbin frames 2 and 3 send a patch ($s2, $s3 bytes)" test -n "$s2" -a "${s2:-99999}" -lt 4096 -a "${s3:-99999}" -lt 4096
+check "a: .fbin frame 3 equals the frame rendered alone" cmp -s fbo/f.3.pfm still/f.3.pfm
 for f in 2 3; do
     hash=$("$WORKER" --scene "a/f.$f.pfm.franja-job/scene.fbin" --check)
     check "a: the cached scene of frame $f is the .fbin" cmp -s "a/work/scenes/$hash.fbin" "a/f.$f.pfm.franja-job/scene.fbin"
