@@ -4,7 +4,9 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <limits.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "clock.h"
@@ -43,6 +45,60 @@ static int splice(const reuse_state *st, const fr_scene *skel, const char *out, 
     int rc = file_write_atomic(out, blob, size, err);
     free(blob);
     return rc < 0 ? -1 : 1;
+}
+
+/* 1 when every file of the list (compile_child.h) is as it was listed. */
+static int files_unchanged(const char *list)
+{
+    if (!list)
+        return 0;
+    for (const char *line = list; *line;) {
+        const char *nl = strchr(line, '\n');
+        if (!nl)
+            return 0;
+        unsigned long long dev, ino;
+        long long size, sec;
+        long nsec;
+        int at = 0;
+        char path[PATH_MAX];
+        size_t n = (size_t)(nl - line);
+        struct stat st;
+        if (sscanf(line, "%llu %llu %lld %lld %ld %n", &dev, &ino, &size, &sec, &nsec, &at) != 5 || at <= 0 ||
+            n - (size_t)at >= sizeof path)
+            return 0;
+        memcpy(path, line + at, n - (size_t)at);
+        path[n - (size_t)at] = 0;
+        if (stat(path, &st) < 0 || (unsigned long long)st.st_dev != dev || (unsigned long long)st.st_ino != ino ||
+            (long long)st.st_size != size || (long long)st.st_mtim.tv_sec != sec || st.st_mtim.tv_nsec != nsec)
+            return 0;
+        line = nl + 1;
+    }
+    return 1;
+}
+
+/* The full compile of the frame into `out`, keeping the list of the files
+ * it read in st->files (none: NULL, so that no frame is made of it). */
+static int full_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out,
+                        volatile sig_atomic_t *stop, compile_child_stats *cs, fr_error *err)
+{
+    char list[4400];
+    snprintf(list, sizeof list, "%s.files", out);
+    unlink(list);
+    compile_opts fo = *co;
+    fo.files = list;
+    free(st->files);
+    st->files = NULL;
+    if (compile_child(scene, &fo, out, stop, cs, err) < 0)
+        return -1;
+    char *text = NULL;
+    size_t len;
+    fr_error ignored;
+    if (file_read(list, &text, &len, &ignored) == 0 && strlen(text) == len)
+        st->files = text;
+    else
+        free(text);
+    unlink(list);
+    return 0;
 }
 
 /* The skeleton of the frame (JSON scenes) into *skel, mapped; its file
@@ -129,12 +185,13 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     if (!have_skel && stop && *stop)
         return fr_fail(err, "%s: compile interrupted", scene);
     int made = 0;
-    if (have_skel && st->have && st->skel.blob && key == st->key && (made = splice(st, &skel, out, err)) < 0) {
+    if (have_skel && st->have && st->skel.blob && key == st->key && files_unchanged(st->files) &&
+        (made = splice(st, &skel, out, err)) < 0) {
         scn_free(&skel);
         return -1;
     }
     compile_child_stats cs = {0};
-    if (!made && compile_child(scene, co, out, stop, &cs, err) < 0) {
+    if (!made && full_compile(st, scene, co, out, stop, &cs, err) < 0) {
         scn_free(&skel);
         return -1;
     }
@@ -171,6 +228,8 @@ int reuse_loaded(reuse_state *st, const char *path, const char *patch, reuse_res
     }
     scn_free(&st->full);
     scn_free(&st->skel); /* a compiled scene has no skeleton: the next frame compiles whole */
+    free(st->files);
+    st->files = NULL;
     st->full = now;
     st->key = 0;
     st->have = 1;
@@ -179,6 +238,7 @@ int reuse_loaded(reuse_state *st, const char *path, const char *patch, reuse_res
 
 void reuse_free(reuse_state *st)
 {
+    free(st->files);
     scn_free(&st->full);
     scn_free(&st->skel);
     memset(st, 0, sizeof *st);

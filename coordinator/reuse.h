@@ -15,7 +15,9 @@
  * the same in the skeleton as in the full scene (the meshes added nothing
  * to it: the camera, the settings, the camera's motion).  Anything else
  * (a mesh that moves, a section the meshes add to: the BVH, the lights)
- * compiles the frame whole.  The result is byte for byte the scene a full
+ * compiles the frame whole, and so does a file that the last full compile
+ * read and that changed since (a mesh's MTL file, a texture it names).
+ * The result is byte for byte the scene a full
  * compile of the frame makes (tests/it_anim_reuse.sh).  Compiled .fbin
  * frames are taken as they are (reuse_loaded).
  *
@@ -41,6 +43,7 @@ typedef struct {
     fr_scene full;             /**< its scene, mapped (the mapping outlives its job directory) */
     fr_scene skel;             /**< its skeleton (JSON scenes; else empty) */
     uint64_t key;              /**< its meshes' key */
+    char *files;               /**< the files its last full compile read (compile_child.h's list), or NULL */
     int have;                  /**< 1 once a frame was compiled */
     int reused;                /**< frames made from the frame before's sections (for the log) */
 } reuse_state;

@@ -38,6 +38,8 @@ typedef struct {
                                     sections the rest makes, for frame_reuse.h */
     uint64_t *mesh_key;        /**< when not NULL, receives the meshes' key (mesh.h's mesh_key over
                                     every mesh shape of a JSON scene, in order; 0 without) */
+    const char *files;         /**< compile_child only: when not NULL, the file it writes the list of
+                                    files the compile read into (compile_child.h) */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */
