@@ -36,6 +36,8 @@ enum {
     SEC_LIGHT_GROUPS, SEC_GROUP_NAMES, SEC_COUNT = SEC_GROUP_NAMES
 };
 
+_Static_assert(SEC_COUNT == FBIN_SECTIONS, "fbin.h's FBIN_SECTIONS is the number of sections");
+
 /* Where each section lives in an fr_scene, so serialize and open share one
  * table instead of thirteen copies of the same lines. */
 typedef struct {

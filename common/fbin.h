@@ -21,6 +21,9 @@
 
 #define FBIN_VERSION 15
 
+/** The number of sections of the format (FORMAT.md, "Sections"). */
+#define FBIN_SECTIONS 32
+
 /** Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */
 int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err);

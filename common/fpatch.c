@@ -16,6 +16,7 @@
 
 /* The binary scene's own layout (FORMAT.md): header, table, alignment. */
 enum { SCN_HEADER = 64, SCN_ENTRY = 32, SCN_ALIGN = 64 };
+_Static_assert(FPATCH_SECTIONS <= 32, "a patch's mask has 32 bits: a new mask is a new patch version");
 enum { SCN_HEAD = SCN_HEADER + SCN_ENTRY * FPATCH_SECTIONS }; /* 1088, a multiple of 64 */
 static const unsigned char scn_magic[8] = {0x89, 'F', 'R', 'J', 'S', 'C', 'N', '\n'};
 

@@ -23,6 +23,7 @@
 #include <stdint.h>
 
 #include "error.h"
+#include "fbin.h"
 
 /** The `--features` word of a worker that applies scene patches. */
 #define FPATCH_FEATURE "patch-1"
@@ -31,8 +32,9 @@
 /** Layout version of patches (FORMAT.md, "Scene patches"). */
 #define FPATCH_VERSION 1u
 /** Sizes: the header; the entry before each section carried; the
- * sections of a binary scene (ids 1 to FPATCH_SECTIONS). */
-enum { FPATCH_HEADER = 64, FPATCH_ENTRY = 16, FPATCH_SECTIONS = 32 };
+ * sections of a binary scene (ids 1 to FPATCH_SECTIONS, fbin.h's; the
+ * mask of carried sections holds up to 32). */
+enum { FPATCH_HEADER = 64, FPATCH_ENTRY = 16, FPATCH_SECTIONS = FBIN_SECTIONS };
 
 /** One section of a binary scene: `count` elements of `elem` bytes at
  * `data` (not owned). */

@@ -20,8 +20,8 @@ enum { PATCH_FRACTION = 4 };
 
 /* The frame's scene made of the frame before's full scene and the
  * sections its skeleton changed, into `out`: 1 when made, 0 when the
- * frame needs a full compile (a changed section the meshes add to), -1
- * with err on a write error or memory. */
+ * frame needs a full compile (a changed section the meshes add to, or
+ * anything unexpected), -1 with err on a write error. */
 static int splice(const reuse_state *st, const fr_scene *skel, const char *out, fr_error *err)
 {
     fpatch_sect full[FPATCH_SECTIONS + 1], was[FPATCH_SECTIONS + 1], now[FPATCH_SECTIONS + 1];
@@ -29,7 +29,7 @@ static int splice(const reuse_state *st, const fr_scene *skel, const char *out, 
     if (fpatch_sections(st->full.blob, st->full.blob_size, full, &e) < 0 ||
         fpatch_sections(st->skel.blob, st->skel.blob_size, was, &e) < 0 ||
         fpatch_sections(skel->blob, skel->blob_size, now, &e) < 0)
-        return fr_fail(err, "%s: %s", out, e.msg);
+        return 0;
     for (int id = 1; id <= FPATCH_SECTIONS; id++) {
         if (fpatch_same(&was[id], &now[id]))
             continue;
@@ -40,8 +40,8 @@ static int splice(const reuse_state *st, const fr_scene *skel, const char *out, 
     void *blob;
     size_t size;
     uint64_t hash;
-    if (fpatch_assemble(full, &blob, &size, &hash, err) < 0)
-        return -1;
+    if (fpatch_assemble(full, &blob, &size, &hash, &e) < 0)
+        return 0;
     int rc = file_write_atomic(out, blob, size, err);
     free(blob);
     return rc < 0 ? -1 : 1;
@@ -155,8 +155,9 @@ static int write_patch(const reuse_state *st, const fr_scene *now, const char *p
     void *p;
     size_t n;
     uint32_t changed;
-    if (fpatch_make(st->full.blob, st->full.blob_size, now->blob, now->blob_size, &p, &n, &changed, err) < 0)
-        return -1;
+    fr_error e;
+    if (fpatch_make(st->full.blob, st->full.blob_size, now->blob, now->blob_size, &p, &n, &changed, &e) < 0)
+        return 0; /* no patch: the scene travels whole */
     int rc = 0;
     if (n < now->blob_size / PATCH_FRACTION && (rc = file_write_atomic(patch, p, n, err)) == 0) {
         r->base = st->full.hash;
