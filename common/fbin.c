@@ -36,6 +36,8 @@ enum {
     SEC_LIGHT_GROUPS, SEC_GROUP_NAMES, SEC_COUNT = SEC_GROUP_NAMES
 };
 
+_Static_assert(SEC_COUNT == FBIN_SECTIONS, "fbin.h's FBIN_SECTIONS is the number of sections");
+
 /* Where each section lives in an fr_scene, so serialize and open share one
  * table instead of thirteen copies of the same lines. */
 typedef struct {
@@ -102,6 +104,16 @@ static const void *sec_data(const fr_scene *s, int id, uint64_t *count)
 
 void fbin_hash_hex(uint64_t hash, char buf[17]) { snprintf(buf, 17, "%016llx", (unsigned long long)hash); }
 
+void fbin_put_header(unsigned char *head, uint64_t size)
+{
+    memcpy(head, fbin_magic, 8);
+    put32(head + 8, FBIN_VERSION);
+    put32(head + 12, 0x01020304u);
+    put32(head + 16, HEADER_SIZE);
+    put32(head + 20, SEC_COUNT);
+    put64(head + 24, size);
+}
+
 /* The bytes before the first section: header (hash still zero) and
  * table, then zeros to the first section's alignment. */
 enum { HEAD_SIZE = (HEADER_SIZE + ENTRY_SIZE * SEC_COUNT + ALIGN - 1) & ~(ALIGN - 1) };
@@ -124,12 +136,7 @@ static size_t layout(const fr_scene *view, unsigned char head[HEAD_SIZE], size_t
         put64(e + 24, count * sections[id].elem);
         off = align_up(off + count * sections[id].elem);
     }
-    memcpy(head, fbin_magic, 8);
-    put32(head + 8, FBIN_VERSION);
-    put32(head + 12, 0x01020304u);
-    put32(head + 16, HEADER_SIZE);
-    put32(head + 20, SEC_COUNT);
-    put64(head + 24, off);
+    fbin_put_header(head, off);
     return off;
 }
 

@@ -21,6 +21,9 @@
 
 #define FBIN_VERSION 15
 
+/** The number of sections of the format (FORMAT.md, "Sections"). */
+#define FBIN_SECTIONS 32
+
 /** Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */
 int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *err);
@@ -41,6 +44,11 @@ int fbin_load(const char *path, fr_scene *out, fr_error *err);
 
 /** Write a scene's blob to `path` atomically (temporary name, then rename). */
 int fbin_write(const fr_scene *s, const char *path, fr_error *err);
+
+/** The header's first 32 bytes of a scene of `size` bytes into head:
+ * magic, version, byte-order mark, header size, section count, size (the
+ * hash and the reserved bytes are the caller's). */
+void fbin_put_header(unsigned char *head, uint64_t size);
 
 /** The 16 lowercase hex digits of a hash, NUL-terminated, into buf[17]. */
 void fbin_hash_hex(uint64_t hash, char buf[17]);

@@ -44,14 +44,29 @@ static void print_warning(void *user, const char *msg)
 }
 
 /* Gets the binary scene: loads an .fbin, or compiles a JSON scene into the
- * job directory.  *path receives the .fbin to ship. */
-static int scene_binary(const frame_settings *a, const char *jobdir, char *path, size_t cap, fr_scene *sc,
-                        volatile sig_atomic_t *stop, fr_error *err)
+ * job directory.  *path receives the .fbin to ship; an animation's frame
+ * (im->reuse) is compiled by reuse.h, which may leave a scene patch in
+ * im->patch. */
+static int scene_binary(frame_image *im, char *path, size_t cap, fr_scene *sc, fr_error *err)
 {
+    const frame_settings *a = &im->a;
+    const char *jobdir = im->jobdir;
+    volatile sig_atomic_t *stop = im->stop;
+    im->patch[0] = 0;
     if (!ends_with(a->scene, ".json") && !compile_is_gltf(a->scene)) {
         if (a->camera)
             return fr_fail(err, "%s: --camera applies to glTF scenes (a compiled scene has its camera)", a->scene);
         snprintf(path, cap, "%s", a->scene);
+        if (im->reuse) {
+            /* The patch goes into the job directory, made for it. */
+            if (mkdir(jobdir, 0755) && errno != EEXIST)
+                return fr_fail(err, "%s: cannot create job directory: %s", jobdir, strerror(errno));
+            snprintf(im->patch, sizeof im->patch, "%s/scene.patch", jobdir);
+            if (reuse_loaded(im->reuse, path, im->patch, &im->reused, err))
+                return -1;
+            if (!im->reused.base)
+                im->patch[0] = 0;
+        }
         return fbin_load(path, sc, err);
     }
     if (mkdir(jobdir, 0755) && errno != EEXIST)
@@ -62,8 +77,15 @@ static int scene_binary(const frame_settings *a, const char *jobdir, char *path,
     compile_child_sweep(path);
     /* In a child process, so that Ctrl-C stops a long compile at once. */
     compile_opts co = {a->camera, print_warning, (void *)"franja", a->allow, a->n_allow, &a->limits, NULL,
-                       a->timed, a->frame, a->fps > 0 ? a->fps : GANIM_FPS, a->timed ? a->shutter : 0.0};
-    if (compile_child(a->scene, &co, path, stop, NULL, err))
+                       a->timed, a->frame, a->fps > 0 ? a->fps : GANIM_FPS, a->timed ? a->shutter : 0.0,
+                       0, NULL, NULL};
+    if (im->reuse) {
+        snprintf(im->patch, sizeof im->patch, "%s/scene.patch", jobdir);
+        if (reuse_compile(im->reuse, a->scene, &co, path, im->patch, stop, &im->reused, err))
+            return -1;
+        if (!im->reused.base)
+            im->patch[0] = 0;
+    } else if (compile_child(a->scene, &co, path, stop, NULL, err))
         return -1;
     return fbin_load(path, sc, err);
 }
@@ -241,7 +263,7 @@ int frame_open(frame_image *im)
     fr_error err;
     im->t0 = clock_now();
     fr_scene sc;
-    if (scene_binary(a, im->jobdir, im->fbin, sizeof im->fbin, &sc, im->stop, &err)) {
+    if (scene_binary(im, im->fbin, sizeof im->fbin, &sc, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         return *im->stop ? 130 : 1;
     }

@@ -26,6 +26,7 @@
 #include "monitor.h"
 #include "output.h"
 #include "progress.h"
+#include "reuse.h"
 #include "sched.h"
 #include "tonemap.h"
 
@@ -126,6 +127,10 @@ typedef struct {
     double t0;
     progress_reporter *pg;           /* --progress json, or NULL */
     mon_server *mon;           /* --monitor, or NULL */
+    reuse_state *reuse;        /* an animation's frame: what the run keeps of the frame before (reuse.h;
+                                  not owned), or NULL */
+    char patch[4300];          /* set by frame_open: a scene patch from the frame before's scene, or "" */
+    reuse_result reused;       /* set by frame_open with reuse: what reuse_compile did */
 } frame_image;
 
 /** What a pass to spp samples per pixel renders: the rows the job

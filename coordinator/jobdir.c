@@ -796,8 +796,8 @@ void job_remove(const char *dir)
     char path[4200];
     each_slab(dir, remove_one, NULL, &ignore);
     remove_temporaries(dir);
-    const char *names[] = {"job", "scene.fbin"};
-    for (size_t i = 0; i < 2; i++) {
+    const char *names[] = {"job", "scene.fbin", "scene.patch"};
+    for (size_t i = 0; i < 3; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
         unlink(path);
     }

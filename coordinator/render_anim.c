@@ -38,6 +38,8 @@ typedef struct {
     double deadline;           /* --time-limit: clock_now() time the run stops at; 0 = none */
     progress_reporter *pg;           /* the run's --progress json, or NULL */
     mon_server *mon;           /* the run's --monitor, or NULL */
+    reuse_state reuse;         /* the frame before's scene, for the next compile and patch (reuse.h) */
+    uint64_t *host_scene;      /* per host: the hash of the last scene staged there, 0 none */
 } anim_run;
 
 /* The monitor's view of frame fs in state st. */
@@ -149,8 +151,21 @@ static int rf_open(anim_run *fx, sched_frame *next)
         fs->im->a.time_limit = 0;
         rc = frame_lock(fs->im);
     }
-    if (!rc)
+    if (!rc) {
+        fs->im->reuse = &fx->reuse;
         rc = frame_open(fs->im);
+    }
+    const reuse_result *rr = fs->im ? &fs->im->reused : NULL;
+    if (!rc && (rr->seconds > 0 || rr->base)) {
+        render_run_clear_line();
+        fprintf(stderr, "franja: %s: ", fs->label);
+        if (rr->seconds > 0)
+            fprintf(stderr, "scene %s in %.3f s%s", rr->reused ? "made of the frame before's" : "compiled",
+                    rr->seconds, rr->base ? "; " : "");
+        if (rr->base)
+            fprintf(stderr, "a patch of %llu bytes from the frame before's", (unsigned long long)rr->patch_bytes);
+        fputc('\n', stderr);
+    }
     if (!rc)
         rc = frame_reporters(fx, fs);
     if (rc) {
@@ -192,14 +207,20 @@ static int rf_stage(void *ctx, int frame, sched_host *h, int host_i, char *scene
     double t0 = clock_now();
     uint64_t sent = 0;
     fr_error e2;
-    if (cluster_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, scene, scene_cap, lease, lease_cap, &sent, &e2))
+    /* A patch only to a host given its base scene in this run. */
+    stage_patch patch = {fs->im->patch, fs->im->reused.base};
+    const stage_patch *pp = fs->im->patch[0] && fx->host_scene[host_i] == patch.base ? &patch : NULL;
+    if (cluster_stage(h->tr, e, fs->im->fbin, fs->im->spec.hash, pp, scene, scene_cap, lease, lease_cap, &sent,
+                      &e2))
         return fr_fail(err, "%s: %s", fs->label, e2.msg);
+    fx->host_scene[host_i] = fs->im->spec.hash;
     h->sent += sent;
     if (fx->table->path[0] != '(' || !isatty(2)) {
         render_run_clear_line();
         char how[64];
         render_run_scene_state(e, sent, how);
-        fprintf(stderr, "franja: host %s: %s: scene %s (%.2f s)\n", h->name, fs->label, how, clock_now() - t0);
+        fprintf(stderr, "franja: host %s: %s: scene %s (%.2f s, %llu bytes sent)\n", h->name, fs->label, how,
+                clock_now() - t0, (unsigned long long)sent);
     }
     return 0;
 }
@@ -309,6 +330,10 @@ int render_anim(int argc, char **argv, frame_settings *a, render_anim_parse_fn p
         rc = render_run_hosts(a, argc, argv, &table, &alloc);
     int timed_out = 0, hosts_ok = !rc;
     fx.table = &table;
+    if (!rc && !(fx.host_scene = calloc((size_t)(table.n > 0 ? table.n : 1), sizeof *fx.host_scene))) {
+        fprintf(stderr, "franja render: out of memory\n");
+        rc = 1;
+    }
     sched_frame first;
     if (!rc && rf_open(&fx, &first) == 0) {
         char used[1024];
@@ -358,6 +383,8 @@ int render_anim(int argc, char **argv, frame_settings *a, render_anim_parse_fn p
         free(fs);
     }
     free(fx.fr);
+    free(fx.host_scene);
+    reuse_free(&fx.reuse);
     progress_run_end(fx.pg, rc == 0 ? "ok" : how, fx.it.fl.n, fx.it.rendered, fx.it.skipped);
     mon_status(fx.mon, rc == 0 ? "done" : rc == 130 ? "interrupted" : rc == FRAMES_TIME_LIMIT ? "stopped" : "failed");
     mon_stop(fx.mon);

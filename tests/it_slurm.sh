@@ -101,9 +101,11 @@ check "it lies in the nodes' cache under its content hash" \
 check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
 check "no step is left after the render" no_leftovers
 
-# An animation in one allocation: every frame equals its own render.
+# An animation in one allocation: every frame equals its own render.  The
+# camera moves (so that frame 2 can travel as a patch of frame 1's scene).
 for i in 1 2; do
-    sed "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [$((150 * i + 100)), 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+    sed -e "/\"shapes\": \[/a { \"type\": \"sphere\", \"center\": [250, 100, 300], \"radius\": 80, \"material\": \"white\" }," \
+        -e "s/\"position\": \[278, 273, -800\]/\"position\": [$((218 + 60 * i)), 273, -800]/" \
         "$ROOT/scenes/cornell.json" >"f.000$i.json"
     "$FRANJA" render "f.000$i.json" -o "fref$i.pfm" $SIZE -j 1 2>/dev/null
 done
@@ -117,6 +119,16 @@ check "the frames run over one set of steps: each node probed once" \
 check "each frame's scene staged on each node" \
     test "$(grep -Ec 'host n[123]: frame [12]: scene (uploaded|already there)' logf)" -eq 6
 check "no step is left after the animation" no_leftovers
+# On one node, which stages frame 1 before frame 2: frame 2's scene goes
+# as a patch of frame 1's (common/fpatch.h), rebuilt by a step there.
+render logp -N1 -n2 "$FRANJA" render 'f.####.json' --frames 1-2 -o 'animp/f.####.pfm' $SIZE --slurm \
+    --workdir "$T/patchwd"
+s1=$(sed -n "s/^franja: host n[123]: frame 1: scene .*, \([0-9]*\) bytes sent).*/\1/p" logp)
+s2=$(sed -n "s/^franja: host n[123]: frame 2: scene .*, \([0-9]*\) bytes sent).*/\1/p" logp)
+check "one node: frame 2 sent as a patch ($s2 bytes) of frame 1's scene ($s1 bytes)" \
+    test -n "$s1" -a -n "$s2" -a "${s2:-0}" -gt 0 -a "$((${s2:-0} * 4))" -lt "${s1:-0}"
+check "one node: no patch failed" sh -c "! grep -q 'did not unpack' logp"
+check "one node: frame 2 equals its own render" cmp -s animp/f.0002.pfm fref2.pfm
 
 # Bidirectional: every step's partial carries its splats over the whole
 # image, and the sum over nodes has the bytes of a one-process render.

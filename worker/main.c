@@ -22,6 +22,7 @@
 #include "splat.h"
 #include "trace.h"
 #include "unpack.h"
+#include "fpatch.h"
 #ifndef FRANJA_NO_JSON
 #include "compile/json_scene.h"
 #endif
@@ -49,10 +50,12 @@ static const char usage[] =
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
-    "  --unpack F     unpack the packed scene or zstd file F into the --scene file,\n"
+    "  --unpack F     unpack the packed scene, zstd file or scene patch F into the\n"
+    "                 --scene file (a patch: of the scene HASH.fbin beside it),\n"
     "                 check it as --check does (printing its hash) and remove F\n"
     "  --features     print what this build can do besides rendering\n"
-    "                 (" PROTO_FEATURE_UNPACK ", " UNPACK_FEATURE ": --unpack of the two forms)\n"
+    "                 (" PROTO_FEATURE_UNPACK ", " UNPACK_FEATURE ": --unpack of the two forms;\n"
+    "                 " FPATCH_FEATURE ": of scene patches)\n"
     "  --lifeline     end when standard input (a pipe) reaches its end\n"
     "  --sums         append each pixel's sample sums to the PF image, so that a\n"
     "                 later render can add samples exactly (path integrator, no\n"
@@ -122,12 +125,13 @@ int main(int argc, char **argv)
         return 0;
     }
     if (req.mode == PROTO_FEATURES) {
-        printf("%s\n", unpack_available() ? PROTO_FEATURE_UNPACK " " UNPACK_FEATURE : "");
+        printf("%s%s\n", unpack_available() ? PROTO_FEATURE_UNPACK " " UNPACK_FEATURE " " : "", FPATCH_FEATURE);
         return 0;
     }
     if (req.mode == PROTO_UNPACK) {
         uint64_t hash;
-        if (unpack_file(req.unpack, req.slab.scene, &hash, &err) < 0) {
+        if ((fpatch_is(req.unpack) ? fpatch_file(req.unpack, req.slab.scene, &hash, &err)
+                                   : unpack_file(req.unpack, req.slab.scene, &hash, &err)) < 0) {
             fprintf(stderr, "franja-worker: %s\n", err.msg);
             return 1;
         }

@@ -73,6 +73,16 @@ static int outside(const confine *c, const char *path, fr_error *err)
                    "(franja --allow-path DIR allows another)", path, c->root);
 }
 
+/* confine_watch's observer (one compile a process). */
+static void (*watch_fn)(void *user, const char *real, const struct stat *st);
+static void *watch_user;
+
+void confine_watch(void (*fn)(void *user, const char *real, const struct stat *st), void *user)
+{
+    watch_fn = fn;
+    watch_user = user;
+}
+
 int confine_open(const confine *c, const char *path, size_t max, int *fd, size_t *size, fr_error *err)
 {
     *fd = -1;
@@ -124,6 +134,8 @@ int confine_open(const confine *c, const char *path, size_t max, int *fd, size_t
     }
     *fd = d;
     *size = (size_t)st.st_size;
+    if (watch_fn)
+        watch_fn(watch_user, real, &st);
     return 0;
 }
 

@@ -19,6 +19,7 @@
 #define FRANJA_CONFINE_H
 
 #include <stddef.h>
+#include <sys/stat.h>
 
 #include "error.h"
 
@@ -56,6 +57,11 @@ int confine_below(const char *real, const char *dir);
  * (a character device, a directory ...), or "PATH: N bytes, more than the
  * M this reader takes". */
 int confine_open(const confine *c, const char *path, size_t max, int *fd, size_t *size, fr_error *err);
+
+/** From now on, in this process, every file confine_open opens is also
+ * given to fn (its real path and its fstat), with `user`; fn NULL stops
+ * it.  How a compile lists the files it read (compile.h: files). */
+void confine_watch(void (*fn)(void *user, const char *real, const struct stat *st), void *user);
 
 /** confine_open, then reads the whole file into a new malloc'd buffer with
  * a NUL after its *len bytes (the caller frees *data).  Also fails with

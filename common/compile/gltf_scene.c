@@ -6,6 +6,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
 
 #include "fmath.h"
 #include "compile/builder_instance.h"
@@ -500,11 +504,41 @@ static int morph_weights(imp *c, uint32_t n, uint32_t m, morph *mw, fr_error *er
  * by several is read once in its own space and placed by an instance per
  * node (builder_instance.h), unless morph weights bend it: then this node's
  * copy is placed into the world's triangles. */
+/* What places and shapes node n's mesh m, folded into the hooks' key. */
+static void mesh_key(imp *c, uint32_t n, uint32_t m, const affine *w, const morph *mw, const skinning *sk)
+{
+    uint64_t *k = c->hooks ? c->hooks->mesh_key : NULL;
+    if (!k)
+        return;
+    uint32_t id[4] = {n, m, mw->n, sk ? sk->n : 0};
+    *k = XXH3_64bits_withSeed(id, sizeof id, *k);
+    *k = XXH3_64bits_withSeed(w->m, sizeof w->m, *k);
+    *k = XXH3_64bits_withSeed(mw->w, mw->n * sizeof *mw->w, *k);
+    if (sk)
+        *k = XXH3_64bits_withSeed(sk->joint, sk->n * sizeof *sk->joint, *k);
+}
+
+/* A skeleton's mesh: one triangle of the default material in its place. */
+static int stand_in(imp *c, fr_error *err)
+{
+    uint32_t mat;
+    const double *uvxf;
+    if (gmat_material(&c->mat, UINT32_MAX, &mat, &uvxf, err) < 0)
+        return -1;
+    if (bld_triangle(c->b, v3(0.0f, 0.0f, 0.0f), v3(1.0f, 0.0f, 0.0f), v3(0.0f, 1.0f, 0.0f), mat) == FR_NONE)
+        return gdoc_fail(c->d, err, NULL, "out of memory");
+    c->r->triangles++;
+    return 0;
+}
+
 static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning *sk, fr_error *err)
 {
     morph mw;
     if (morph_weights(c, n, m, &mw, err) < 0)
         return -1;
+    mesh_key(c, n, m, w, &mw, sk);
+    if (c->hooks && c->hooks->skeleton)
+        return stand_in(c, err);
     if (c->uses[m] < 2 || mw.n || sk)
         return mesh_prims(c, m, w, &mw, sk, err);
     if (c->mesh_of[m] == FR_NONE) {
@@ -1016,10 +1050,28 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
     return rc;
 }
 
+/* The file's name and identity on disk (device, inode, size, time),
+ * folded into the hooks' mesh key: another file, or this one rewritten,
+ * may hold other meshes under the same nodes. */
+static void file_key(const char *path, const scene_hooks *hooks)
+{
+    uint64_t *k = hooks ? hooks->mesh_key : NULL;
+    struct stat st;
+    uint64_t id[5] = {0};
+    if (!k)
+        return;
+    if (stat(path, &st) == 0)
+        id[0] = (uint64_t)st.st_dev, id[1] = (uint64_t)st.st_ino, id[2] = (uint64_t)st.st_size,
+        id[3] = (uint64_t)st.st_mtim.tv_sec, id[4] = (uint64_t)st.st_mtim.tv_nsec;
+    *k = XXH3_64bits_withSeed(path, strlen(path) + 1, *k);
+    *k = XXH3_64bits_withSeed(id, sizeof id, *k);
+}
+
 int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *o, fr_builder *b, gltf_result *r,
                 fr_error *err)
 {
     gltf_doc d;
+    file_key(path, hooks);
     confine own;
     const confine *scope = o->scope;
     if (!scope) {

@@ -90,6 +90,15 @@ typedef struct {
      * `frame` (0: no motion blur).  What moves across it is blurred
      * (scene.h's fr_motion). */
     double shutter;
+    /** A skeleton (coordinator/reuse.h): glTF meshes are not read, each
+     * node's mesh stands as one triangle of the default material; the
+     * mesh shapes of JSON scenes are the mesh hook's to leave out. */
+    int skeleton;
+    /** When not NULL, every glTF file read folds its name and identity on
+     * disk, and every mesh a node draws what places and shapes it (node,
+     * mesh, world transform, morph weights, joints), into *mesh_key, in a
+     * skeleton or not alike. */
+    uint64_t *mesh_key;
 } scene_hooks;
 
 #endif

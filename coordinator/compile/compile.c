@@ -68,18 +68,34 @@ int compile_is_gltf(const char *path)
     return (n > 5 && !strcasecmp(path + n - 5, ".gltf")) || (n > 4 && !strcasecmp(path + n - 4, ".glb"));
 }
 
+/* The compile's meshes' key, and whether they are left out (compile_opts:
+ * skeleton, mesh_key); a compile runs on one thread. */
+static uint64_t keys;
+static int skeleton;
+
+/* The mesh hook: its key folded in, then the mesh read unless left out. */
+static int mesh_hook(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
+                     uint32_t material, fr_error *err)
+{
+    if (mesh_key(b, node, where, dir, material, &keys, err) < 0)
+        return -1;
+    return skeleton ? mesh_stand_in(b, err) : mesh_add(b, node, where, dir, scope, material, err);
+}
+
 int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err)
 {
+    keys = 0;
+    skeleton = o && o->skeleton;
     fr_budget budget;
     if (o && o->limits)
         memcpy(budget.limit, o->limits->limit, sizeof budget.limit);
     else
         budget_init(&budget);
     memset(budget.used, 0, sizeof budget.used);
-    scene_hooks hooks = {mesh_add, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
+    scene_hooks hooks = {mesh_hook, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
                          o ? o->allow : NULL, o ? o->n_allow : 0, &budget,
                          o ? o->fbin : NULL, o ? o->timed : 0, o ? o->frame : 0.0, o ? o->fps : 0.0,
-                         o ? o->shutter : 0.0};
+                         o ? o->shutter : 0.0, skeleton, &keys};
     int rc;
     if (compile_is_gltf(path))
         rc = gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
@@ -87,6 +103,8 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
         return fr_fail(err, "%s: --camera names a camera of a glTF scene; a JSON scene has its own", path);
     else
         rc = json_scene_load(path, &hooks, out, err);
+    if (rc == 0 && o && o->mesh_key)
+        *o->mesh_key = keys;
     char where[4200];
     snprintf(where, sizeof where, "%s: the binary scene", path);
     if (rc == 0 && budget_take(&budget, BUDGET_FBIN, out->blob_size, where, err) < 0) {

@@ -34,6 +34,12 @@ typedef struct {
     int timed;                 /**< pose animated scenes at `frame` (scene_hooks.h); 0: at rest */
     double frame, fps;         /**< when timed: the frame, and frames per second (0: GANIM_FPS) */
     double shutter;            /**< frames the shutter is open around `frame` (motion blur); 0: none */
+    int skeleton;              /**< a JSON scene without its meshes (their files not read): the
+                                    sections the rest makes, for frame_reuse.h */
+    uint64_t *mesh_key;        /**< when not NULL, receives the meshes' key (mesh.h's mesh_key over
+                                    every mesh shape of a JSON scene, in order; 0 without) */
+    const char *files;         /**< compile_child only: when not NULL, the file it writes the list of
+                                    files the compile read into (compile_child.h) */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */

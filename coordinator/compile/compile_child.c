@@ -6,6 +6,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +21,7 @@
 #include "fbin.h"
 #include "file.h"
 #include "clock.h"
+#include "compile/confine.h"
 #include "compile/rlimit.h"
 
 /* What the child sends back, in one write. */
@@ -28,6 +30,38 @@ typedef struct {
     fr_error err;
     compile_child_stats st;
 } answer;
+
+/* The files a compile read (compile_child.h), as text. */
+typedef struct {
+    char *text;
+    size_t len, cap;
+    int failed;                /* out of memory: the list is not written */
+} read_list;
+
+static void note_read(void *user, const char *real, const struct stat *st)
+{
+    read_list *l = user;
+    char line[PATH_MAX + 128];
+    int n = strchr(real, '\n') ? snprintf(line, sizeof line, "!\n")
+                               : snprintf(line, sizeof line, "%llu %llu %lld %lld %ld %s\n",
+                                          (unsigned long long)st->st_dev, (unsigned long long)st->st_ino,
+                                          (long long)st->st_size, (long long)st->st_mtim.tv_sec,
+                                          (long)st->st_mtim.tv_nsec, real);
+    if (n < 0 || (size_t)n >= sizeof line)
+        n = snprintf(line, sizeof line, "!\n");
+    if (l->len + (size_t)n > l->cap) {
+        size_t cap = 2 * l->cap + (size_t)n + 4096;
+        char *t = realloc(l->text, cap);
+        if (!t) {
+            l->failed = 1;
+            return;
+        }
+        l->text = t;
+        l->cap = cap;
+    }
+    memcpy(l->text + l->len, line, (size_t)n);
+    l->len += (size_t)n;
+}
 
 static void child(const char *scene, const compile_opts *o, const char *file, int fd)
 {
@@ -48,8 +82,18 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
     else
         memset(&co, 0, sizeof co);
     co.fbin = file;
+    co.mesh_key = &a.st.mesh_key;
+    read_list reads = {NULL, 0, 0, 0};
+    if (co.files)
+        confine_watch(note_read, &reads);
     double t0 = clock_now();
     a.rc = compile_scene(scene, &co, &s, &a.err);
+    confine_watch(NULL, NULL);
+    fr_error fe;
+    if (a.rc == 0 && co.files && (reads.failed || file_write_atomic(co.files, reads.text ? reads.text : "",
+                                                                    reads.len, &fe) < 0))
+        unlink(co.files); /* no list: the caller reads none */
+    free(reads.text);
     if (a.rc && strstr(a.err.msg, "out of memory")) {
         size_t n = strlen(a.err.msg);
         snprintf(a.err.msg + n, sizeof a.err.msg - n, " (the compile may map %llu MiB: --limit memory=BYTES raises it)",

@@ -19,6 +19,13 @@
  * running (fork).  compile_child_sweep removes such leftovers where the
  * caller knows no other compile into the same output can be running.
  *
+ * With o->files, the child also writes the files the compile read
+ * through its confine.h scope (the scene, meshes, MTL files, textures,
+ * glTF buffers; not those an Assimp import opens in its own process) to
+ * that file, a line each: "DEV INO SIZE MTIME_S MTIME_NS REALPATH" in
+ * decimal, or a line "!" for a path that holds a newline (reuse.h reads
+ * it).
+ *
  * The child runs within the compile's limits (budget.h): RLIMIT_CPU at the
  * cpu limit, RLIMIT_AS at what it maps when it starts plus the memory
  * limit, no core file.  Passing one fails with a message that names the
@@ -39,6 +46,7 @@ typedef struct {
     unsigned prims, triangles, materials, lights, nodes, leaves;
     unsigned instances, meshes; /**< placements of meshes, and the meshes they place */
     double seconds;         /**< compile time, without writing the file */
+    uint64_t mesh_key;      /**< compile_opts.mesh_key's */
 } compile_child_stats;
 
 /** Compiles `scene` with options o (warnings are reported by the child

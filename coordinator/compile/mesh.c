@@ -8,11 +8,15 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "fmath.h"
 #include "compile/builder_instance.h"
 #include "compile/jsonval.h"
 #include "compile/mesh_import.h"
+
+#define XXH_INLINE_ALL
+#include <xxhash.h>
 
 enum { LOD_MAX = 16 };
 #define LOD_DENSITY 0.25f      /* default triangles per pixel of projected area */
@@ -234,6 +238,61 @@ static int level_paths(const cJSON *o, const char *where, const char *dir, char 
         if (snprintf(paths[i], 4096, "%s%s%s", s[0] == '/' ? "" : dir, s[0] == '/' ? "" : "/", s) >= 4096)
             return fr_fail(err, "%s: file name too long", where);
     }
+    return 0;
+}
+
+/* Folds n bytes at p into *key. */
+static void fold(uint64_t *key, const void *p, size_t n) { *key = XXH3_64bits_withSeed(p, n, *key); }
+
+int mesh_key(const fr_builder *b, const cJSON *o, const char *where, const char *dir, uint32_t material,
+             uint64_t *key, fr_error *err)
+{
+    char paths[LOD_MAX][4096];
+    int levels;
+    if (level_paths(o, where, dir, paths, &levels, err) < 0)
+        return -1;
+    char *text = cJSON_PrintUnformatted(o);
+    if (!text)
+        return fr_fail(err, "%s: out of memory", where);
+    fold(key, where, strlen(where) + 1);
+    fold(key, text, strlen(text) + 1);
+    free(text);
+    fold(key, &material, sizeof material);
+    for (int i = 0; i < levels; i++) {
+        struct stat st;
+        uint64_t id[6] = {0};
+        if (stat(paths[i], &st) == 0)
+            id[0] = 1, id[1] = (uint64_t)st.st_dev, id[2] = (uint64_t)st.st_ino, id[3] = (uint64_t)st.st_size,
+            id[4] = (uint64_t)st.st_mtim.tv_sec, id[5] = (uint64_t)st.st_mtim.tv_nsec;
+        fold(key, paths[i], strlen(paths[i]) + 1);
+        fold(key, id, sizeof id);
+    }
+    /* The level is chosen by the mesh's size on screen; a mesh with an
+     * interior medium may hold the camera (fr_volume.camera_medium). */
+    const fr_material *mats = b->materials.data;
+    if (levels > 1 || (material != FR_NONE && material < b->materials.count && mats[material].medium)) {
+        const fr_camera *c = &b->camera;
+        float cam[12] = {c->position.x, c->position.y, c->position.z, c->target.x, c->target.y, c->target.z,
+                         c->up.x, c->up.y, c->up.z, c->tan_half, (float)b->settings.width, (float)b->settings.height};
+        fold(key, cam, sizeof cam);
+    }
+    return 0;
+}
+
+int mesh_stand_in(fr_builder *b, fr_error *err)
+{
+    mesh_material dm;
+    memset(&dm, 0, sizeof dm);
+    dm.kd = v3s(0.8f);
+    dm.tf = v3s(1.0f);
+    dm.ni = 1.5f;
+    dm.d = 1.0f;
+    dm.illum = -1;
+    fr_material fm;
+    mesh_data_material(&dm, &fm);
+    uint32_t m = bld_push(&b->materials, &fm);
+    if (m == FR_NONE || bld_sphere(b, v3s(0.0f), 1.0f, m) == FR_NONE)
+        return fr_fail(err, "out of memory");
     return 0;
 }
 

@@ -28,4 +28,21 @@
 int mesh_add(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
              uint32_t material, fr_error *err);
 
+/** What mesh_add would read for shape `node` (JSON path `where`, file
+ * names relative to `dir`, material `material`), folded into *key (a
+ * hash): the shape's JSON as posed, its files' names and their identity
+ * on disk (device, inode, size, modification time), and for a shape with
+ * levels of detail (chosen by its size on screen) or a material with an
+ * interior medium (which may hold the camera) the camera and image size.  Two
+ * compiles that fold the same keys read the same meshes (unless a file
+ * the mesh file names, such as an MTL, changed by itself).  Fails like
+ * mesh_add on a shape without files. */
+int mesh_key(const fr_builder *b, const cJSON *node, const char *where, const char *dir, uint32_t material,
+             uint64_t *key, fr_error *err);
+
+/** What a skeleton compile (compile.h) adds in place of a mesh shape: a
+ * unit sphere at the origin, of a default diffuse material of its own,
+ * so that a scene of meshes alone still has a shape.  Fails on memory. */
+int mesh_stand_in(fr_builder *b, fr_error *err);
+
 #endif

@@ -78,10 +78,10 @@ typedef struct {
     uint64_t hash;
 } open_ctx;
 
-int cluster_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, char *remote, size_t cap,
-             char *lease, size_t lease_cap, uint64_t *sent, fr_error *err)
+int cluster_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, const stage_patch *patch,
+                  char *remote, size_t cap, char *lease, size_t lease_cap, uint64_t *sent, fr_error *err)
 {
-    if (stage_scene(tr, scene, hash, remote, cap, lease, lease_cap, sent, err))
+    if (stage_scene(tr, scene, hash, patch, remote, cap, lease, lease_cap, sent, err))
         return -1;
     /* The cache stays bounded; a failure to trim it does not stop the render. */
     uint64_t limit = entry->cache ? entry->cache : HOSTS_CACHE_DEFAULT, bytes;
@@ -107,7 +107,7 @@ static int probe_and_stage(cluster_host *h, int i, void *vctx, fr_error *err)
         return -1;
     if (!c->scene)
         return 0;
-    return cluster_stage(h->tr, h->entry, c->scene, c->hash, h->scene, sizeof h->scene, h->lease, sizeof h->lease,
+    return cluster_stage(h->tr, h->entry, c->scene, c->hash, NULL, h->scene, sizeof h->scene, h->lease, sizeof h->lease,
                     &h->sent, err);
 }
 

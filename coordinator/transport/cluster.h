@@ -10,6 +10,7 @@
 #define FRANJA_CLUSTER_H
 
 #include "protocol.h"
+#include "transport/stage.h"
 #include "transport/transport.h"
 
 /** One host's state. */
@@ -41,12 +42,12 @@ void cluster_each(cluster_host *hosts, int n, const tr_options *o, cluster_step 
 void cluster_open(cluster_host *hosts, int n, const tr_options *o, const char *scene, uint64_t hash);
 
 /** The render's step after the probe, for one more scene on a ready host
- * (the frames of an animation): stage_scene (remote, lease, *sent as
- * it says), then the host's scene cache trimmed to its limit (stage_evict;
+ * (the frames of an animation): stage_scene (patch, remote, lease, *sent
+ * as it says), then the host's scene cache trimmed to its limit (stage_evict;
  * what went, or why it could not, is a remark of the host).  -1 with err
  * when the scene cannot be staged. */
-int cluster_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, char *remote, size_t cap,
-             char *lease, size_t lease_cap, uint64_t *sent, fr_error *err);
+int cluster_stage(tr_host *tr, const hosts_entry *entry, const char *scene, uint64_t hash, const stage_patch *patch,
+                  char *remote, size_t cap, char *lease, size_t lease_cap, uint64_t *sent, fr_error *err);
 
 /** Hosts being made ready in the background (cluster_start). */
 typedef struct cluster_group cluster_group;

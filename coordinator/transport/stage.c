@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "fbin.h"
+#include "fpatch.h"
 #include "transport/pack.h"
 #include "unpack.h"
 
@@ -115,10 +116,13 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err)
 /* 1 when the cached copy at path checks out, 0 when there is none, 2 when
  * it is damaged (or unreadable for this worker), -1 on error.  When there
  * is none, *unpack says in which form the worker can unpack a compressed
- * scene (PACK_PARTS, PACK_ZSTD; else it is 0). */
-static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash, int *unpack, fr_error *err)
+ * scene (PACK_PARTS, PACK_ZSTD; else it is 0) and *patches whether it
+ * applies scene patches (fpatch.h). */
+static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash, int *unpack, int *patches,
+                  fr_error *err)
 {
     *unpack = 0;
+    *patches = 0;
     const char *check[4];
     proto_check_argv(path, check);
     const char *plain[] = {"sh", "-c", CHECK_SCRIPT, tr_host_worker(h), check[0], check[1], check[2], NULL};
@@ -140,6 +144,7 @@ static int cached(tr_host *h, const char *path, const char *lease, uint64_t hash
         *unpack = proto_has_feature(out, len, UNPACK_FEATURE)         ? PACK_PARTS
                   : proto_has_feature(out, len, PROTO_FEATURE_UNPACK) ? PACK_ZSTD
                                                                       : 0;
+        *patches = proto_has_feature(out, len, FPATCH_FEATURE);
     }
     else
         rc = tr_proc_status(p) == 0 && proto_parse_check(out, len, &got, &e) == 0 && got == hash ? 1 : 2;
@@ -162,18 +167,16 @@ static int lease_name(const char *remote, char *lease, size_t cap)
                     ts.tv_nsec / 1000000) >= (int)cap;
 }
 
-/* Sends the scene compressed (pack.h, in form `form`) under a name of its own beside
- * `remote` and has the host's worker unpack it into `remote` (unpack.h),
- * adding the bytes sent to *sent.  0 when the unpacked scene has the
- * expected hash; 1 when the unpacking failed (a damaged transfer: worth
- * sending again); -1 on error (the upload failed). */
-static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int form, const char *remote,
-                       uint64_t *sent, fr_error *err)
+/* Uploads the local file `file` (`size` bytes: a compressed scene or a
+ * patch, `what`) under a name of its own beside `remote` and has the
+ * host's worker unpack it into `remote` (unpack.h, fpatch.h), adding the
+ * bytes sent to *sent.  0 when the unpacked scene has the expected hash;
+ * 1 when the unpacking failed (noted: a damaged transfer, or a patch
+ * whose base is gone); -1 on error (the upload failed). */
+static int upload_unpack(tr_host *h, const char *file, uint64_t size, uint64_t hash, const char *remote,
+                         const char *what, uint64_t *sent, fr_error *err)
 {
-    char packed[4200], name[1400];
-    uint64_t size;
-    if (pack_acquire(local_path, hash, form, packed, sizeof packed, &size, err))
-        return -1;
+    char name[1400];
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     char host[64] = "";
@@ -182,9 +185,7 @@ static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int fo
         if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '-'))
             *c = '_';
     snprintf(name, sizeof name, "%s.zst-%s-%ld-%ld", remote, host, (long)getpid(), (long)ts.tv_nsec);
-    int rc = tr_upload(h, packed, name, 0600, err);
-    pack_release(hash, form);
-    if (rc)
+    if (tr_upload(h, file, name, 0600, err))
         return -1;
     *sent += size;
     const char *un[6];
@@ -197,6 +198,7 @@ static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int fo
     const char *out = (const char *)tr_proc_output(p, &len);
     uint64_t got;
     fr_error e;
+    int rc;
     if (tr_proc_state(p) == TR_EXITED && tr_proc_status(p) == 0 && proto_parse_check(out, len, &got, &e) == 0 &&
         got == hash) {
         rc = 0;
@@ -204,7 +206,8 @@ static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int fo
         char why[300];
         snprintf(why, sizeof why, "%s", tr_proc_state(p) == TR_EXITED && tr_proc_status(p) == 0
                                             ? "a scene of another hash" : tr_proc_reason(p));
-        tr_note(h, "the compressed scene did not unpack (%s); sending it again", why);
+        tr_note(h, "the %s did not unpack (%s); sending %s", what, why,
+                strstr(what, "patch") ? "the whole scene" : "it again");
         if (tr_proc_state(p) != TR_EXITED) {
             fr_error ignored;
             tr_remove(h, name, &ignored); /* the worker removes it itself when it runs */
@@ -215,11 +218,25 @@ static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int fo
     return rc;
 }
 
+/* Sends the scene compressed (pack.h, in form `form`) and has the host's
+ * worker unpack it into `remote` (upload_unpack's statuses). */
+static int send_packed(tr_host *h, const char *local_path, uint64_t hash, int form, const char *remote,
+                       uint64_t *sent, fr_error *err)
+{
+    char packed[4200];
+    uint64_t size;
+    if (pack_acquire(local_path, hash, form, packed, sizeof packed, &size, err))
+        return -1;
+    int rc = upload_unpack(h, packed, size, hash, remote, "compressed scene", sent, err);
+    pack_release(hash, form);
+    return rc;
+}
+
 /* Attempts at a compressed transfer before the scene is sent as it is. */
 enum { PACKED_TRIES = 2 };
 
-int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
-                size_t lease_cap, uint64_t *sent, fr_error *err)
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, const stage_patch *patch, char *remote,
+                size_t cap, char *lease, size_t lease_cap, uint64_t *sent, fr_error *err)
 {
     *sent = 0;
     if (lease_cap)
@@ -243,16 +260,23 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
     if (lease_cap && !strcmp(tr_host_backend(h), "ssh") && lease_name(remote, lease, lease_cap))
         return fr_fail(err, "%s: work directory path too long", tr_host_label(h));
     const char *mine = lease_cap ? lease : "";
-    int unpack;
-    int ok = cached(h, remote, mine, hash, &unpack, err);
+    int unpack, patches;
+    int ok = cached(h, remote, mine, hash, &unpack, &patches, err);
     if (ok < 0 || ok == 1)
         return ok < 0 ? -1 : 0;
     if (ok == 2)
         tr_note(h, "cached scene %s is damaged; uploading it again", remote);
+    /* A patch against a scene the host was given before, when its worker
+     * applies them; one that does not apply is followed by the scene. */
+    struct stat ps;
+    int patched = -1;
+    if (ok == 0 && patch && patch->path && patches && tr_host_link_upload(h) && stat(patch->path, &ps) == 0 &&
+        (patched = upload_unpack(h, patch->path, (uint64_t)ps.st_size, hash, remote, "scene patch", sent, err)) < 0)
+        return -1;
     /* Over a link, compressed when the worker there can unpack (a worker
      * built without libzstd cannot); a transfer that does not unpack to
      * the scene is sent again, then sent as it is. */
-    int packed = -1;
+    int packed = patched == 0 ? 0 : -1;
     for (int i = 0; i < PACKED_TRIES && tr_host_link_upload(h) && unpack && packed != 0; i++)
         if ((packed = send_packed(h, local_path, hash, unpack, remote, sent, err)) < 0)
             return -1;
@@ -264,7 +288,7 @@ int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote,
         struct stat st;
         *sent += stat(local_path, &st) == 0 ? (uint64_t)st.st_size : 0;
     }
-    ok = cached(h, remote, mine, hash, &unpack, err); /* takes the lease if the directory was new */
+    ok = cached(h, remote, mine, hash, &unpack, &patches, err); /* takes the lease if the directory was new */
     if (ok < 0)
         return -1;
     if (ok != 1)

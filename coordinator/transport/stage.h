@@ -28,6 +28,13 @@
  * when the worker cannot be run there. */
 int stage_probe(tr_host *h, proto_host *info, fr_error *err);
 
+/** A scene patch on this machine (fpatch.h): the file, and the hash of
+ * the scene it patches. */
+typedef struct {
+    const char *path;
+    uint64_t base;
+} stage_patch;
+
 /** Makes the binary scene at local_path (content hash `hash`) available on
  * the host and writes the path its worker must be given into remote[cap].
  * *sent gets the bytes sent (0: the cached copy was used).  A damaged
@@ -41,6 +48,14 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
  * cache's name; a transfer that does not unpack (damaged on the way) is
  * noted and sent again, and after two such it is sent uncompressed.
  *
+ * A patch (may be NULL): when the host has no copy of the scene, sends
+ * over a network link to a worker that advertises FPATCH_FEATURE the
+ * patch file patch->path (fpatch.h: the scene as the sections it changes
+ * in the scene of hash patch->base, which the host should hold from
+ * before) instead of the scene; the worker rebuilds the scene from its
+ * cached base and checks its hash.  A patch that does not apply (the base
+ * evicted, a damaged transfer) is noted and the scene sent as above.
+ *
  * The lease: on an SSH host with a scene cache, and when lease_cap is not
  * 0, the render takes a lease on the scene before looking for it: an empty
  * file beside it, SCENE.lease-MACHINE-PID-TIME, whose path goes into
@@ -51,8 +66,8 @@ int stage_probe(tr_host *h, proto_host *info, fr_error *err);
  * every minute or so and removes it at its end (tr_remove).  The lease of
  * a render that died goes stale in ten minutes and is then removed by the
  * next eviction or clean. */
-int stage_scene(tr_host *h, const char *local_path, uint64_t hash, char *remote, size_t cap, char *lease,
-                size_t lease_cap, uint64_t *sent, fr_error *err);
+int stage_scene(tr_host *h, const char *local_path, uint64_t hash, const stage_patch *patch, char *remote,
+                size_t cap, char *lease, size_t lease_cap, uint64_t *sent, fr_error *err);
 
 /** Checks that files reach the host's scene cache the way a render's scene
  * does (tr_upload: SFTP for an SSH host): a small file is uploaded into

@@ -6,9 +6,13 @@
 # keyed (json_keys.h), FRAMES frames (default 3) rendered with --frames
 # over one fake SSH host (tests/support/fakehosts.sh: sshd on loopback),
 # 64x64 at 1 spp.  Prints the median of three `franja compile` times of
-# the scene (the work each frame's compile repeats), the .fbin's size, and
-# per frame what the coordinator says it sent the host.  Results:
-# tests/bench/README.md, "A camera move through a large scene".
+# the scene (a full compile: what the first frame costs), the .fbin's
+# size, then RUNS renders of the animation (default 3; the host's scene
+# cache emptied before each) and per frame the medians of what the
+# coordinator says: the frame's compile time (a full compile, or the
+# frame made of the frame before's sections: coordinator/reuse.h) and the
+# bytes it sent the host (the packed scene, or a patch: common/fpatch.h).
+# Results: tests/bench/README.md, "A camera move through a large scene".
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 . "$ROOT/tests/support/fakehosts.sh"
 fh_init
@@ -33,10 +37,24 @@ for i in 1 2 3; do
 done
 echo "compile of one frame ($TRIS triangles): $times s, median $(median $times) s; .fbin $(stat -c %s "$T/move.fbin") bytes"
 fh_start a 2 2
-s=$(date +%s.%N)
-fr render "$T/move.json" --frames 1-"$FRAMES" -o "$T/out/f.#.pfm" --hosts "$FH/hosts" 2>"$T/log" ||
-    { cat "$T/log"; exit 1; }
-echo "render of $FRAMES frames over one SSH host: $(calc "$(date +%s.%N) - $s") s"
-grep -E "host a: frame [0-9]+: scene" "$T/log"
-grep -E "^  a " "$T/log"
+: >"$T/logs"
+r=1
+while [ $r -le "$RUNS" ]; do
+    rm -rf "$T/out" "$FH/a/work/scenes"/*
+    s=$(date +%s.%N)
+    fr render "$T/move.json" --frames 1-"$FRAMES" -o "$T/out/f.#.pfm" --hosts "$FH/hosts" 2>"$T/log" ||
+        { cat "$T/log"; exit 1; }
+    echo "run $r: render of $FRAMES frames over one SSH host: $(calc "$(date +%s.%N) - $s") s"
+    sed "s/^/run $r: /" "$T/log" >>"$T/logs"
+    r=$((r + 1))
+done
+f=1
+while [ $f -le "$FRAMES" ]; do
+    c=$(sed -n "s/^run [0-9]*: franja: frame $f: scene .* in \([0-9.]*\) s.*/\1/p" "$T/logs")
+    how=$(sed -n "s/^run 1: franja: frame $f: scene \(compiled\|made of the frame before's\) in.*/\1/p" "$T/logs")
+    b=$(sed -n "s/^run [0-9]*: franja: host a: frame $f: scene .*, \([0-9]*\) bytes sent).*/\1/p" "$T/logs")
+    echo "frame $f: $how; compile s:" $c "(median $(median $c)); bytes sent:" $b "(median $(median $b))"
+    f=$((f + 1))
+done
+grep -E "^run [0-9]*: +a " "$T/logs"
 echo "machine after: load $(cut -d' ' -f1-3 /proc/loadavg)"

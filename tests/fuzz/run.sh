@@ -28,6 +28,7 @@
 #   jobdir   a job directory on --resume and `franja stitch` (job file,
 #            slab files, stitching, continuing from kept sums)
 #   unpack   a packed scene or zstd frame a worker unpacks (--unpack)
+#   patch    a scene patch a worker applies to its cached base (--unpack)
 #
 # Seeds: tests/fuzz/corpus/TARGET, written by hand (inputs of remote and
 # args start with a byte that picks the reader; see each target's
@@ -46,7 +47,7 @@
 cd "$(dirname "$0")/../.." || exit 1
 SECS=${1:-60}
 [ $# -gt 0 ] && shift
-TARGETS=${*:-fbin json obj gltf ply hosts partial remote args jobdir unpack}
+TARGETS=${*:-fbin json obj gltf ply hosts partial remote args jobdir unpack patch}
 W=build/fuzz/run
 MAX_LEN=65536
 rm -rf "$W"
