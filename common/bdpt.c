@@ -513,7 +513,7 @@ static int light_subpath(const fr_scene *s, rnd *smp, vert *lgt, int maxv)
     l->pdf_fwd = e.distant ? emit_pdf_origin(s, l) : e.pdf_pos;
     float cosl = local ? fabsf(v3_dot(e.n, e.ray.d)) : 1.0f;
     vec3 beta = v3_scale(e.Le, cosl / (e.pdf_pos * e.pdf_dir));
-    fr_ray ray = {local ? geo_offset(e.ray.o, e.perr, e.n, e.ray.d) : e.ray.o, e.ray.d};
+    fr_ray ray = {local ? geo_offset(e.ray.o, e.perr, e.n, e.ray.d) : e.ray.o, e.ray.d, 0.0f};
     return walk(s, smp, ray, beta, e.pdf_dir, 1, lgt, maxv);
 }
 
@@ -529,7 +529,7 @@ static int visible(const fr_scene *s, const vert *a, const vert *b)
     float margin = (v3_max(v3_abs(o)) + v3_max(v3_abs(b->p)) + v3_max(b->sf.perr)) * GEO_GAMMA(32);
     if (!(len > margin))
         return 1;
-    fr_ray r = {o, v3_scale(d, 1.0f / len)};
+    fr_ray r = {o, v3_scale(d, 1.0f / len), 0.0f};
     return !trace_occluded(s, &r, len - margin, FR_NONE);
 }
 
@@ -649,7 +649,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         vec3 L = v3_scale(v3_mul(qs->beta, vert_f(qs, wi, 1)), fabsf(v3_dot(wi, qs->ns)) * g);
         if (v3_is_zero(L))
             return zero;
-        fr_ray r = {geo_offset(qs->p, qs->sf.perr, qs->ng, wi), wi};
+        fr_ray r = {geo_offset(qs->p, qs->sf.perr, qs->ng, wi), wi, 0.0f};
         if (trace_occluded(s, &r, v3_len(v3_sub(lens, r.o)), FR_NONE))
             return zero;
         sampled->type = BD_CAMERA;
@@ -674,7 +674,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         L = v3_scale(L, fabsf(v3_dot(ls.wi, pt->ns)) / ls.pdf);
         if (v3_is_zero(L))
             return zero;
-        fr_ray r = {geo_offset(pt->p, pt->sf.perr, pt->ng, ls.wi), ls.wi};
+        fr_ray r = {geo_offset(pt->p, pt->sf.perr, pt->ng, ls.wi), ls.wi, 0.0f};
         float tmax = ls.distant ? INFINITY : v3_dot(v3_sub(ls.p, r.o), ls.wi);
         if (!(tmax > 0.0f) || trace_occluded(s, &r, tmax, ls.prim))
             return zero;

@@ -1,0 +1,106 @@
+/* json_motion.c -- keyed JSON shapes moving across the shutter: mesh shapes
+ * become moving instances, others are posed at the frame with a warning
+ * (see json_motion.h). */
+
+#include "compile/json_motion.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "compile/builder_motion.h"
+#include "compile/json_keys.h"
+
+/* The fields that place a mesh shape or one of its instances. */
+static const char *const placing[] = {"scale", "rotate", "translate", "matrix", NULL};
+
+int json_motion_pose(cJSON *s, const char *where, const scene_hooks *h, cJSON **close, fr_error *err)
+{
+    *close = NULL;
+    double f0 = h->frame - 0.5 * h->shutter, f1 = h->frame + 0.5 * h->shutter;
+    cJSON *a = cJSON_Duplicate(s, 1), *z = cJSON_Duplicate(s, 1);
+    if (!a || !z) {
+        cJSON_Delete(a);
+        cJSON_Delete(z);
+        return fr_fail(err, "%s: out of memory", where);
+    }
+    int rc = json_keys_pose(a, where, f0, err) < 0 || json_keys_pose(z, where, f1, err) < 0 ? -1 : 0;
+    int moves = rc == 0 && !cJSON_Compare(a, z, 1);
+    cJSON_Delete(a);
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(s, "type");
+    int mesh = cJSON_IsString(type) && !strcmp(type->valuestring, "mesh");
+    if (rc == 0 && moves && mesh) {
+        *close = z;
+        return json_keys_pose(s, where, f0, err);
+    }
+    cJSON_Delete(z);
+    if (rc < 0)
+        return -1;
+    if (moves && h->warn) {
+        char msg[512];
+        snprintf(msg, sizeof msg, "%s: moves across the shutter, but only mesh shapes and their instances are "
+                 "motion blurred: it is posed at the frame's time, sharp", where);
+        h->warn(h->user, msg);
+    }
+    return json_keys_pose(s, where, h->frame, err);
+}
+
+/* A copy of mesh shape o placed by instances: as it is when it has some,
+ * else with its own placing fields moved into one instance. */
+static cJSON *as_instances(const cJSON *o)
+{
+    cJSON *c = cJSON_Duplicate(o, 1);
+    if (!c || cJSON_GetObjectItemCaseSensitive(c, "instances"))
+        return c;
+    cJSON *list = cJSON_CreateArray(), *one = cJSON_CreateObject();
+    if (!list || !one || !cJSON_AddItemToArray(list, one) || !cJSON_AddItemToObject(c, "instances", list)) {
+        cJSON_Delete(list);
+        if (!list)
+            cJSON_Delete(one);
+        cJSON_Delete(c);
+        return NULL;
+    }
+    for (int i = 0; placing[i]; i++) {
+        cJSON *f = cJSON_DetachItemFromObjectCaseSensitive(c, placing[i]);
+        if (f)
+            cJSON_AddItemToObject(one, placing[i], f);
+    }
+    return c;
+}
+
+int json_motion_mesh(fr_builder *b, cJSON *open, const cJSON *close, const char *where, const char *dir,
+                     const confine *scope, const scene_hooks *h, uint32_t material, fr_error *err)
+{
+    if (cJSON_GetObjectItemCaseSensitive(open, "instances"))
+        for (int i = 0; placing[i]; i++) {
+            const cJSON *x = cJSON_GetObjectItemCaseSensitive(open, placing[i]),
+                        *y = cJSON_GetObjectItemCaseSensitive(close, placing[i]);
+            if (!x != !y || (x && !cJSON_Compare(x, y, 1)))
+                return fr_fail(err, "%s.%s: a mesh shape with instances moves by its instances' transforms, not "
+                               "its own (key the instances' %s instead)", where, placing[i], placing[i]);
+        }
+    cJSON *a = as_instances(open), *z = as_instances(close);
+    fr_builder tmp;
+    bld_init(&tmp);
+    uint32_t first = b->instances.count;
+    int rc = a && z ? 0 : fr_fail(err, "%s: out of memory", where);
+    fr_error e;
+    if (rc == 0 && h->mesh(b, a, where, dir, scope, material, &e) < 0)
+        rc = fr_fail(err, "%s", e.msg);
+    /* The placements at shutter close, from the same shape posed then. */
+    tmp.camera = b->camera;
+    tmp.settings = b->settings;
+    if (rc == 0 && h->mesh(&tmp, z, where, dir, scope, material, &e) < 0)
+        rc = fr_fail(err, "%s (at shutter close): %s", where, e.msg);
+    if (rc == 0 && tmp.instances.count != b->instances.count - first)
+        rc = fr_fail(err, "%s: %u placements at shutter open, %u at close", where, b->instances.count - first,
+                     tmp.instances.count);
+    for (uint32_t k = 0; rc == 0 && k < tmp.instances.count; k++) {
+        const fr_instance *in = (const fr_instance *)tmp.instances.data + k;
+        if (bld_instance_motion(b, first + k, (const float(*)[4])in->xf, &e) < 0)
+            rc = fr_fail(err, "%s.instances[%u]: %s", where, k, e.msg);
+    }
+    bld_free(&tmp);
+    cJSON_Delete(a);
+    cJSON_Delete(z);
+    return rc;
+}

@@ -1,0 +1,57 @@
+/* motion.c -- the transform of a moving instance at a time across the
+ * shutter (see motion.h). */
+
+#include "motion.h"
+
+#include <math.h>
+
+#include "fmath.h"
+
+void motion_at(const fr_inst_motion *m, float u, float xf[3][4], float inv[3][4])
+{
+    /* The rotation: slerp weights, or linear ones for a small angle; then
+     * renormalised, which also removes the slerp's rounding. */
+    float a = 1.0f - u, b = u;
+    if (m->inv_sin > 0.0f) {
+        a = fm_sinf(a * m->angle) * m->inv_sin;
+        b = fm_sinf(u * m->angle) * m->inv_sin;
+    }
+    float q[4], n2 = 0.0f;
+    for (int i = 0; i < 4; i++) {
+        q[i] = a * m->q0[i] + b * m->q1[i];
+        n2 += q[i] * q[i];
+    }
+    float k = 1.0f / sqrtf(n2);
+    float x = q[0] * k, y = q[1] * k, z = q[2] * k, w = q[3] * k;
+    float r[3][3] = {{1.0f - 2.0f * (y * y + z * z), 2.0f * (x * y - w * z), 2.0f * (x * z + w * y)},
+                     {2.0f * (x * y + w * z), 1.0f - 2.0f * (x * x + z * z), 2.0f * (y * z - w * x)},
+                     {2.0f * (x * z - w * y), 2.0f * (y * z + w * x), 1.0f - 2.0f * (x * x + y * y)}};
+    float s[3][3], mm[3][3], t[3] = {(1.0f - u) * m->t0.x + u * m->t1.x, (1.0f - u) * m->t0.y + u * m->t1.y,
+                                     (1.0f - u) * m->t0.z + u * m->t1.z};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            s[i][j] = (1.0f - u) * m->s0[i][j] + u * m->s1[i][j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            mm[i][j] = r[i][0] * s[0][j] + r[i][1] * s[1][j] + r[i][2] * s[2][j];
+    if (xf)
+        for (int i = 0; i < 3; i++) {
+            for (int j = 0; j < 3; j++)
+                xf[i][j] = mm[i][j];
+            xf[i][3] = t[i];
+        }
+    if (!inv)
+        return;
+    float c[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            int i1 = (j + 1) % 3, i2 = (j + 2) % 3, j1 = (i + 1) % 3, j2 = (i + 2) % 3;
+            c[i][j] = mm[i1][j1] * mm[i2][j2] - mm[i1][j2] * mm[i2][j1];
+        }
+    float det = mm[0][0] * c[0][0] + mm[0][1] * c[1][0] + mm[0][2] * c[2][0], id = 1.0f / det;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            inv[i][j] = c[i][j] * id;
+        inv[i][3] = -(inv[i][0] * t[0] + inv[i][1] * t[1] + inv[i][2] * t[2]);
+    }
+}

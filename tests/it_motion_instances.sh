@@ -1,0 +1,135 @@
+#!/bin/sh
+# it_motion_instances.sh -- tests motion blur of moving instances.
+#
+# A black quad (a mesh, 12 pixels wide) slides past the camera in front of
+# a white environment, its `translate` keyed: with --shutter 0.5 it smears
+# over 8 pixels, and each column's mean coverage (1 - its mean) is the
+# analytic smear, a trapezoid (ramps 8 pixels long, a plateau of 4),
+# within the noise of 64 x 16 samples a column; without --shutter its
+# edges are sharp.  A black bar turning 45 degrees across the shutter
+# (`rotate` keyed) covers each 6 x 6 block of pixels as the exact bar,
+# integrated over the pixels and the turn, does, and not as the bar at
+# rest; its total coverage is the bar's area.  The frames are
+# byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
+# keys that do not move keep the still scene's bytes; a keyed sphere is
+# warned about (not blurred); a moving emitter and the bidirectional
+# integrator are refused with a message.
+. "$(dirname "$0")/support/fakehosts.sh"
+need python3 cmp
+fh_init
+cd "$ROOT" || exit 1
+F=bin/franja T=$FH
+
+# 0.1 scene units a pixel at the plane z = 0: tan(fov / 2) = 0.08 (16
+# rows) and 0.24 (48 rows) from 10 units away.
+printf 'v -0.6 -2 0\nv 0.6 -2 0\nv 0.6 2 0\nv -0.6 2 0\nf 1 2 3\nf 1 3 4\n' >"$T/quad.obj"
+printf 'v -2 -0.3 0\nv 2 -0.3 0\nv 2 0.3 0\nv -2 0.3 0\nf 1 2 3\nf 1 3 4\n' >"$T/bar.obj"
+scene() { # FILE ROWS FOV MESH TRANSFORM [EXTRA SHAPE]
+    printf '{ "image": { "width": %s, "height": %s, "spp": 64, "max_depth": 1 },
+  "camera": { "position": [0, 0, 10], "target": [0, 0, 0], "up": [0, 1, 0], "fov": %s },
+  "environment": { "color": [1, 1, 1] },
+  "materials": { "black": { "type": "lambert", "albedo": [0, 0, 0] },
+                 "lamp": { "type": "emitter", "emission": [1, 1, 1] } },
+  "shapes": [ { "type": "mesh", "file": "%s", "material": "black", %s } %s ] }\n' \
+        "$(( $2 * 4 ))" "$2" "$3" "$4" "$5" "$6" >"$1"
+}
+scene "$T/slide.json" 16 9.148694 quad.obj '"translate": { "keys": [[0, [-8, 0, 0]], [10, [8, 0, 0]]] }'
+R="--frames 5"
+$F render "$T/slide.json" $R -o "$T/sharp.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "sharp: $(cat "$T/err")"
+$F render "$T/slide.json" $R --shutter 0.5 -o "$T/a.#.pfm" -j 1 >/dev/null 2>"$T/err" || bad "blur: $(cat "$T/err")"
+python3 - "$T/sharp.5.pfm" "$T/a.5.pfm" <<'PY' >"$T/check" || bad "profile check did not run"
+import sys
+sys.path.insert(0, 'tests/support')
+from pfmcols import columns
+def covered(x, s):
+    return max(0.0, min(x + 1, 38 + s) - max(x, 26 + s))
+def smear(x, n=800):
+    return sum(covered(x, -4 + 8 * (k + 0.5) / n) for k in range(n)) / n
+sharp = [1 - v for v in columns(sys.argv[1])]
+blur = [1 - v for v in columns(sys.argv[2])]
+worst = max(abs(blur[x] - smear(x)) for x in range(64))
+print("sharp", all(abs(sharp[x] - (1.0 if 26 <= x < 38 else 0.0)) < 0.01 for x in range(64)))
+print("smear", worst < 0.06, worst)
+print("total", abs(sum(blur) - 12.0) < 0.1, sum(blur))
+print("spread", sum(1 for v in blur if v > 0.01), sum(1 for v in sharp if v > 0.01))
+PY
+grep -q "^sharp True" "$T/check" && ok || bad "without a shutter the quad's edges are not sharp: $(cat "$T/check")"
+grep -q "^smear True" "$T/check" && ok || bad "the smear is not the analytic one: $(cat "$T/check")"
+grep -q "^total True" "$T/check" && ok || bad "the smear does not keep the quad's coverage: $(cat "$T/check")"
+grep -q "^spread 20 12$" "$T/check" && ok || bad "the smear's width: $(cat "$T/check")"
+
+# split invariance
+$F render "$T/slide.json" $R --shutter 0.5 -o "$T/b.#.pfm" -j 2 --slab-rows 5 >/dev/null 2>&1 ||
+    bad "render -j 2 --slab-rows 5"
+cmp -s "$T/a.5.pfm" "$T/b.5.pfm" && ok || bad "-j 1 and -j 2 --slab-rows 5 differ"
+fh_start a 2 2
+fh_start b 3 1
+fr render "$T/slide.json" $R --shutter 0.5 -o "$T/c.#.pfm" --hosts "$FH/hosts" --slab-rows 3 \
+    >/dev/null 2>"$T/err" || bad "fake SSH hosts: $(cat "$T/err")"
+cmp -s "$T/a.5.pfm" "$T/c.5.pfm" && ok || bad "fake SSH hosts render a different image"
+
+# a turning bar: 90 degrees a frame, so 67.5 to 112.5 degrees across the shutter
+scene "$T/turn.json" 48 26.991467 bar.obj '"rotate": { "keys": [[0, [0, 0, 0]], [10, [0, 0, 900]]] }'
+sed 's/"width": 192/"width": 48/' "$T/turn.json" >"$T/t" && mv "$T/t" "$T/turn.json"
+$F render "$T/turn.json" $R --shutter 0.5 -o "$T/turn.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "turn: $(cat "$T/err")"
+python3 - "$T/turn.5.pfm" <<'PY' >"$T/check" || bad "turn check did not run"
+import math, struct, sys
+data, lines = open(sys.argv[1], 'rb').read(), []
+while len(lines) < 3:
+    line, data = data.split(b'\n', 1)
+    if not line.startswith(b'#'):
+        lines.append(line)
+w, h = (int(v) for v in lines[1].split())
+vals = struct.unpack('<%df' % (3 * w * h), data[:12 * w * h])
+# rows bottom first: image row y is stored row h - 1 - y
+got = [[1 - vals[3 * ((h - 1 - y) * w + x)] for x in range(w)] for y in range(h)]
+def cover(px, py, angles):
+    n = 0
+    for a in angles:
+        c, s = math.cos(a), math.sin(a)
+        n += abs(px * c + py * s) <= 2.0 and abs(-px * s + py * c) <= 0.3
+    return n / len(angles)
+turn = [math.radians(67.5 + 45 * (k + 0.5) / 24) for k in range(24)]
+rest = [math.radians(90.0)]
+def expect(angles):
+    e = [[0.0] * w for _ in range(h)]
+    for y in range(h):
+        for x in range(w):
+            e[y][x] = sum(cover((x + (i + 0.5) / 3 - 24) * 0.1, (24 - y - (j + 0.5) / 3) * 0.1, angles)
+                          for i in range(3) for j in range(3)) / 9
+    return e
+blur, sharp = expect(turn), expect(rest)
+def blocks(a):
+    return [sum(a[y][x] for y in range(by, by + 6) for x in range(bx, bx + 6)) / 36
+            for by in range(0, h, 6) for bx in range(0, w, 6)]
+g, b, s = blocks(got), blocks(blur), blocks(sharp)
+worst = max(abs(p - q) for p, q in zip(g, b))
+apart = max(abs(p - q) for p, q in zip(b, s))
+print("blocks", worst < 0.025, worst)
+print("apart", apart > 0.05, apart)
+print("area", abs(sum(map(sum, got)) - 240) < 5, sum(map(sum, got)))
+PY
+grep -q "^blocks True" "$T/check" && ok || bad "the turning bar's blur is not the exact one: $(cat "$T/check")"
+grep -q "^apart True" "$T/check" && ok || bad "the turn does not blur enough to test: $(cat "$T/check")"
+grep -q "^area True" "$T/check" && ok || bad "the turning bar does not keep its area: $(cat "$T/check")"
+
+# keys that do not move: the still scene's bytes
+scene "$T/still.json" 16 9.148694 quad.obj '"translate": [1, 0, 0]'
+scene "$T/keyed.json" 16 9.148694 quad.obj '"translate": { "keys": [[0, [1, 0, 0]], [10, [1, 0, 0]]] }'
+$F render "$T/still.json" -o "$T/still.pfm" -j 2 >/dev/null 2>&1 || bad "still"
+$F render "$T/keyed.json" $R --shutter 0.5 -o "$T/keyed.#.pfm" -j 2 >/dev/null 2>&1 || bad "keyed still"
+tail -c 12288 "$T/still.pfm" >"$T/s.px" && tail -c 12288 "$T/keyed.5.pfm" >"$T/k.px"
+cmp -s "$T/s.px" "$T/k.px" && ok || bad "keys that do not move change the still scene's pixels"
+
+# a keyed sphere is posed sharp, with a warning; a moving emitter, bdpt: refused
+scene "$T/sphere.json" 16 9.148694 quad.obj '"translate": [1, 0, 0]' \
+    ', { "type": "sphere", "radius": 0.5, "material": "black", "center": { "keys": [[0, [-8, 0, -1]], [10, [8, 0, -1]]] } }'
+$F render "$T/sphere.json" $R --shutter 0.5 -o "$T/sph.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "sphere: $(cat "$T/err")"
+grep -q "shapes\[1\]: moves across the shutter, but only mesh shapes" "$T/err" && ok ||
+    bad "no warning for a keyed sphere: $(cat "$T/err")"
+sed 's/"material": "black", "translate": {/"material": "lamp", "translate": {/' "$T/slide.json" >"$T/lamp.json"
+expect_error "moving emitter" "moving lights are not motion blurred" \
+    $F render "$T/lamp.json" $R --shutter 0.5 -o "$T/l.#.pfm"
+expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
+    $F render "$T/slide.json" $R --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm"
+summary
