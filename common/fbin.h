@@ -19,7 +19,7 @@
 #include "error.h"
 #include "scene.h"
 
-#define FBIN_VERSION 15
+#define FBIN_VERSION 16
 
 /** Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */
