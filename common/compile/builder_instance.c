@@ -5,11 +5,13 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "compile/builder_motion.h"
 #include "compile/builder_object.h"
+#include "motion.h"
 
 uint32_t bld_mesh_begin(fr_builder *b)
 {
@@ -213,12 +215,22 @@ int bld_flatten(fr_builder *b, int all, fr_error *err)
         }
     }
     uint32_t kept = 0;
-    for (uint32_t i = 0; i < ni && rc == 0; i++)
-        if (flat[inst[i].mesh] && inst[i].motion && meshes[inst[i].mesh].count)
-            rc = fr_fail(err, "instance %u moves across the shutter, but its mesh emits light: moving lights are not "
-                         "motion blurred (give the emitter no motion, or render without a shutter)", i);
-    if (rc < 0)
-        goto done;
+    /* A moving instance flattened (an emitter) is placed where it is at
+     * the middle of the shutter, with a warning. */
+    uint32_t still = 0;
+    for (uint32_t i = 0; i < ni; i++)
+        if (flat[inst[i].mesh] && inst[i].motion) {
+            motion_at((const fr_inst_motion *)b->inst_motions.data + inst[i].motion - 1, 0.5f, inst[i].xf,
+                      inst[i].inv);
+            inst[i].motion = 0;
+            still++;
+        }
+    if (still && b->warn) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "%u moving instance%s of an emissive mesh: moving lights are not motion blurred; "
+                 "placed where they are at the middle of the shutter, sharp", still, still == 1 ? "" : "s");
+        b->warn(b->warn_user, msg);
+    }
     for (uint32_t i = 0; i < ni; i++) {
         inst_to[i] = flat[inst[i].mesh] ? FR_NONE : kept++;
         if (inst_to[i] != FR_NONE)
