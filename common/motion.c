@@ -26,8 +26,9 @@ void motion_at(const fr_inst_motion *m, float u, float xf[3][4], float inv[3][4]
     float r[3][3] = {{1.0f - 2.0f * (y * y + z * z), 2.0f * (x * y - w * z), 2.0f * (x * z + w * y)},
                      {2.0f * (x * y + w * z), 1.0f - 2.0f * (x * x + z * z), 2.0f * (y * z - w * x)},
                      {2.0f * (x * z - w * y), 2.0f * (y * z + w * x), 1.0f - 2.0f * (x * x + y * y)}};
-    float s[3][3], mm[3][3], t[3] = {(1.0f - u) * m->t0.x + u * m->t1.x, (1.0f - u) * m->t0.y + u * m->t1.y,
-                                     (1.0f - u) * m->t0.z + u * m->t1.z};
+    float t[3] = {(1.0f - u) * m->t0.x + u * m->t1.x, (1.0f - u) * m->t0.y + u * m->t1.y,
+                  (1.0f - u) * m->t0.z + u * m->t1.z};
+    float s[3][3], mm[3][3];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
             s[i][j] = (1.0f - u) * m->s0[i][j] + u * m->s1[i][j];
@@ -42,13 +43,15 @@ void motion_at(const fr_inst_motion *m, float u, float xf[3][4], float inv[3][4]
         }
     if (!inv)
         return;
-    float c[3][3];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            int i1 = (j + 1) % 3, i2 = (j + 2) % 3, j1 = (i + 1) % 3, j2 = (i + 2) % 3;
-            c[i][j] = mm[i1][j1] * mm[i2][j2] - mm[i1][j2] * mm[i2][j1];
-        }
-    float det = mm[0][0] * c[0][0] + mm[0][1] * c[1][0] + mm[0][2] * c[2][0], id = 1.0f / det;
+    /* The inverse by cofactors: c[i][j] is the cofactor of mm[j][i]. */
+    const float (*mt)[3] = mm;
+    float c[3][3] = {{mt[1][1] * mt[2][2] - mt[1][2] * mt[2][1], mt[0][2] * mt[2][1] - mt[0][1] * mt[2][2],
+                      mt[0][1] * mt[1][2] - mt[0][2] * mt[1][1]},
+                     {mt[1][2] * mt[2][0] - mt[1][0] * mt[2][2], mt[0][0] * mt[2][2] - mt[0][2] * mt[2][0],
+                      mt[0][2] * mt[1][0] - mt[0][0] * mt[1][2]},
+                     {mt[1][0] * mt[2][1] - mt[1][1] * mt[2][0], mt[0][1] * mt[2][0] - mt[0][0] * mt[2][1],
+                      mt[0][0] * mt[1][1] - mt[0][1] * mt[1][0]}};
+    float det = mt[0][0] * c[0][0] + mt[0][1] * c[1][0] + mt[0][2] * c[2][0], id = 1.0f / det;
     for (int i = 0; i < 3; i++) {
         for (int j = 0; j < 3; j++)
             inv[i][j] = c[i][j] * id;
