@@ -41,18 +41,8 @@ $F render "$T/slide.json" $R --shutter 0.5 -o "$T/a.#.pfm" -j 1 >/dev/null 2>"$T
 python3 - "$T/sharp.5.pfm" "$T/a.5.pfm" <<'PY' >"$T/check" || bad "profile check did not run"
 import sys
 sys.path.insert(0, 'tests/support')
-from pfmcols import columns
-def covered(x, s):
-    return max(0.0, min(x + 1, 38 + s) - max(x, 26 + s))
-def smear(x, n=800):
-    return sum(covered(x, -4 + 8 * (k + 0.5) / n) for k in range(n)) / n
-sharp = [1 - v for v in columns(sys.argv[1])]
-blur = [1 - v for v in columns(sys.argv[2])]
-worst = max(abs(blur[x] - smear(x)) for x in range(64))
-print("sharp", all(abs(sharp[x] - (1.0 if 26 <= x < 38 else 0.0)) < 0.01 for x in range(64)))
-print("smear", worst < 0.06, worst)
-print("total", abs(sum(blur) - 12.0) < 0.1, sum(blur))
-print("spread", sum(1 for v in blur if v > 0.01), sum(1 for v in sharp if v > 0.01))
+from pfmcols import columns, smear_report
+smear_report([1 - v for v in columns(sys.argv[1])], [1 - v for v in columns(sys.argv[2])], 26, 38, 8)
 PY
 grep -q "^sharp True" "$T/check" && ok || bad "without a shutter the quad's edges are not sharp: $(cat "$T/check")"
 grep -q "^smear True" "$T/check" && ok || bad "the smear is not the analytic one: $(cat "$T/check")"
@@ -74,16 +64,11 @@ scene "$T/turn.json" 48 26.991467 bar.obj '"rotate": { "keys": [[0, [0, 0, 0]], 
 sed 's/"width": 192/"width": 48/' "$T/turn.json" >"$T/t" && mv "$T/t" "$T/turn.json"
 $F render "$T/turn.json" $R --shutter 0.5 -o "$T/turn.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "turn: $(cat "$T/err")"
 python3 - "$T/turn.5.pfm" <<'PY' >"$T/check" || bad "turn check did not run"
-import math, struct, sys
-data, lines = open(sys.argv[1], 'rb').read(), []
-while len(lines) < 3:
-    line, data = data.split(b'\n', 1)
-    if not line.startswith(b'#'):
-        lines.append(line)
-w, h = (int(v) for v in lines[1].split())
-vals = struct.unpack('<%df' % (3 * w * h), data[:12 * w * h])
-# rows bottom first: image row y is stored row h - 1 - y
-got = [[1 - vals[3 * ((h - 1 - y) * w + x)] for x in range(w)] for y in range(h)]
+import math, sys
+sys.path.insert(0, 'tests/support')
+from pfmcols import rows
+got = [[1 - v for v in row] for row in rows(sys.argv[1])]
+h, w = len(got), len(got[0])
 def cover(px, py, angles):
     n = 0
     for a in angles:
@@ -156,11 +141,9 @@ $F render "$T/gslide.json" $R --shutter 0.5 -o "$T/g.#.pfm" -j 2 >/dev/null 2>"$
 python3 - "$T/g.5.pfm" <<'PY' >"$T/check" || bad "gltf profile check did not run"
 import sys
 sys.path.insert(0, 'tests/support')
-from pfmcols import columns
-def covered(x, s):
-    return max(0.0, min(x + 1, 38 + s) - max(x, 26 + s))
+from pfmcols import columns, smear
 blur = [1 - v for v in columns(sys.argv[1])]
-worst = max(abs(blur[x] - sum(covered(x, -4 + 8 * (k + 0.5) / 800) for k in range(800)) / 800) for x in range(64))
+worst = max(abs(blur[x] - smear(x, 26, 38, 8)) for x in range(64))
 print("smear", worst < 0.06, worst)
 PY
 grep -q "^smear True" "$T/check" && ok || bad "a glTF node's smear is not the analytic one: $(cat "$T/check")"

@@ -95,7 +95,9 @@ static uint32_t mesh(fr_builder *b, int n)
     return m;
 }
 
-static void builder(fr_builder *b)
+/* A builder with one grey material, small image settings and a camera,
+ * and a mesh of n random triangles (and the cube's corners): its index. */
+static uint32_t builder(fr_builder *b, int n)
 {
     bld_init(b);
     fr_material mat;
@@ -108,6 +110,7 @@ static void builder(fr_builder *b)
     b->camera.up = v3(0, 1, 0);
     b->camera.vfov = 0.8f;
     b->camera.focus = 10.0f;
+    return mesh(b, n);
 }
 
 static float err_xf(const float (*a)[4], const float (*b)[4])
@@ -123,8 +126,7 @@ static float err_xf(const float (*a)[4], const float (*b)[4])
 static void test_blend(void)
 {
     fr_builder b;
-    builder(&b);
-    uint32_t m = mesh(&b, 4);
+    uint32_t m = builder(&b, 4);
     fr_error e;
     for (int n = 0; n < 300; n++) {
         float open[3][4], close[3][4];
@@ -186,8 +188,7 @@ static void test_blend(void)
 static void test_bounds(void)
 {
     fr_builder b;
-    builder(&b);
-    uint32_t m = mesh(&b, 40);
+    uint32_t m = builder(&b, 40);
     fr_error e;
     const bld_mesh *bm = (const bld_mesh *)b.meshes.data + m;
     int outside = 0, checked = 0;
@@ -255,8 +256,7 @@ static float brute(const fr_scene *s, const fr_ray *r)
 static fr_scene scene_moving(void)
 {
     fr_builder b;
-    builder(&b);
-    uint32_t m = mesh(&b, 60);
+    uint32_t m = builder(&b, 60);
     fr_error e;
     float xf[4][2][3][4];
     make_xf(xf[0][0], v3(0, 1, 0), 10.0, v3s(1.0f), v3(-5, 0, 0));          /* still */
