@@ -10,7 +10,8 @@
 # (`rotate` keyed) covers each 6 x 6 block of pixels as the exact bar,
 # integrated over the pixels and the turn, does, and not as the bar at
 # rest; its total coverage is the bar's area.  A glTF node moved by the
-# file's animation smears as the JSON quad does.  The frames are
+# file's animation smears as the JSON quad does, unwarned; a whole turn
+# across the shutter is warned about.  The frames are
 # byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
 # keys that do not move keep the still scene's bytes; a keyed sphere is
 # and a moving emitter are warned about (not blurred); the bidirectional
@@ -147,6 +148,13 @@ worst = max(abs(blur[x] - smear(x, 26, 38, 8)) for x in range(64))
 print("smear", worst < 0.06, worst)
 PY
 grep -q "^smear True" "$T/check" && ok || bad "a glTF node's smear is not the analytic one: $(cat "$T/check")"
+grep -q "blend" "$T/err" && bad "a glTF node moving at constant speed is warned about: $(cat "$T/err")" || ok
+
+# a spin of more than half a turn across the shutter is warned about
+scene "$T/spin.json" 16 9.148694 quad.obj '"rotate": { "keys": [[0, [0, 0, 0]], [10, [0, 0, 7200]]] }'
+$F render "$T/spin.json" $R --shutter 0.5 -o "$T/spin.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "spin: $(cat "$T/err")"
+grep -q "turns 360 degrees across the shutter; the blur takes the shorter way" "$T/err" && ok ||
+    bad "no warning for a spin of a whole turn: $(cat "$T/err")"
 expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
     $F render "$T/slide.json" $R --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm"
 summary

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fmath.h"
+#include "motion.h"
 #include "compile/builder_instance.h"
 #include "compile/builder_motion.h"
 #include "compile/builder_object.h"
@@ -499,6 +500,23 @@ static int morph_weights(imp *c, uint32_t n, uint32_t m, morph *mw, fr_error *er
     return 0;
 }
 
+/* Whether moving instance k at mid-shutter is at `frame` (the node's pose
+ * at the frame's time), to 10^-3 of the transform's size: else the motion
+ * across the shutter is not the blend of its ends that the renderer draws. */
+static int blends(const fr_builder *b, uint32_t k, const affine *frame)
+{
+    const fr_instance *in = (const fr_instance *)b->instances.data + k;
+    float mid[3][4];
+    motion_at((const fr_inst_motion *)b->inst_motions.data + in->motion - 1, 0.5f, mid, NULL);
+    double size = 0.0, off = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++) {
+            size = fmax(size, fabs(frame->m[i][j]));
+            off = fmax(off, fabs(mid[i][j] - frame->m[i][j]));
+        }
+    return off <= 1e-3 * size;
+}
+
 /* A mesh drawn by one node is placed into the world's triangles; one drawn
  * by several is read once in its own space and placed by an instance per
  * node (builder_instance.h), unless morph weights bend it: then this node's
@@ -518,6 +536,7 @@ static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning 
                   "blurred: it is posed at the frame's time, sharp", ptr);
         moves = 0;
     }
+    const affine *w_frame = w;
     if (moves)
         w = &c->shut[0][n];
     if ((c->uses[m] < 2 && !moves) || mw.n || sk)
@@ -551,11 +570,14 @@ static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning 
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 4; j++)
             xf[i][j] = (float)c->shut[1][n].m[i][j];
-    if (bld_instance_motion(c->b, k, (const float(*)[4])xf, &e) < 0) {
-        char ptr[48];
-        snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+    if (bld_instance_motion(c->b, k, (const float(*)[4])xf, &e) < 0)
         return gdoc_fail(c->d, err, ptr, "%s", e.msg);
-    }
+    if (!blends(c->b, k, w_frame))
+        gdoc_warn(c->d, "blend", "%s: at the frame's time the node is not where the blend of its poses at the "
+                  "shutter's opening and closing puts it (more than half a turn across the shutter, or keys "
+                  "inside it): it is blurred along that blend", ptr);
     return 0;
 }
 

@@ -4,6 +4,7 @@
 
 #include "compile/json_motion.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -67,6 +68,30 @@ static cJSON *as_instances(const cJSON *o)
     return c;
 }
 
+/* Warns (through h->warn) of each placement of a and z (shapes as
+ * as_instances makes them) whose `rotate` turns by more than half a turn
+ * about an axis between them: the renderer blends the shorter way. */
+static void half_turns(const cJSON *a, const cJSON *z, const char *where, const scene_hooks *h)
+{
+    const cJSON *la = cJSON_GetObjectItemCaseSensitive(a, "instances"), *lz = cJSON_GetObjectItemCaseSensitive(z, "instances");
+    int k = 0;
+    for (const cJSON *x = la ? la->child : NULL, *y = lz ? lz->child : NULL; x && y && h->warn;
+         x = x->next, y = y->next, k++) {
+        const cJSON *ra = cJSON_GetObjectItemCaseSensitive(x, "rotate"), *rz = cJSON_GetObjectItemCaseSensitive(y, "rotate");
+        if (cJSON_GetArraySize(ra) != 3 || cJSON_GetArraySize(rz) != 3)
+            continue;
+        double most = 0.0;
+        for (int i = 0; i < 3; i++)
+            most = fmax(most, fabs(cJSON_GetArrayItem(ra, i)->valuedouble - cJSON_GetArrayItem(rz, i)->valuedouble));
+        if (most > 180.0) {
+            char msg[512];
+            snprintf(msg, sizeof msg, "%s.instances[%d].rotate: turns %g degrees across the shutter; the blur takes "
+                     "the shorter way between its two ends (at most half a turn)", where, k, most);
+            h->warn(h->user, msg);
+        }
+    }
+}
+
 int json_motion_mesh(fr_builder *b, cJSON *open, const cJSON *close, const char *where, const char *dir,
                      const confine *scope, const scene_hooks *h, uint32_t material, fr_error *err)
 {
@@ -79,6 +104,8 @@ int json_motion_mesh(fr_builder *b, cJSON *open, const cJSON *close, const char 
                                "its own (key the instances' %s instead)", where, placing[i], placing[i]);
         }
     cJSON *a = as_instances(open), *z = as_instances(close);
+    if (a && z)
+        half_turns(a, z, where, h);
     fr_builder tmp;
     bld_init(&tmp);
     uint32_t first = b->instances.count;
