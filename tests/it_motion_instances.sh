@@ -11,7 +11,8 @@
 # integrated over the pixels and the turn, does, and not as the bar at
 # rest; its total coverage is the bar's area.  A glTF node moved by the
 # file's animation smears as the JSON quad does, unwarned; a whole turn
-# across the shutter is warned about.  The frames are
+# across the shutter is warned about.  A shape keying both its own
+# transform and instances, and a scale through 0, are refused.  The frames are
 # byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
 # keys that do not move keep the still scene's bytes; a keyed sphere is
 # and a moving emitter are warned about (not blurred); the bidirectional
@@ -155,6 +156,11 @@ scene "$T/spin.json" 16 9.148694 quad.obj '"rotate": { "keys": [[0, [0, 0, 0]], 
 $F render "$T/spin.json" $R --shutter 0.5 -o "$T/spin.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "spin: $(cat "$T/err")"
 grep -q "turns 360 degrees across the shutter; the blur takes the shorter way" "$T/err" && ok ||
     bad "no warning for a spin of a whole turn: $(cat "$T/err")"
+scene "$T/both.json" 16 9.148694 quad.obj '"translate": { "keys": [[0, [-8, 0, 0]], [10, [8, 0, 0]]] }, "instances": [ {} ]'
+expect_error "a keyed shape with instances" "shapes[0].translate: a mesh shape with instances moves by its instances'" \
+    $F render "$T/both.json" $R --shutter 0.5 -o "$T/both.#.pfm"
+scene "$T/flat.json" 16 9.148694 quad.obj '"scale": { "keys": [[0, [1, 1, 1]], [10, [1, -9, 1]]] }'
+expect_error "a flat blend" "passes through a flat transform" $F render "$T/flat.json" --frames 1 --shutter 0.5 -o "$T/f.#.pfm"
 expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
     $F render "$T/slide.json" $R --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm"
 summary
