@@ -11,7 +11,8 @@
 # integrated over the pixels and the turn, does, and not as the bar at
 # rest; its total coverage is the bar's area.  A glTF node moved by the
 # file's animation smears as the JSON quad does, unwarned; a whole turn
-# across the shutter is warned about.  A shape keying both its own
+# across the shutter (JSON), and keys inside it that the blend cannot
+# follow (glTF), are warned about.  A shape keying both its own
 # transform and instances, and a scale through 0, are refused.  The frames are
 # byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
 # keys that do not move keep the still scene's bytes; a keyed sphere is
@@ -136,7 +137,25 @@ doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
        "animations": [{"samplers": [{"input": 1, "output": 2, "interpolation": "LINEAR"}],
                        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}]}
 json.dump(doc, open(sys.argv[1], 'w'))
+# and a node turning 270 degrees across the shutter of frame 5 (keys at
+# 4.75, 5 and 5.25: 0, 135 and 270 degrees about z), which the blend of
+# its two ends cannot follow
+import math
+q = lambda deg: [0, 0, math.sin(math.radians(deg) / 2), math.cos(math.radians(deg) / 2)]
+raw = struct.pack('<18f', *pos) + struct.pack('<3f', *(f(k / 24) for k in (4.75, 5, 5.25)))
+raw += struct.pack('<12f', *(q(0) + q(135) + q(270)))
+doc["buffers"][0] = {"byteLength": len(raw),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}
+doc["bufferViews"][0]["byteLength"] = len(raw)
+doc["accessors"][1:] = [dict(acc(72, 3, "SCALAR"), min=[f(4.75 / 24)], max=[f(5.25 / 24)]), acc(84, 3, "VEC4")]
+doc["animations"][0]["channels"][0]["target"]["path"] = "rotation"
+json.dump(doc, open(sys.argv[1].replace('slide', 'spin'), 'w'))
 PY
+scene "$T/gspin.json" 16 9.148694 quad.obj '"translate": [100, 0, 0]' \
+    ', { "type": "gltf", "file": "spin.gltf", "material": "black" }'
+$F render "$T/gspin.json" $R --shutter 0.5 -o "$T/gs.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "gltf spin: $(cat "$T/err")"
+grep -q "nodes/0: at the frame's time the node is not where the blend" "$T/err" && ok ||
+    bad "no warning for a glTF node the blend cannot follow: $(cat "$T/err")"
 scene "$T/gslide.json" 16 9.148694 quad.obj '"translate": [100, 0, 0]' \
     ', { "type": "gltf", "file": "slide.gltf", "material": "black" }'
 $F render "$T/gslide.json" $R --shutter 0.5 -o "$T/g.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "gltf: $(cat "$T/err")"
