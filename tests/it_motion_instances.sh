@@ -16,7 +16,8 @@
 # transform and instances, and a scale through 0, are refused.  The frames are
 # byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
 # keys that do not move keep the still scene's bytes; a keyed sphere is
-# and a moving emitter are warned about (not blurred); the bidirectional
+# and a moving emitter are warned about (not blurred: the emitter renders
+# as the still one at mid-shutter, byte for byte); the bidirectional
 # integrator refuses moving instances.
 . "$(dirname "$0")/support/fakehosts.sh"
 need python3 cmp
@@ -119,6 +120,11 @@ grep -q "shapes\[1\]: moves across the shutter, but only mesh shapes" "$T/err" &
 sed 's/"material": "black", "translate": {/"material": "lamp", "translate": {/' "$T/slide.json" >"$T/lamp.json"
 $F render "$T/lamp.json" $R --shutter 0.5 -o "$T/l.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "lamp: $(cat "$T/err")"
 grep -q "moving lights are not motion blurred" "$T/err" && ok || bad "no warning for a moving emitter: $(cat "$T/err")"
+sed 's/"translate": { "keys": \[\[0, \[-8, 0, 0\]\], \[10, \[8, 0, 0\]\]\] }/"translate": [0, 0, 0]/' "$T/lamp.json" \
+    >"$T/lamp0.json"
+$F render "$T/lamp0.json" -o "$T/l0.pfm" -j 2 >/dev/null 2>&1 || bad "still lamp"
+tail -c 12288 "$T/l.5.pfm" >"$T/l.px" && tail -c 12288 "$T/l0.pfm" >"$T/l0.px"
+cmp -s "$T/l.px" "$T/l0.px" && ok || bad "a moving emitter is not the still one at mid-shutter"
 
 # a glTF node moved by the file's animation: the same smear as the JSON quad's
 python3 - "$T/slide.gltf" <<'PY' || bad "writing slide.gltf"

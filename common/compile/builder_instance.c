@@ -225,6 +225,14 @@ int bld_flatten(fr_builder *b, int all, fr_error *err)
             inst[i].motion = 0;
             still++;
         }
+    /* With no instance left moving, no sample needs a time. */
+    int moving = 0;
+    for (uint32_t i = 0; i < ni; i++)
+        moving |= inst[i].motion != 0;
+    if (!moving) {
+        b->inst_motions.count = 0;
+        b->motion.flags &= ~(uint32_t)FR_MOTION_INSTANCES;
+    }
     if (still && b->warn) {
         char msg[200];
         snprintf(msg, sizeof msg, "%u moving instance%s of an emissive mesh: moving lights are not motion blurred; "
