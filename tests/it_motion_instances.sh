@@ -6,7 +6,7 @@
 # over 8 pixels, and each column's mean coverage (1 - its mean) is the
 # analytic smear, a trapezoid (ramps 8 pixels long, a plateau of 4),
 # within the noise of 64 x 16 samples a column; without --shutter its
-# edges are sharp.  A black bar turning 45 degrees across the shutter
+# edges are sharp; its shadow from a sun smears as the quad does.  A black bar turning 45 degrees across the shutter
 # (`rotate` keyed) covers each 6 x 6 block of pixels as the exact bar,
 # integrated over the pixels and the turn, does, and not as the bar at
 # rest; its total coverage is the bar's area.  A glTF node moved by the
@@ -52,6 +52,26 @@ grep -q "^sharp True" "$T/check" && ok || bad "without a shutter the quad's edge
 grep -q "^smear True" "$T/check" && ok || bad "the smear is not the analytic one: $(cat "$T/check")"
 grep -q "^total True" "$T/check" && ok || bad "the smear does not keep the quad's coverage: $(cat "$T/check")"
 grep -q "^spread 20 12$" "$T/check" && ok || bad "the smear's width: $(cat "$T/check")"
+
+# its shadow from a sun 2 units along +x for each unit up: the shadow ray
+# of each sample meets the quad where that sample's camera ray would.  On
+# the floor 1 unit behind, the shadow lies 2 units to the left, 11/10 as
+# far from the camera: the box [8.36, 19.27) of pixels, smeared 7.27.
+sed -e 's/"environment": { "color": \[1, 1, 1\] },/"lights": [ { "type": "sun", "direction": [-2, 0, -1], "irradiance": [3, 3, 3] } ],/' \
+    -e 's/"shapes": \[ /"shapes": [ { "type": "plane", "point": [0, 0, -1], "normal": [0, 0, 1], "material": "floor" }, /' \
+    -e 's/"materials": { /"materials": { "floor": { "type": "lambert", "albedo": [0.8, 0.8, 0.8] }, /' \
+    "$T/slide.json" >"$T/shadow.json"
+$F render "$T/shadow.json" $R --shutter 0.5 -o "$T/sh.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "shadow: $(cat "$T/err")"
+python3 - "$T/sh.5.pfm" <<'PY' >"$T/check" || bad "shadow check did not run"
+import sys
+sys.path.insert(0, 'tests/support')
+from pfmcols import columns, smear
+c = columns(sys.argv[1])
+shade = [1 - v / c[0] for v in c]
+worst = max(abs(shade[x] - smear(x, 8.3636, 19.2727, 7.2727)) for x in range(21))
+print("shadow", worst < 0.06, worst)
+PY
+grep -q "^shadow True" "$T/check" && ok || bad "the moving quad's shadow is not the analytic smear: $(cat "$T/check")"
 
 # split invariance
 $F render "$T/slide.json" $R --shutter 0.5 -o "$T/b.#.pfm" -j 2 --slab-rows 5 >/dev/null 2>&1 ||
