@@ -61,16 +61,13 @@ check "instanced scene renders" test -s "$T/in-ref.pf"
 check "amd64 static instanced slab is byte-identical" cmp "$T/in-s64.pf" "$T/in-ref.pf"
 "$QEMU" "$SA64" --scene "$T/inst.fbin" $IN -o "$T/in-sa64.pf"
 check "arm64 static instanced slab under qemu is byte-identical" cmp "$T/in-sa64.pf" "$T/in-ref.pf"
-# Moving instances (motion blur): the same mesh sliding, turning and
-# growing across the shutter, each ray placing it at its own time.
-cp "$ROOT/tests/fuzz/corpus/fbin/quad.obj" "$T/"
-sed -e 's|{"translate": \[-1, 0.5, 0\], "rotate": \[30, 0, 0\]}|{"translate": {"keys": [[0, [-2, 0.5, 0]], [2, [0, 0.5, 0]]]}, "rotate": {"keys": [[0, [0, 0, 0]], [2, [90, 40, 0]]]}}|' \
-    -e 's|"scale": \[-1, 1, 1\]}|"scale": {"keys": [[0, [-1, 1, 1]], [2, [-2, 0.5, 1]]]}}|' \
-    "$ROOT/tests/fuzz/corpus/fbin/instances.json" >"$T/moving.json"
-"$ROOT/bin/franja" render "$T/moving.json" --frames 1 --shutter 1 -o "$T/mv.#.pfm" --keep-job -j 1 >/dev/null 2>&1
+# Moving instances (motion blur): the fuzz seed moving.json, two of the
+# placements above sliding, turning and growing across the shutter.
+MJ="$ROOT/tests/fuzz/corpus/fbin/moving.json"
+"$ROOT/bin/franja" render "$MJ" --frames 1 --shutter 1 -o "$T/mv.#.pfm" --keep-job -j 1 >/dev/null 2>&1
 MV="--rows 0:12 --spp 8 --size 32x24"
 "$ROOT/bin/franja-worker" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-ref.pf"
-"$ROOT/bin/franja" render "$T/moving.json" --frames 1 -o "$T/st.#.pfm" --keep-job -j 1 >/dev/null 2>&1
+"$ROOT/bin/franja" render "$MJ" --frames 1 -o "$T/st.#.pfm" --keep-job -j 1 >/dev/null 2>&1
 "$ROOT/bin/franja-worker" --scene "$T/st.1.pfm.franja-job/scene.fbin" $MV -o "$T/st-ref.pf"
 check "moving instances render, blurred" test -s "$T/mv-ref.pf" -a -s "$T/st-ref.pf"
 check "the blurred slab is not the still one" sh -c "! cmp -s '$T/mv-ref.pf' '$T/st-ref.pf'"
