@@ -38,7 +38,7 @@ scene() { # FILE ROWS FOV MESH TRANSFORM [EXTRA SHAPE]
   "shapes": [ { "type": "mesh", "file": "%s", "material": "black", %s } %s ] }\n' \
         "$(( $2 * 4 ))" "$2" "$3" "$4" "$5" "$6" >"$1"
 }
-scene "$T/slide.json" 16 9.148694 quad.obj '"translate": { "keys": [[0, [-8, 0, 0]], [10, [8, 0, 0]]] }'
+scene "$T/slide.json" 16 9.148694 quad.obj '"name": "slider", "translate": { "keys": [[0, [-8, 0, 0]], [10, [8, 0, 0]]] }'
 R="--frames 5"
 $F render "$T/slide.json" $R -o "$T/sharp.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "sharp: $(cat "$T/err")"
 $F render "$T/slide.json" $R --shutter 0.5 -o "$T/a.#.pfm" -j 1 >/dev/null 2>"$T/err" || bad "blur: $(cat "$T/err")"
@@ -137,7 +137,7 @@ scene "$T/sphere.json" 16 9.148694 quad.obj '"translate": [1, 0, 0]' \
 $F render "$T/sphere.json" $R --shutter 0.5 -o "$T/sph.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "sphere: $(cat "$T/err")"
 grep -q "shapes\[1\]: moves across the shutter, but only mesh shapes" "$T/err" && ok ||
     bad "no warning for a keyed sphere: $(cat "$T/err")"
-sed 's/"material": "black", "translate": {/"material": "lamp", "translate": {/' "$T/slide.json" >"$T/lamp.json"
+sed 's/"material": "black", "name"/"material": "lamp", "name"/' "$T/slide.json" >"$T/lamp.json"
 $F render "$T/lamp.json" $R --shutter 0.5 -o "$T/l.#.pfm" -j 2 >/dev/null 2>"$T/err" || bad "lamp: $(cat "$T/err")"
 grep -q "moving lights are not motion blurred" "$T/err" && ok || bad "no warning for a moving emitter: $(cat "$T/err")"
 sed 's/"translate": { "keys": \[\[0, \[-8, 0, 0\]\], \[10, \[8, 0, 0\]\]\] }/"translate": [0, 0, 0]/' "$T/lamp.json" \

@@ -104,6 +104,10 @@ int json_motion_mesh(fr_builder *b, cJSON *open, const cJSON *close, const char 
                                "its own (key the instances' %s instead)", where, placing[i], placing[i]);
         }
     cJSON *a = as_instances(open), *z = as_instances(close);
+    /* The shape's name was read from the open pose (parse_shape sets it
+     * aside while the shape's fields are read): the closing one's too. */
+    if (z)
+        cJSON_DeleteItemFromObjectCaseSensitive(z, "name");
     if (a && z)
         half_turns(a, z, where, h);
     fr_builder tmp;
