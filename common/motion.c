@@ -4,6 +4,7 @@
 #include "motion.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "fmath.h"
 
@@ -57,4 +58,32 @@ void motion_at(const fr_inst_motion *m, float u, float xf[3][4], float inv[3][4]
             inv[i][j] = c[i][j] * id;
         inv[i][3] = -(inv[i][0] * t[0] + inv[i][1] * t[1] + inv[i][2] * t[2]);
     }
+}
+
+/* The cache of motion_at_cached: direct-mapped by the motion's index, so a
+ * scene of up to MOTION_CACHE moving instances keeps each one's pose
+ * for as long as the time stays. */
+#define MOTION_CACHE 16
+
+typedef struct {
+    fr_inst_motion m;   /* the motion the pose was made from */
+    uint32_t ubits;     /* and the time's bits */
+    int valid;
+    motion_pose pose;
+} motion_entry;
+
+static _Thread_local motion_entry motion_cache[MOTION_CACHE];
+
+const motion_pose *motion_at_cached(const fr_inst_motion *m, uint32_t slot, float u)
+{
+    motion_entry *e = &motion_cache[slot % MOTION_CACHE];
+    uint32_t ubits;
+    memcpy(&ubits, &u, sizeof ubits);
+    if (!e->valid || e->ubits != ubits || memcmp(&e->m, m, sizeof *m) != 0) {
+        motion_at(m, u, e->pose.xf, e->pose.inv);
+        e->m = *m;
+        e->ubits = ubits;
+        e->valid = 1;
+    }
+    return &e->pose;
 }

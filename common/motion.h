@@ -23,4 +23,19 @@
  * singular, which the compiler refuses).  Either may be NULL. */
 void motion_at(const fr_inst_motion *m, float u, float xf[3][4], float inv[3][4]);
 
+/** A moving instance's transform at one time (motion_at's xf and inv). */
+typedef struct {
+    float xf[3][4], inv[3][4];
+} motion_pose;
+
+/** motion_at's transform and inverse of moving instance m (slot: its
+ * index in the scene's inst_motions) at time u, through a small cache of
+ * the calling thread: every ray of a camera sample has the sample's time,
+ * so the rays of one sample blend each instance they meet once.  A cached
+ * pose is used only when the motion's bytes and u's bits are those it was
+ * made from, so the result is bit for bit motion_at's, whatever scene m
+ * belongs to.  The pose returned is the thread's own and holds until the
+ * thread's next call. */
+const motion_pose *motion_at_cached(const fr_inst_motion *m, uint32_t slot, float u);
+
 #endif

@@ -121,11 +121,10 @@ static inline void record(hit_state *H, float t, uint32_t prim, float a, float b
 }
 
 /* A world-space ray in an instance's object space: origin and direction by
- * the inverse transform, the direction not renormalised, so a point at t
+ * the inverse transform m, the direction not renormalised, so a point at t
  * along one is the point at t along the other. */
-static inline void instance_ray(const fr_instance *in, const fr_ray *r, fr_ray *o)
+static inline void instance_ray(const float (*m)[4], const fr_ray *r, fr_ray *o)
 {
-    const float (*m)[4] = in->inv;
     vec3 p = r->o, d = r->d;
     o->o = v3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
               m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
@@ -141,9 +140,7 @@ static inline void instance_ray(const fr_instance *in, const fr_ray *r, fr_ray *
 static __attribute__((noinline)) void instance_ray_moving(const fr_scene *s, const fr_instance *in, const fr_ray *r,
                                                           fr_ray *o)
 {
-    fr_instance at;
-    motion_at(&s->inst_motions[in->motion - 1], r->time, NULL, at.inv);
-    instance_ray(&at, r, o);
+    instance_ray(motion_at_cached(&s->inst_motions[in->motion - 1], in->motion - 1, r->time)->inv, r, o);
 }
 
 typedef struct { uint32_t child, leaf; float t; } stack_entry;
@@ -482,7 +479,9 @@ static __attribute__((noinline)) void instance_surface(const fr_scene *s, const 
     const fr_instance *in = &s->instances[hit->inst - 1];
     fr_instance at;
     if (in->motion) {
-        motion_at(&s->inst_motions[in->motion - 1], r->time, at.xf, at.inv);
+        const motion_pose *p = motion_at_cached(&s->inst_motions[in->motion - 1], in->motion - 1, r->time);
+        memcpy(at.xf, p->xf, sizeof at.xf);
+        memcpy(at.inv, p->inv, sizeof at.inv);
         in = &at;
     }
     fr_hit h = *hit;

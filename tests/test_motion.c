@@ -11,7 +11,8 @@
  * random times find exactly what testing every triangle of every
  * instance placed at that time finds, in every walk: so the top-level
  * BVH bounds each instance at every time.  The loader refuses damaged
- * motions; a flat blend is refused when compiled. */
+ * motions; a flat blend is refused when compiled.  The per-thread cache
+ * of blended poses gives motion_at's bits. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -123,6 +124,34 @@ static float err_xf(const float (*a)[4], const float (*b)[4])
 }
 
 /* The ends, the inverse, and a constant angular speed. */
+/* motion_at_cached gives motion_at's bits: motions sharing cache slots,
+ * few times (so entries are met again), and a motion changed in place
+ * at the same time (a new scene at the old address) is blended anew. */
+static void test_cached(const fr_inst_motion *mo, uint32_t n)
+{
+    const float times[3] = {0.25f, 0.7f, 0.7000001f};
+    for (int i = 0; i < 4000 && n; i++) {
+        uint32_t k = (uint32_t)(rnd() * (float)n) % n;
+        float u = times[i % 3 == 0 ? 0 : (int)(rnd() * 3.0f) % 3];
+        float xf[3][4], inv[3][4];
+        motion_at(&mo[k], u, xf, inv);
+        const motion_pose *p = motion_at_cached(&mo[k], k, u);
+        CHECK(memcmp(p->xf, xf, sizeof xf) == 0 && memcmp(p->inv, inv, sizeof inv) == 0,
+              "cached pose %d of motion %u at %g is not motion_at's", i, k, u);
+    }
+    if (n < 2)
+        return;
+    fr_inst_motion m = mo[0];
+    const motion_pose *p = motion_at_cached(&m, 0, 0.5f);
+    float xf0 = p->xf[0][0];
+    m = mo[1];
+    float xf[3][4];
+    motion_at(&m, 0.5f, xf, NULL);
+    p = motion_at_cached(&m, 0, 0.5f);
+    CHECK(memcmp(p->xf, xf, sizeof xf) == 0 && (xf0 != xf[0][0] || memcmp(&mo[0], &mo[1], sizeof m) == 0),
+          "a motion changed in place kept its old cached pose");
+}
+
 static void test_blend(void)
 {
     fr_builder b;
@@ -181,6 +210,7 @@ static void test_blend(void)
     make_xf(close, v3(0, 0, 1), 0.0, v3(1, -1, 1), v3s(0.0f));
     CHECK(bld_instance_motion(&b, k, (const float(*)[4])close, &e) < 0 && strstr(e.msg, "flat"),
           "a blend through a flat transform was accepted");
+    test_cached((const fr_inst_motion *)b.inst_motions.data, b.inst_motions.count);
     bld_free(&b);
 }
 
