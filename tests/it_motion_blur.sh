@@ -52,7 +52,7 @@ $F render "$T/jblur.json" --frames 12 --shutter 0.5 -o "$T/j.#.pfm" -j 2 >/dev/n
 tail -c 12288 "$T/a.12.pfm" >"$T/a.px" && tail -c 12288 "$T/j.12.pfm" >"$T/j.px"
 cmp -s "$T/a.px" "$T/j.px" && ok || bad "a gltf shape's moving camera is not blurred as the file's own"
 
-expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
+expect_error "bdpt" "camera moves across the shutter, which the bidirectional integrator does not support" \
     $F render "$T/blur.gltf" --frames 12 --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm" $R
 expect_error "--shutter without --frames" "--shutter is for --frames of one glTF or JSON file" \
     $F render "$T/blur.gltf" --shutter 0.5 -o "$T/e.pfm" $R

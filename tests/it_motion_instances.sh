@@ -17,8 +17,10 @@
 # byte-identical across -j 1, -j 2 --slab-rows 5 and two fake SSH hosts;
 # keys that do not move keep the still scene's bytes; a keyed sphere is
 # and a moving emitter are warned about (not blurred: the emitter renders
-# as the still one at mid-shutter, byte for byte); the bidirectional
-# integrator refuses moving instances.
+# as the still one at mid-shutter, byte for byte).  Under the
+# bidirectional integrator the quad smears as under the path tracer and
+# its shadow as the analytic one, byte-identical across -j 1 and -j 2
+# --slab-rows 5; Metropolis light transport refuses motion blur.
 . "$(dirname "$0")/support/fakehosts.sh"
 need python3 cmp
 fh_init
@@ -206,6 +208,30 @@ expect_error "a keyed shape with instances" "shapes[0].translate: a mesh shape w
     $F render "$T/both.json" $R --shutter 0.5 -o "$T/both.#.pfm"
 scene "$T/flat.json" 16 9.148694 quad.obj '"scale": { "keys": [[0, [1, 1, 1]], [10, [1, -9, 1]]] }'
 expect_error "a flat blend" "passes through a flat transform" $F render "$T/flat.json" --frames 1 --shutter 0.5 -o "$T/f.#.pfm"
-expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
-    $F render "$T/slide.json" $R --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm"
+
+# bidirectional: a sample's light subpath and connections see the scene at
+# the sample's time, so the quad smears as under the path tracer and its
+# shadow (sun: next-event and light-traced paths) as the analytic one;
+# byte-identical across splits.  Metropolis refuses motion.
+$F render "$T/slide.json" $R --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm" -j 1 >/dev/null 2>"$T/err" ||
+    bad "bdpt: $(cat "$T/err")"
+$F render "$T/shadow.json" $R --shutter 0.5 --integrator bdpt -o "$T/ds.#.pfm" -j 1 >/dev/null 2>"$T/err" ||
+    bad "bdpt shadow: $(cat "$T/err")"
+$F render "$T/shadow.json" $R --shutter 0.5 --integrator bdpt -o "$T/ds2.#.pfm" -j 2 --slab-rows 5 >/dev/null 2>&1 ||
+    bad "bdpt shadow -j 2 --slab-rows 5"
+cmp -s "$T/ds.5.pfm" "$T/ds2.5.pfm" && ok || bad "bdpt: -j 1 and -j 2 --slab-rows 5 differ"
+python3 - "$T/a.5.pfm" "$T/d.5.pfm" "$T/ds.5.pfm" <<'PY' >"$T/check" || bad "bdpt check did not run"
+import sys
+sys.path.insert(0, 'tests/support')
+from pfmcols import columns, smear, smear_report
+smear_report([1 - v for v in columns(sys.argv[1])], [1 - v for v in columns(sys.argv[2])], 26, 38, 8)
+c = columns(sys.argv[3])
+shade = [1 - v / c[0] for v in c]
+worst = max(abs(shade[x] - smear(x, 8.3636, 19.2727, 7.2727)) for x in range(21))
+print("shadow", worst < 0.06, worst)
+PY
+grep -q "^smear True" "$T/check" && ok || bad "bdpt: the smear is not the path tracer's: $(cat "$T/check")"
+grep -q "^shadow True" "$T/check" && ok || bad "bdpt: the shadow is not the analytic smear: $(cat "$T/check")"
+expect_error "mlt" "motion blur, which Metropolis light transport does not support" \
+    $F render "$T/slide.json" $R --shutter 0.5 --integrator mlt -o "$T/m.#.pfm"
 summary
