@@ -73,7 +73,7 @@ all: bin/franja-worker bin/franja $(IIO_PLUGIN)
 # tests/bench/README.md, "-O3 on the render path"; the same bits, since
 # -ffp-contract=off and no fast-math keep every rounding where the source
 # puts it); the rest stays at $(OPT).
-HOT_SRC = $(addprefix common/,bsdf.c camera.c envmap.c fmath.c geom.c light.c medium.c microfacet.c \
+HOT_SRC = $(addprefix common/,bsdf.c camera.c envmap.c fmath.c geom.c light.c medium.c microfacet.c motion.c \
           pathtrace.c sampler.c texture.c trace.c vertex.c)
 # They also carry GCC's intermediate code beside the machine code (fat LTO
 # objects), and the two programs are linked with link-time optimisation:

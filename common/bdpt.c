@@ -96,6 +96,7 @@ struct bd_work {
     uint32_t cap;
     vert *cam, *lgt;
     int ncam;                  /* the vertices of the last sample's camera subpath */
+    float time;                /* the last sample's time across the shutter, which all its rays carry */
 };
 
 int bd_supported(const fr_scene *s, fr_error *err)
@@ -113,9 +114,9 @@ int bd_supported(const fr_scene *s, fr_error *err)
     if (media)
         return fr_fail(err, "the scene has participating media (fog or a medium inside a shape), which the "
                             "bidirectional integrator does not support; render it with the path integrator");
-    if (s->motion.flags)
-        return fr_fail(err, "the scene has motion blur, which the bidirectional integrator does not support; "
-                            "render it with the path integrator");
+    if (s->motion.flags & FR_MOTION_CAMERA)
+        return fr_fail(err, "the scene's camera moves across the shutter, which the bidirectional integrator does "
+                            "not support (moving instances it does); render it with the path integrator");
     return 0;
 }
 
@@ -449,9 +450,11 @@ static int walk(const fr_scene *s, rnd *smp, fr_ray ray, vec3 beta, float pdf_di
 
 /* The camera subpath of pixel (x, y); from a stream (smp->st), the first
  * two numbers place it anywhere in the image instead, and *rx, *ry (when
- * not NULL) receive its raster position. */
+ * not NULL) receive its raster position.  *time receives the sample's
+ * time across the shutter (0 without motion, where no pair is drawn for
+ * it), which every ray of the sample carries, the light subpath's too. */
 static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, vert *cam, int maxv, float *rx,
-                          float *ry)
+                          float *ry, float *time)
 {
     float px, py, lx = 0.0f, ly = 0.0f, pdf_dir;
     rnd_2d(smp, &px, &py);
@@ -470,7 +473,15 @@ static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, v
         rnd_2d(smp, &lx, &ly);
     else
         rnd_skip(smp);         /* a pinhole has no lens to sample */
+    *time = 0.0f;
+    if (s->motion.flags) {
+        /* As the path tracer draws it (pathtrace.c); only instances move
+         * here (bd_supported). */
+        float unused;
+        rnd_2d(smp, time, &unused);
+    }
     fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
+    ray.time = *time;
     cam_importance(s, ray.o, ray.d, &pdf_dir, NULL, NULL);
     vert *c = &cam[0];
     c->type = BD_CAMERA;
@@ -484,7 +495,8 @@ static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, v
     return walk(s, smp, ray, c->beta, pdf_dir, 0, cam, maxv);
 }
 
-static int light_subpath(const fr_scene *s, rnd *smp, vert *lgt, int maxv)
+/* The light subpath, its rays at the camera subpath's time. */
+static int light_subpath(const fr_scene *s, rnd *smp, vert *lgt, int maxv, float time)
 {
     float upick, unused, u1, u2, u3, u4;
     rnd_2d(smp, &upick, &unused);
@@ -513,7 +525,7 @@ static int light_subpath(const fr_scene *s, rnd *smp, vert *lgt, int maxv)
     l->pdf_fwd = e.distant ? emit_pdf_origin(s, l) : e.pdf_pos;
     float cosl = local ? fabsf(v3_dot(e.n, e.ray.d)) : 1.0f;
     vec3 beta = v3_scale(e.Le, cosl / (e.pdf_pos * e.pdf_dir));
-    fr_ray ray = {local ? geo_offset(e.ray.o, e.perr, e.n, e.ray.d) : e.ray.o, e.ray.d};
+    fr_ray ray = {local ? geo_offset(e.ray.o, e.perr, e.n, e.ray.d) : e.ray.o, e.ray.d, time};
     return walk(s, smp, ray, beta, e.pdf_dir, 1, lgt, maxv);
 }
 
@@ -521,15 +533,15 @@ static int light_subpath(const fr_scene *s, rnd *smp, vert *lgt, int maxv)
  * vertex b.  The segment leaves a pushed off its surface (geo_offset) and
  * ends short of b by a bound on how far the rounding of a hit distance can
  * put b's own surface in front of b (a few dozen ulps of the coordinates
- * involved), so that b's surface does not hide b. */
-static int visible(const fr_scene *s, const vert *a, const vert *b)
+ * involved), so that b's surface does not hide b.  At the sample's time. */
+static int visible(const fr_scene *s, const vert *a, const vert *b, float time)
 {
     vec3 o = geo_offset(a->p, a->sf.perr, a->ng, v3_sub(b->p, a->p)), d = v3_sub(b->p, o);
     float len = v3_len(d);
     float margin = (v3_max(v3_abs(o)) + v3_max(v3_abs(b->p)) + v3_max(b->sf.perr)) * GEO_GAMMA(32);
     if (!(len > margin))
         return 1;
-    fr_ray r = {o, v3_scale(d, 1.0f / len)};
+    fr_ray r = {o, v3_scale(d, 1.0f / len), time};
     return !trace_occluded(s, &r, len - margin, FR_NONE);
 }
 
@@ -649,7 +661,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         vec3 L = v3_scale(v3_mul(qs->beta, vert_f(qs, wi, 1)), fabsf(v3_dot(wi, qs->ns)) * g);
         if (v3_is_zero(L))
             return zero;
-        fr_ray r = {geo_offset(qs->p, qs->sf.perr, qs->ng, wi), wi};
+        fr_ray r = {geo_offset(qs->p, qs->sf.perr, qs->ng, wi), wi, w->time};
         if (trace_occluded(s, &r, v3_len(v3_sub(lens, r.o)), FR_NONE))
             return zero;
         sampled->type = BD_CAMERA;
@@ -674,7 +686,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         L = v3_scale(L, fabsf(v3_dot(ls.wi, pt->ns)) / ls.pdf);
         if (v3_is_zero(L))
             return zero;
-        fr_ray r = {geo_offset(pt->p, pt->sf.perr, pt->ng, ls.wi), ls.wi};
+        fr_ray r = {geo_offset(pt->p, pt->sf.perr, pt->ng, ls.wi), ls.wi, w->time};
         float tmax = ls.distant ? INFINITY : v3_dot(v3_sub(ls.p, r.o), ls.wi);
         if (!(tmax > 0.0f) || trace_occluded(s, &r, tmax, ls.prim))
             return zero;
@@ -703,7 +715,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
     vec3 fq = vert_f(qs, wq, 1), fp = vert_f(pt, v3_neg(wq), 0);
     float g = fabsf(v3_dot(wq, qs->ns)) * fabsf(v3_dot(wq, pt->ns)) / d2;
     vec3 L = v3_scale(v3_mul(v3_mul(qs->beta, fq), v3_mul(fp, pt->beta)), g);
-    if (v3_is_zero(L) || !visible(s, qs, pt))
+    if (v3_is_zero(L) || !visible(s, qs, pt, w->time))
         return zero;
     return L;
 }
@@ -721,8 +733,8 @@ static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_
     ls.dim = LIGHT_DIM;
     int maxd = (int)s->settings.max_depth;
     rnd rc = {&cs, NULL}, rl = {&ls, NULL};
-    int nc = w->ncam = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL);
-    int nl = light_subpath(s, &rl, w->lgt, maxd + 1);
+    int nc = w->ncam = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL, &w->time);
+    int nl = light_subpath(s, &rl, w->lgt, maxd + 1, w->time);
     /* s = 1 samples its own light point: possible even when the light
      * subpath could not start. */
     int smax = nl > 0 ? nl : s->n_lights > 0;
@@ -793,10 +805,10 @@ vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam,
         return zero;
     rnd rc = {NULL, cam}, rl = {NULL, light};
     float cx = 0.0f, cy = 0.0f;
-    if (camera_subpath(s, &rc, 0, 0, w->cam, t, &cx, &cy) != t)
+    if (camera_subpath(s, &rc, 0, 0, w->cam, t, &cx, &cy, &w->time) != t)
         return zero;
     /* s = 1 samples its light point from the camera vertex's numbers. */
-    if (s_ > 1 && light_subpath(s, &rl, w->lgt, s_) != s_)
+    if (s_ > 1 && light_subpath(s, &rl, w->lgt, s_, w->time) != s_)
         return zero;
     if (s_ == 1 && s->n_lights == 0)
         return zero;

@@ -38,8 +38,12 @@
  * Russian roulette.  So each light subpath belongs to one pixel sample, and
  * a split of the image into rows traces every light subpath once.
  *
- * Scenes that use participating media (fog, a medium inside a shape) or
- * motion blur are refused (bd_supported).
+ * Moving instances blur: a sample draws its time across the shutter after
+ * the camera's lens pair (as the path tracer does; scenes without motion
+ * draw none), and its light subpath, connections and shadow rays all see
+ * the scene at that time.  Scenes that use participating media (fog, a
+ * medium inside a shape) or a camera moving across the shutter are refused
+ * (bd_supported).
  */
 #ifndef FRANJA_BDPT_H
 #define FRANJA_BDPT_H
@@ -72,7 +76,7 @@ typedef struct {
 typedef struct bd_work bd_work;
 
 /** 0 when bidirectional path tracing can render scene s; otherwise -1
- * with err saying why (participating media, motion blur). */
+ * with err saying why (participating media, a moving camera). */
 int bd_supported(const fr_scene *s, fr_error *err);
 
 /** Allocate working memory for scene s (subpaths of max_depth + 2

@@ -5,6 +5,8 @@
 
 #include "bvh.h"
 #include "file.h"
+#include "fmath.h"
+#include "motion.h"
 #include "passes.h"
 #include "proto_limits.h"
 #include "scene_pages.h"
@@ -33,7 +35,7 @@ enum {
     SEC_TEXTURES, SEC_TEXELS, SEC_MEDIA, SEC_VOLUME, SEC_TONEMAP, SEC_WORLD, SEC_DISTRIB,
     SEC_MESHES, SEC_INSTANCES, SEC_MESH_NODES, SEC_MESH_LEAVES, SEC_LIGHTTREE, SEC_NAMES, SEC_MOTION,
     SEC_OBJECTS, SEC_OBJECT_NAMES,
-    SEC_LIGHT_GROUPS, SEC_GROUP_NAMES, SEC_COUNT = SEC_GROUP_NAMES
+    SEC_LIGHT_GROUPS, SEC_GROUP_NAMES, SEC_INST_MOTIONS, SEC_COUNT = SEC_INST_MOTIONS
 };
 
 _Static_assert(SEC_COUNT == FBIN_SECTIONS, "fbin.h's FBIN_SECTIONS is the number of sections");
@@ -81,6 +83,7 @@ static const section_desc sections[SEC_COUNT + 1] = {
     ARR(SEC_OBJECT_NAMES, "object_names", object_names, fr_name),
     ARR(SEC_LIGHT_GROUPS, "light_groups", light_groups, uint32_t),
     ARR(SEC_GROUP_NAMES, "group_names", group_names, fr_name),
+    ARR(SEC_INST_MOTIONS, "inst_motions", inst_motions, fr_inst_motion),
 };
 #undef ARR
 
@@ -437,9 +440,12 @@ static int validate_instances(const fr_scene *s, const void *base, fr_error *err
                        (unsigned long long)prim, s->n_mesh_nodes, s->n_mesh_leaves, s->n_prims);
     for (uint32_t i = 0; i < s->n_instances; i++) {
         const fr_instance *in = &s->instances[i];
-        if (in->mesh >= s->n_meshes || in->pad[0] || in->pad[1] || in->pad[2])
+        if (in->mesh >= s->n_meshes || in->pad[0] || in->pad[1])
             return fr_fail(err, "section instances, byte %zu: instance %u: mesh %u of %u", AT(&in->mesh), i,
                            in->mesh, s->n_meshes);
+        if (in->motion > s->n_inst_motions || (in->motion && !(s->motion.flags & FR_MOTION_INSTANCES)))
+            return fr_fail(err, "section instances, byte %zu: instance %u: motion %u of %u (or the motion section "
+                           "does not say instances move)", AT(&in->motion), i, in->motion, s->n_inst_motions);
         for (int r = 0; r < 3; r++)
             for (int c = 0; c < 4; c++)
                 if (!isfinite(in->xf[r][c]) || !isfinite(in->inv[r][c]) || fabsf(in->xf[r][c]) > 1e30f ||
@@ -457,6 +463,44 @@ static int validate_instances(const fr_scene *s, const void *base, fr_error *err
                     return fr_fail(err, "section instances, byte %zu: instance %u: the inverse is not the "
                                    "transform's inverse", AT(in->inv), i);
             }
+    }
+    return 0;
+}
+
+/* The moving instances' motions (scene.h's fr_inst_motion): finite
+ * numbers of a sane size, unit quaternions on the same side (q0 . q1 >= 0)
+ * whose angle and its inverse sine are the ones stored (to a tolerance: a
+ * wrong pair only draws wrong); the motion flag set when there are any. */
+static int validate_motions(const fr_scene *s, const void *base, fr_error *err)
+{
+    if (s->n_inst_motions && !(s->motion.flags & FR_MOTION_INSTANCES))
+        return fr_fail(err, "section inst_motions: %u motions, but the motion section does not say instances move",
+                       s->n_inst_motions);
+    for (uint32_t i = 0; i < s->n_inst_motions; i++) {
+        const fr_inst_motion *m = &s->inst_motions[i];
+        const float *f = &m->t0.x;
+        for (size_t k = 0; k < offsetof(fr_inst_motion, pad) / sizeof(float); k++)
+            if (!isfinite(f[k]) || fabsf(f[k]) > 1e30f)
+                return fr_fail(err, "section inst_motions, byte %zu: motion %u: a number not finite or above 1e30",
+                               AT(&f[k]), i);
+        if (m->pad[0] || m->pad[1])
+            return fr_fail(err, "section inst_motions, byte %zu: motion %u: pad not zero", AT(m->pad), i);
+        double n0 = 0.0, n1 = 0.0, dot = 0.0;
+        for (int k = 0; k < 4; k++) {
+            n0 += (double)m->q0[k] * m->q0[k];
+            n1 += (double)m->q1[k] * m->q1[k];
+            dot += (double)m->q0[k] * m->q1[k];
+        }
+        if (!(fabs(n0 - 1.0) <= 1e-4 && fabs(n1 - 1.0) <= 1e-4 && dot >= -1e-6))
+            return fr_fail(err, "section inst_motions, byte %zu: motion %u: rotations not unit quaternions with "
+                           "q0 . q1 >= 0", AT(m->q0), i);
+        double ang = fm_acosf((float)dot);
+        int slerp = m->inv_sin > 0.0f;
+        if (!(m->angle >= 0.0f && m->angle <= 1.5708f && fabs(ang - m->angle) <= 1e-3) ||
+            !(m->inv_sin >= 0.0f) || slerp != (m->angle >= MOTION_SLERP_MIN) ||
+            (slerp && !(fabs((double)m->inv_sin * fm_sinf(m->angle) - 1.0) <= 1e-4)))
+            return fr_fail(err, "section inst_motions, byte %zu: motion %u: angle or its inverse sine not the "
+                           "quaternions'", AT(&m->angle), i);
     }
     return 0;
 }
@@ -541,7 +585,7 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
     if (!camera_ok(&s->camera))
         return fr_fail(err, "section camera, byte %zu: degenerate or non-finite camera", AT1(SEC_CAMERA, fr_camera, position));
     const fr_motion *mo = &s->motion;
-    if (mo->flags & ~(uint32_t)FR_MOTION_CAMERA || !(mo->shutter >= 0.0f && mo->shutter <= 1e6f))
+    if (mo->flags & ~(uint32_t)(FR_MOTION_CAMERA | FR_MOTION_INSTANCES) || !(mo->shutter >= 0.0f && mo->shutter <= 1e6f))
         return fr_fail(err, "section motion, byte %zu: unknown flags or a shutter not a time in seconds",
                        AT1(SEC_MOTION, fr_motion, flags));
     if ((mo->flags & FR_MOTION_CAMERA) && !camera_ok(&mo->camera_close))
@@ -591,7 +635,7 @@ static int validate(const fr_scene *s, const void *base, const uint64_t *off, fr
         if (s->light_groups[i] >= s->n_group_names)
             return fr_fail(err, "section light_groups, byte %zu: group %u of %u names", AT(&s->light_groups[i]),
                            s->light_groups[i], s->n_group_names);
-    if (validate_instances(s, base, err) < 0)
+    if (validate_motions(s, base, err) < 0 || validate_instances(s, base, err) < 0)
         return -1;
     uint32_t top = s->n_meshes ? s->meshes[0].prim_first : s->n_prims;
     uint32_t kind_count[FR_PRIM_KINDS] = {s->n_triangles, s->n_spheres, s->n_rects, s->n_instances};

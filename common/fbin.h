@@ -19,10 +19,10 @@
 #include "error.h"
 #include "scene.h"
 
-#define FBIN_VERSION 15
+#define FBIN_VERSION 16
 
 /** The number of sections of the format (FORMAT.md, "Sections"). */
-#define FBIN_SECTIONS 32
+#define FBIN_SECTIONS 33
 
 /** Serialize the arrays `view` points at into a new malloc'd blob (owned by
  * the caller) and compute its hash. */

@@ -16,8 +16,10 @@
 
 /* The binary scene's own layout (FORMAT.md): header, table, alignment. */
 enum { SCN_HEADER = 64, SCN_ENTRY = 32, SCN_ALIGN = 64 };
-_Static_assert(FPATCH_SECTIONS <= 32, "a patch's mask has 32 bits: a new mask is a new patch version");
-enum { SCN_HEAD = SCN_HEADER + SCN_ENTRY * FPATCH_SECTIONS }; /* 1088, a multiple of 64 */
+_Static_assert(FPATCH_SECTIONS > 32, "the sections past the mask's first word are named from byte 52");
+_Static_assert(FPATCH_SECTIONS <= 64, "a patch's mask has 64 bits: a new mask is a new patch version");
+/* The header and table, then zeros to the first section's alignment. */
+enum { SCN_HEAD = (SCN_HEADER + SCN_ENTRY * FPATCH_SECTIONS + SCN_ALIGN - 1) & ~(SCN_ALIGN - 1) };
 static const unsigned char scn_magic[8] = {0x89, 'F', 'R', 'J', 'S', 'C', 'N', '\n'};
 
 static void wr32(unsigned char *p, uint32_t v) { for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i)); }
@@ -94,7 +96,7 @@ int fpatch_same(const fpatch_sect *a, const fpatch_sect *b)
 }
 
 int fpatch_make(const void *base, size_t bsize, const void *res, size_t rsize, void **patch, size_t *psize,
-                uint32_t *changed, fr_error *err)
+                uint64_t *changed, fr_error *err)
 {
     fpatch_sect b[FPATCH_SECTIONS + 1], r[FPATCH_SECTIONS + 1];
     fr_error e;
@@ -102,11 +104,11 @@ int fpatch_make(const void *base, size_t bsize, const void *res, size_t rsize, v
         return fr_fail(err, "patch: %s", e.msg);
     if (rd32((const unsigned char *)base + 8) != rd32((const unsigned char *)res + 8))
         return fr_fail(err, "patch: scenes of two format versions");
-    uint32_t mask = 0;
+    uint64_t mask = 0;
     size_t n = FPATCH_HEADER;
     for (int id = 1; id <= FPATCH_SECTIONS; id++)
         if (!fpatch_same(&b[id], &r[id])) {
-            mask |= 1u << (id - 1);
+            mask |= 1ull << (id - 1);
             n += FPATCH_ENTRY + (size_t)(r[id].count * r[id].elem);
         }
     unsigned char *p = calloc(1, n);
@@ -114,7 +116,8 @@ int fpatch_make(const void *base, size_t bsize, const void *res, size_t rsize, v
         return fr_fail(err, "out of memory making a patch of %zu bytes", n);
     memcpy(p, FPATCH_MAGIC, 8);
     wr32(p + 8, FPATCH_VERSION);
-    wr32(p + 12, mask);
+    wr32(p + 12, (uint32_t)mask);
+    wr32(p + 52, (uint32_t)(mask >> 32));
     wr64(p + 16, rd64((const unsigned char *)base + 32));
     wr64(p + 24, bsize);
     wr64(p + 32, rd64((const unsigned char *)res + 32));
@@ -158,7 +161,7 @@ int fpatch_apply(const void *patch, size_t psize, const void *base, size_t bsize
     if (rd32(p + 48) != FBIN_VERSION)
         return fr_fail(err, "byte 48: a patch of scene format version %u, this program reads version %d",
                        rd32(p + 48), FBIN_VERSION);
-    for (int k = 52; k < FPATCH_HEADER; k++)
+    for (int k = 56; k < FPATCH_HEADER; k++)
         if (p[k])
             return fr_fail(err, "byte %d: reserved header byte is not zero", k);
     fpatch_sect s[FPATCH_SECTIONS + 1];
@@ -169,7 +172,9 @@ int fpatch_apply(const void *patch, size_t psize, const void *base, size_t bsize
         return fr_fail(err, "byte 16: the patch is of base scene %016llx (%llu bytes), not of %016llx (%zu bytes)",
                        (unsigned long long)want_base, (unsigned long long)rd64(p + 24),
                        (unsigned long long)rd64(b + 32), bsize);
-    uint32_t mask = rd32(p + 12);
+    uint64_t mask = rd32(p + 12) | (uint64_t)rd32(p + 52) << 32;
+    if (mask >> FPATCH_SECTIONS)
+        return fr_fail(err, "byte 52: the mask names a section past %d", FPATCH_SECTIONS);
     size_t at = FPATCH_HEADER;
     for (uint32_t id = 1; id <= FPATCH_SECTIONS; id++) {
         if (!(mask >> (id - 1) & 1))

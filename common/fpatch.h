@@ -3,7 +3,7 @@
  * in another one, for the frames of an animation whose geometry stays
  * (FORMAT.md, "Scene patches").
  *
- * A binary scene is a table of 32 sections laid out one after the other
+ * A binary scene is a table of sections (fbin.h FBIN_SECTIONS) laid out one after the other
  * in id order, each at the next multiple of 64 bytes.  fpatch_sections
  * reads that table; fpatch_assemble lays sections taken from anywhere
  * out again, byte for byte as fbin_serialize would; fpatch_make says
@@ -33,7 +33,7 @@
 #define FPATCH_VERSION 1u
 /** Sizes: the header; the entry before each section carried; the
  * sections of a binary scene (ids 1 to FPATCH_SECTIONS, fbin.h's; the
- * mask of carried sections holds up to 32). */
+ * mask of carried sections holds up to 64). */
 enum { FPATCH_HEADER = 64, FPATCH_ENTRY = 16, FPATCH_SECTIONS = FBIN_SECTIONS };
 
 /** One section of a binary scene: `count` elements of `elem` bytes at
@@ -44,7 +44,7 @@ typedef struct {
     uint64_t count;
 } fpatch_sect;
 
-/** The sections of the binary scene blob[0..size) into s[1..32] (s[0]
+/** The sections of the binary scene blob[0..size) into s[1..FPATCH_SECTIONS] (s[0]
  * unused), pointing into the blob.  The blob should have been opened
  * (fbin_open_mem); its table is checked again here all the same.  Fails,
  * naming the byte offset, on a table out of bounds. */
@@ -54,7 +54,7 @@ int fpatch_sections(const void *blob, size_t size, fpatch_sect s[FPATCH_SECTIONS
 int fpatch_same(const fpatch_sect *a, const fpatch_sect *b);
 
 /** A new malloc'd binary scene (owned by the caller) of the sections
- * s[1..32], laid out as fbin_serialize lays them out, with its content
+ * s[1..FPATCH_SECTIONS], laid out as fbin_serialize lays them out, with its content
  * hash; *size and *hash say its size and hash.  Fails on a size past
  * what size_t holds, or memory. */
 int fpatch_assemble(const fpatch_sect s[FPATCH_SECTIONS + 1], void **blob, size_t *size, uint64_t *hash,
@@ -66,7 +66,7 @@ int fpatch_assemble(const fpatch_sect s[FPATCH_SECTIONS + 1], void **blob, size_
  * that differs from base's (in size or in a byte).  *changed gets a mask
  * of them (bit id - 1). */
 int fpatch_make(const void *base, size_t bsize, const void *res, size_t rsize, void **patch, size_t *psize,
-                uint32_t *changed, fr_error *err);
+                uint64_t *changed, fr_error *err);
 
 /** The base scene hash a patch names, read from its header (no other
  * check).  Fails when the bytes are not a patch's header. */

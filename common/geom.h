@@ -17,7 +17,10 @@
 
 #include "scene.h"
 
-typedef struct { vec3 o, d; } fr_ray;   /**< d need not be unit length */
+/** A ray: origin o, direction d (need not be unit length), and the time
+ * across the shutter, in [0, 1), of the sample that traces it (scene.h's
+ * fr_motion; 0 when nothing moves, as `{o, d}` leaves it). */
+typedef struct { vec3 o, d; float time; } fr_ray;
 
 float geo_sphere(const fr_sphere *s, const fr_ray *r, float tmax);
 float geo_plane(const fr_plane *p, const fr_ray *r, float tmax);

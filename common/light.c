@@ -26,7 +26,7 @@ static inline __attribute__((always_inline)) vec3 textured(const fr_scene *s, co
     if (m->tex_emission == FR_NONE || v3_is_zero(le))
         return le;
     fr_hit h = {0.0f, prim, FR_NONE, a, b, 0};
-    fr_ray r = {p, v3s(0.0f)};
+    fr_ray r = {p, v3s(0.0f), 0.0f};
     fr_surface sf;
     trace_surface(s, &r, &h, &sf);
     return tex_emission(s, m, sf.uv);

@@ -66,7 +66,7 @@ typedef struct {
 } mlt_boot;
 
 /** 0 when Metropolis light transport can render scene s (what bd_supported
- * accepts); otherwise -1 with err saying why. */
+ * accepts, and no motion blur); otherwise -1 with err saying why. */
 int mlt_supported(const fr_scene *s, fr_error *err);
 
 /** Run the bootstrap of scene s into *bt (n states); -1 with err when out

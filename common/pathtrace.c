@@ -71,7 +71,7 @@ static fr_ray camera_ray_from(const fr_scene *s, const fr_camera *c, uint32_t x,
     float sx = (2.0f * ((float)x + px) - w) / h * c->tan_half;
     float sy = (h - 2.0f * ((float)y + py)) / h * c->tan_half;
     vec3 d = v3_add(c->forward, v3_add(v3_scale(c->right, sx), v3_scale(c->upv, sy)));
-    fr_ray r = {c->position, d};
+    fr_ray r = {c->position, d, 0.0f};
     if (c->aperture > 0.0f) {
         /* A point on the lens disk (camera.h), aimed at the point of the
          * focal plane the pinhole ray reaches, `focus` along the view axis. */
@@ -167,15 +167,18 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
         smp_skip(&smp);        /* a pinhole has no lens to sample */
     fr_camera at;
     const fr_camera *cam = &s->camera;
+    float tu = 0.0f;
     if (s->motion.flags) {
         /* The sample's time across the shutter (scenes without motion
-         * draw no pair here: their numbers stay as they were). */
-        float tu, unused;
+         * draw no pair here: their numbers stay as they were); every ray
+         * of the path carries it (fr_ray.time). */
+        float unused;
         smp_2d(&smp, &tu, &unused);
         cam_at(s, tu, &at);
         cam = &at;
     }
     fr_ray ray = camera_ray_from(s, cam, x, y, px, py, lx, ly);
+    ray.time = tu;
     vec3 camera = ray.o;
     if (ps)
         pass_start(ps);

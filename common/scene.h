@@ -382,8 +382,28 @@ typedef struct {
     float xf[3][4];
     float inv[3][4];
     uint32_t mesh;             /**< index into meshes */
-    uint32_t pad[3];
+    uint32_t motion;           /**< 0: still; else 1 + index into inst_motions (xf and inv are then the
+                                    pose at shutter open, and the pose at the ray's time is used) */
+    uint32_t pad[2];
 } fr_instance;
+
+/** How a moving instance moves across the shutter (FR_MOTION_INSTANCES):
+ * its transform at shutter open and close, each split into a translation,
+ * a rotation (unit quaternion x, y, z, w) and a stretch (a 3x3 matrix:
+ * scale and shear, what the polar decomposition leaves after the
+ * rotation), so that the object-to-world transform is
+ * world = T + R S p.  At time u in [0, 1] (motion.h's motion_at): T and S
+ * blend linearly, R along the shortest arc from q0 to q1 (slerp; q0 . q1
+ * >= 0, at most half a turn).  The top-level BVH bounds the instance over
+ * the whole shutter. */
+typedef struct {
+    vec3 t0, t1;               /**< translation at open, close */
+    float q0[4], q1[4];        /**< rotation at open, close: unit quaternions (x, y, z, w), q0 . q1 >= 0 */
+    float s0[3][3], s1[3][3];  /**< stretch at open, close (row-major) */
+    float angle;               /**< the angle between q0 and q1 in 4-space, [0, pi/2] (half the turn) */
+    float inv_sin;             /**< 1 / sin(angle); 0 below MOTION_SLERP_MIN, where the blend is linear (nlerp) */
+    uint32_t pad[2];
+} fr_inst_motion;
 
 /** A material's name (material_names section): NUL-terminated UTF-8, at
  * most 63 bytes (longer names are cut), no control character; "" when
@@ -393,13 +413,16 @@ typedef struct {
 } fr_name;
 
 /** Motion blur (fr_motion.flags). */
-enum { FR_MOTION_CAMERA = 1 };
+enum { FR_MOTION_CAMERA = 1, FR_MOTION_INSTANCES = 2 };
 
 /** What moves while the shutter is open.  A camera sample has a time u in
  * [0, 1) across the shutter (from its sampler, pathtrace.h), 0 at
  * shutter open; with FR_MOTION_CAMERA the camera at u is `camera` (the
  * pose at shutter open) blended toward `camera_close` (camera.h's
- * cam_at).  Without flags nothing moves and no sample draws a time. */
+ * cam_at); with FR_MOTION_INSTANCES some instances move (fr_inst_motion)
+ * and every ray of the sample, camera, bounce and shadow rays alike,
+ * carries u (fr_ray.time).  Without flags nothing moves and no sample
+ * draws a time. */
 typedef struct {
     uint32_t flags;            /**< FR_MOTION_* */
     float shutter;             /**< how long the shutter is open, seconds (informational; 0: no shutter) */
@@ -448,6 +471,7 @@ typedef struct {
      * "default"), for the light_groups pass. */
     const uint32_t *light_groups; uint32_t n_light_groups;
     const fr_name *group_names; uint32_t n_group_names; /**< the light groups' names */
+    const fr_inst_motion *inst_motions; uint32_t n_inst_motions; /**< how moving instances move */
 
     uint64_t hash;                /**< content hash of the binary scene */
     void *blob; size_t blob_size; int mapped;

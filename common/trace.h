@@ -40,6 +40,9 @@ typedef struct {
      * which image lookups pick a mip level (texture.h); 0 (as every
      * trace_surface* leaves it): the finest level. */
     float footprint;
+    /** The time across the shutter of the ray that found it (fr_ray.time):
+     * rays leaving the surface carry it on. */
+    float time;
 } fr_surface;
 
 /** Nearest hit in (0, tmax).  Returns 1 and fills *hit, or 0.  The result

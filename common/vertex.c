@@ -64,7 +64,7 @@ static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, f
     x = v3_madd(ray->o, ray->d, t);
     if (!lgt_sample_table(s, x, upick, ul1, ul2, &ls))
         return v3s(0.0f);
-    fr_ray shadow = {x, ls.wi};
+    fr_ray shadow = {x, ls.wi, ray->time};
     vec3 tr = med_shadow(s, medium, &shadow, ls.dist, ls.prim);
     if (v3_is_zero(tr))
         return v3s(0.0f);
@@ -170,7 +170,7 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
     vec3 f = bsdf_eval(m, sf, wo, ls->wi, &out->scatter_pdf);
     if (v3_is_zero(f))
         return 0;
-    fr_ray shadow = {origin(org, sf, ls->wi), ls->wi};
+    fr_ray shadow = {origin(org, sf, ls->wi), ls->wi, sf->time};
     float tmax = ls->distant ? INFINITY : v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
     out->weight = (ls->delta || !mis.area) ? 1.0f : vtx_power_heuristic(ls->pdf, out->scatter_pdf);
     float cosi = fabsf(v3_dot(ls->wi, sf->ns));
@@ -192,7 +192,7 @@ int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, v
     if (light == FR_NONE || !lgt_sample_chosen(s, light, pick, v->p, u1, u2, ls))
         return 0;
     const fr_medium *md = &s->media[medium - 1];
-    fr_ray shadow = {v->p, ls->wi};
+    fr_ray shadow = {v->p, ls->wi, v->seg.time};
     vec3 tr = med_shadow(s, medium, &shadow, ls->dist, ls->prim);
     float ph = med_phase(md->g, v3_dot(v->seg.d, ls->wi));
     out->scatter_pdf = ph;

@@ -154,7 +154,7 @@ static int write_patch(const reuse_state *st, const fr_scene *now, const char *p
         return 0;
     void *p;
     size_t n;
-    uint32_t changed;
+    uint64_t changed;
     fr_error e;
     if (fpatch_make(st->full.blob, st->full.blob_size, now->blob, now->blob_size, &p, &n, &changed, &e) < 0)
         return 0; /* no patch: the scene travels whole */

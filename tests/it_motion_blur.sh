@@ -28,17 +28,8 @@ $F render "$T/blur.gltf" --frames 12 --shutter 0.5 -o "$T/a.#.pfm" $R -j 1 >/dev
 python3 - "$T/sharp.12.pfm" "$T/a.12.pfm" <<'PY' >"$T/check" || bad "profile check did not run"
 import sys
 sys.path.insert(0, 'tests/support')
-from pfmcols import columns as profile
-def covered(x, s):
-    return max(0.0, min(x + 1, 38 + s) - max(x, 26 + s))
-def smear(x, n=800):
-    return sum(covered(x, -4 + 8 * (k + 0.5) / n) for k in range(n)) / n
-sharp, blur = profile(sys.argv[1]), profile(sys.argv[2])
-worst = max(abs(blur[x] - smear(x)) for x in range(64))
-print("sharp", all(abs(sharp[x] - (1.0 if 26 <= x < 38 else 0.0)) < 1e-6 for x in range(64)))
-print("smear", worst < 0.06, worst)
-print("total", abs(sum(blur) - 12.0) < 0.1, sum(blur))
-print("spread", sum(1 for v in blur if v > 0.01), sum(1 for v in sharp if v > 0.01))
+from pfmcols import columns, smear_report
+smear_report(columns(sys.argv[1]), columns(sys.argv[2]), 26, 38, 8, 1e-6)
 PY
 grep -q "^sharp True" "$T/check" && ok || bad "without a shutter the quad's edges are not sharp: $(cat "$T/check")"
 grep -q "^smear True" "$T/check" && ok || bad "the smear is not the analytic one: $(cat "$T/check")"
@@ -61,7 +52,7 @@ $F render "$T/jblur.json" --frames 12 --shutter 0.5 -o "$T/j.#.pfm" -j 2 >/dev/n
 tail -c 12288 "$T/a.12.pfm" >"$T/a.px" && tail -c 12288 "$T/j.12.pfm" >"$T/j.px"
 cmp -s "$T/a.px" "$T/j.px" && ok || bad "a gltf shape's moving camera is not blurred as the file's own"
 
-expect_error "bdpt" "motion blur, which the bidirectional integrator does not support" \
+expect_error "bdpt" "camera moves across the shutter, which the bidirectional integrator does not support" \
     $F render "$T/blur.gltf" --frames 12 --shutter 0.5 --integrator bdpt -o "$T/d.#.pfm" $R
 expect_error "--shutter without --frames" "--shutter is for --frames of one glTF or JSON file" \
     $F render "$T/blur.gltf" --shutter 0.5 -o "$T/e.pfm" $R

@@ -75,9 +75,9 @@ int main(void)
     /* A camera move: the camera section alone, and the scene rebuilt. */
     void *p = NULL;
     size_t n = 0;
-    uint32_t mask = 0;
+    uint64_t mask = 0;
     CHECK(fpatch_make(a.blob, a.blob_size, b.blob, b.blob_size, &p, &n, &mask, &err) == 0, "make: %s", err.msg);
-    CHECK(mask == 1u << 1, "a camera move changes the camera section alone, mask %#x", mask);
+    CHECK(mask == 1u << 1, "a camera move changes the camera section alone, mask %#llx", (unsigned long long)mask);
     CHECK(n == FPATCH_HEADER + FPATCH_ENTRY + sizeof(fr_camera), "camera patch of %zu bytes", n);
     uint64_t base = 0;
     CHECK(fpatch_base(p, n, &base, &err) == 0 && base == a.hash, "the patch names its base");
@@ -130,6 +130,9 @@ int main(void)
     wr32(q + 12, 1u << 2);
     refused("a mask naming another section", q, n, &a, "where the mask says");
     memcpy(q, p, n);
+    wr32(q + 52, 1u << (FPATCH_SECTIONS - 32));
+    refused("a mask naming a section past the last", q, n, &a, "byte 52");
+    memcpy(q, p, n);
     wr64(q + 40, b.blob_size + 64);
     refused("announced size", q, n, &a, "byte 40");
     free(q);
@@ -137,7 +140,7 @@ int main(void)
 
     /* New geometry: sections of new sizes, rebuilt exactly too. */
     CHECK(fpatch_make(a.blob, a.blob_size, c.blob, c.blob_size, &p, &n, &mask, &err) == 0, "make: %s", err.msg);
-    CHECK(mask & 1u << 4, "a new sphere changes the spheres section, mask %#x", mask);
+    CHECK(mask & 1u << 4, "a new sphere changes the spheres section, mask %#llx", (unsigned long long)mask);
     rebuilds("geometry", p, n, &a, &c);
     free(p);
 

@@ -21,7 +21,7 @@ static float rnd(uint32_t *state)
 static void test_sphere(void)
 {
     fr_sphere s = {v3(0, 0, 10), 2};
-    fr_ray r = {v3(0, 0, 0), v3(0, 0, 1)};
+    fr_ray r = {v3(0, 0, 0), v3(0, 0, 1), 0.0f};
     CHECK(fabsf(geo_sphere(&s, &r, INFINITY) - 8.0f) < 1e-5f, "sphere hit from outside at t=8");
     r.o = v3(0, 0, 10);
     CHECK(fabsf(geo_sphere(&s, &r, INFINITY) - 2.0f) < 1e-5f, "sphere hit from inside at t=2");
@@ -45,7 +45,7 @@ static void test_sphere(void)
 static void test_plane_rect(void)
 {
     fr_plane p = {v3(0, 1, 0), v3(0, 1, 0), 0, 0};
-    fr_ray r = {v3(0, 5, 0), v3(0, -1, 0)};
+    fr_ray r = {v3(0, 5, 0), v3(0, -1, 0), 0.0f};
     CHECK(fabsf(geo_plane(&p, &r, INFINITY) - 4.0f) < 1e-6f, "plane from above");
     r.o = v3(0, -3, 0);
     r.d = v3(0, 1, 0);
@@ -73,7 +73,7 @@ static void test_plane_rect(void)
 static void test_triangle(void)
 {
     vec3 a = v3(0, 0, 3), b = v3(1, 0, 3), c = v3(0, 1, 3);
-    fr_ray r = {v3(0.25f, 0.25f, 0), v3(0, 0, 1)};
+    fr_ray r = {v3(0.25f, 0.25f, 0), v3(0, 0, 1), 0.0f};
     float b1, b2;
     float t = geo_triangle(a, b, c, &r, INFINITY, &b1, &b2);
     CHECK(fabsf(t - 3.0f) < 1e-6f && fabsf(b1 - 0.25f) < 1e-6f && fabsf(b2 - 0.25f) < 1e-6f,
@@ -111,7 +111,7 @@ static void test_watertight(void)
                             : v3_add(centre, v3_add(v3_scale(v3_sub(rim[i], centre), f * 0.6f),
                                                     v3_scale(v3_sub(rim[(i + 1) % FAN], centre), rnd(&st) * 0.3f)));
         vec3 o = v3(rnd(&st) * 4 - 2, rnd(&st) * 4 - 2, -5.0f);
-        fr_ray r = {o, v3_sub(target, o)};
+        fr_ray r = {o, v3_sub(target, o), 0.0f};
         int hits = 0;
         for (int j = 0; j < FAN; j++) {
             float b1, b2;
@@ -192,13 +192,13 @@ static void test_offset(void)
             vec3 tgt = v3_add(q[0], v3_add(v3_scale(v3_sub(q[1], q[0]), f), v3_scale(v3_sub(q[3], q[0]), g)));
             vec3 side = k & 1 ? n : v3_neg(n);
             vec3 o = v3_add(tgt, v3_scale(v3_add(side, v3_scale(leave(&st, side), 0.9f)), size));
-            fr_ray r = {o, v3_sub(tgt, o)};
+            fr_ray r = {o, v3_sub(tgt, o), 0.0f};
             vec3 p, err, ng;
             if (!(quad_hit(q, &r, &p, &err, &ng) > 0.0f))
                 continue;
             for (int back = 0; back < 2; back++) {
                 vec3 out = leave(&st, back ? v3_neg(side) : side);
-                fr_ray r2 = {geo_offset(p, err, ng, out), out};
+                fr_ray r2 = {geo_offset(p, err, ng, out), out, 0.0f};
                 vec3 p2, e2, n2;
                 total++;
                 acne += quad_hit(q, &r2, &p2, &e2, &n2) > 0.0f;
@@ -219,14 +219,14 @@ static void test_offset(void)
             /* Spheres: hit from outside, leave outward or inward. */
             const fr_sphere *sp = k & 1 ? &s : &s0;
             vec3 o = v3_add(sp->center, v3_scale(v3(rnd(&st) - 0.5f, rnd(&st) - 0.5f, rnd(&st) - 0.5f), sc * 8));
-            fr_ray r = {o, v3_norm(v3_sub(v3_add(sp->center, v3_scale(v3(rnd(&st), rnd(&st), rnd(&st)), sc * 0.5f)), o))};
+            fr_ray r = {o, v3_norm(v3_sub(v3_add(sp->center, v3_scale(v3(rnd(&st), rnd(&st), rnd(&st)), sc * 0.5f)), o)), 0.0f};
             float t = geo_sphere(sp, &r, INFINITY);
             if (t > 0.0f) {
                 vec3 err, n = v3_norm(v3_sub(v3_madd(r.o, r.d, t), sp->center));
                 vec3 p = geo_sphere_point(sp, n, &err);
                 for (int side = 0; side < 2; side++) {
                     vec3 out = leave(&st, side ? v3_neg(n) : n);
-                    fr_ray r2 = {geo_offset(p, err, n, out), out};
+                    fr_ray r2 = {geo_offset(p, err, n, out), out, 0.0f};
                     float t2 = geo_sphere(sp, &r2, INFINITY);
                     /* Outward: nothing; inward: only the far side. */
                     acne += side ? t2 > 0.0f && t2 < sc * 1e-3f : t2 > 0.0f;
@@ -238,25 +238,25 @@ static void test_offset(void)
             vec3 side = rnd(&st) < 0.5f ? v3_norm(rc.normal) : v3_neg(v3_norm(rc.normal));
             vec3 tgt = v3_add(rc.origin, v3_add(v3_scale(rc.edge_u, rnd(&st)), v3_scale(rc.edge_v, rnd(&st))));
             o = v3_add(tgt, v3_scale(v3_add(side, leave(&st, side)), sc * 3));
-            r = (fr_ray){o, v3_sub(tgt, o)};
+            r = (fr_ray){o, v3_sub(tgt, o), 0.0f};
             if (geo_rect(&rc, &r, INFINITY, &s1, &s2) > 0.0f) {
                 vec3 err, p = geo_rect_point(&rc, s1, s2, &err), ng = v3_norm(rc.normal);
                 for (int back = 0; back < 2; back++) {
                     vec3 out = leave(&st, back ? v3_neg(side) : side);
-                    fr_ray r2 = {geo_offset(p, err, ng, out), out};
+                    fr_ray r2 = {geo_offset(p, err, ng, out), out, 0.0f};
                     acne += geo_rect(&rc, &r2, INFINITY, &s1, &s2) > 0.0f;
                     total++;
                 }
             }
             side = rnd(&st) < 0.5f ? pl.normal : v3_neg(pl.normal);
             o = v3_add(pl.point, v3_scale(v3(rnd(&st) - 0.5f, rnd(&st) - 0.5f, rnd(&st) - 0.5f), sc * 20));
-            r = (fr_ray){o, leave(&st, v3_dot(v3_sub(pl.point, o), pl.normal) > 0.0f ? pl.normal : v3_neg(pl.normal))};
+            r = (fr_ray){o, leave(&st, v3_dot(v3_sub(pl.point, o), pl.normal) > 0.0f ? pl.normal : v3_neg(pl.normal)), 0.0f};
             t = geo_plane(&pl, &r, INFINITY);
             if (t > 0.0f) {
                 vec3 err, p = geo_plane_point(&pl, &r, t, &err);
                 for (int back = 0; back < 2; back++) {
                     vec3 out = leave(&st, back ? v3_neg(side) : side);
-                    fr_ray r2 = {geo_offset(p, err, pl.normal, out), out};
+                    fr_ray r2 = {geo_offset(p, err, pl.normal, out), out, 0.0f};
                     acne += geo_plane(&pl, &r2, INFINITY) > 0.0f;
                     total++;
                 }
@@ -274,7 +274,7 @@ static void test_offset(void)
 static void test_offset_small(void)
 {
     vec3 q[4] = {v3(0, 0, 559.2f), v3(0, 0, 0), v3(0, 548.8f, 0), v3(0, 548.8f, 559.2f)};
-    fr_ray r = {v3(300, 200, 100), v3(-1, 0.1f, 0.2f)};
+    fr_ray r = {v3(300, 200, 100), v3(-1, 0.1f, 0.2f), 0.0f};
     vec3 p, err, ng;
     float t = quad_hit(q, &r, &p, &err, &ng);
     CHECK(t > 0.0f, "the wall is hit");
@@ -283,7 +283,7 @@ static void test_offset_small(void)
           o.y - p.y, o.z - p.z);
     /* A parallel wall 0.01 in front is hit from the offset point. */
     vec3 q2[4] = {v3(0.01f, 0, 559.2f), v3(0.01f, 0, 0), v3(0.01f, 548.8f, 0), v3(0.01f, 548.8f, 559.2f)};
-    fr_ray r2 = {o, v3_norm(v3(1, 0.2f, 0.1f))};
+    fr_ray r2 = {o, v3_norm(v3(1, 0.2f, 0.1f)), 0.0f};
     vec3 p2, e2, n2;
     CHECK(quad_hit(q2, &r2, &p2, &e2, &n2) > 0.0f, "a wall 0.01 away is found");
     /* A degenerate normal gives no NaN origin. */

@@ -224,7 +224,7 @@ static void test_walks(const fr_scene *s)
         walks++;
         for (int k = 0; k < 5000; k++) {
             fr_ray r = {v3(rnd() * 8.0f - 4.0f, rnd() * 3.0f, rnd() * 8.0f - 4.0f),
-                        v3_norm(v3(rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f))};
+                        v3_norm(v3(rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f)), 0.0f};
             fr_hit a = {0}, b = {0};
             trace_set_walk(w);
             int ha = trace_closest(s, &r, INFINITY, &a);
@@ -433,7 +433,7 @@ static void test_gltf(void)
     /* The shared mesh and the 12 copies are the same surfaces. */
     int differ = 0;
     for (int k = 0; k < 4000; k++) {
-        fr_ray r = {v3(rnd() * 8.0f - 1.0f, 2.0f, rnd() * 6.0f - 1.0f), v3_norm(v3(rnd() - 0.5f, -1.0f, rnd() - 0.5f))};
+        fr_ray r = {v3(rnd() * 8.0f - 1.0f, 2.0f, rnd() * 6.0f - 1.0f), v3_norm(v3(rnd() - 0.5f, -1.0f, rnd() - 0.5f)), 0.0f};
         fr_hit a, c;
         int ha = trace_closest(&shared, &r, INFINITY, &a), hc = trace_closest(&copies, &r, INFINITY, &c);
         differ += ha != hc || (ha && fabsf(a.t - c.t) > 1e-5f * c.t);
@@ -447,7 +447,7 @@ static void test_gltf(void)
     int other = 0, hits = 0;
     unsigned seen = 0;
     for (int k = 0; k < 4000; k++) {
-        fr_ray r = {v3(rnd() * 8.0f - 1.0f, 2.0f, rnd() * 6.0f - 1.0f), v3_norm(v3(rnd() - 0.5f, -1.0f, rnd() - 0.5f))};
+        fr_ray r = {v3(rnd() * 8.0f - 1.0f, 2.0f, rnd() * 6.0f - 1.0f), v3_norm(v3(rnd() - 0.5f, -1.0f, rnd() - 0.5f)), 0.0f};
         fr_hit a, c;
         if (!trace_closest(&shared, &r, INFINITY, &a) || !trace_closest(&copies, &r, INFINITY, &c))
             continue;

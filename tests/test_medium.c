@@ -169,7 +169,7 @@ static void slabs(void)
             worst = fmax(worst, fabs(rgb[i * 3 + c] - e[c]) / e[c]);
     CHECK(worst < 5e-4, "emitter through slabs: off by %g (relative) from Le e^(-sigma_t d)", worst);
     /* A shadow ray from z = 4 to z = -2.5 crosses both slabs. */
-    fr_ray r = {v3(0.1f, 0.2f, 4.0f), v3(0, 0, -1)};
+    fr_ray r = {v3(0.1f, 0.2f, 4.0f), v3(0, 0, -1), 0.0f};
     vec3 tr = med_shadow(&s, 0, &r, 6.5f, FR_NONE);
     /* (Each boundary crossing moves the ray by the surface offset, ~1e-4.) */
     CHECK(fabs(tr.x * 3 - e[0]) < 5e-4 * e[0] && fabs(tr.y * 2 - e[1]) < 5e-4 * e[1] && fabs(tr.z - e[2]) < 5e-4 * e[2],

@@ -182,7 +182,7 @@ static void lookups(void)
 static void round_trip(const fr_scene *s, const char *what, vec3 from, vec3 p, vec2 uv, vec3 dpdu, vec3 dpdv,
                        int mirrored)
 {
-    fr_ray r = {from, v3_norm(v3_sub(p, from))};
+    fr_ray r = {from, v3_norm(v3_sub(p, from)), 0.0f};
     fr_hit h;
     if (!trace_closest(s, &r, INFINITY, &h)) {
         CHECK(0, "%s: ray missed", what);
@@ -423,7 +423,7 @@ static void ramp_bump_normal(void)
         CHECK(0, "ramp scene: %s", err.msg);
         return;
     }
-    fr_ray r = {v3(0.1f, 0.2f, 1), v3(0, 0, -1)};
+    fr_ray r = {v3(0.1f, 0.2f, 1), v3(0, 0, -1), 0.0f};
     fr_hit h;
     trace_closest(&s, &r, INFINITY, &h);
     fr_surface sf;
@@ -479,7 +479,7 @@ static void no_leaks(void)
     }
     int wrong = 0, tilted = 0, tries = 0;
     for (int i = 0; i < 64; i++) {
-        fr_ray r = {v3(-0.9f + 0.028f * i, 0.7f - 0.02f * i, 1), v3_norm(v3(0.3f, -0.2f, -1))};
+        fr_ray r = {v3(-0.9f + 0.028f * i, 0.7f - 0.02f * i, 1), v3_norm(v3(0.3f, -0.2f, -1)), 0.0f};
         fr_hit h;
         if (!trace_closest(&s, &r, INFINITY, &h))
             continue;

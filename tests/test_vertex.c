@@ -55,7 +55,7 @@ static int close_rel(float a, float b, float tol) { return fabsf(a - b) <= tol *
 /* The surface vertex straight below (0.5, 1, 0). */
 static int floor_vertex(const fr_scene *s, fr_sampler *smp, vtx_vertex *v)
 {
-    fr_ray ray = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, -1.0f, 0.0f)};
+    fr_ray ray = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, -1.0f, 0.0f), 0.0f};
     uint32_t medium = 0;
     vec3 beta = v3s(1.0f);
     smp_start(smp, 3, 4, 0, 0);
@@ -111,7 +111,7 @@ static void point_light(void)
     org = vtx_origin_at(&v.sf, v3(0, 1, 0));
     CHECK(vtx_direct_surface(&s, m, &v.sf, v3(0, 1, 0), 0, beta, mis, 0, 1.0f, 0.6f, 0.2f, &org, &d) == 0,
           "a ball between the floor and the light blocks it");
-    fr_ray up = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, 1.0f, 0.0f)};
+    fr_ray up = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, 1.0f, 0.0f), 0.0f};
     uint32_t medium = 0;
     CHECK(vtx_next(&s, &smp, &up, &medium, &beta, (vtx_mis){1, 1}, NULL, &v) == VTX_ESCAPED, "a ray into the sky escapes");
     scn_free(&s);
@@ -183,7 +183,7 @@ static void media(void)
         fr_sampler s1, s2;
         smp_start(&s1, 1, 2, i, 7);
         smp_start(&s2, 1, 2, i, 7);
-        fr_ray r1 = {v3(0.0f, 1.0f, -3.0f), v3_norm(v3(0.0f, -1.0f, 3.0f))}, r2 = r1;
+        fr_ray r1 = {v3(0.0f, 1.0f, -3.0f), v3_norm(v3(0.0f, -1.0f, 3.0f)), 0.0f}, r2 = r1;
         uint32_t m1 = 1, m2 = 1;
         vec3 b1 = v3s(1.0f), b2 = v3s(1.0f), L = v3s(0.0f);
         vtx_vertex v1, v2;
@@ -216,7 +216,7 @@ static void media(void)
     /* Vacuum in a scene with media: nothing drawn. */
     fr_sampler smp;
     smp_start(&smp, 0, 0, 0, 0);
-    fr_ray r = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, -1.0f, 0.0f)};
+    fr_ray r = {v3(0.5f, 1.0f, 0.0f), v3(0.0f, -1.0f, 0.0f), 0.0f};
     uint32_t medium = 0;
     vec3 beta = v3s(1.0f);
     vtx_vertex v;

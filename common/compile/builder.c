@@ -30,6 +30,7 @@ void bld_init(fr_builder *b)
     array_init(&b->distrib, sizeof(float));
     array_init(&b->meshes, sizeof(bld_mesh));
     array_init(&b->instances, sizeof(fr_instance));
+    array_init(&b->inst_motions, sizeof(fr_inst_motion));
     array_init(&b->light_nodes, sizeof(fr_light_node));
     array_init(&b->material_names, sizeof(fr_name));
     array_init(&b->object_names, sizeof(fr_name));
@@ -48,7 +49,7 @@ void bld_free(fr_builder *b)
     fr_array *all[] = {&b->materials, &b->prims, &b->spheres, &b->rects, &b->triangles,
                        &b->positions, &b->normals, &b->uvs, &b->planes, &b->lights,
                        &b->textures, &b->texels, &b->media, &b->distrib, &b->meshes, &b->instances,
-                       &b->light_nodes, &b->material_names,
+                       &b->inst_motions,                       &b->light_nodes, &b->material_names,
                        &b->object_names, &b->object_runs, &b->inst_objects, &b->group_names,
                        &b->given_groups, &b->material_groups, &b->light_groups};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)

@@ -56,6 +56,7 @@ typedef struct {
     fr_array distrib;          /**< float: filled by frz_scene */
     fr_array meshes;           /**< bld_mesh: meshes that instances place (builder_instance.h) */
     fr_array instances;        /**< fr_instance: meshes placed (builder_instance.h) */
+    fr_array inst_motions;     /**< fr_inst_motion: how moving instances move (builder_motion.h) */
     fr_budget *budget;         /**< the compile's limits (budget.h), not owned; NULL: none */
     void (*warn)(void *user, const char *msg); /**< where readers of the scene's files report warnings
                                                     (scene_hooks.h); NULL: nowhere */

@@ -5,10 +5,13 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "compile/builder_motion.h"
 #include "compile/builder_object.h"
+#include "motion.h"
 
 uint32_t bld_mesh_begin(fr_builder *b)
 {
@@ -90,11 +93,10 @@ void bld_instance_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi)
     const bld_mesh *m = (const bld_mesh *)b->meshes.data + in->mesh;
     *lo = v3s(INFINITY);
     *hi = v3s(-INFINITY);
-    for (int c = 0; c < 8; c++) {
-        vec3 q = xf_point(in->xf, v3(c & 1 ? m->hi.x : m->lo.x, c & 2 ? m->hi.y : m->lo.y, c & 4 ? m->hi.z : m->lo.z));
-        *lo = v3_vmin(*lo, q);
-        *hi = v3_vmax(*hi, q);
-    }
+    if (in->motion)
+        bld_motion_bounds((const fr_inst_motion *)b->inst_motions.data + in->motion - 1, m->lo, m->hi, lo, hi);
+    else
+        bld_box_placed(in->xf, m->lo, m->hi, lo, hi);
     /* The corners are rounded, and the ray test runs in object space: a
      * margin of 2^-16 of the box's size and position covers both. */
     vec3 pad = v3_scale(v3_add(v3_sub(*hi, *lo), v3_add(v3_vmax(v3_neg(*lo), *lo), v3_vmax(v3_neg(*hi), *hi))),
@@ -213,6 +215,30 @@ int bld_flatten(fr_builder *b, int all, fr_error *err)
         }
     }
     uint32_t kept = 0;
+    /* A moving instance flattened (an emitter) is placed where it is at
+     * the middle of the shutter, with a warning. */
+    uint32_t still = 0;
+    for (uint32_t i = 0; i < ni; i++)
+        if (flat[inst[i].mesh] && inst[i].motion) {
+            motion_at((const fr_inst_motion *)b->inst_motions.data + inst[i].motion - 1, 0.5f, inst[i].xf,
+                      inst[i].inv);
+            inst[i].motion = 0;
+            still++;
+        }
+    /* With no instance left moving, no sample needs a time. */
+    int moving = 0;
+    for (uint32_t i = 0; i < ni; i++)
+        moving |= inst[i].motion != 0;
+    if (!moving) {
+        b->inst_motions.count = 0;
+        b->motion.flags &= ~(uint32_t)FR_MOTION_INSTANCES;
+    }
+    if (still && b->warn) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "%u moving instance%s of an emissive mesh: moving lights are not motion blurred; "
+                 "placed where they are at the middle of the shutter, sharp", still, still == 1 ? "" : "s");
+        b->warn(b->warn_user, msg);
+    }
     for (uint32_t i = 0; i < ni; i++) {
         inst_to[i] = flat[inst[i].mesh] ? FR_NONE : kept++;
         if (inst_to[i] != FR_NONE)

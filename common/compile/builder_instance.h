@@ -34,7 +34,8 @@ int bld_instance(fr_builder *b, uint32_t mesh, const float xf[3][4], fr_error *e
  * *err set on memory exhaustion. */
 int bld_flatten(fr_builder *b, int all, fr_error *err);
 /** World-space bounds of instance i (its mesh's vertex bounds carried
- * through the transform, widened by a few ulps so that they hold every
+ * through the transform, over the whole shutter when it moves
+ * (bld_motion_bounds), widened by a few ulps so that they hold every
  * point the ray test can find). */
 void bld_instance_bounds(const fr_builder *b, uint32_t i, vec3 *lo, vec3 *hi);
 

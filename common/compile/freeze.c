@@ -149,7 +149,7 @@ static int prepare(fr_builder *b, frozen *f, fr_scene *view, fr_error *err)
     view->world = b->world;
     view->motion = b->motion;
     VIEW(distrib, b->distrib);
-    VIEW(meshes, f->table); VIEW(instances, b->instances);
+    VIEW(meshes, f->table); VIEW(instances, b->instances); VIEW(inst_motions, b->inst_motions);
     VIEW(mesh_nodes, f->mnodes); VIEW(mesh_leaves, f->mleaves);
     VIEW(light_nodes, b->light_nodes);
     VIEW(material_names, b->material_names);

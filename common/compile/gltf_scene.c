@@ -12,7 +12,9 @@
 #include <xxhash.h>
 
 #include "fmath.h"
+#include "motion.h"
 #include "compile/builder_instance.h"
+#include "compile/builder_motion.h"
 #include "compile/builder_object.h"
 #include "compile/builder_light.h"
 #include "compile/freeze.h"
@@ -90,6 +92,8 @@ typedef struct {
     ganim_pose pose;           /* the animated nodes (o->animate), else empty */
     affine *world;             /* with skins: every node's world transform (from the counting pass) */
     unsigned char *placed;     /* with skins: which nodes of world are set (in the scene) */
+    affine *shut[2];           /* with a shutter: every node's world transform at its opening and closing
+                                  (gltf_motion), else NULL */
 } imp;
 
 /* A skin as one node uses it: its joints' matrices (joint's world
@@ -500,6 +504,26 @@ static int morph_weights(imp *c, uint32_t n, uint32_t m, morph *mw, fr_error *er
     return 0;
 }
 
+/* Whether moving instance k at mid-shutter is at `frame` (the node's pose
+ * at the frame's time), to 10^-3 of the transform's size: else the motion
+ * across the shutter is not the blend of its ends that the renderer draws. */
+static int blends(const fr_builder *b, uint32_t k, const affine *frame)
+{
+    const fr_instance *in = (const fr_instance *)b->instances.data + k;
+    float mid[3][4];
+    motion_at((const fr_inst_motion *)b->inst_motions.data + in->motion - 1, 0.5f, mid, NULL);
+    /* Every element within 10^-3 of the largest (a sum of squares, not a
+     * running maximum: GCC 12's AArch64 vectoriser fails on that loop). */
+    double size = 0.0, off = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++) {
+            double d = mid[i][j] - frame->m[i][j];
+            size += frame->m[i][j] * frame->m[i][j];
+            off += d * d;
+        }
+    return off <= 1e-6 * size;
+}
+
 /* A mesh drawn by one node is placed into the world's triangles; one drawn
  * by several is read once in its own space and placed by an instance per
  * node (builder_instance.h), unless morph weights bend it: then this node's
@@ -536,10 +560,28 @@ static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning 
     morph mw;
     if (morph_weights(c, n, m, &mw, err) < 0)
         return -1;
+    /* A node that moves across the shutter places its mesh by a moving
+     * instance (builder_motion.h), drawn once or not. */
+    int moves = c->shut[0] && memcmp(&c->shut[0][n], &c->shut[1][n], sizeof(affine)) != 0;
+    if (moves && (mw.n || sk)) {
+        char ptr[48];
+        snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+        gdoc_warn(c->d, "deforming", "%s: moves across the shutter, but a skinned or morphed mesh is not motion "
+                  "blurred: it is posed at the frame's time, sharp", ptr);
+        moves = 0;
+    }
     mesh_key(c, n, m, w, &mw, sk);
+    /* The poses at the shutter's ends are part of what the mesh makes. */
+    if (moves && c->hooks && c->hooks->mesh_key) {
+        mesh_key(c, n, m, &c->shut[0][n], &mw, sk);
+        mesh_key(c, n, m, &c->shut[1][n], &mw, sk);
+    }
     if (c->hooks && c->hooks->skeleton)
         return stand_in(c, err);
-    if (c->uses[m] < 2 || mw.n || sk)
+    const affine *w_frame = w;
+    if (moves)
+        w = &c->shut[0][n];
+    if ((c->uses[m] < 2 && !moves) || mw.n || sk)
         return mesh_prims(c, m, w, &mw, sk, err);
     if (c->mesh_of[m] == FR_NONE) {
         affine id;
@@ -559,11 +601,25 @@ static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning 
         for (int j = 0; j < 4; j++)
             xf[i][j] = (float)w->m[i][j];
     fr_error e;
+    uint32_t k = c->b->instances.count;
     if (bld_instance(c->b, c->mesh_of[m], (const float(*)[4])xf, &e) < 0) {
         char ptr[48];
         snprintf(ptr, sizeof ptr, "/meshes/%u", m);
         return gdoc_fail(c->d, err, ptr, "%s", e.msg);
     }
+    if (!moves)
+        return 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            xf[i][j] = (float)c->shut[1][n].m[i][j];
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/nodes/%u", n);
+    if (bld_instance_motion(c->b, k, (const float(*)[4])xf, &e) < 0)
+        return gdoc_fail(c->d, err, ptr, "%s", e.msg);
+    if (!blends(c->b, k, w_frame))
+        gdoc_warn(c->d, "blend", "%s: at the frame's time the node is not where the blend of its poses at the "
+                  "shutter's opening and closing puts it (more than half a turn across the shutter, or keys "
+                  "inside it): it is blurred along that blend", ptr);
     return 0;
 }
 
@@ -768,6 +824,10 @@ static int node(imp *c, uint32_t n, const affine *w, fr_error *err)
         gdoc_index(d, o, ptr, "camera", 0, d->cameras.n, "cameras", &cam, err) < 0 ||
         gdoc_object(d, o, ptr, "extensions", &ext, err) < 0)
         return -1;
+    if (c->counting == 2) {
+        c->world[n] = *w;      /* gltf_motion's pass */
+        return 0;
+    }
     if (c->counting) {
         if (m != UINT32_MAX)
             c->uses[m]++;
@@ -876,6 +936,38 @@ static int scene_roots(imp *c, const uint32_t *parent, uint32_t *roots, uint32_t
  * (each node is on it at most once: the nodes form trees). */
 static int walk_nodes(imp *c, fr_error *err);
 
+/* With a shutter (the hooks' timed shutter, animations played): every
+ * node's world transform at the shutter's opening and closing into
+ * c->shut, each by a walk over the nodes posed at that time. */
+static int gltf_motion(imp *c, fr_error *err)
+{
+    const scene_hooks *h = c->hooks;
+    if (!c->o->animate || c->o->camera_only || !h || !h->timed || !(h->shutter > 0.0) || !ganim_present(c->d))
+        return 0;
+    uint32_t nn = c->d->nodes.n ? c->d->nodes.n : 1;
+    ganim_pose frame = c->pose;
+    affine *keep = c->world;
+    int rc = 0;
+    for (int k = 0; k < 2 && rc == 0; k++) {
+        ganim_pose at = {0};
+        if (!(c->shut[k] = calloc(nn, sizeof(affine)))) {
+            rc = gdoc_fail(c->d, err, NULL, "out of memory");
+            break;
+        }
+        rc = ganim_eval(c->d, ganim_hooks_time(h, h->frame + (k ? 0.5 : -0.5) * h->shutter), &at, err);
+        c->pose = at;
+        c->world = c->shut[k];
+        c->counting = 2;
+        if (rc == 0)
+            rc = walk_nodes(c, err);
+        c->counting = 0;
+        ganim_free(&at);
+    }
+    c->pose = frame;
+    c->world = keep;
+    return rc;
+}
+
 /* Every node of the scene, twice: the uses of each mesh counted, then
  * each node read. */
 static int traverse(imp *c, fr_error *err)
@@ -905,12 +997,17 @@ static int traverse(imp *c, fr_error *err)
         rc = walk_nodes(c, err);
         c->counting = 0;
         if (rc == 0)
+            rc = gltf_motion(c, err);
+        if (rc == 0)
             rc = walk_nodes(c, err);
     }
     free(c->uses);
     free(c->mesh_of);
     free(c->world);
     free(c->placed);
+    free(c->shut[0]);
+    free(c->shut[1]);
+    c->shut[0] = c->shut[1] = NULL;
     c->uses = c->mesh_of = NULL;
     c->world = NULL;
     c->placed = NULL;
@@ -1022,7 +1119,7 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
 {
     memset(r, 0, sizeof *r);
     imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0,
-             NULL, NULL, {0}, NULL, NULL};
+             NULL, NULL, {0}, NULL, NULL, {NULL, NULL}};
     gdoc_warn_extensions(d, known_extensions);
     if (o->animate) {
         if (ganim_eval(d, o->time, &c.pose, err) < 0) {

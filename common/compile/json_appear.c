@@ -441,7 +441,7 @@ static uint32_t medium_around(const fr_builder *b, vec3 o, vec3 d, uint32_t outs
     const fr_material *mats = b->materials.data;
     const fr_prim *prims = b->prims.data;
     const vec3 *pos = b->positions.data;
-    fr_ray r = {o, d};
+    fr_ray r = {o, d, 0.0f};
     float best = INFINITY;
     uint32_t found = outside;
     for (uint32_t i = 0; i < b->prims.count; i++) {

@@ -19,6 +19,7 @@
 #include "compile/json_appear.h"
 #include "compile/json_gltf.h"
 #include "compile/json_keys.h"
+#include "compile/json_motion.h"
 #include "compile/json_light.h"
 #include "compile/json_microfacet.h"
 #include "compile/builder_group.h"
@@ -40,6 +41,9 @@ typedef struct {
     json_appear *look;          /* textures, media (json_appear.h) */
     int gltf_moving;           /* the gltf shape's camera moves across the shutter: *gltf_open is b->camera */
     fr_camera *gltf_open;
+    cJSON **closes;            /* per shape: its pose at shutter close when it is a moving mesh (json_motion.h) */
+    int n_closes;
+    const cJSON *close;        /* the shape being read's */
 } ctx;
 
 static int nonneg3(vec3 v) { return v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
@@ -147,11 +151,24 @@ static int pose_keys(ctx *c, cJSON *root, cJSON **open, cJSON **close)
     if (json_keys_pose(cam, "camera", frame, c->err) < 0)
         return -1;
     int i = 0;
+    if (timed && shutter > 0.0 && cJSON_IsArray(shapes)) {
+        int n = cJSON_GetArraySize(shapes);
+        if (!(c->closes = calloc((size_t)n + 1, sizeof *c->closes)))
+            return fr_fail(c->err, "shapes: out of memory");
+        c->n_closes = n;
+        c->b->motion.shutter = (float)(shutter / (h->fps > 0.0 ? h->fps : 24.0));
+    }
     for (cJSON *s = cJSON_IsArray(shapes) ? shapes->child : NULL; s; s = s->next, i++) {
         char where[PATHLEN];
         snprintf(where, sizeof where, "shapes[%d]", i);
-        if (json_keys_pose(s, where, frame, c->err) < 0)
+        if (c->closes && json_keys_in(s)) {
+            scene_hooks at = *h;
+            at.shutter = shutter;
+            if (json_motion_pose(s, where, &at, &c->closes[i], c->err) < 0)
+                return -1;
+        } else if (json_keys_pose(s, where, frame, c->err) < 0) {
             return -1;
+        }
     }
     return 0;
 }
@@ -475,6 +492,8 @@ static int parse_shape_fields(ctx *c, const cJSON *o, const char *where)
         if (!c->hooks || !c->hooks->mesh)
             return fr_fail(c->err, "%s: meshes need the scene compiler: run `franja compile` and render the .fbin", where);
         fr_error e;
+        if (c->close)
+            return json_motion_mesh(c->b, (cJSON *)o, c->close, where, c->dir, c->scope, c->hooks, mat, c->err);
         if (c->hooks->mesh(c->b, o, where, c->dir, c->scope, mat, &e) < 0)
             return fr_fail(c->err, "%s", e.msg);
     } else if (!strcmp(type, "gltf")) {
@@ -516,7 +535,7 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
     json_appear look;
     memset(&look, 0, sizeof look);
     fr_camera gltf_open;
-    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look, 0, &gltf_open};
+    ctx c = {file, dir, &scope, hooks, b, NULL, NULL, 0, 0, &e, &look, 0, &gltf_open, NULL, 0, NULL};
     static const char *const top[] = {"image", "camera", "materials", "shapes", "lights", "description",
                                       "textures", "media", "medium", "tonemap", "environment", NULL};
     int rc = -1;
@@ -539,6 +558,7 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
             for (const cJSON *s = shapes->child; s && rc == 0; s = s->next, i++) {
                 char where[PATHLEN];
                 snprintf(where, sizeof where, "shapes[%d]", i);
+                c.close = c.closes ? c.closes[i] : NULL;
                 rc = parse_shape(&c, s, where);
             }
             if (rc == 0 && b->prims.count == 0 && b->planes.count == 0)
@@ -563,6 +583,9 @@ int json_scene_parse(const char *text, const char *file, const scene_hooks *hook
     }
     cJSON_Delete(cam_open);
     cJSON_Delete(cam_close);
+    for (int i = 0; i < c.n_closes; i++)
+        cJSON_Delete(c.closes[i]);
+    free(c.closes);
     json_appear_free(&look);
     free(c.by_name);
     cJSON_Delete(root);

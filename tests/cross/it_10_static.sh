@@ -6,7 +6,8 @@
 # byte-identical to this machine's bin/franja-worker, and a bidirectional
 # slab too (its rows and its light-tracing splats over the whole image),
 # and a slab of instanced meshes (the fuzz seed tests/fuzz/corpus/fbin/
-# instances.json: a rotation, a mirror, a non-uniform scale).
+# instances.json: a rotation, a mirror, a non-uniform scale), and one of
+# the same instances moving across a shutter.
 . "$(dirname "$0")/lib.sh"
 need readelf cmp "$QEMU"
 T=$(mktemp -d /tmp/franja-static.XXXXXX)
@@ -60,6 +61,20 @@ check "instanced scene renders" test -s "$T/in-ref.pf"
 check "amd64 static instanced slab is byte-identical" cmp "$T/in-s64.pf" "$T/in-ref.pf"
 "$QEMU" "$SA64" --scene "$T/inst.fbin" $IN -o "$T/in-sa64.pf"
 check "arm64 static instanced slab under qemu is byte-identical" cmp "$T/in-sa64.pf" "$T/in-ref.pf"
+# Moving instances (motion blur): the fuzz seed moving.json, two of the
+# placements above sliding, turning and growing across the shutter.
+MJ="$ROOT/tests/fuzz/corpus/fbin/moving.json"
+"$ROOT/bin/franja" render "$MJ" --frames 1 --shutter 1 -o "$T/mv.#.pfm" --keep-job -j 1 >/dev/null 2>&1
+MV="--rows 0:12 --spp 8 --size 32x24"
+"$ROOT/bin/franja-worker" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-ref.pf"
+"$ROOT/bin/franja" render "$MJ" --frames 1 -o "$T/st.#.pfm" --keep-job -j 1 >/dev/null 2>&1
+"$ROOT/bin/franja-worker" --scene "$T/st.1.pfm.franja-job/scene.fbin" $MV -o "$T/st-ref.pf"
+check "moving instances render, blurred" test -s "$T/mv-ref.pf" -a -s "$T/st-ref.pf"
+check "the blurred slab is not the still one" sh -c "! cmp -s '$T/mv-ref.pf' '$T/st-ref.pf'"
+"$S64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-s64.pf"
+check "amd64 static slab of moving instances is byte-identical" cmp "$T/mv-s64.pf" "$T/mv-ref.pf"
+"$QEMU" "$SA64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-sa64.pf"
+check "arm64 static slab of moving instances under qemu is byte-identical" cmp "$T/mv-sa64.pf" "$T/mv-ref.pf"
 # Textures at their own precision and mip levels: 8-bit sRGB images read
 # through the table and filtered across mip levels (the brick wall spans
 # several texels a pixel at 64x64), and an HDR sky stored as halves.

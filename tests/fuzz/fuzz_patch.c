@@ -55,7 +55,7 @@ static void setup(void)
     scene(SCENE("[0, 1, -4]", ", {\"type\": \"triangle\", \"vertices\": [[-2, 0, 1], [2, 0, 1], [0, 2, 1]], "
                               "\"material\": \"w\"}"), &res[1]);
     for (int i = 0; i < 2; i++) {
-        uint32_t mask;
+        uint64_t mask;
         fr_error err;
         if (fpatch_make(base.blob, base.blob_size, res[i].blob, res[i].blob_size, &patch[i], &patch_size[i], &mask,
                         &err) < 0) {

@@ -34,7 +34,8 @@
 # args start with a byte that picks the reader; see each target's
 # comment), and seeds made here from this build so that they are always
 # of the current formats: binary scenes compiled from the example scenes
-# without meshes and from tests/fuzz/corpus/fbin/*.json; partial images
+# without meshes and from tests/fuzz/corpus/fbin/*.json, and a frame of
+# moving instances (moving.json across a shutter); partial images
 # that franja-worker writes (path-traced with sums, bidirectional with
 # splats, without sums, 8- and 16-bit P6); the binary scene seeds packed
 # (bin/bench/packbench), as sent and with their frame open; job directories that franja
@@ -56,7 +57,7 @@ mkdir -p "$W/seed-fbin" "$W/seed-partial" "$W/seed-jobdir" "$W/seed-unpack" "$W/
 fail_seed() { echo "fuzz: cannot make seeds: $*"; echo "0 passed, 1 failed"; exit 1; }
 
 for s in scenes/*.json tests/fuzz/corpus/fbin/*.json; do
-    case "$s" in scenes/*) grep -q '"mesh"' "$s" && continue ;; esac
+    case "$s" in scenes/*) grep -q '"mesh"' "$s" && continue ;; */moving.json) continue ;; esac
     out="$W/seed-fbin/$(basename "$s" .json).fbin"
     bin/franja compile "$s" -o "$out" >/dev/null || fail_seed "franja compile $s"
     size=$(wc -c <"$out")
@@ -67,6 +68,13 @@ for s in scenes/*.json tests/fuzz/corpus/fbin/*.json; do
     *) fail_seed "seed $s compiles to $size bytes, more than the $MAX_LEN the fuzzer reads" ;;
     esac
 done
+
+# A frame of moving instances across a shutter (the inst_motions section),
+# from the scene that franja render compiles for it.
+bin/franja render tests/fuzz/corpus/fbin/moving.json --frames 1 --shutter 1 -o "$W/render/moving.#.pfm" \
+    --keep-job -j 1 >/dev/null 2>&1 &&
+    cp "$W/render/moving.1.pfm.franja-job/scene.fbin" "$W/seed-fbin/moving-frame.fbin" ||
+    fail_seed "franja render tests/fuzz/corpus/fbin/moving.json --frames 1 --shutter 1"
 
 # Partial images, as workers send them back.
 S=$W/seed-fbin/spheres-point.fbin
