@@ -88,6 +88,7 @@ typedef struct {
     uint32_t light;            /* light: index into lights; surface: its area light or FR_NONE */
     float u[3];                /* camera subpath: light pick and point for s = 1; light subpath: lens point */
     vec3 weight;               /* surface: the weight of the bounce that left it (the render passes' albedo) */
+    const fr_camera *camera;   /* camera: the camera at the sample's time (cam_at) */
     fr_surface sf;
     fr_material m;             /* as textured at sf */
 } vert;
@@ -97,6 +98,7 @@ struct bd_work {
     vert *cam, *lgt;
     int ncam;                  /* the vertices of the last sample's camera subpath */
     float time;                /* the last sample's time across the shutter, which all its rays carry */
+    fr_camera at;              /* the camera at that time */
 };
 
 int bd_supported(const fr_scene *s, fr_error *err)
@@ -114,9 +116,6 @@ int bd_supported(const fr_scene *s, fr_error *err)
     if (media)
         return fr_fail(err, "the scene has participating media (fog or a medium inside a shape), which the "
                             "bidirectional integrator does not support; render it with the path integrator");
-    if (s->motion.flags & FR_MOTION_CAMERA)
-        return fr_fail(err, "the scene's camera moves across the shutter, which the bidirectional integrator does "
-                            "not support (moving instances it does); render it with the path integrator");
     return 0;
 }
 
@@ -275,7 +274,7 @@ static float dir_pdf(const fr_scene *s, const vert *v, const vert *prev, const v
     if (v->distant)
         pdf = 0.0f;
     else if (v->type == BD_CAMERA)
-        cam_importance(s, v->p, dir_to(v, next), &pdf, NULL, NULL);
+        cam_importance(s, v->camera, v->p, dir_to(v, next), &pdf, NULL, NULL);
     else if (v->type == BD_LIGHT)
         pdf = emit_pdf_dir(s, v, dir_to(v, next));
     else
@@ -454,7 +453,7 @@ static int walk(const fr_scene *s, rnd *smp, fr_ray ray, vec3 beta, float pdf_di
  * time across the shutter (0 without motion, where no pair is drawn for
  * it), which every ray of the sample carries, the light subpath's too. */
 static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, vert *cam, int maxv, float *rx,
-                          float *ry, float *time)
+                          float *ry, float *time, fr_camera *at)
 {
     float px, py, lx = 0.0f, ly = 0.0f, pdf_dir;
     rnd_2d(smp, &px, &py);
@@ -475,14 +474,14 @@ static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, v
         rnd_skip(smp);         /* a pinhole has no lens to sample */
     *time = 0.0f;
     if (s->motion.flags) {
-        /* As the path tracer draws it (pathtrace.c); only instances move
-         * here (bd_supported). */
+        /* As the path tracer draws it (pathtrace.c). */
         float unused;
         rnd_2d(smp, time, &unused);
     }
-    fr_ray ray = pt_camera_ray(s, x, y, px, py, lx, ly);
+    cam_at(s, *time, at);
+    fr_ray ray = pt_camera_ray_from(s, at, x, y, px, py, lx, ly);
     ray.time = *time;
-    cam_importance(s, ray.o, ray.d, &pdf_dir, NULL, NULL);
+    cam_importance(s, at, ray.o, ray.d, &pdf_dir, NULL, NULL);
     vert *c = &cam[0];
     c->type = BD_CAMERA;
     c->delta = c->delta_light = c->distant = 0;
@@ -492,6 +491,7 @@ static int camera_subpath(const fr_scene *s, rnd *smp, uint32_t x, uint32_t y, v
     c->beta = v3s(1.0f);
     c->pdf_fwd = c->pdf_rev = 0.0f;
     c->light = FR_NONE;
+    c->camera = at;
     return walk(s, smp, ray, c->beta, pdf_dir, 0, cam, maxv);
 }
 
@@ -644,7 +644,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         const vert *qs = &w->lgt[s_ - 1];
         if (!qs->connectible)
             return zero;
-        const fr_camera *c = &s->camera;
+        const fr_camera *c = &w->at;
         vec3 lens = v3_add(c->position, cam_lens(c, qs->u[0], qs->u[1]));
         vec3 d = v3_sub(qs->p, lens);
         float d2 = v3_len2(d);
@@ -652,7 +652,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
             return zero;
         float dist = sqrtf(d2), pdf_dir;
         vec3 wc = v3_scale(d, 1.0f / dist), wi = v3_neg(wc);
-        float we = cam_importance(s, lens, wc, &pdf_dir, rx, ry);
+        float we = cam_importance(s, c, lens, wc, &pdf_dir, rx, ry);
         if (!(we > 0.0f))
             return zero;
         /* The lens point was sampled by area: the solid-angle density at
@@ -670,6 +670,7 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
         sampled->p = lens;
         sampled->ng = sampled->ns = sampled->wo = zero;
         sampled->light = FR_NONE;
+        sampled->camera = c;
         sampled->pdf_fwd = sampled->pdf_rev = 0.0f;
         return L;
     }
@@ -733,7 +734,7 @@ static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_
     ls.dim = LIGHT_DIM;
     int maxd = (int)s->settings.max_depth;
     rnd rc = {&cs, NULL}, rl = {&ls, NULL};
-    int nc = w->ncam = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL, &w->time);
+    int nc = w->ncam = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL, &w->time, &w->at);
     int nl = light_subpath(s, &rl, w->lgt, maxd + 1, w->time);
     /* s = 1 samples its own light point: possible even when the light
      * subpath could not start. */
@@ -805,7 +806,7 @@ vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam,
         return zero;
     rnd rc = {NULL, cam}, rl = {NULL, light};
     float cx = 0.0f, cy = 0.0f;
-    if (camera_subpath(s, &rc, 0, 0, w->cam, t, &cx, &cy, &w->time) != t)
+    if (camera_subpath(s, &rc, 0, 0, w->cam, t, &cx, &cy, &w->time, &w->at) != t)
         return zero;
     /* s = 1 samples its light point from the camera vertex's numbers. */
     if (s_ > 1 && light_subpath(s, &rl, w->lgt, s_, w->time) != s_)

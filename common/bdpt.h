@@ -38,11 +38,12 @@
  * Russian roulette.  So each light subpath belongs to one pixel sample, and
  * a split of the image into rows traces every light subpath once.
  *
- * Moving instances blur: a sample draws its time across the shutter after
- * the camera's lens pair (as the path tracer does; scenes without motion
- * draw none), and its light subpath, connections and shadow rays all see
- * the scene at that time.  Scenes that use participating media (fog, a
- * medium inside a shape) or a camera moving across the shutter are refused
+ * Motion blur: a sample draws its time across the shutter after the
+ * camera's lens pair (as the path tracer does; scenes without motion draw
+ * none); its light subpath, connections and shadow rays all see the
+ * scene at that time, and its camera rays, lens points and light-tracing
+ * splats use the camera at that time (camera.h's cam_at).  Scenes that
+ * use participating media (fog, a medium inside a shape) are refused
  * (bd_supported).
  */
 #ifndef FRANJA_BDPT_H
@@ -76,7 +77,7 @@ typedef struct {
 typedef struct bd_work bd_work;
 
 /** 0 when bidirectional path tracing can render scene s; otherwise -1
- * with err saying why (participating media, a moving camera). */
+ * with err saying why (participating media). */
 int bd_supported(const fr_scene *s, fr_error *err);
 
 /** Allocate working memory for scene s (subpaths of max_depth + 2

@@ -68,9 +68,9 @@ float cam_footprint(float width, vec3 ng, vec3 d)
     return c > 0.0f ? width / sqrtf(c) : 0.0f;
 }
 
-int cam_raster(const fr_scene *s, vec3 o, vec3 w, float *rx, float *ry)
+/* cam_raster through camera c. */
+static int raster(const fr_scene *s, const fr_camera *c, vec3 o, vec3 w, float *rx, float *ry)
 {
-    const fr_camera *c = &s->camera;
     float cos_t = v3_dot(w, c->forward);
     if (!(cos_t > 0.0f))
         return 0;
@@ -94,12 +94,16 @@ int cam_raster(const fr_scene *s, vec3 o, vec3 w, float *rx, float *ry)
     return 1;
 }
 
-float cam_importance(const fr_scene *s, vec3 o, vec3 w, float *pdf_dir, float *rx, float *ry)
+int cam_raster(const fr_scene *s, vec3 o, vec3 w, float *rx, float *ry)
 {
-    const fr_camera *c = &s->camera;
+    return raster(s, &s->camera, o, w, rx, ry);
+}
+
+float cam_importance(const fr_scene *s, const fr_camera *c, vec3 o, vec3 w, float *pdf_dir, float *rx, float *ry)
+{
     float x, y;
     *pdf_dir = 0.0f;
-    if (!cam_raster(s, o, w, &x, &y))
+    if (!raster(s, c, o, w, &x, &y))
         return 0.0f;
     if (rx && ry) {
         *rx = x;

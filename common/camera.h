@@ -46,10 +46,12 @@ float cam_lens_area(const fr_camera *c);
 int cam_raster(const fr_scene *s, vec3 o, vec3 w, float *rx, float *ry);
 
 /** Importance We of the ray from lens point o in unit direction w (0
- * outside the image), in *pdf_dir the solid-angle density with which
- * pt_camera_ray picks w given o (0 outside), and, when rx and ry are not
- * NULL and the ray lands inside, its raster position as cam_raster gives. */
-float cam_importance(const fr_scene *s, vec3 o, vec3 w, float *pdf_dir, float *rx, float *ry);
+ * outside the image) through camera c (s->camera, or cam_at's camera at a
+ * sample's time; the image's size is s->settings'), in *pdf_dir the
+ * solid-angle density with which pt_camera_ray_from picks w given o (0
+ * outside), and, when rx and ry are not NULL and the ray lands inside,
+ * its raster position as cam_raster gives for that camera. */
+float cam_importance(const fr_scene *s, const fr_camera *c, vec3 o, vec3 w, float *pdf_dir, float *rx, float *ry);
 
 /** The ray cone of a camera ray (Akenine-Moller et al. 2019, "Texture
  * Level of Detail Strategies for Real-Time Ray Tracing"): the angle one

@@ -40,7 +40,7 @@ int mlt_supported(const fr_scene *s, fr_error *err)
 {
     if (s->motion.flags)
         return fr_fail(err, "the scene has motion blur, which Metropolis light transport does not support; render "
-                            "it with the path or bidirectional integrator (moving instances only)");
+                            "it with the path or bidirectional integrator");
     fr_error why;
     if (bd_supported(s, &why) < 0)
         return fr_fail(err, "the scene has participating media (fog or a medium inside a shape), which Metropolis "

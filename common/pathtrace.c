@@ -62,10 +62,8 @@ static void light_numbers(const fr_scene *s, vec3 from, vec3 nrm, int choose, fr
         smp_2d(smp, u1, u2);
 }
 
-/* pt_camera_ray from camera c (camera.h's cam_at: the camera at a time
- * within the shutter) instead of the scene's. */
-static fr_ray camera_ray_from(const fr_scene *s, const fr_camera *c, uint32_t x, uint32_t y, float px, float py,
-                              float lx, float ly)
+fr_ray pt_camera_ray_from(const fr_scene *s, const fr_camera *c, uint32_t x, uint32_t y, float px, float py,
+                          float lx, float ly)
 {
     float w = (float)s->settings.width, h = (float)s->settings.height;
     float sx = (2.0f * ((float)x + px) - w) / h * c->tan_half;
@@ -85,7 +83,7 @@ static fr_ray camera_ray_from(const fr_scene *s, const fr_camera *c, uint32_t x,
 
 fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly)
 {
-    return camera_ray_from(s, &s->camera, x, y, px, py, lx, ly);
+    return pt_camera_ray_from(s, &s->camera, x, y, px, py, lx, ly);
 }
 
 /* Light reached by a BSDF or phase sample (or seen directly) at surface
@@ -177,7 +175,7 @@ static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x
         cam_at(s, tu, &at);
         cam = &at;
     }
-    fr_ray ray = camera_ray_from(s, cam, x, y, px, py, lx, ly);
+    fr_ray ray = pt_camera_ray_from(s, cam, x, y, px, py, lx, ly);
     ray.time = tu;
     vec3 camera = ray.o;
     if (ps)

@@ -29,6 +29,11 @@ typedef enum { PT_MIS = 0, PT_LIGHT_ONLY, PT_BSDF_ONLY, PT_MIS_DISTANCE } pt_str
  * camera has an aperture.  The direction is unit length. */
 fr_ray pt_camera_ray(const fr_scene *s, uint32_t x, uint32_t y, float px, float py, float lx, float ly);
 
+/** pt_camera_ray from camera c (camera.h's cam_at: the camera at a time
+ * within the shutter) instead of the scene's. */
+fr_ray pt_camera_ray_from(const fr_scene *s, const fr_camera *c, uint32_t x, uint32_t y, float px, float py,
+                          float lx, float ly);
+
 /** Radiance of sample `index` of pixel (x, y); 0 for a sample that came
  * out NaN or infinite (dropped the same way everywhere).  The sample's
  * numbers: the pixel pair, the lens pair (skipped by a pinhole), then,

@@ -7,7 +7,8 @@
 # slab too (its rows and its light-tracing splats over the whole image),
 # and a slab of instanced meshes (the fuzz seed tests/fuzz/corpus/fbin/
 # instances.json: a rotation, a mirror, a non-uniform scale), and one of
-# the same instances moving across a shutter.
+# the same instances moving across a shutter, path traced and
+# bidirectionally.
 . "$(dirname "$0")/lib.sh"
 need readelf cmp "$QEMU"
 T=$(mktemp -d /tmp/franja-static.XXXXXX)
@@ -75,6 +76,14 @@ check "the blurred slab is not the still one" sh -c "! cmp -s '$T/mv-ref.pf' '$T
 check "amd64 static slab of moving instances is byte-identical" cmp "$T/mv-s64.pf" "$T/mv-ref.pf"
 "$QEMU" "$SA64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-sa64.pf"
 check "arm64 static slab of moving instances under qemu is byte-identical" cmp "$T/mv-sa64.pf" "$T/mv-ref.pf"
+# and bidirectionally (light subpaths and connections at each sample's time)
+MB="$MV --integrator bdpt"
+"$ROOT/bin/franja-worker" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MB -o "$T/mb-ref.pf"
+"$S64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MB -o "$T/mb-s64.pf"
+check "amd64 static bidirectional slab of moving instances is byte-identical" cmp "$T/mb-s64.pf" "$T/mb-ref.pf"
+"$QEMU" "$SA64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MB -o "$T/mb-sa64.pf"
+check "arm64 static bidirectional slab of moving instances under qemu is byte-identical" \
+    cmp "$T/mb-sa64.pf" "$T/mb-ref.pf"
 # Textures at their own precision and mip levels: 8-bit sRGB images read
 # through the table and filtered across mip levels (the brick wall spans
 # several texels a pixel at 64x64), and an HDR sky stored as halves.
