@@ -26,6 +26,7 @@
 #include "monitor.h"
 #include "output.h"
 #include "progress.h"
+#include "protocol.h"
 #include "sched.h"
 #include "tonemap.h"
 
@@ -126,6 +127,7 @@ typedef struct {
     double t0;
     progress_reporter *pg;           /* --progress json, or NULL */
     mon_server *mon;           /* --monitor, or NULL */
+    float mlt_norm[PROTO_MLT_DEPTHS]; /* --integrator mlt: the normalisation every worker gets (spec.mlt_norm) */
 } frame_image;
 
 /** What a pass to spp samples per pixel renders: the rows the job

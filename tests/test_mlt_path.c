@@ -57,7 +57,7 @@ static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_s
     pt_render_rows(&s, PT_MIS, 0, H, ref);
 
     mlt_boot bt;
-    CHECK(mlt_bootstrap(&s, MLT_BOOTSTRAP, &bt, &err) == 0, "%s: bootstrap: %s", path, err.msg);
+    CHECK(mlt_bootstrap(&s, MLT_NORM_MIN, &bt, &err) == 0, "%s: bootstrap: %s", path, err.msg);
     double pt_mean = quadrant(ref, 4);
     CHECK(fabs(bt.b / pt_mean - 1.0) < 0.02, "%s: b %g, path tracing's mean luminance %g", path, bt.b, pt_mean);
 
