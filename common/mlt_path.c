@@ -116,7 +116,7 @@ int mlt_bootstrap(const fr_scene *s, uint32_t n, mlt_boot *bt, fr_error *err)
 
 uint32_t mlt_norm_samples(const fr_scene *s)
 {
-    uint64_t n = (uint64_t)s->settings.width * s->settings.height * MLT_NORM_SPP;
+    uint64_t n = (uint64_t)s->settings.width * s->settings.height * s->settings.spp / MLT_NORM_SHARE;
     return n < MLT_NORM_MIN ? MLT_NORM_MIN : n > MLT_NORM_MAX ? MLT_NORM_MAX : (uint32_t)n;
 }
 

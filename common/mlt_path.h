@@ -45,9 +45,11 @@
 #include "error.h"
 #include "scene.h"
 
-/** Bidirectional samples per pixel that estimate b_d (mlt_norm_samples),
- * at least MLT_NORM_MIN and at most MLT_NORM_MAX in all. */
-#define MLT_NORM_SPP 4u
+/** Mutations per bidirectional sample that estimates b_d
+ * (mlt_norm_samples: one sample for every MLT_NORM_SHARE mutations of
+ * the render, about a sixth of its time, so that b's error shrinks with
+ * the render's), at least MLT_NORM_MIN and at most MLT_NORM_MAX. */
+#define MLT_NORM_SHARE 16u
 #define MLT_NORM_MIN 65536u
 #define MLT_NORM_MAX 4194304u
 /** Candidate states a chain's start is picked from; at most MLT_START_MAX
@@ -55,7 +57,7 @@
 #define MLT_START_CANDIDATES 64u
 #define MLT_START_MAX 65536u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
-#define MLT_P_LARGE 0.1f
+#define MLT_P_LARGE 0.3f
 
 /** The normalisation: b and b_d. */
 typedef struct {
@@ -74,8 +76,9 @@ int mlt_supported(const fr_scene *s, fr_error *err);
 int mlt_bootstrap(const fr_scene *s, uint32_t n, mlt_boot *bt, fr_error *err);
 void mlt_boot_free(mlt_boot *bt);
 
-/** The bidirectional samples a render's normalisation takes: MLT_NORM_SPP
- * per pixel of scene s's image, within [MLT_NORM_MIN, MLT_NORM_MAX]. */
+/** The bidirectional samples a render's normalisation takes: one for
+ * every MLT_NORM_SHARE mutations of scene s's image (its size and spp),
+ * within [MLT_NORM_MIN, MLT_NORM_MAX]. */
 uint32_t mlt_norm_samples(const fr_scene *s);
 
 /** *bt with b_d = bd[d] for d < nd (a normalisation handed over by the

@@ -236,13 +236,14 @@ int frame_lock(frame_image *im)
  * works out what to render and opens the job directory: the rows it
  * holds, the passes of --time-limit.  0, or the exit status (said). */
 /* Metropolis light transport's normalisation (mlt_path.h), once for the
- * render at its image size: into im->mlt_norm, handed to every worker by
+ * render at its image size and samples: into im->mlt_norm, handed to every worker by
  * spec.  A scene deeper than the command line carries leaves it to each
  * worker (the same numbers, computed per slab). */
 static int normalise(frame_image *im, fr_scene *sc, job_spec *spec, fr_error *err)
 {
     sc->settings.width = spec->width;
     sc->settings.height = spec->height;
+    sc->settings.spp = spec->spp;
     uint32_t nd = sc->settings.max_depth + 1, n = mlt_norm_samples(sc);
     if (nd > PROTO_MLT_DEPTHS) {
         fprintf(stderr, "franja: Metropolis light transport: max_depth %u: each worker computes its own "
@@ -342,14 +343,14 @@ int frame_open(frame_image *im)
     else if (a->crop && !crop_rows)
         fprintf(stderr, "franja: --crop with --integrator bdpt renders every row (light traced from the whole "
                 "image reaches the window)\n");
+    uint32_t asked = spec.spp;
+    if (quick_spp(&spec.spp, &err) > 0)
+        fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
     if (mlt && normalise(im, &sc, &spec, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         scn_free(&sc);
         return 1;
     }
-    uint32_t asked = spec.spp;
-    if (quick_spp(&spec.spp, &err) > 0)
-        fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
     /* Tone mapping: the scene's defaults, overridden by the command line. */
     im->tm = sc.tonemap;
     if (a->exposure_set)
