@@ -54,7 +54,7 @@
 #define MLT_NORM_MAX 4194304u
 /** Candidate states a chain's start is picked from; at most MLT_START_MAX
  * when they are all black. */
-#define MLT_START_CANDIDATES 64u
+#define MLT_START_CANDIDATES 1024u
 #define MLT_START_MAX 65536u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f

@@ -42,8 +42,9 @@ static double quadrant(const float *rgb, int q)
 }
 
 /* quad_tol: the relative difference allowed in a quadrant (MLT's noise:
- * the spheres' caustics make it several times the Cornell box's; over
- * six seeds their worst quadrant strayed 16 %). */
+ * on the Cornell box over five seeds the darkest quadrant strayed up to
+ * 8.4 %, its standard deviation about 4 %; the spheres' caustics make it
+ * several times that, their worst quadrant over six seeds 16 %). */
 static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_spp, double quad_tol)
 {
     fr_scene s;
@@ -134,7 +135,7 @@ static void norm_samples(void)
 int main(void)
 {
     norm_samples();
-    scene_against_path("scenes/cornell.json", 1024, 512, 0.05);
+    scene_against_path("scenes/cornell.json", 1024, 512, 0.12);
     scene_against_path("scenes/spheres.json", 1024, 512, 0.25);
     return check_done();
 }
