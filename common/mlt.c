@@ -7,9 +7,10 @@
 
 #include "fmath.h"
 
-/* Kelemen et al.'s bounds of a small step's distance. */
+/* Bounds of a small step's distance (Kelemen et al.'s s1; s2 four times
+ * theirs, mlt.h). */
 #define S1 (1.0f / 1024.0f)
-#define S2 (1.0f / 64.0f)
+#define S2 (1.0f / 16.0f)
 
 static void rewind_streams(mlt_chain *c)
 {
@@ -67,8 +68,8 @@ void mlt_step(mlt_chain *c, int force_large)
 float mlt_perturb(float u, float a, float b)
 {
     /* Distance s2 * (s1/s2)^a = s2 * exp(-ln(s2/s1) a): density ~ 1/d on
-     * [s1, s2]; ln(s2/s1) = ln 16. */
-    float d = S2 * fm_expf(-2.77258872f * a);
+     * [s1, s2]; ln(s2/s1) = ln 64. */
+    float d = S2 * fm_expf(-4.15888308f * a);
     float v = b < 0.5f ? u + d : u - d;
     if (v >= 1.0f)
         v -= 1.0f;
@@ -88,15 +89,6 @@ static void extend(mlt_chain *c, uint64_t idx)
     }
     if (idx >= c->used)
         c->used = (uint32_t)idx + 1;
-}
-
-void mlt_set(mlt_chain *c, uint32_t stream, uint32_t k, float v)
-{
-    uint64_t idx = (uint64_t)k * c->n_streams + stream;
-    if (idx >= c->cap)
-        return;
-    extend(c, idx);
-    c->x[idx].value = v;
 }
 
 float mlt_next(mlt_chain *c, uint32_t stream)

@@ -13,9 +13,9 @@
 /* Streams of a state's numbers (mlt_path.h). */
 enum { ST_CAMERA, ST_LIGHT, ST_STRATEGY, N_STREAMS };
 
-/* Seeds of the generators: bootstrap state i and chain k, apart. */
-#define SEED_BOOT 1ull
+/* Seeds of the generators: chain k's mutations and its start, apart. */
 #define SEED_CHAIN 2ull
+#define SEED_START 3ull
 
 typedef struct {
     vec3 c;                    /* the value C */
@@ -99,84 +99,45 @@ static void runner_close(runner *r)
     bd_work_free(r->w);
 }
 
-/* The radical inverse of m in base 2, to 24 bits. */
-static float radical2(uint32_t m)
-{
-    uint32_t r = 0;
-    for (int b = 0; b < 24; b++, m >>= 1)
-        r = r << 1 | (m & 1);
-    return (float)r * (1.0f / 16777216.0f);
-}
-
-/* Bootstrap states of depth d among n. */
-static uint32_t depth_count(uint32_t n, uint32_t nd, uint32_t d) { return n / nd + (d < n % nd); }
-
-/* Bootstrap state i of n, evaluated at its depth (into *st, its depth
- * returned).  Its camera ray is stratified: state m of depth d's count
- * takes the m-th point of a Hammersley set over the image, shifted by a
- * random offset per depth (Cranley-Patterson rotation), so that b_d does
- * not carry the noise of random pixels (small bright lights seen directly
- * would make it). */
-static int boot_state(runner *r, uint32_t i, uint32_t n, state *st)
-{
-    uint32_t nd = r->s->settings.max_depth + 1, d = i % nd, m = i / nd, count = depth_count(n, nd, d);
-    mlt_restart(&r->ch, key(SEED_BOOT, r->s->settings.seed, 0xffffffu - d));
-    float r0 = mlt_uniform(&r->ch), r1 = mlt_uniform(&r->ch);
-    mlt_restart(&r->ch, key(SEED_BOOT, r->s->settings.seed, i));
-    float u0 = ((float)m + r0) / (float)count, u1 = radical2(m) + r1;
-    mlt_set(&r->ch, ST_CAMERA, 0, u0 < 1.0f ? u0 : 0.99999994f);
-    mlt_set(&r->ch, ST_CAMERA, 1, u1 < 1.0f ? u1 : u1 - 1.0f);
-    evaluate(r, (int)d, st);
-    return (int)d;
-}
-
 int mlt_bootstrap(const fr_scene *s, uint32_t n, mlt_boot *bt, fr_error *err)
 {
     memset(bt, 0, sizeof *bt);
-    uint32_t nd = bt->nd = s->settings.max_depth + 1;
-    bt->cdf = malloc(((size_t)n + 1) * sizeof *bt->cdf);
-    bt->bd = calloc(nd, sizeof *bt->bd);
-    bt->off = calloc((size_t)nd + 1, sizeof *bt->off);
-    runner r;
-    if (!bt->cdf || !bt->bd || !bt->off || runner_open(&r, s, NULL, err) < 0) {
-        mlt_boot_free(bt);
-        return fr_fail(err, "out of memory for the Metropolis bootstrap");
-    }
-    bt->n = n;
-    for (uint32_t d = 0; d < nd; d++)
-        bt->off[d + 1] = bt->off[d] + depth_count(n, nd, d);
-    /* f of state i = d + nd * m at position off[d] + m + 1, then summed up. */
-    bt->cdf[0] = 0.0;
-    for (uint32_t i = 0; i < n; i++) {
-        state st;
-        int d = boot_state(&r, i, n, &st);
-        bt->cdf[bt->off[d] + i / nd + 1] = st.f;
-    }
+    bt->nd = s->settings.max_depth + 1;
+    bt->bd = calloc(bt->nd, sizeof *bt->bd);
     /* b_d: each depth's mean luminance by bidirectional path tracing over
-     * the image, all strategies MIS-weighted and the pixels stratified (the
-     * states' own mean, one random strategy each, is several times noisier
-     * where light comes through narrow passages). */
-    if (bd_depth_means(s, MLT_BOOTSTRAP_BDPT, bt->bd) < 0) {
-        runner_close(&r);
+     * the image, all strategies MIS-weighted and the pixels stratified. */
+    if (!bt->bd || bd_depth_means(s, n, bt->bd) < 0) {
         mlt_boot_free(bt);
-        return fr_fail(err, "out of memory for the Metropolis bootstrap");
+        return fr_fail(err, "out of memory for the Metropolis normalisation");
     }
+    /* In float, as the coordinator hands it to the workers (--mlt-norm): a
+     * worker that computes it gives the same bits. */
+    for (uint32_t d = 0; d < bt->nd; d++)
+        bt->b += bt->bd[d] = (float)bt->bd[d];
+    return 0;
+}
+
+uint32_t mlt_norm_samples(const fr_scene *s)
+{
+    uint64_t n = (uint64_t)s->settings.width * s->settings.height * s->settings.spp / MLT_NORM_SHARE;
+    return n < MLT_NORM_MIN ? MLT_NORM_MIN : n > MLT_NORM_MAX ? MLT_NORM_MAX : (uint32_t)n;
+}
+
+int mlt_boot_set(mlt_boot *bt, const float *bd, uint32_t nd, fr_error *err)
+{
+    memset(bt, 0, sizeof *bt);
+    bt->nd = nd;
+    if (!(bt->bd = calloc(nd ? nd : 1, sizeof *bt->bd)))
+        return fr_fail(err, "out of memory for the Metropolis normalisation");
     for (uint32_t d = 0; d < nd; d++)
-        bt->b += bt->bd[d];
-    for (uint32_t p = 0; p < n; p++)
-        bt->cdf[p + 1] += bt->cdf[p];
-    runner_close(&r);
+        bt->b += bt->bd[d] = bd[d];
     return 0;
 }
 
 void mlt_boot_free(mlt_boot *bt)
 {
-    free(bt->cdf);
     free(bt->bd);
-    free(bt->off);
-    bt->cdf = NULL;
     bt->bd = NULL;
-    bt->off = NULL;
 }
 
 /* Add v * C / f of state st to its pixel's sums. */
@@ -189,22 +150,6 @@ static void splat_state(runner *r, const state *st, float v)
     spl_add(&p[0], spl_fixed(st->c.x * k));
     spl_add(&p[1], spl_fixed(st->c.y * k));
     spl_add(&p[2], spl_fixed(st->c.z * k));
-}
-
-/* The bootstrap state of depth d whose f-interval holds the fraction u of
- * the depth's total. */
-static uint32_t pick(const mlt_boot *bt, uint32_t d, double u)
-{
-    uint32_t lo = bt->off[d], hi = bt->off[d + 1] - 1;
-    double x = bt->cdf[lo] + u * (bt->cdf[hi + 1] - bt->cdf[lo]);
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (bt->cdf[mid + 1] <= x)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return (lo - bt->off[d]) * bt->nd + d;
 }
 
 /* How many of n_chains chains each depth gets (per_depth, bt->nd
@@ -235,9 +180,37 @@ static void allocate(const mlt_boot *bt, uint32_t n_chains, uint32_t *per_depth)
     }
 }
 
+/* The start of chain k, at depth d: the best of MLT_START_CANDIDATES
+ * independent states of depth d (from generator seeds of the chain's
+ * own), one picked with probability f_j / sum f (importance resampling,
+ * so that the start is distributed about as f is); when all are black,
+ * MLT_START_CANDIDATES more, up to MLT_START_MAX.  Leaves the chain's
+ * state at the picked candidate's, in *x. */
+static void start_state(runner *r, uint32_t k, int d, state *x)
+{
+    uint32_t seed = r->s->settings.seed, best = 0;
+    uint64_t pick_rng = key(SEED_START, seed, k);
+    double sum = 0.0;
+    for (uint32_t j = 0; j < MLT_START_MAX && (j < MLT_START_CANDIDATES || !(sum > 0.0)); j++) {
+        mlt_restart(&r->ch, key(SEED_START, seed, k) ^ (uint64_t)(j + 1) << 40);
+        evaluate(r, d, x);
+        if (!(x->f > 0.0f))
+            continue;
+        sum += x->f;
+        /* Keep j with probability f_j / (sum so far): j ends up picked with
+         * probability f_j / sum. */
+        mlt_chain g = {.rng = pick_rng};
+        float u = mlt_uniform(&g);
+        pick_rng = g.rng;
+        if ((double)u * sum < x->f)
+            best = j;
+    }
+    mlt_restart(&r->ch, key(SEED_START, seed, k) ^ (uint64_t)(best + 1) << 40);
+    evaluate(r, d, x);
+}
+
 /* Run chain k of n_chains: the chains of depth 0 first, then depth 1's...
- * (per_depth); the q-th of depth d's count starts from the bootstrap state
- * picked by systematic resampling, stratum q of depth d's cumulative f. */
+ * (per_depth); each starts from start_state. */
 static void run_chain(runner *r, const mlt_boot *bt, uint32_t k, uint32_t n_chains, const uint32_t *per_depth,
                       uint64_t mutations)
 {
@@ -246,10 +219,8 @@ static void run_chain(runner *r, const mlt_boot *bt, uint32_t k, uint32_t n_chai
         q -= per_depth[d];
         d++;
     }
-    mlt_restart(&r->ch, key(SEED_CHAIN, seed, k));
-    uint32_t j = pick(bt, d, ((double)q + mlt_uniform(&r->ch)) / per_depth[d]);
     state x, y;
-    boot_state(r, j, bt->n, &x);
+    start_state(r, k, (int)d, &x);
     /* Depth d's light over its chains' share of the mutations. */
     r->scale = bt->bd[d] * n_chains / per_depth[d];
     mlt_reseed(&r->ch, key(SEED_CHAIN, seed, k) ^ 0x5bd1e995u);
@@ -271,7 +242,7 @@ static void run_chain(runner *r, const mlt_boot *bt, uint32_t k, uint32_t n_chai
 int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, uint32_t n_chains, uint64_t mutations,
                uint64_t *splat, fr_error *err)
 {
-    if (!(bt->b > 0.0) || bt->n == 0)
+    if (!(bt->b > 0.0))
         return 0;              /* no light reaches the camera: a black image */
     runner r;
     uint32_t *per_depth = calloc(bt->nd, sizeof *per_depth);
@@ -289,17 +260,21 @@ int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, 
     return 0;
 }
 
-int mlt_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err)
+int mlt_render_rows(const fr_scene *s, const mlt_boot *given, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat,
+                    fr_error *err)
 {
     if (mlt_supported(s, err) < 0)
         return -1;
     memset(rgb, 0, (size_t)s->settings.width * (y1 - y0) * 3 * sizeof *rgb);
-    uint64_t n = (uint64_t)s->settings.width * s->settings.height * 16;
-    n = n < MLT_BOOTSTRAP_MIN ? MLT_BOOTSTRAP_MIN : n > MLT_BOOTSTRAP ? MLT_BOOTSTRAP : n;
-    mlt_boot bt;
-    if (mlt_bootstrap(s, (uint32_t)n, &bt, err) < 0)
+    mlt_boot own;
+    if (!given && mlt_bootstrap(s, mlt_norm_samples(s), &own, err) < 0)
         return -1;
-    int rc = mlt_chains(s, &bt, y0, y1, s->settings.height, (uint64_t)s->settings.width * s->settings.spp, splat, err);
-    mlt_boot_free(&bt);
+    if (given && given->nd != s->settings.max_depth + 1)
+        return fr_fail(err, "the Metropolis normalisation has %u depths, the scene %u (max_depth + 1)", given->nd,
+                       s->settings.max_depth + 1);
+    int rc = mlt_chains(s, given ? given : &own, y0, y1, s->settings.height,
+                        (uint64_t)s->settings.width * s->settings.spp, splat, err);
+    if (!given)
+        mlt_boot_free(&own);
     return rc;
 }

@@ -16,17 +16,16 @@
  *
  * Normalisation (b) and start: b_d, the integral of f over depth d's
  * states, is the mean luminance of depth d's paths over the image, which
- * bidirectional path tracing estimates (bd_depth_means, about
- * MLT_BOOTSTRAP_BDPT samples with all strategies); b = sum of b_d.  A
- * bootstrap of n independent states (state i: depth i mod (max_depth + 1),
- * numbers from seed i) gives the chains' starts.  Chain k starts from bootstrap
- * sample j picked with probability f_j / sum f (its depth so has
- * probability b_d / b, and its state is distributed about as f is: little
- * start-up bias), and from there mutates with its own generator, seed k.
- * The picks are systematic resampling: chain k of K takes the state at
- * (k + u_k) / K of the cumulative f, so that each depth gets its share
- * b_d / b of the chains to within one chain (independent picks would
- * leave a few chains' worth of noise in each depth's brightness).
+ * bidirectional path tracing estimates (bd_depth_means, with all
+ * strategies); b = sum of b_d.  It is computed once per render (by the
+ * coordinator, which hands it to every worker: protocol.h's --mlt-norm)
+ * from mlt_norm_samples samples.  The chains are shared out among the
+ * depths in proportion to b_d (largest remainders, at least one for each
+ * lit depth), so each depth gets its share of the mutations to within one
+ * chain.  Chain k starts from a state of its own, picked among
+ * MLT_START_CANDIDATES independent states of its depth in proportion to
+ * f (importance resampling: distributed about as f is, so little
+ * start-up bias), and from there mutates with its own generator.
  *
  * Estimate: each mutation splats, expected-value style, the proposal y
  * with weight a and the current state x with weight 1 - a (a, the
@@ -34,7 +33,7 @@
  * pixel's value is the sum of its splats over the mutations per pixel.
  *
  * Determinism: a chain is a pure function of the scene, its index and
- * the bootstrap, which is itself a pure function of the scene; splats are
+ * the normalisation, which is itself a pure function of the scene; splats are
  * 64-bit fixed-point sums (splat.h).  So any set of chains rendered
  * anywhere, added in any order, gives the same bits.
  */
@@ -46,33 +45,45 @@
 #include "error.h"
 #include "scene.h"
 
-/** Bootstrap states of a render: 16 per pixel, at least 2^15 and at most
- * MLT_BOOTSTRAP (2^18: b within about 1 % on the Cornell box, 0.2 s). */
-#define MLT_BOOTSTRAP 262144u
-#define MLT_BOOTSTRAP_MIN 32768u
-/** Bidirectional samples that estimate b_d (bd_depth_means). */
-#define MLT_BOOTSTRAP_BDPT 32768u
+/** Mutations per bidirectional sample that estimates b_d
+ * (mlt_norm_samples: one sample for every MLT_NORM_SHARE mutations of
+ * the render, about a sixth of its time, so that b's error shrinks with
+ * the render's), at least MLT_NORM_MIN and at most MLT_NORM_MAX. */
+#define MLT_NORM_SHARE 16u
+#define MLT_NORM_MIN 65536u
+#define MLT_NORM_MAX 4194304u
+/** Candidate states a chain's start is picked from; at most MLT_START_MAX
+ * when they are all black. */
+#define MLT_START_CANDIDATES 1024u
+#define MLT_START_MAX 65536u
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f
 
-/** The bootstrap: b and the cumulative f of its states. */
+/** The normalisation: b and b_d. */
 typedef struct {
     double b;                  /**< sum over depths of the mean f: the integral of the target */
     double *bd;                /**< nd entries: b_d, the integral of f over depth d (owned) */
     uint32_t nd;               /**< depths, max_depth + 1 */
-    uint32_t *off;             /**< nd + 1 entries: depth d's states are cdf positions off[d]..off[d+1]-1 (owned) */
-    uint32_t n;                /**< states */
-    double *cdf;               /**< n + 1 entries, the states ordered by depth: cdf[p] = sum of f over those before p (owned) */
 } mlt_boot;
 
 /** 0 when Metropolis light transport can render scene s (what bd_supported
  * accepts, and no motion blur); otherwise -1 with err saying why. */
 int mlt_supported(const fr_scene *s, fr_error *err);
 
-/** Run the bootstrap of scene s into *bt (n states); -1 with err when out
- * of memory.  Free with mlt_boot_free. */
+/** Estimate b_d of scene s into *bt from n bidirectional samples
+ * (bd_depth_means); -1 with err when out of memory.  Free with
+ * mlt_boot_free. */
 int mlt_bootstrap(const fr_scene *s, uint32_t n, mlt_boot *bt, fr_error *err);
 void mlt_boot_free(mlt_boot *bt);
+
+/** The bidirectional samples a render's normalisation takes: one for
+ * every MLT_NORM_SHARE mutations of scene s's image (its size and spp),
+ * within [MLT_NORM_MIN, MLT_NORM_MAX]. */
+uint32_t mlt_norm_samples(const fr_scene *s);
+
+/** *bt with b_d = bd[d] for d < nd (a normalisation handed over by the
+ * coordinator); -1 with err when out of memory.  Free with mlt_boot_free. */
+int mlt_boot_set(mlt_boot *bt, const float *bd, uint32_t nd, fr_error *err);
 
 /** Run chains [k0, k1) of n_chains, each of `mutations` mutations, adding their
  * splats to splat (3 fixed-point sums per pixel of the whole image,
@@ -84,10 +95,13 @@ int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, 
 
 /** Render rows [y0, y1) of scene s by MLT, as franja-worker does: row y
  * stands for chain y, of width * spp mutations (so a whole image has spp
- * mutations per pixel); rgb (the rows' own pixels) is zeroed and splat
- * receives the chains' splats over the whole image (bd_render_rows'
- * contract: the image is rgb plus spl_resolve with spp).  -1 with err when
- * unsupported or out of memory. */
-int mlt_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err);
+ * mutations per pixel), normalised by bt (NULL: computed here, as the
+ * coordinator does, mlt_bootstrap of mlt_norm_samples); rgb (the rows' own
+ * pixels) is zeroed and splat receives the chains' splats over the whole
+ * image (bd_render_rows' contract: the image is rgb plus spl_resolve with
+ * spp).  -1 with err when unsupported, bt has another number of depths
+ * than the scene, or out of memory. */
+int mlt_render_rows(const fr_scene *s, const mlt_boot *bt, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat,
+                    fr_error *err);
 
 #endif

@@ -4,6 +4,7 @@
 #include "suggest.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,6 +85,8 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
         return fr_fail(err, "unknown partial image format %d", (int)s->format);
     if (s->integrator < 0 || s->integrator > FR_INTEGRATORS)
         return fr_fail(err, "unknown integrator %d", s->integrator - 1);
+    if (s->mlt_norm && (s->mlt_depths == 0 || s->mlt_depths > PROTO_MLT_DEPTHS))
+        return fr_fail(err, "Metropolis normalisation of %u depths: not in 1..%u", s->mlt_depths, PROTO_MLT_DEPTHS);
     int n = 0;
     snprintf(a->rows, sizeof a->rows, "%u:%u", s->y0, s->y1);
     a->argv[n++] = "--scene";
@@ -127,8 +130,49 @@ int proto_slab_argv(const proto_slab *s, proto_argv *a, fr_error *err)
         a->argv[n++] = "--passes";
         a->argv[n++] = a->passes;
     }
+    if (s->mlt_norm) {
+        /* The floats' bits, exact: every worker gets the same numbers. */
+        size_t o = 0;
+        for (uint32_t d = 0; d < s->mlt_depths; d++) {
+            uint32_t bits;
+            memcpy(&bits, &s->mlt_norm[d], sizeof bits);
+            o += (size_t)snprintf(a->mlt_norm + o, sizeof a->mlt_norm - o, "%s%08x", d ? "," : "", bits);
+        }
+        a->argv[n++] = "--mlt-norm";
+        a->argv[n++] = a->mlt_norm;
+    }
     a->argv[n] = NULL;
     return 0;
+}
+
+/* Parses --mlt-norm's LIST into out (at most PROTO_MLT_DEPTHS values, their
+ * count in *n): 8 hex digits a value, the bits of a finite float >= 0,
+ * separated by commas.  Fails naming the byte offset of what is wrong. */
+static int parse_mlt_norm(const char *list, float *out, uint32_t *n, fr_error *err)
+{
+    const char *p = list;
+    *n = 0;
+    for (;;) {
+        if (*n == PROTO_MLT_DEPTHS)
+            return fr_fail(err, "--mlt-norm: byte %zu: more than %u values", (size_t)(p - list), PROTO_MLT_DEPTHS);
+        uint32_t bits = 0;
+        for (int k = 0; k < 8; k++, p++) {
+            int c = *p, v = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+            if (v < 0)
+                return fr_fail(err, "--mlt-norm: byte %zu: expected a hex digit (0-9, a-f)", (size_t)(p - list));
+            bits = bits << 4 | (uint32_t)v;
+        }
+        float f;
+        memcpy(&f, &bits, sizeof f);
+        if (!(f >= 0.0f) || !isfinite(f))
+            return fr_fail(err, "--mlt-norm: byte %zu: not a finite value >= 0", (size_t)(p - 8 - list));
+        out[(*n)++] = f;
+        if (!*p)
+            return 0;
+        if (*p != ',')
+            return fr_fail(err, "--mlt-norm: byte %zu: expected ',' or the end", (size_t)(p - list));
+        p++;
+    }
 }
 
 int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *err)
@@ -158,7 +202,7 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
         } else if (!has_arg && (!strcmp(a, "--scene") || !strcmp(a, "--rows") || !strcmp(a, "--spp") ||
                                 !strcmp(a, "--size") || !strcmp(a, "--format") || !strcmp(a, "--integrator") ||
                                 !strcmp(a, "--noise-threshold") || !strcmp(a, "--continue") || !strcmp(a, "-o") ||
-                                !strcmp(a, "--unpack") || !strcmp(a, "--passes"))) {
+                                !strcmp(a, "--unpack") || !strcmp(a, "--passes") || !strcmp(a, "--mlt-norm"))) {
             return fr_fail(err, "%s needs a value", a);
         } else if (!strcmp(a, "--scene")) {
             r->slab.scene = argv[++i];
@@ -193,11 +237,15 @@ int proto_parse_args(int argc, char *const *argv, proto_request *r, fr_error *er
             fr_error e;
             if (pass_parse(argv[++i], &r->slab.passes, &e) < 0)
                 return fr_fail(err, "--passes: %s", e.msg);
+        } else if (!strcmp(a, "--mlt-norm")) {
+            if (parse_mlt_norm(argv[++i], r->mlt_norm, &r->slab.mlt_depths, err) < 0)
+                return -1;
+            r->slab.mlt_norm = r->mlt_norm;
         } else {
             static const char *const known[] = {"help",       "version",         "check",    "lifeline", "sums",
                                                 "scene",      "rows",            "spp",      "size",     "format",
                                                 "integrator", "noise-threshold", "continue", "o",        "h",
-                                                "features",   "unpack",          "passes"};
+                                                "features",   "unpack",          "passes",   "mlt-norm"};
             char near[64];
             if (a[0] == '-' && sug_option(a, known, sizeof known / sizeof *known, near, sizeof near) == 0)
                 return fr_fail(err, "unknown argument '%s' (did you mean %s? see --help)", a, near);

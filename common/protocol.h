@@ -46,14 +46,23 @@ typedef struct {
     const char *continue_from; /**< --continue FILE: a partial with sums of the same slab and fewer samples,
                                     whose samples are not rendered again; NULL = none */
     uint32_t passes;           /**< --passes LIST: render passes (passes.h mask) in the PF partial; 0 = none */
+    const float *mlt_norm;     /**< --mlt-norm LIST: Metropolis light transport's b_d per depth (mlt_path.h),
+                                    mlt_depths entries, computed once by the coordinator; NULL = none (the
+                                    worker computes it) */
+    uint32_t mlt_depths;       /**< entries of mlt_norm, 1..PROTO_MLT_DEPTHS */
 } proto_slab;
+
+/** The most depths (max_depth + 1) whose Metropolis normalisation travels
+ * on a worker's command line: 8 hex digits and a comma each, well inside
+ * a remote command's bounds.  Deeper scenes' workers compute their own. */
+#define PROTO_MLT_DEPTHS 128u
 
 /** A worker command line built by proto_slab_argv: argv points into the
  * struct's own buffers (and at the caller's strings), NULL-terminated,
  * without the program name. */
 typedef struct {
     const char *argv[24];
-    char rows[32], size[32], spp[16], noise[32], passes[400];
+    char rows[32], size[32], spp[16], noise[32], passes[400], mlt_norm[PROTO_MLT_DEPTHS * 9];
 } proto_argv;
 
 /** Builds the worker arguments that ask for slab s.  Fails when a number
@@ -76,6 +85,7 @@ typedef struct {
     proto_slab slab;           /**< scene, rows, size, spp, format, out */
     int have_rows;             /**< --rows was given */
     const char *unpack;        /**< --unpack: the compressed scene (the output is slab.scene) */
+    float mlt_norm[PROTO_MLT_DEPTHS]; /**< --mlt-norm's values (slab.mlt_norm points here) */
 } proto_request;
 
 /** Reads a worker command line (argv[0] is the program).  Checks the syntax

@@ -257,6 +257,35 @@ int frame_lock(frame_image *im)
 /* Gets the image's scene (compiled into its job directory when needed),
  * works out what to render and opens the job directory: the rows it
  * holds, the passes of --time-limit.  0, or the exit status (said). */
+/* Metropolis light transport's normalisation (mlt_path.h), once for the
+ * render at its image size and samples: into im->mlt_norm, handed to every worker by
+ * spec.  A scene deeper than the command line carries leaves it to each
+ * worker (the same numbers, computed per slab). */
+static int normalise(frame_image *im, fr_scene *sc, job_spec *spec, fr_error *err)
+{
+    sc->settings.width = spec->width;
+    sc->settings.height = spec->height;
+    sc->settings.spp = spec->spp;
+    uint32_t nd = sc->settings.max_depth + 1, n = mlt_norm_samples(sc);
+    if (nd > PROTO_MLT_DEPTHS) {
+        fprintf(stderr, "franja: Metropolis light transport: max_depth %u: each worker computes its own "
+                "normalisation (%u bidirectional samples a slab)\n", nd - 1, n);
+        return 0;
+    }
+    double t0 = clock_now();
+    mlt_boot bt;
+    if (mlt_bootstrap(sc, n, &bt, err))
+        return -1;
+    for (uint32_t d = 0; d < nd; d++)
+        im->mlt_norm[d] = (float)bt.bd[d];
+    fprintf(stderr, "franja: Metropolis normalisation: b = %.6g from %u bidirectional samples (%.1f s)\n", bt.b, n,
+            clock_now() - t0);
+    mlt_boot_free(&bt);
+    spec->mlt_norm = im->mlt_norm;
+    spec->mlt_depths = nd;
+    return 0;
+}
+
 int frame_open(frame_image *im)
 {
     frame_settings *a = &im->a;
@@ -271,7 +300,7 @@ int frame_open(frame_image *im)
                      a->spp ? a->spp : sc.settings.spp,
                      a->integrator ? (uint32_t)(a->integrator - 1) : sc.settings.integrator,
                      a->noise_threshold > 0.0f ? a->noise_threshold : sc.settings.noise_threshold,
-                     a->passes_set ? a->passes : sc.settings.passes};
+                     a->passes_set ? a->passes : sc.settings.passes, NULL, 0};
     if (a->scale > 0) {
         spec.width = opt_scaled(sc.settings.width, a->scale);
         spec.height = opt_scaled(sc.settings.height, a->scale);
@@ -339,6 +368,11 @@ int frame_open(frame_image *im)
     uint32_t asked = spec.spp;
     if (quick_spp(&spec.spp, &err) > 0)
         fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
+    if (mlt && normalise(im, &sc, &spec, &err)) {
+        fprintf(stderr, "franja render: %s\n", err.msg);
+        scn_free(&sc);
+        return 1;
+    }
     /* Tone mapping: the scene's defaults, overridden by the command line. */
     im->tm = sc.tonemap;
     if (a->exposure_set)

@@ -26,6 +26,7 @@
 #include "monitor.h"
 #include "output.h"
 #include "progress.h"
+#include "protocol.h"
 #include "reuse.h"
 #include "sched.h"
 #include "tonemap.h"
@@ -131,6 +132,7 @@ typedef struct {
                                   not owned), or NULL */
     char patch[4300];          /* set by frame_open: a scene patch from the frame before's scene, or "" */
     reuse_result reused;       /* set by frame_open with reuse: what reuse_compile did */
+    float mlt_norm[PROTO_MLT_DEPTHS]; /* --integrator mlt: the normalisation every worker gets (spec.mlt_norm) */
 } frame_image;
 
 /** What a pass to spp samples per pixel renders: the rows the job

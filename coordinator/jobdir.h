@@ -39,6 +39,9 @@ typedef struct {
     uint32_t integrator;       /**< FR_INTEGRATOR_* (scene.h): bidirectional partials carry splats */
     float noise_threshold;     /**< adaptive sampling threshold the workers render with (pathtrace.h); 0 = off */
     uint32_t passes;           /**< render passes every slab carries (passes.h mask); 0 = none */
+    const float *mlt_norm;     /**< Metropolis light transport: b_d per depth, computed once for the render and
+                                    handed to every worker (mlt_depths entries, not owned); NULL = none */
+    uint32_t mlt_depths;
 } job_spec;
 
 /** job_open's status for a job directory it will not use. */

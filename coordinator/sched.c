@@ -422,7 +422,8 @@ static int start(sched *s, int host_i, int slab_i, fr_error *err)
     const sched_frame *f = &s->frames[sl->frame].f;
     const job_spec *sp = &f->spec;
     proto_slab req = {scene_on(s, host_i, sl), sl->y0, sl->y1, sp->width, sp->height, sp->spp, IMG_PF, "-",
-                      s->p->lifeline, 1 + (int)sp->integrator, sp->noise_threshold, f->sums, NULL, sp->passes};
+                      s->p->lifeline, 1 + (int)sp->integrator, sp->noise_threshold, f->sums, NULL, sp->passes,
+                      sp->mlt_norm, sp->mlt_depths};
     const char *cont = cont_file(s, sl);
     char remote[1400];
     int sent = 0;

@@ -4,7 +4,9 @@
 # Metropolis light transport through the band renderer: row y of the image
 # stands for chain y, so a slab is a range of chains whose splats cover the
 # whole image.  The stitched image is byte-identical for any slab height,
-# any number of worker processes, local or over fake SSH hosts; a resumed
+# any number of worker processes, local or over fake SSH hosts; the
+# normalisation is computed once, by the coordinator, and handed to every
+# worker (one left to compute it gets the same bits); a resumed
 # job renders only the lost chains, to the same bytes; franja stitch adds
 # a kept job's splats; what MLT cannot do is refused with the reason.
 . "$(dirname "$0")/support/fakehosts.sh"
@@ -51,6 +53,20 @@ rm -f kj/rows-00007-00014.pf
 "$FRANJA" render scene.fbin -o keep2.pfm $SIZE $M -j 2 --slab-rows 2 --job kj --resume --keep-job 2>logk
 check "a resume with 2-row slabs renders only the lost chains" grep -q "; 4 slabs" logk
 check "and gives the bytes of the uninterrupted render" cmp -s keep2.pfm one.pfm
+check "the normalisation is computed once per render, not per slab" \
+    test "$(grep -c 'Metropolis normalisation: b = ' logk)" -eq 1
+
+# The coordinator hands its normalisation to every worker (--mlt-norm); a
+# worker without it computes the same bits itself, and one given other
+# numbers renders another image.
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M -o own.pf
+check "a worker's own normalisation gives the job's slab, byte for byte" cmp -s own.pf kj/rows-00000-00007.pf
+ones=3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $ones -o ones.pf
+check "a worker uses the normalisation it is given" sh -c "test -s ones.pf && ! cmp -s ones.pf own.pf"
+"$WORKER" --scene scene.fbin --rows 7:14 $SIZE $M --mlt-norm 3f800000 -o x.pf 2>e0
+check "a normalisation of the wrong number of depths is refused (status 2)" test $? -eq 2
+check "saying how many it expects" grep -q "1 values for mlt, expected 9" e0
 "$FRANJA" stitch kj -o st.pfm >/dev/null 2>logst
 check "franja stitch of a complete Metropolis job: the same bytes" cmp -s st.pfm one.pfm
 "$FRANJA" render scene.fbin -o other.pfm $SIZE --integrator bdpt -j 2 --job kj --resume 2>logo

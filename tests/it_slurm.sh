@@ -4,7 +4,8 @@
 # franja render --slurm and franja hosts check --slurm on a real Slurm
 # cluster of three nodes on this machine (tests/support/slurm_cluster.sh): renders
 # inside salloc and sbatch allocations are byte-identical to a one-process
-# render whatever the node count, render passes included; the scene is
+# render whatever the node count, render passes and Metropolis light
+# transport included; the scene is
 # broadcast once per node, found cached later and sent again when the cached copy is damaged; a
 # straggling node's slabs get second copies elsewhere; progress in a batch
 # job is a plain line every 10 s;
@@ -100,6 +101,12 @@ check "it lies in the nodes' cache under its content hash" \
     test "$(ls "$WD/scenes" | grep -Ec '^[0-9a-f]{16}\.fbin$')" -eq 1
 check "every node rendered rows" sh -c "for n in n1 n2 n3; do grep -Eq \"^  \$n +2 +[1-9]\" log3 || exit 1; done"
 check "no step is left after the render" no_leftovers
+
+# Metropolis light transport: the coordinator's normalisation reaches every
+# node's workers through srun (--mlt-norm), the chains the bytes of one process.
+"$FRANJA" render scene.fbin -o mref.pfm $SIZE --integrator mlt -j 1 2>/dev/null
+render logm -N3 -n6 "$FRANJA" render scene.fbin -o m3.pfm $SIZE --integrator mlt --slurm --workdir "$WD"
+check "a 3-node Metropolis render is byte-identical to one process ($(tail -n 2 logm))" cmp -s m3.pfm mref.pfm
 
 # An animation in one allocation: every frame equals its own render.  The
 # camera moves (so that frame 2 can travel as a patch of frame 1's scene).

@@ -24,17 +24,24 @@ static int reparse(const proto_argv *a, proto_request *r, fr_error *err)
 
 static void test_round_trip(void)
 {
+    /* Metropolis normalisations: zeros, a subnormal, the largest float. */
+    static const float norm[5] = {0.0f, 1e-40f, 0.00203f, 3.4028235e38f, 1.0f};
+    static float deep[PROTO_MLT_DEPTHS];
+    for (uint32_t d = 0; d < PROTO_MLT_DEPTHS; d++)
+        deep[d] = 1.0f / (float)(d + 1);
     const proto_slab cases[] = {
         /* lifeline, integrator (1 + FR_INTEGRATOR_*, 0 for the scene's), noise threshold, sums, continue */
-        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},
-        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH, 0.0123f, 0, NULL, 0},
+        {"scenes/a.fbin", 0, 1, 1, 1, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},
+        {"/x y/'quoted'.fbin", 17, 4096, 640, 4096, 64, IMG_PPM16, "out.ppm", 0, 1 + FR_INTEGRATOR_PATH, 0.0123f, 0, NULL, 0, NULL, 0},
         {"s.fbin", PROTO_MAX_SIZE - 1, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SIZE, PROTO_MAX_SPP, IMG_PPM8, "-", 0,
-         1 + FR_INTEGRATOR_BDPT, 1.0f, 0, NULL, 0},
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0}, /* the scene's size, samples, integrator, threshold */
-        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2, 0.05f, 0, NULL, 0}, /* --lifeline, --integrator bdpt, a threshold */
-        {"s.fbin", 3, 9, 0, 0, 20, IMG_PF, "-", 1, 0, 0.0f, 1, "job dir/rows-3-9.pf", 0}, /* --sums, --continue */
-        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, PASS_ALL},                /* --passes, every one */
-        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 1u << PASS_NORMAL | 1u << PASS_MATERIAL_ID},
+         1 + FR_INTEGRATOR_BDPT, 1.0f, 0, NULL, 0, NULL, 0},
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0}, /* the scene's size, samples, integrator, threshold */
+        {"s.fbin", 3, 9, 0, 0, 0, IMG_PF, "-", 1, 2, 0.05f, 0, NULL, 0, NULL, 0}, /* --lifeline, --integrator bdpt, a threshold */
+        {"s.fbin", 3, 9, 0, 0, 20, IMG_PF, "-", 1, 0, 0.0f, 1, "job dir/rows-3-9.pf", 0, NULL, 0}, /* --sums, --continue */
+        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, PASS_ALL, NULL, 0},                /* --passes, every one */
+        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 1u << PASS_NORMAL | 1u << PASS_MATERIAL_ID, NULL, 0},
+        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 3, 0.0f, 0, NULL, 0, norm, 5},         /* --mlt-norm */
+        {"s.fbin", 0, 4, 0, 0, 0, IMG_PF, "-", 0, 3, 0.0f, 0, NULL, 0, deep, PROTO_MLT_DEPTHS}, /* the most depths */
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         const proto_slab *s = &cases[k];
@@ -66,22 +73,29 @@ static void test_round_trip(void)
                                                          : !r.slab.continue_from),
               "case %zu: sums %d, continue %s", k, r.slab.sums, r.slab.continue_from ? r.slab.continue_from : "-");
         CHECK(r.slab.passes == s->passes, "case %zu: passes %#x, expected %#x", k, r.slab.passes, s->passes);
+        CHECK(r.slab.mlt_depths == s->mlt_depths && !r.slab.mlt_norm == !s->mlt_norm &&
+                  (!s->mlt_norm || !memcmp(r.slab.mlt_norm, s->mlt_norm, s->mlt_depths * sizeof *s->mlt_norm)),
+              "case %zu: Metropolis normalisation of %u depths, expected the same bits of %u", k, r.slab.mlt_depths,
+              s->mlt_depths);
     }
 }
 
 static void test_build_refuses(void)
 {
+    static const float one[PROTO_MLT_DEPTHS + 1] = {1.0f};
     const proto_slab bad[] = {
-        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                     /* empty rows */
-        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                     /* rows past the height */
-        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},    /* too wide */
-        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},     /* too many samples */
-        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                     /* half a size */
-        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0},                    /* no scene */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS, 0.0f, 0, NULL, 0},   /* no such integrator */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1, 0.0f, 0, NULL, 0},                   /* no such integrator */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 1.5f, 0, NULL, 0},                     /* threshold above 1 */
-        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, -0.5f, 0, NULL, 0},                    /* negative threshold */
+        {"s", 5, 5, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},                     /* empty rows */
+        {"s", 0, 9, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},                     /* rows past the height */
+        {"s", 0, 1, PROTO_MAX_SIZE + 1, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},    /* too wide */
+        {"s", 0, 1, 8, 8, PROTO_MAX_SPP + 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},     /* too many samples */
+        {"s", 0, 1, 8, 0, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},                     /* half a size */
+        {NULL, 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 0.0f, 0, NULL, 0, NULL, 0},                    /* no scene */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 1 + FR_INTEGRATORS, 0.0f, 0, NULL, 0, NULL, 0},   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, -1, 0.0f, 0, NULL, 0, NULL, 0},                   /* no such integrator */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, 1.5f, 0, NULL, 0, NULL, 0},                     /* threshold above 1 */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 0, -0.5f, 0, NULL, 0, NULL, 0},                    /* negative threshold */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 3, 0.0f, 0, NULL, 0, one, 0},                     /* no depths */
+        {"s", 0, 1, 8, 8, 1, IMG_PF, "-", 0, 3, 0.0f, 0, NULL, 0, one, PROTO_MLT_DEPTHS + 1},  /* too many */
     };
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
         proto_argv a;
@@ -114,6 +128,15 @@ static void test_parse_errors(void)
         {{"--scene", "s", "--rows", "0:1", "--noise-treshold", "0.1"}, "(did you mean --noise-threshold?"},
         {{"--scene", "s", "--rows", "0:1", "--resume"}, "'--resume' (see --help)"},
         {{"--scene", "s", "--rows", "0:1", "stray"}, "unknown argument 'stray' (see --help)"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", ""}, "--mlt-norm: byte 0: expected a hex digit"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "3f80000"}, "--mlt-norm: byte 7: expected a hex digit"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "3F800000"}, "--mlt-norm: byte 1: expected a hex digit"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "3f800000;0"}, "--mlt-norm: byte 8: expected ',' or the end"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "3f800000,"}, "--mlt-norm: byte 9: expected a hex digit"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "00000000,bf800000"}, "--mlt-norm: byte 9: not a finite"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "7fc00000"}, "--mlt-norm: byte 0: not a finite value"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm", "7f800000"}, "--mlt-norm: byte 0: not a finite value"},
+        {{"--scene", "s", "--rows", "0:1", "--mlt-norm"}, "--mlt-norm needs a value"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char *argv[10] = {"franja-worker"};
@@ -132,6 +155,13 @@ static void test_parse_errors(void)
     CHECK(proto_parse_args(4, check, &r, &err) == 0 && r.mode == PROTO_CHECK && !r.have_rows, "--check not parsed");
     char *ver[] = {"franja-worker", "--bogus", "--version"};
     CHECK(proto_parse_args(3, ver, &r, &err) < 0, "an unknown option before --version was accepted");
+    /* One value more than PROTO_MLT_DEPTHS: refused at the value past the last. */
+    static char many[(PROTO_MLT_DEPTHS + 1) * 9];
+    for (uint32_t d = 0; d <= PROTO_MLT_DEPTHS; d++)
+        memcpy(many + 9 * d, d < PROTO_MLT_DEPTHS ? "3f800000," : "3f800000", 9);
+    char *toomany[] = {"franja-worker", "--scene", "s", "--rows", "0:1", "--mlt-norm", many};
+    CHECK(proto_parse_args(7, toomany, &r, &err) < 0 && strstr(err.msg, "byte 1152: more than 128 values"),
+          "%u + 1 normalisation values: '%s'", PROTO_MLT_DEPTHS, err.msg);
     char *ver2[] = {"franja-worker", "--version", "--bogus"};
     CHECK(proto_parse_args(3, ver2, &r, &err) == 0 && r.mode == PROTO_VERSION, "--version first is not answered");
 }

@@ -31,6 +31,7 @@ static const char usage[] =
     "usage: franja-worker --scene FILE --rows Y0:Y1 [--spp N] [--size WxH]\n"
     "                     [--integrator path|bdpt|mlt] [--noise-threshold E] [--format pf|ppm16|ppm8]\n"
     "                     [-o FILE|-] [--lifeline] [--sums] [--continue FILE] [--passes LIST]\n"
+    "                     [--mlt-norm LIST]\n"
     "       franja-worker --scene FILE --check\n"
     "       franja-worker --unpack FILE --scene FILE\n"
     "       franja-worker --features\n"
@@ -47,6 +48,10 @@ static const char usage[] =
     "  --size WxH     image size (default: the scene's)\n"
     "  --integrator I path, bdpt or mlt (default: the scene's); mlt renders\n"
     "                 chain y for row y (Metropolis chains splat anywhere)\n"
+    "  --mlt-norm LIST  mlt's normalisation, b per path depth (max_depth + 1 floats\n"
+    "                 as 8 hex digits of their bits, comma-separated), computed\n"
+    "                 once for the whole render by franja; without it the worker\n"
+    "                 computes the same itself\n"
     "  --format F     pf, ppm16 or ppm8 (default pf)\n"
     "  -o FILE        output file, or - for standard output (default -)\n"
     "  --check        validate the scene and print its content hash\n"
@@ -191,6 +196,13 @@ int main(int argc, char **argv)
         scn_free(&scene);
         return sl->integrator ? 2 : 1;
     }
+    if (sl->mlt_norm && (!mlt || sl->mlt_depths != scene.settings.max_depth + 1)) {
+        fprintf(stderr, "franja-worker: --mlt-norm: %u values for %s, expected %u (max_depth + 1) with the mlt "
+                        "integrator\n", sl->mlt_depths, mlt ? "mlt" : "another integrator than mlt",
+                scene.settings.max_depth + 1);
+        scn_free(&scene);
+        return 2;
+    }
     if (bdpt && sl->format != IMG_PF && (y0 != 0 || y1 != height)) {
         fprintf(stderr, "franja-worker: --format %s with the %s integrator needs the whole image (--rows 0:%u): "
                         "%s adds light to every row; use --format pf for a slab\n",
@@ -242,9 +254,14 @@ int main(int argc, char **argv)
         return 2;
     }
     img_partial_info info = {scene.hash, y0, y1, spp, width, height, 0, 0, 0, 0, passes, 0};
+    /* The coordinator's normalisation (mlt_path.h), else the worker's own. */
+    mlt_boot norm = {0};
+    int norm_failed = sl->mlt_norm && mlt_boot_set(&norm, sl->mlt_norm, sl->mlt_depths, &err) < 0;
     if (bdpt) {
-        if ((mlt ? mlt_render_rows(&scene, y0, y1, rgb, splat, &err)
-                 : bd_render_rows_passes(&scene, y0, y1, rgb, splat, passes, pass, &err)) < 0) {
+        int failed = norm_failed || (mlt ? mlt_render_rows(&scene, sl->mlt_norm ? &norm : NULL, y0, y1, rgb, splat, &err)
+                                         : bd_render_rows_passes(&scene, y0, y1, rgb, splat, passes, pass, &err)) < 0;
+        mlt_boot_free(&norm);
+        if (failed) {
             fprintf(stderr, "franja-worker: %s\n", err.msg);
             free(rgb);
             free(splat);
