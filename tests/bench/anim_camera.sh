@@ -12,6 +12,8 @@
 # coordinator says: the frame's compile time (a full compile, or the
 # frame made of the frame before's sections: coordinator/reuse.h) and the
 # bytes it sent the host (the packed scene, or a patch: common/fpatch.h).
+# MOVE=instance keeps the camera still and keys instead the translation
+# of one of two instances of the knot (a rigid object moving).
 # Results: tests/bench/README.md, "A camera move through a large scene".
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 . "$ROOT/tests/support/fakehosts.sh"
@@ -23,12 +25,18 @@ FRAMES=${FRAMES:-3}
 make -s bin/franja bin/franja-worker bin/gen/genmesh >/dev/null || exit 1
 T=$FH
 bin/gen/genmesh knot --tris "$TRIS" -o "$T/knot.obj" >/dev/null || exit 1
-cat >"$T/move.json" <<'JSON'
+CAM='"position": { "keys": [[1, [0, 1, -3.4]], [24, [2.4, 1, -2.4]]] }'
+INST=''
+if [ "${MOVE:-camera}" = instance ]; then
+    CAM='"position": [0, 1, -3.4]'
+    INST=', "instances": [ { "translate": { "keys": [[1, [0, 0, 0]], [24, [1, 0, 0]]] } }, { "translate": [-1.5, 0, 1] } ]'
+fi
+cat >"$T/move.json" <<JSON
 { "image": { "width": 64, "height": 64, "spp": 1 },
-  "camera": { "position": { "keys": [[1, [0, 1, -3.4]], [24, [2.4, 1, -2.4]]] }, "target": [0, 0.3, 0], "fov": 34 },
+  "camera": { $CAM, "target": [0, 0.3, 0], "fov": 34 },
   "materials": { "gold": { "type": "phong", "diffuse": [0.4, 0.3, 0.1], "glossy": [0.4, 0.3, 0.1], "exponent": 40 } },
   "lights": [ { "type": "point", "position": [0, 4, -3], "intensity": [20, 20, 20] } ],
-  "shapes": [ { "type": "mesh", "file": "knot.obj", "material": "gold" } ] }
+  "shapes": [ { "type": "mesh", "file": "knot.obj", "material": "gold"$INST } ] }
 JSON
 machine
 times=""
