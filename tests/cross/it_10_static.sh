@@ -19,6 +19,17 @@ SA64="$ROOT/bin/static/arm64/franja-worker"
 # names the BVH walk the processor runs, which differs between them.
 VERSION=$("$ROOT/bin/franja-worker" --version | head -n 1)
 
+# alike TAG SCENE WHAT OPTS...: the static amd64 worker, and the arm64 one
+# under qemu, render SCENE with OPTS byte-identical to $T/TAG-ref.pf.
+alike() {
+    tag=$1 sc=$2 what=$3
+    shift 3
+    "$S64" --scene "$sc" "$@" -o "$T/$tag-s64.pf"
+    check "amd64 static $what is byte-identical" cmp "$T/$tag-s64.pf" "$T/$tag-ref.pf"
+    "$QEMU" "$SA64" --scene "$sc" "$@" -o "$T/$tag-sa64.pf"
+    check "arm64 static $what under qemu is byte-identical" cmp "$T/$tag-sa64.pf" "$T/$tag-ref.pf"
+}
+
 cross_refs "$T"
 
 check "amd64 static worker built" test -x "$S64"
@@ -48,20 +59,14 @@ check "arm64 static worker validates the scene to the same hash" \
 BD="--rows 10:14 --spp 2 --size 32x32 --integrator bdpt"
 "$ROOT/bin/franja-worker" --scene "$T/spheres.fbin" $BD -o "$T/bd-ref.pf"
 check "reference bidirectional slab carries splats" grep -q "splat=" "$T/bd-ref.pf"
-"$S64" --scene "$T/spheres.fbin" $BD -o "$T/bd-s64.pf"
-check "amd64 static bidirectional slab is byte-identical" cmp "$T/bd-s64.pf" "$T/bd-ref.pf"
-"$QEMU" "$SA64" --scene "$T/spheres.fbin" $BD -o "$T/bd-sa64.pf"
-check "arm64 static bidirectional slab under qemu is byte-identical" cmp "$T/bd-sa64.pf" "$T/bd-ref.pf"
+alike bd "$T/spheres.fbin" "bidirectional slab" $BD
 
 # Instances: the mesh walked in object space, normals back by the inverse.
 "$ROOT/bin/franja" compile "$ROOT/tests/fuzz/corpus/fbin/instances.json" -o "$T/inst.fbin" >/dev/null 2>&1
 IN="--rows 0:12 --spp 8 --size 32x24"
 "$ROOT/bin/franja-worker" --scene "$T/inst.fbin" $IN -o "$T/in-ref.pf"
 check "instanced scene renders" test -s "$T/in-ref.pf"
-"$S64" --scene "$T/inst.fbin" $IN -o "$T/in-s64.pf"
-check "amd64 static instanced slab is byte-identical" cmp "$T/in-s64.pf" "$T/in-ref.pf"
-"$QEMU" "$SA64" --scene "$T/inst.fbin" $IN -o "$T/in-sa64.pf"
-check "arm64 static instanced slab under qemu is byte-identical" cmp "$T/in-sa64.pf" "$T/in-ref.pf"
+alike in "$T/inst.fbin" "instanced slab" $IN
 # Moving instances (motion blur): the fuzz seed moving.json, two of the
 # placements above sliding, turning and growing across the shutter.
 MJ="$ROOT/tests/fuzz/corpus/fbin/moving.json"
@@ -72,18 +77,11 @@ MV="--rows 0:12 --spp 8 --size 32x24"
 "$ROOT/bin/franja-worker" --scene "$T/st.1.pfm.franja-job/scene.fbin" $MV -o "$T/st-ref.pf"
 check "moving instances render, blurred" test -s "$T/mv-ref.pf" -a -s "$T/st-ref.pf"
 check "the blurred slab is not the still one" sh -c "! cmp -s '$T/mv-ref.pf' '$T/st-ref.pf'"
-"$S64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-s64.pf"
-check "amd64 static slab of moving instances is byte-identical" cmp "$T/mv-s64.pf" "$T/mv-ref.pf"
-"$QEMU" "$SA64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MV -o "$T/mv-sa64.pf"
-check "arm64 static slab of moving instances under qemu is byte-identical" cmp "$T/mv-sa64.pf" "$T/mv-ref.pf"
+alike mv "$T/mv.1.pfm.franja-job/scene.fbin" "slab of moving instances" $MV
 # and bidirectionally (light subpaths and connections at each sample's time)
 MB="$MV --integrator bdpt"
 "$ROOT/bin/franja-worker" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MB -o "$T/mb-ref.pf"
-"$S64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MB -o "$T/mb-s64.pf"
-check "amd64 static bidirectional slab of moving instances is byte-identical" cmp "$T/mb-s64.pf" "$T/mb-ref.pf"
-"$QEMU" "$SA64" --scene "$T/mv.1.pfm.franja-job/scene.fbin" $MB -o "$T/mb-sa64.pf"
-check "arm64 static bidirectional slab of moving instances under qemu is byte-identical" \
-    cmp "$T/mb-sa64.pf" "$T/mb-ref.pf"
+alike mb "$T/mv.1.pfm.franja-job/scene.fbin" "bidirectional slab of moving instances" $MB
 # Textures at their own precision and mip levels: 8-bit sRGB images read
 # through the table and filtered across mip levels (the brick wall spans
 # several texels a pixel at 64x64), and an HDR sky stored as halves.
