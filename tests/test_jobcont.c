@@ -67,7 +67,7 @@ int main(void)
         perror("mkdtemp");
         return 1;
     }
-    job_spec sp = {0x1234abcdULL, W, H, 8, 0, 0.0f, 0};
+    job_spec sp = {0x1234abcdULL, W, H, 8, 0, 0.0f, 0, NULL, 0};
     fr_error err;
     CHECK(job_sums(&sp), "path tracing without a threshold keeps sums");
     CHECK(job_open(dir, &sp, 0, &err) == 0, "job_open: %s", err.msg);
