@@ -180,21 +180,53 @@ int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err)
     *spp = 0;
     if (lo >= ps->cap)
         return 0;
-    if (!job_sums(&ps->spec))
-        lo = hi = ps->reached; /* slabs with render passes: each pass renders from the first sample */
+    if (!job_sums(&ps->spec)) {
+        /* Slabs with render passes and Metropolis chains: each pass
+         * renders from the first sample (first, at most ps->first). */
+        lo = ps->reached;
+        hi = ps->reached ? ps->reached : ps->first;
+    }
     uint32_t twice = lo == 0 ? 1 : lo > ps->cap / 2 ? ps->cap : 2 * lo;
     *spp = twice > hi ? twice : hi;
     return 0;
 }
 
-/* The image of the pass just planned and complete into ps->rgb. */
+/* The image of the pass just planned and complete into ps->rgb.  A
+ * Metropolis pass's whole image makes the slabs of fewer mutations
+ * useless (a resume goes on from it): they go. */
 int frame_pass_image(frame_passes *ps, fr_error *err)
 {
     if (ps->crop_rows)
         return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->passes, ps->scratch, err);
-    return job_stitch_passes(ps->jobdir, &ps->spec, ps->rgb, ps->passes, &ps->a->tr.notes, err);
+    if (job_stitch_passes(ps->jobdir, &ps->spec, ps->rgb, ps->passes, &ps->a->tr.notes, err))
+        return -1;
+    if (ps->spec.integrator == FR_INTEGRATOR_MLT)
+        job_prune(ps->jobdir, &ps->spec);
+    return 0;
 }
 
+/* Metropolis, resumed (no sums: each pass renders every chain from its
+ * start): where the passes start.  *whole: the most mutations per pixel
+ * below ps->cap at which the job directory holds every chain (the image
+ * of the last complete pass), else 0; ps->first: the most it holds for a
+ * chain, which the first pass renders to when there is no such image (a
+ * pass's slab has the name of the last pass's of the same rows).  For a
+ * plan to ps->cap, which it leaves in ps->base. */
+static int kept_passes(frame_passes *ps, uint32_t *whole, fr_error *err)
+{
+    *whole = 0;
+    if (job_scan(ps->jobdir, &ps->spec, ps->have, ps->base, &ps->a->tr.notes, err) < 0)
+        return -1;
+    uint32_t lo, hi;
+    kept_range(ps, &lo, &hi);
+    ps->first = hi;
+    if (lo == 0 || lo >= ps->cap)
+        return 0;
+    if (frame_plan(ps, lo, err))
+        return -1;
+    *whole = ps->rows_missing ? 0 : lo;
+    return 0;
+}
 
 /* Takes the image's job lock and checks what its job directory holds
  * against --resume and --fresh.  0, or the exit status (said). */
@@ -475,14 +507,19 @@ int frame_open(frame_image *im)
         ps->deadline = im->t0 + a->time_limit;
         /* A complete image kept at one sample count is where the passes
          * start, and what is written if the first of them does not end. */
-        if (lo == hi && lo > 0 && lo < spec.spp) {
-            if (frame_plan(ps, lo, &err) || frame_pass_image(ps, &err)) {
+        uint32_t from = lo == hi && lo > 0 && lo < spec.spp ? lo : 0;
+        if (mlt && kept_passes(ps, &from, &err)) {
+            fprintf(stderr, "franja render: %s\n", err.msg);
+            return 1;
+        }
+        if (from) {
+            if (frame_plan(ps, from, &err) || frame_pass_image(ps, &err)) {
                 fprintf(stderr, "franja render: %s\n", err.msg);
                 return 1;
             }
-            ps->reached = lo;
+            ps->reached = from;
             fprintf(stderr, "franja: the job holds a whole image with %u samples per pixel; passes go on from it\n",
-                    lo);
+                    from);
             if (frame_plan(ps, spec.spp, &err)) {
                 fprintf(stderr, "franja render: %s\n", err.msg);
                 return 1;

@@ -97,6 +97,8 @@ typedef struct {
     float *passes;             /* --time-limit: its render passes (the frame_image's), or NULL */
     unsigned char *scratch;    /* height bytes */
     uint32_t reached;          /* the samples per pixel of rgb; 0 = none yet */
+    uint32_t first;            /* no sums, no rgb yet: the samples of the first pass, when more than 1
+                                  (Metropolis, resumed: the most kept for a chain); else 0 */
     int npass;                 /* passes run */
     uint32_t stopped;          /* the samples per pixel of the pass the limit stopped; 0 = none */
     sched_stats total;         /* over the frame_passes */

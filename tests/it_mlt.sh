@@ -43,7 +43,7 @@ done
 # --time-limit: passes of 1, 2, 4, 8 mutations per pixel, each the render
 # of its mutations with their own normalisation; the last complete pass is
 # written.  A pass that must not end is held by a worker that never
-# answers, so nothing depends on how fast the machine is.
+# answers its last chains, so nothing depends on how fast the machine is.
 "$FRANJA" render scene.fbin -o t8.pfm $SIZE $M -j 2 --time-limit 1h 2>logt8
 check "--time-limit with room for every pass: passes of 1, 2, 4 and 8 mutations" \
     sh -c "sed -n 's/.*pass [0-9]* done: \([0-9]*\) samples.*/\1/p' logt8 | tr '\n' ' ' | grep -qx '1 2 4 8 '"
@@ -52,11 +52,13 @@ fr render scene.fbin -o t8s.pfm --hosts hosts $SIZE $M --slab-rows 4 --time-limi
 check "the same bytes over 2 SSH hosts" cmp -s t8s.pfm one.pfm
 cat >stuck.sh <<SH
 #!/bin/sh
-prev=
+prev= spp=0 rows=
 for a in "\$@"; do
-    if [ "\$prev" = --spp ] && [ "\$a" -ge 4 ]; then exec sleep 7$$; fi
+    [ "\$prev" = --spp ] && spp=\$a
+    [ "\$prev" = --rows ] && rows=\$a
     prev=\$a
 done
+if [ "\$spp" -ge 4 ] && [ "\$rows" = 14:21 ]; then exec sleep 7$$; fi
 exec "$WORKER" "\$@"
 SH
 chmod +x stuck.sh
@@ -79,11 +81,25 @@ near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { exit !(a > 0 && b > 0 && a /
 check "the stopped render's mean luminance $(lum ts.pfm) is the whole render's $(lum one.pfm) (0.1 %)" \
     near "$(lum ts.pfm)" "$(lum one.pfm)" 0.001
 check "and path tracing's $(lum pt.pfm) within 5 %" near "$(lum ts.pfm)" "$(lum pt.pfm)" 0.05
-# Resumed with other slabs, the job holds passes of two sample counts
-# side by side: each pass's image is stitched from its own slabs only.
+# A complete pass makes the slabs of fewer mutations useless, and the
+# chains of the stopped pass that ended stay: resumed, the first pass
+# renders only the chains it lacks (with other slabs: the job then holds
+# passes of two sample counts side by side, and each pass's image is
+# stitched from its own slabs only).
+check "the stopped job keeps no slab of fewer than ${N:-0} mutations" \
+    sh -c "for f in tj/rows-*.pf; do head -n 2 \$f | grep -Eq ' spp=(${N:-0}|$((2 * ${N:-0}))) ' || exit 1; done"
+R=0 # chains kept of the stopped pass
+for f in tj/rows-*.pf; do
+    rows=$(head -n 2 "$f" | sed -n "s/.* rows=\([0-9]*\):\([0-9]*\) spp=$((2 * ${N:-0})) .*/\2 - \1/p")
+    R=$((R + ${rows:-0}))
+done
 "$FRANJA" render scene.fbin -o tr.pfm $SIZE $M -j 2 --slab-rows 3 --time-limit 1h --job tj --resume 2>logtr
-check "a stopped job resumed to the end gives the bytes of 8 at once" cmp -s tr.pfm one.pfm
-check "its passes stitched without a discarded slab" sh -c "grep -q 'pass 4 done' logtr && ! grep -q discarded logtr"
+check "the first renders the $((H - R)) chains the stopped pass left" \
+    grep -q "pass 1: $((2 * ${N:-0})) samples per pixel, $((H - R)) rows to render" logtr
+check "to 8, the passes of 1 not rendered again" sh -c "grep -q 'pass [0-9]* done: 8 samples' logtr &&
+    ! grep -q 'pass [0-9]*: 1 samples' logtr"
+check "the bytes of 8 at once" cmp -s tr.pfm one.pfm
+check "no slab discarded" sh -c "! grep -q discarded logtr"
 
 # The partial image: its rows (black: all light is splatted), then the
 # splats of its chains over the whole image.
