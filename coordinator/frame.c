@@ -210,8 +210,8 @@ int frame_pass_image(frame_passes *ps, fr_error *err)
  * below ps->cap at which the job directory holds every chain (the image
  * of the last complete pass), else 0; ps->first: the most it holds for a
  * chain, which the first pass renders to when there is no such image (a
- * pass's slab has the name of the last pass's of the same rows).  For a
- * plan to ps->cap, which it leaves in ps->base. */
+ * pass's slab has the name of the last pass's of the same rows).  From a
+ * plan to ps->cap, and leaves one. */
 static int kept_passes(frame_passes *ps, uint32_t *whole, fr_error *err)
 {
     *whole = 0;
@@ -225,7 +225,7 @@ static int kept_passes(frame_passes *ps, uint32_t *whole, fr_error *err)
     if (frame_plan(ps, lo, err))
         return -1;
     *whole = ps->rows_missing ? 0 : lo;
-    return 0;
+    return frame_plan(ps, ps->cap, err);
 }
 
 /* Takes the image's job lock and checks what its job directory holds
