@@ -180,21 +180,53 @@ int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err)
     *spp = 0;
     if (lo >= ps->cap)
         return 0;
-    if (!job_sums(&ps->spec))
-        lo = hi = ps->reached; /* slabs with render passes: each pass renders from the first sample */
+    if (!job_sums(&ps->spec)) {
+        /* Slabs with render passes and Metropolis chains: each pass
+         * renders from the first sample (first, at most ps->first). */
+        lo = ps->reached;
+        hi = ps->reached ? ps->reached : ps->first;
+    }
     uint32_t twice = lo == 0 ? 1 : lo > ps->cap / 2 ? ps->cap : 2 * lo;
     *spp = twice > hi ? twice : hi;
     return 0;
 }
 
-/* The image of the pass just planned and complete into ps->rgb. */
+/* The image of the pass just planned and complete into ps->rgb.  A
+ * Metropolis pass's whole image makes the slabs of fewer mutations
+ * useless (a resume goes on from it): they go. */
 int frame_pass_image(frame_passes *ps, fr_error *err)
 {
     if (ps->crop_rows)
         return crop_stitch(ps->jobdir, &ps->spec, &ps->a->win, ps->rgb, ps->passes, ps->scratch, err);
-    return job_stitch_passes(ps->jobdir, &ps->spec, ps->rgb, ps->passes, &ps->a->tr.notes, err);
+    if (job_stitch_passes(ps->jobdir, &ps->spec, ps->rgb, ps->passes, &ps->a->tr.notes, err))
+        return -1;
+    if (ps->spec.integrator == FR_INTEGRATOR_MLT)
+        job_prune(ps->jobdir, &ps->spec);
+    return 0;
 }
 
+/* Metropolis, resumed (no sums: each pass renders every chain from its
+ * start): where the passes start.  *whole: the most mutations per pixel
+ * below ps->cap at which the job directory holds every chain (the image
+ * of the last complete pass), else 0; ps->first: the most it holds for a
+ * chain, which the first pass renders to when there is no such image (a
+ * pass's slab has the name of the last pass's of the same rows).  From a
+ * plan to ps->cap, and leaves one. */
+static int kept_passes(frame_passes *ps, uint32_t *whole, fr_error *err)
+{
+    *whole = 0;
+    if (job_scan(ps->jobdir, &ps->spec, ps->have, ps->base, &ps->a->tr.notes, err) < 0)
+        return -1;
+    uint32_t lo, hi;
+    kept_range(ps, &lo, &hi);
+    ps->first = hi;
+    if (lo == 0 || lo >= ps->cap)
+        return 0;
+    if (frame_plan(ps, lo, err))
+        return -1;
+    *whole = ps->rows_missing ? 0 : lo;
+    return frame_plan(ps, ps->cap, err);
+}
 
 /* Takes the image's job lock and checks what its job directory holds
  * against --resume and --fresh.  0, or the exit status (said). */
@@ -254,14 +286,12 @@ int frame_lock(frame_image *im)
     return 0;
 }
 
-/* Gets the image's scene (compiled into its job directory when needed),
- * works out what to render and opens the job directory: the rows it
- * holds, the passes of --time-limit.  0, or the exit status (said). */
-/* Metropolis light transport's normalisation (mlt_path.h), once for the
- * render at its image size and samples: into im->mlt_norm, handed to every worker by
- * spec.  A scene deeper than the command line carries leaves it to each
- * worker (the same numbers, computed per slab). */
-static int normalise(frame_image *im, fr_scene *sc, job_spec *spec, fr_error *err)
+/* Metropolis light transport's normalisation (mlt_path.h) for spec's
+ * image size and samples (mlt_norm_samples of them): into norm (at least
+ * PROTO_MLT_DEPTHS floats), handed to every worker by spec.  A scene
+ * deeper than the command line carries leaves it to each worker (the same
+ * numbers, computed per slab) and spec without it. */
+static int normalise(fr_scene *sc, job_spec *spec, float *norm, fr_error *err)
 {
     sc->settings.width = spec->width;
     sc->settings.height = spec->height;
@@ -277,15 +307,34 @@ static int normalise(frame_image *im, fr_scene *sc, job_spec *spec, fr_error *er
     if (mlt_bootstrap(sc, n, &bt, err))
         return -1;
     for (uint32_t d = 0; d < nd; d++)
-        im->mlt_norm[d] = (float)bt.bd[d];
+        norm[d] = (float)bt.bd[d];
     fprintf(stderr, "franja: Metropolis normalisation: b = %.6g from %u bidirectional samples (%.1f s)\n", bt.b, n,
             clock_now() - t0);
     mlt_boot_free(&bt);
-    spec->mlt_norm = im->mlt_norm;
+    spec->mlt_norm = norm;
     spec->mlt_depths = nd;
     return 0;
 }
 
+int frame_normalise(frame_passes *ps, fr_error *err)
+{
+    if (!ps->mlt_scene)
+        return 0;
+    ps->mlt_scene->settings.width = ps->spec.width;
+    ps->mlt_scene->settings.height = ps->spec.height;
+    ps->mlt_scene->settings.spp = ps->spec.spp;
+    uint32_t n = mlt_norm_samples(ps->mlt_scene);
+    if (n == ps->mlt_samples)
+        return 0;              /* the same samples give the same numbers */
+    if (normalise(ps->mlt_scene, &ps->spec, ps->mlt_norm, err))
+        return -1;
+    ps->mlt_samples = n;
+    return 0;
+}
+
+/* Gets the image's scene (compiled into its job directory when needed),
+ * works out what to render and opens the job directory: the rows it
+ * holds, the passes of --time-limit.  0, or the exit status (said). */
 int frame_open(frame_image *im)
 {
     frame_settings *a = &im->a;
@@ -339,14 +388,13 @@ int frame_open(frame_image *im)
         fprintf(stderr, "franja render: %s: %s: %s\n", a->scene,
                 mlt ? "Metropolis light transport" : "bidirectional path tracing", err.msg);
         rc = a->integrator ? 2 : 1;
-    } else if (!rc && a->time_limit > 0 && !job_sums(&spec) &&
+    } else if (!rc && a->time_limit > 0 && !job_sums(&spec) && !mlt &&
                !(spec.passes && spec.integrator == FR_INTEGRATOR_PATH)) {
         fprintf(stderr, "franja render: --time-limit: its passes add samples to each pixel's kept sample sums, which "
                 "only path tracing without adaptive sampling keeps (this render %s)\n",
                 spec.integrator == FR_INTEGRATOR_BDPT ? "is bidirectional"
-                : mlt                                   ? "is Metropolis light transport"
-                : a->noise_threshold > 0.0f       ? "has --noise-threshold"
-                                                  : "has the scene's noise_threshold");
+                : a->noise_threshold > 0.0f             ? "has --noise-threshold"
+                                                        : "has the scene's noise_threshold");
         rc = 2;
     } else if (!rc && a->crop && crop_check(&a->win, spec.width, spec.height, &err)) {
         fprintf(stderr, "franja render: --crop %s\n", err.msg);
@@ -368,7 +416,18 @@ int frame_open(frame_image *im)
     uint32_t asked = spec.spp;
     if (quick_spp(&spec.spp, &err) > 0)
         fprintf(stderr, "franja render: %s: %u samples per pixel instead of %u\n", QUICK_ENV, spec.spp, asked);
-    if (mlt && normalise(im, &sc, &spec, &err)) {
+    /* --time-limit: each pass's own normalisation (frame_normalise), from
+     * the scene kept until the render ends; else the render's, now. */
+    int per_pass = mlt && a->time_limit > 0 && sc.settings.max_depth < PROTO_MLT_DEPTHS;
+    fr_scene *keep = per_pass ? malloc(sizeof *keep) : NULL;
+    if (per_pass && !keep) {
+        fprintf(stderr, "franja render: out of memory for the scene\n");
+        scn_free(&sc);
+        return 1;
+    } else if (per_pass) {
+        spec.mlt_norm = im->mlt_norm;
+        spec.mlt_depths = sc.settings.max_depth + 1;
+    } else if (mlt && normalise(&sc, &spec, im->mlt_norm, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         scn_free(&sc);
         return 1;
@@ -388,7 +447,10 @@ int frame_open(frame_image *im)
         memcpy(im->obj_names, sc.object_names, (im->n_obj_names = sc.n_object_names) * sizeof *im->obj_names);
     if (spec.passes && sc.n_group_names && (im->group_names = malloc(sc.n_group_names * sizeof *im->group_names)))
         memcpy(im->group_names, sc.group_names, (im->n_group_names = sc.n_group_names) * sizeof *im->group_names);
-    scn_free(&sc);
+    if (keep)
+        *keep = sc;            /* the scene moves: its arrays stay where they are */
+    else
+        scn_free(&sc);
     im->spec = spec;
     if ((spec.passes & (1u << PASS_CRYPTO_MATERIAL | 1u << PASS_CRYPTO_OBJECT)) && !out_has_ext(a->out, "exr"))
         fprintf(stderr, "franja render: warning: crypto_material and crypto_object are written to .exr outputs "
@@ -399,7 +461,8 @@ int frame_open(frame_image *im)
     im->rgb = calloc((size_t)spec.width * spec.height * 3, sizeof *im->rgb);
     frame_passes *ps = &im->ps;
     *ps = (frame_passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
-                   .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL};
+                   .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL,
+                   .mlt_scene = keep, .mlt_norm = im->mlt_norm};
     /* --time-limit keeps the passes of its last complete pass beside rgb. */
     if (spec.passes && a->time_limit > 0)
         im->passes = ps->passes = calloc((size_t)spec.width * spec.height * pass_channels(spec.passes),
@@ -444,14 +507,19 @@ int frame_open(frame_image *im)
         ps->deadline = im->t0 + a->time_limit;
         /* A complete image kept at one sample count is where the passes
          * start, and what is written if the first of them does not end. */
-        if (lo == hi && lo > 0 && lo < spec.spp) {
-            if (frame_plan(ps, lo, &err) || frame_pass_image(ps, &err)) {
+        uint32_t from = lo == hi && lo > 0 && lo < spec.spp ? lo : 0;
+        if (mlt && kept_passes(ps, &from, &err)) {
+            fprintf(stderr, "franja render: %s\n", err.msg);
+            return 1;
+        }
+        if (from) {
+            if (frame_plan(ps, from, &err) || frame_pass_image(ps, &err)) {
                 fprintf(stderr, "franja render: %s\n", err.msg);
                 return 1;
             }
-            ps->reached = lo;
+            ps->reached = from;
             fprintf(stderr, "franja: the job holds a whole image with %u samples per pixel; passes go on from it\n",
-                    lo);
+                    from);
             if (frame_plan(ps, spec.spp, &err)) {
                 fprintf(stderr, "franja render: %s\n", err.msg);
                 return 1;
@@ -571,6 +639,9 @@ void frame_close(frame_image *im, int rc)
     free(im->mat_names);
     free(im->obj_names);
     free(im->group_names);
+    if (im->ps.mlt_scene)
+        scn_free(im->ps.mlt_scene);
+    free(im->ps.mlt_scene);
     free(im);
 }
 
@@ -589,4 +660,8 @@ void frame_shrink(frame_image *im)
     im->rgb = im->ps.rgb = NULL;
     im->ps.have = NULL;
     im->ps.base = NULL;
+    if (im->ps.mlt_scene)
+        scn_free(im->ps.mlt_scene);
+    free(im->ps.mlt_scene);
+    im->ps.mlt_scene = NULL;
 }

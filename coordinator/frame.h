@@ -28,6 +28,7 @@
 #include "progress.h"
 #include "protocol.h"
 #include "reuse.h"
+#include "scene.h"
 #include "sched.h"
 #include "tonemap.h"
 
@@ -77,7 +78,10 @@ typedef struct {
  * when the limit stops a pass, that image is written.  Slabs with render
  * passes keep no sums: each pass then renders its rows from the first
  * sample, to twice the samples of the last complete pass, and its passes
- * are kept in memory with its image. */
+ * are kept in memory with its image.  So do Metropolis light transport's
+ * (whose chains keep no state to go on from): each pass is the render of
+ * its samples (mutations) per pixel, its normalisation computed for them
+ * (frame_normalise), so its image is that of a render asked for them. */
 typedef struct {
     const frame_settings *a;
     const char *jobdir;
@@ -93,10 +97,16 @@ typedef struct {
     float *passes;             /* --time-limit: its render passes (the frame_image's), or NULL */
     unsigned char *scratch;    /* height bytes */
     uint32_t reached;          /* the samples per pixel of rgb; 0 = none yet */
+    uint32_t first;            /* no sums, no rgb yet: the samples of the first pass, when more than 1
+                                  (Metropolis, resumed: the most kept for a chain); else 0 */
     int npass;                 /* passes run */
     uint32_t stopped;          /* the samples per pixel of the pass the limit stopped; 0 = none */
     sched_stats total;         /* over the frame_passes */
     const char *label;         /* an animation's frame: "frame N"; NULL otherwise */
+    fr_scene *mlt_scene;       /* --time-limit with mlt: the scene each pass's normalisation is computed
+                                  from (owned by the frame_image), else NULL */
+    float *mlt_norm;           /* that normalisation, spec.mlt_norm (the frame_image's) */
+    uint32_t mlt_samples;      /* the bidirectional samples it was computed from; 0 = not yet */
 } frame_passes;
 
 /** One image of a render, from its job lock to its output: the render of
@@ -145,6 +155,14 @@ int frame_plan(frame_passes *ps, uint32_t spp, fr_error *err);
  * *spp, 0 when every needed row has the samples asked for.  -1 with err
  * when the job directory cannot be read. */
 int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err);
+
+/** Metropolis light transport with --time-limit: the normalisation of the
+ * pass just planned (ps->spec.spp) into ps->mlt_norm, as a render asked
+ * for its samples computes it (mlt_path.h), unless the one there was
+ * computed from the same number of bidirectional samples (the same
+ * numbers); nothing for another render.  -1 with err when out of
+ * memory. */
+int frame_normalise(frame_passes *ps, fr_error *err);
 
 /** The image of the pass just planned and complete into ps->rgb.  -1 with
  * err when a row is missing or unreadable. */

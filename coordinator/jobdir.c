@@ -248,6 +248,38 @@ int job_open(const char *dir, const job_spec *spec, int resume, fr_error *err)
     return file_write_atomic(path, want, strlen(want), err);
 }
 
+/* The slab files of a directory, for the bidirectional stitch. */
+typedef struct {
+    uint32_t y0, y1;
+    char name[64];
+} slab_file;
+
+typedef struct {
+    slab_file *v;
+    size_t n, cap;
+} slab_list;
+
+static int list_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
+{
+    (void)dir;
+    slab_list *l = vctx;
+    if (y0 >= y1 || strlen(name) >= sizeof l->v->name)
+        return 0;
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? l->cap * 2 : 64;
+        slab_file *v = realloc(l->v, cap * sizeof *v);
+        if (!v)
+            return -1;
+        l->v = v;
+        l->cap = cap;
+    }
+    l->v[l->n].y0 = y0;
+    l->v[l->n].y1 = y1;
+    snprintf(l->v[l->n].name, sizeof l->v[l->n].name, "%s", name);
+    l->n++;
+    return 0;
+}
+
 /* What a pass over the slab files does with each (scan_ctx.mode). */
 enum {
     SCAN,                      /* job_scan: rows at the render's samples; lower counts with sums as bases */
@@ -266,6 +298,8 @@ typedef struct {
     const note_sink *notes;
     int mode;
     int skipped;               /* GATHER: slab files that did not check out, kept */
+    slab_list *slabs;          /* STITCH: receives the slab files at the render's samples, or NULL */
+    int no_memory;             /* set when slabs could not grow */
 } scan_ctx;
 
 static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
@@ -354,13 +388,15 @@ static int scan_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
     }
     free(rows);
     free(prows);
+    if (c->mode == STITCH && c->slabs && list_one(dir, name, y0, y1, c->slabs))
+        return c->no_memory = -1;
     return 0;
 }
 
 int job_scan(const char *dir, const job_spec *spec, unsigned char *have, uint32_t *base, const note_sink *notes,
              fr_error *err)
 {
-    scan_ctx c = {spec, have, base, NULL, NULL, 0, notes, SCAN, 0};
+    scan_ctx c = {spec, have, base, NULL, NULL, 0, notes, SCAN, 0, NULL, 0};
     memset(have, 0, spec->height);
     if (base)
         memset(base, 0, spec->height * sizeof *base);
@@ -587,38 +623,6 @@ void job_missing_rows(const unsigned char *have, uint32_t height, char *out, siz
     }
 }
 
-/* The slab files of a directory, for the bidirectional stitch. */
-typedef struct {
-    uint32_t y0, y1;
-    char name[64];
-} slab_file;
-
-typedef struct {
-    slab_file *v;
-    size_t n, cap;
-} slab_list;
-
-static int list_one(const char *dir, const char *name, uint32_t y0, uint32_t y1, void *vctx)
-{
-    (void)dir;
-    slab_list *l = vctx;
-    if (y0 >= y1 || strlen(name) >= sizeof l->v->name)
-        return 0;
-    if (l->n == l->cap) {
-        size_t cap = l->cap ? l->cap * 2 : 64;
-        slab_file *v = realloc(l->v, cap * sizeof *v);
-        if (!v)
-            return -1;
-        l->v = v;
-        l->cap = cap;
-    }
-    l->v[l->n].y0 = y0;
-    l->v[l->n].y1 = y1;
-    snprintf(l->v[l->n].name, sizeof l->v[l->n].name, "%s", name);
-    l->n++;
-    return 0;
-}
-
 static int by_rows(const void *a, const void *b)
 {
     const slab_file *x = a, *y = b;
@@ -627,11 +631,12 @@ static int by_rows(const void *a, const void *b)
     return x->y1 < y->y1 ? -1 : x->y1 > y->y1;
 }
 
-/* Bidirectional: rows from a chain of slabs that splits [0, height) into
- * non-overlapping pieces, and every chosen slab's splats summed. */
-static int stitch_splats(const char *dir, const job_spec *spec, float *rgb, fr_error *err)
+/* Bidirectional: rows from a chain of the slabs l (those at the render's
+ * samples: a --time-limit job holds other passes' too) that splits
+ * [0, height) into non-overlapping pieces, and every chosen slab's splats
+ * summed. */
+static int stitch_splats(const char *dir, const job_spec *spec, slab_list l, float *rgb, fr_error *err)
 {
-    slab_list l = {NULL, 0, 0};
     int32_t *from = malloc(sizeof *from * ((size_t)spec->height + 1));
     uint64_t *sum = calloc((size_t)spec->width * spec->height * 3, sizeof *sum);
     int rc = -1;
@@ -639,8 +644,6 @@ static int stitch_splats(const char *dir, const job_spec *spec, float *rgb, fr_e
         fr_fail(err, "out of memory for the splats of a %ux%u image", spec->width, spec->height);
         goto out;
     }
-    if (each_slab(dir, list_one, &l, err))
-        goto out;
     /* Slabs in row order; from[y] is the slab that ends a chain from row 0
      * at row y (-1: none yet, -2: row 0 itself). */
     qsort(l.v, l.n, sizeof *l.v, by_rows);
@@ -682,7 +685,6 @@ static int stitch_splats(const char *dir, const job_spec *spec, float *rgb, fr_e
     spl_resolve(rgb, sum, spec->width, 0, spec->height, spec->spp);
     rc = 0;
 out:
-    free(l.v);
     free(from);
     free(sum);
     return rc;
@@ -699,16 +701,21 @@ int job_stitch_passes(const char *dir, const job_spec *spec, float *rgb, float *
     unsigned char *have = calloc(spec->height, 1);
     if (!have)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, NULL, fr_integrator_splats(spec->integrator) ? NULL : rgb, passes, 0, notes, STITCH, 0};
+    int splats = fr_integrator_splats(spec->integrator);
+    slab_list l = {NULL, 0, 0};
+    scan_ctx c = {spec, have, NULL, splats ? NULL : rgb, passes, 0, notes, STITCH, 0, splats ? &l : NULL, 0};
     int rc = each_slab(dir, scan_one, &c, err);
+    if (rc && c.no_memory)
+        rc = fr_fail(err, "%s: out of memory for the list of its slabs", dir);
     if (rc == 0 && (uint32_t)c.rows != spec->height) {
         char missing[300];
         job_missing_rows(have, spec->height, missing, sizeof missing);
         rc = fr_fail(err, "rows %s are missing from %s; the image was not written", missing, dir);
     }
     free(have);
-    if (rc == 0 && fr_integrator_splats(spec->integrator))
-        rc = stitch_splats(dir, spec, rgb, err);
+    if (rc == 0 && splats)
+        rc = stitch_splats(dir, spec, l, rgb, err);
+    free(l.v);
     return rc;
 }
 
@@ -724,7 +731,7 @@ int job_gather_passes(const char *dir, const job_spec *spec, float *rgb, float *
     uint32_t *best = calloc(spec->height, sizeof *best);
     if (!best)
         return fr_fail(err, "out of memory");
-    scan_ctx c = {spec, have, best, rgb, passes, 0, NULL, GATHER, 0};
+    scan_ctx c = {spec, have, best, rgb, passes, 0, NULL, GATHER, 0, NULL, 0};
     memset(have, 0, spec->height);
     int rc = each_slab(dir, scan_one, &c, err);
     free(best);

@@ -39,8 +39,9 @@ typedef struct {
     uint32_t integrator;       /**< FR_INTEGRATOR_* (scene.h): bidirectional partials carry splats */
     float noise_threshold;     /**< adaptive sampling threshold the workers render with (pathtrace.h); 0 = off */
     uint32_t passes;           /**< render passes every slab carries (passes.h mask); 0 = none */
-    const float *mlt_norm;     /**< Metropolis light transport: b_d per depth, computed once for the render and
-                                    handed to every worker (mlt_depths entries, not owned); NULL = none */
+    const float *mlt_norm;     /**< Metropolis light transport: b_d per depth, computed once for the render (for
+                                    each pass of --time-limit) and handed to every worker (mlt_depths entries,
+                                    not owned); NULL = none */
     uint32_t mlt_depths;
 } job_spec;
 
@@ -108,10 +109,11 @@ int job_save(const char *dir, uint32_t y0, uint32_t y1, const unsigned char *buf
  * floats, top row first); slab files that no longer check out are deleted
  * with a line to notes, as in job_scan, and those of other sample counts
  * are left alone.  Fails, naming the missing rows, unless every row is covered.
- * For a bidirectional render, the slabs used must split the image into
- * non-overlapping rows (each light subpath counted once): their splats are
- * summed in fixed point, in any order to the same bits, and added to the
- * rows (spl_resolve); it fails if no such split is among the slabs. */
+ * For a bidirectional render, the slabs used (of spec->spp samples, among
+ * others a --time-limit job holds) must split the image into
+ * non-overlapping rows (each light subpath counted once): their splats
+ * are summed in fixed point, in any order to the same bits, and added to
+ * the rows (spl_resolve); it fails if no such split is among them. */
 int job_stitch(const char *dir, const job_spec *spec, float *rgb, const note_sink *notes, fr_error *err);
 
 /** job_stitch that also copies the render passes of the slabs (spec->passes

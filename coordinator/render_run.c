@@ -395,7 +395,7 @@ int render_run(const frame_settings *a, const hosts_table *table, const char *fb
                     ps->stopped = spp;
                     break;
                 }
-                if (frame_plan(ps, spp, err)) {
+                if (frame_plan(ps, spp, err) || (ps->rows_missing && frame_normalise(ps, err))) {
                     rc = -1;
                     break;
                 }
