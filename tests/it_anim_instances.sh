@@ -7,7 +7,8 @@
 # skeleton's placements, and every frame's scene is byte for byte the full
 # compile of that frame alone, without and with a shutter (the moving
 # instance blurred: inst_motions).  A mesh of its file's materials (the
-# skeleton cannot make them) and a mesh whose own transform is keyed compile every
+# skeleton cannot make them), a mesh of an interior medium that moves
+# around the camera and a mesh whose own transform is keyed compile every
 # frame whole, to the bytes of the frame alone.
 . "$(dirname "$0")/support/lib.sh"
 T=$(mktemp -d) || exit 1
@@ -53,6 +54,21 @@ check "inst: the shutter changes frame 2's scene (the instance blurred)" \
     sh -c "! cmp -s inst-0/f.2.pfm.franja-job/scene.fbin inst-0.5/f.2.pfm.franja-job/scene.fbin"
 anim mtl mtl.json 0.5
 check "mtl: the file's materials compile every frame whole" test "$(grep -c "scene compiled" log-mtl)" -eq 4
+"$ROOT/bin/gen/genmesh" sphere --tris 2000 -o ball.obj >/dev/null || bad "genmesh sphere"
+cat >medium.json <<'JSON'
+{ "image": { "width": 16, "height": 12, "spp": 1 },
+  "camera": { "position": [0, 0, -4], "target": [0, 0, 1], "fov": 40 },
+  "media": { "cloud": { "sigma_a": 0.1, "sigma_s": 0.5 } },
+  "materials": { "cloud": { "type": "interface", "medium": "cloud" },
+                 "w": { "type": "lambert", "albedo": [0.6, 0.6, 0.6] } },
+  "lights": [ { "type": "point", "position": [0, 0, 0.5], "intensity": [5, 5, 5] } ],
+  "shapes": [ { "type": "mesh", "file": "ball.obj", "material": "cloud",
+                "instances": [ { "translate": { "keys": [[1, [0, 0, 0]], [4, [0, 0, -4.5]]] } } ] },
+              { "type": "plane", "point": [0, -3, 0], "normal": [0, 1, 0], "material": "w" } ] }
+JSON
+anim medium medium.json 0
+check "medium: a mesh that may hold the camera compiles every frame whole" \
+    test "$(grep -c "scene compiled" log-medium)" -eq 4
 anim own own.json 0
 check "own: a mesh moving itself compiles every frame whole" test "$(grep -c "scene compiled" log-own)" -eq 4
 summary

@@ -79,7 +79,11 @@ static uint32_t n_bounds;
 static int mesh_hook(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
                      uint32_t material, fr_error *err)
 {
+    /* A mesh of an interior medium may hold the camera (json_appear.c
+     * looks at its triangles): not stood in.  (A builder without the
+     * material places the shape's instances at shutter close only.) */
     if (skeleton && material != FR_NONE && b->meshes.count < n_bounds &&
+        (material >= b->materials.count || !((const fr_material *)b->materials.data)[material].medium) &&
         cJSON_GetObjectItemCaseSensitive(node, "instances")) {
         cJSON *content = cJSON_Duplicate(node, 1);
         if (!content)

@@ -42,8 +42,8 @@ typedef struct {
                                     files the compile read into (compile_child.h) */
     const float *mesh_bounds;  /**< skeleton: NULL, or the object-space vertex bounds (lo x y z, hi x y z)
                                     of the n_mesh_bounds meshes of the full compile the skeleton follows,
-                                    by mesh index: a mesh shape with instances and a material whose
-                                    mesh index has bounds becomes mesh.h's mesh_stand_in_placed, and its
+                                    by mesh index: a mesh shape with instances and a material (without
+                                    an interior medium) whose mesh index has bounds becomes mesh.h's mesh_stand_in_placed, and its
                                     key leaves its instances out (what the mesh's own content reads) */
     uint32_t n_mesh_bounds;
 } compile_opts;
