@@ -264,7 +264,6 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
         return -1;
     }
     r->reused = made;
-    r->seconds = clock_now() - t0;
     st->reused += made;
     /* The skeleton stands for the full scene only when both read the same
      * meshes (key_now: the frame's key without the shutter's). */
