@@ -14,6 +14,7 @@
 #include "fbin.h"
 #include "file.h"
 #include "fpatch.h"
+#include "reuse_placed.h"
 
 /* A patch is sent instead of the scene when it is under this fraction. */
 enum { PATCH_FRACTION = 4 };
@@ -167,13 +168,68 @@ static int write_patch(const reuse_state *st, const fr_scene *now, const char *p
     return rc;
 }
 
+/* The skeleton of the frame with the meshes' bounds st->bounds into *s,
+ * its key (the meshes' content, and half a frame around with a shutter)
+ * into *key; 0, or -1 (no such skeleton). */
+static int placed_skeleton(const reuse_state *st, const char *scene, const compile_opts *co, const char *out,
+                           volatile sig_atomic_t *stop, fr_scene *s, uint64_t *key)
+{
+    compile_opts bo = *co;
+    bo.mesh_bounds = st->bounds;
+    bo.n_mesh_bounds = st->n_bounds;
+    fr_error ignored;
+    if (skeleton(scene, &bo, out, stop, s, key, &ignored) < 0)
+        return -1;
+    if (co->timed && shutter_keys(scene, &bo, out, stop, key) < 0) {
+        scn_free(s);
+        return -1;
+    }
+    return 0;
+}
+
+/* The frame made of the frame before's meshes placed anew
+ * (reuse_placed.h) into `out`: 1 made (its skeleton into *s, key *key), 0
+ * not, -1 with err on a write error. */
+static int placed(const reuse_state *st, const char *scene, const compile_opts *co, const char *out,
+                  volatile sig_atomic_t *stop, fr_scene *s, uint64_t *key, fr_error *err)
+{
+    if (!st->have || !st->placed.blob || !st->n_bounds || !files_unchanged(st->files) ||
+        placed_skeleton(st, scene, co, out, stop, s, key) < 0)
+        return 0;
+    int made = *key == st->placed_key ? reuse_placed_splice(&st->full, &st->placed, s, out, err) : 0;
+    if (made <= 0)
+        scn_free(s);
+    return made;
+}
+
+/* What the next frame's placed() needs of this frame's scene st->full:
+ * its meshes' bounds and its skeleton with them (made here unless given
+ * as *s, which st then owns). */
+static void keep_placed(reuse_state *st, const char *scene, const compile_opts *co, const char *out,
+                        volatile sig_atomic_t *stop, fr_scene *s, uint64_t key)
+{
+    scn_free(&st->placed);
+    if (s->blob) {
+        st->placed = *s;
+        st->placed_key = key;
+        return;
+    }
+    free(st->bounds);
+    st->bounds = NULL;
+    st->n_bounds = 0;
+    fr_error ignored;
+    if (reuse_placed_bounds(&st->full, &st->bounds, &st->n_bounds, &ignored) < 0 || !st->n_bounds ||
+        placed_skeleton(st, scene, co, out, stop, &st->placed, &st->placed_key) < 0)
+        memset(&st->placed, 0, sizeof st->placed);
+}
+
 int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, const char *out, const char *patch,
                   volatile sig_atomic_t *stop, reuse_result *r, fr_error *err)
 {
     memset(r, 0, sizeof *r);
     double t0 = clock_now();
-    fr_scene skel = {0}, now = {0};
-    uint64_t key = 0;
+    fr_scene skel = {0}, now = {0}, pskel = {0};
+    uint64_t key = 0, pkey = 0;
     /* A skeleton that does not compile leaves the frame to a full compile,
      * which says what is wrong. */
     fr_error ignored;
@@ -191,6 +247,11 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
         scn_free(&skel);
         return -1;
     }
+    /* Else the meshes may be the frame before's placed elsewhere. */
+    if (!made && (made = placed(st, scene, co, out, stop, &pskel, &pkey, err)) < 0) {
+        scn_free(&skel);
+        return -1;
+    }
     compile_child_stats cs = {0};
     if (!made && full_compile(st, scene, co, out, stop, &cs, err) < 0) {
         scn_free(&skel);
@@ -198,11 +259,11 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     }
     if (fbin_load(out, &now, err) < 0 || write_patch(st, &now, patch, r, err) < 0) {
         scn_free(&skel);
+        scn_free(&pskel);
         scn_free(&now);
         return -1;
     }
     r->reused = made;
-    r->seconds = clock_now() - t0;
     st->reused += made;
     /* The skeleton stands for the full scene only when both read the same
      * meshes (key_now: the frame's key without the shutter's). */
@@ -214,6 +275,8 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     st->skel = skel;
     st->key = key;
     st->have = 1;
+    keep_placed(st, scene, co, out, stop, &pskel, pkey);
+    r->seconds = clock_now() - t0;
     return 0;
 }
 
@@ -229,6 +292,10 @@ int reuse_loaded(reuse_state *st, const char *path, const char *patch, reuse_res
     }
     scn_free(&st->full);
     scn_free(&st->skel); /* a compiled scene has no skeleton: the next frame compiles whole */
+    scn_free(&st->placed);
+    free(st->bounds);
+    st->bounds = NULL;
+    st->n_bounds = 0;
     free(st->files);
     st->files = NULL;
     st->full = now;
@@ -240,7 +307,9 @@ int reuse_loaded(reuse_state *st, const char *path, const char *patch, reuse_res
 void reuse_free(reuse_state *st)
 {
     free(st->files);
+    free(st->bounds);
     scn_free(&st->full);
     scn_free(&st->skel);
+    scn_free(&st->placed);
     memset(st, 0, sizeof *st);
 }

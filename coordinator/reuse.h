@@ -13,9 +13,13 @@
  * sections that differ between the two skeletons replaced by this
  * skeleton's, provided each of those sections was, in the frame before,
  * the same in the skeleton as in the full scene (the meshes added nothing
- * to it: the camera, the settings, the camera's motion).  Anything else
- * (a mesh that moves, a section the meshes add to: the BVH, the lights)
- * compiles the frame whole, and so does a file that the last full compile
+ * to it: the camera, the settings, the camera's motion).  When instead
+ * only the instances of meshes moved (a rigid object placed by keyed
+ * instances), the frame is made of the frame before's mesh sections and
+ * the rest of a skeleton given those meshes' bounds (reuse_placed.h),
+ * keyed by the meshes' content alone.  Anything else (a mesh that moves
+ * itself, a mesh of its file's materials, a glTF mesh, a section the
+ * meshes add to: the lights of an emissive mesh) compiles the frame whole, and so does a file that the last full compile
  * read and that changed since (a mesh's MTL file, a texture it names).
  * The result is byte for byte the scene a full
  * compile of the frame makes (tests/it_anim_reuse.sh).  Compiled .fbin
@@ -43,6 +47,11 @@ typedef struct {
     fr_scene full;             /**< its scene, mapped (the mapping outlives its job directory) */
     fr_scene skel;             /**< its skeleton (JSON scenes; else empty) */
     uint64_t key;              /**< its meshes' key */
+    fr_scene placed;           /**< its skeleton with its meshes' bounds (a scene with instanced meshes;
+                                    else empty): reuse_placed.h */
+    uint64_t placed_key;       /**< that skeleton's key (the meshes' content, without their instances) */
+    float *bounds;             /**< its meshes' object-space vertex bounds, 6 floats each, or NULL */
+    uint32_t n_bounds;
     char *files;               /**< the files its last full compile read (compile_child.h's list), or NULL */
     int have;                  /**< 1 once a frame was compiled */
     int reused;                /**< frames made from the frame before's sections (for the log) */

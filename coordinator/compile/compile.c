@@ -72,11 +72,27 @@ int compile_is_gltf(const char *path)
  * skeleton, mesh_key); a compile runs on one thread. */
 static uint64_t keys;
 static int skeleton;
+static const float *bounds;
+static uint32_t n_bounds;
 
 /* The mesh hook: its key folded in, then the mesh read unless left out. */
 static int mesh_hook(fr_builder *b, const cJSON *node, const char *where, const char *dir, const confine *scope,
                      uint32_t material, fr_error *err)
 {
+    /* A mesh of an interior medium may hold the camera (json_appear.c
+     * looks at its triangles): not stood in.  (A builder without the
+     * material places the shape's instances at shutter close only.) */
+    if (skeleton && material != FR_NONE && b->meshes.count < n_bounds &&
+        (material >= b->materials.count || !((const fr_material *)b->materials.data)[material].medium) &&
+        cJSON_GetObjectItemCaseSensitive(node, "instances")) {
+        cJSON *content = cJSON_Duplicate(node, 1);
+        if (!content)
+            return fr_fail(err, "%s: out of memory", where);
+        cJSON_DeleteItemFromObjectCaseSensitive(content, "instances");
+        int rc = mesh_key(b, content, where, dir, material, &keys, err);
+        cJSON_Delete(content);
+        return rc < 0 ? -1 : mesh_stand_in_placed(b, node, where, bounds + 6 * (size_t)b->meshes.count, material, err);
+    }
     if (mesh_key(b, node, where, dir, material, &keys, err) < 0)
         return -1;
     return skeleton ? mesh_stand_in(b, err) : mesh_add(b, node, where, dir, scope, material, err);
@@ -86,6 +102,8 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
 {
     keys = 0;
     skeleton = o && o->skeleton;
+    bounds = skeleton ? o->mesh_bounds : NULL;
+    n_bounds = bounds ? o->n_mesh_bounds : 0;
     fr_budget budget;
     if (o && o->limits)
         memcpy(budget.limit, o->limits->limit, sizeof budget.limit);

@@ -40,6 +40,12 @@ typedef struct {
                                     every mesh shape of a JSON scene, in order; 0 without) */
     const char *files;         /**< compile_child only: when not NULL, the file it writes the list of
                                     files the compile read into (compile_child.h) */
+    const float *mesh_bounds;  /**< skeleton: NULL, or the object-space vertex bounds (lo x y z, hi x y z)
+                                    of the n_mesh_bounds meshes of the full compile the skeleton follows,
+                                    by mesh index: a mesh shape with instances and a material (without
+                                    an interior medium) whose mesh index has bounds becomes mesh.h's mesh_stand_in_placed, and its
+                                    key leaves its instances out (what the mesh's own content reads) */
+    uint32_t n_mesh_bounds;
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */

@@ -45,4 +45,15 @@ int mesh_key(const fr_builder *b, const cJSON *node, const char *where, const ch
  * so that a scene of meshes alone still has a shape.  Fails on memory. */
 int mesh_stand_in(fr_builder *b, fr_error *err);
 
+/** What a skeleton compile given the meshes' bounds (compile.h:
+ * mesh_bounds) adds in place of a mesh shape with `instances` and a
+ * material (not FR_NONE): a mesh of one triangle of that material whose
+ * vertices span `box` (lo x y z, hi x y z: the object-space vertex bounds
+ * of the mesh a full compile made), placed by the shape's instances as
+ * mesh_add places them; so the instances, their bounds and the scene's
+ * tree are the full compile's.  Fails on a bad instance (as mesh_add) or
+ * on memory. */
+int mesh_stand_in_placed(fr_builder *b, const cJSON *node, const char *where, const float box[6],
+                         uint32_t material, fr_error *err);
+
 #endif
