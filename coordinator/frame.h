@@ -107,6 +107,7 @@ typedef struct {
                                   from (owned by the frame_image), else NULL */
     float *mlt_norm;           /* that normalisation, spec.mlt_norm (the frame_image's) */
     uint32_t mlt_samples;      /* the bidirectional samples it was computed from; 0 = not yet */
+    volatile sig_atomic_t *stop; /* the frame_image's: stops a normalisation (not owned) */
 } frame_passes;
 
 /** One image of a render, from its job lock to its output: the render of
