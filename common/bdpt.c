@@ -794,7 +794,9 @@ typedef struct {
     atomic_uint next;          /* the next of them to take */
     atomic_int failed;         /* a thread ran out of memory */
     double *sums;              /* count * nd: each block's sums per depth */
-    volatile sig_atomic_t *stop;
+    bd_stop_fn stop;
+    void *ctx;
+    atomic_int stopped;        /* stop said so */
 } norm_job;
 
 static void *norm_thread(void *arg)
@@ -806,7 +808,11 @@ static void *norm_thread(void *arg)
         return NULL;
     }
     const bd_strategy all = {-1, -1, -1};
-    for (unsigned b; (b = atomic_fetch_add(&j->next, 1)) < j->count && !(j->stop && *j->stop);) {
+    for (unsigned b; (b = atomic_fetch_add(&j->next, 1)) < j->count;) {
+        if (atomic_load(&j->stopped) || (j->stop && j->stop(j->ctx))) {
+            atomic_store(&j->stopped, 1);
+            break;
+        }
         uint64_t j0 = (j->first + b) * NORM_BLOCK, j1 = j0 + NORM_BLOCK < j->total ? j0 + NORM_BLOCK : j->total;
         for (uint64_t q = j0; q < j1; q++) {
             uint64_t p = q / j->spp * j->pixels / j->used;
@@ -818,9 +824,9 @@ static void *norm_thread(void *arg)
     return NULL;
 }
 
-int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, volatile sig_atomic_t *stop, double *by_depth)
+int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, bd_stop_fn stop, void *ctx, double *by_depth)
 {
-    norm_job j = {.s = s, .width = s->settings.width, .nd = s->settings.max_depth + 1, .stop = stop};
+    norm_job j = {.s = s, .width = s->settings.width, .nd = s->settings.max_depth + 1, .stop = stop, .ctx = ctx};
     j.pixels = j.width * s->settings.height;
     /* Every pixel spp times, or n pixels evenly spread once each. */
     j.spp = n > j.pixels ? (n + j.pixels - 1) / j.pixels : 1;
@@ -832,6 +838,7 @@ int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, volatile sig_a
     pthread_t *tid = malloc((size_t)threads * sizeof *tid);
     int rc = j.sums && tid ? 0 : -1;
     atomic_init(&j.failed, 0);
+    atomic_init(&j.stopped, 0);
     for (uint32_t d = 0; d < j.nd; d++)
         by_depth[d] = 0.0;
     for (j.first = 0; rc == 0 && j.first < blocks; j.first += NORM_WAVE) {
@@ -846,7 +853,7 @@ int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, volatile sig_a
             pthread_join(tid[t], NULL);
         if (atomic_load(&j.failed))
             rc = -1;
-        else if (stop && *stop)
+        else if (atomic_load(&j.stopped))
             rc = 1;
         /* In block order, whichever thread summed each block. */
         for (uint32_t b = 0; rc == 0 && b < j.count; b++)
@@ -862,7 +869,7 @@ int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, volatile sig_a
 
 int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth)
 {
-    return bd_depth_means_mt(s, n, 1, NULL, by_depth);
+    return bd_depth_means_mt(s, n, 1, NULL, NULL, by_depth);
 }
 
 vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam, const bd_stream *light, float *rx,

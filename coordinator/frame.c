@@ -287,12 +287,28 @@ int frame_lock(frame_image *im)
     return 0;
 }
 
+/* What stops a normalisation: SIGINT (stop), or --time-limit's deadline
+ * (stop_at, clock_now() time; 0 = none). */
+typedef struct {
+    volatile sig_atomic_t *stop;
+    double stop_at;
+} norm_stop;
+
+static int norm_stopped(void *ctx)
+{
+    const norm_stop *ns = ctx;
+    return *ns->stop || (ns->stop_at > 0 && clock_now() >= ns->stop_at);
+}
+
 /* Metropolis light transport's normalisation (mlt_path.h) for spec's
  * image size and samples (mlt_norm_samples of them): into norm (at least
  * PROTO_MLT_DEPTHS floats), handed to every worker by spec.  A scene
  * deeper than the command line carries leaves it to each worker (the same
- * numbers, computed per slab) and spec without it. */
-static int normalise(fr_scene *sc, job_spec *spec, float *norm, volatile sig_atomic_t *stop, fr_error *err)
+ * numbers, computed per slab) and spec without it.  Computed on every
+ * core, the bits of a worker's own (bd_depth_means_mt), and given up
+ * between blocks when ns says: -1 with err on SIGINT or out of memory, 1
+ * at the deadline (norm and spec unchanged). */
+static int normalise(fr_scene *sc, job_spec *spec, float *norm, norm_stop *ns, fr_error *err)
 {
     sc->settings.width = spec->width;
     sc->settings.height = spec->height;
@@ -303,12 +319,13 @@ static int normalise(fr_scene *sc, job_spec *spec, float *norm, volatile sig_ato
                 "normalisation (%u bidirectional samples a slab)\n", nd - 1, n);
         return 0;
     }
-    /* On every core: bd_depth_means_mt gives the bits of a worker's own
-     * mlt_bootstrap (one thread), rounded to float as it does. */
+    /* mlt_bootstrap's numbers, rounded to float as it does. */
     double t0 = clock_now(), bd[PROTO_MLT_DEPTHS], b = 0.0;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int threads = cores < 1 ? 1 : cores > 256 ? 256 : (int)cores;
-    int rc = bd_depth_means_mt(sc, n, threads, stop, bd);
+    int rc = bd_depth_means_mt(sc, n, threads, norm_stopped, ns, bd);
+    if (rc > 0 && !*ns->stop)
+        return 1;
     if (rc)
         return fr_fail(err, rc > 0 ? "Metropolis normalisation: interrupted"
                                    : "out of memory for the Metropolis normalisation");
@@ -331,8 +348,11 @@ int frame_normalise(frame_passes *ps, fr_error *err)
     uint32_t n = mlt_norm_samples(ps->mlt_scene);
     if (n == ps->mlt_samples)
         return 0;              /* the same samples give the same numbers */
-    if (normalise(ps->mlt_scene, &ps->spec, ps->mlt_norm, ps->stop, err))
-        return -1;
+    /* The first pass always ends (frame_passes), so does its normalisation. */
+    norm_stop ns = {ps->stop, ps->reached ? ps->deadline : 0};
+    int rc = normalise(ps->mlt_scene, &ps->spec, ps->mlt_norm, &ns, err);
+    if (rc)
+        return rc;
     ps->mlt_samples = n;
     return 0;
 }
@@ -432,7 +452,7 @@ int frame_open(frame_image *im)
     } else if (per_pass) {
         spec.mlt_norm = im->mlt_norm;
         spec.mlt_depths = sc.settings.max_depth + 1;
-    } else if (mlt && normalise(&sc, &spec, im->mlt_norm, im->stop, &err)) {
+    } else if (mlt && normalise(&sc, &spec, im->mlt_norm, &(norm_stop){im->stop, 0}, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         scn_free(&sc);
         return *im->stop ? 130 : 1;

@@ -5,10 +5,10 @@
  * count (one partial block), over it and not a multiple of the 4096-sample
  * block (the last block partial, more threads than blocks), each on 1, 2,
  * 3 and 7 threads against bd_depth_means (one thread), compared as bytes;
- * the means are finite, non-negative and not all zero; a stop flag set
- * before the call returns 1, one left clear changes nothing. */
+ * the means are finite, non-negative and not all zero; a stop callback
+ * that says stop before the first block, or after it when there are more,
+ * returns 1, one that never does changes nothing. */
 #include <math.h>
-#include <signal.h>
 #include <string.h>
 
 #include "bdpt.h"
@@ -16,6 +16,13 @@
 #include "compile/json_scene.h"
 
 #define MAXD 64
+
+/* A stop callback: stops once *ctx blocks have been asked about. */
+static int stop_after(void *ctx)
+{
+    int *left = ctx;
+    return __atomic_sub_fetch(left, 1, __ATOMIC_SEQ_CST) < 0;
+}
 
 static void same_bits(const fr_scene *s, uint32_t n)
 {
@@ -30,16 +37,19 @@ static void same_bits(const fr_scene *s, uint32_t n)
     const int threads[] = {1, 2, 3, 7};
     for (size_t k = 0; k < sizeof threads / sizeof *threads; k++) {
         memset(many, 0xff, sizeof many);
-        CHECK(bd_depth_means_mt(s, n, threads[k], NULL, many) == 0, "n %u, %d threads: failed", n, threads[k]);
+        CHECK(bd_depth_means_mt(s, n, threads[k], NULL, NULL, many) == 0, "n %u, %d threads: failed", n, threads[k]);
         CHECK(memcmp(one, many, nd * sizeof *one) == 0, "n %u, %d threads: other bits than one thread (b_0 %.17g, %.17g)",
               n, threads[k], one[0], many[0]);
     }
-    volatile sig_atomic_t stop = 0;
+    int left = 1 << 30;
     memset(many, 0xff, sizeof many);
-    CHECK(bd_depth_means_mt(s, n, 2, &stop, many) == 0 && memcmp(one, many, nd * sizeof *one) == 0,
-          "n %u: a clear stop flag changes the means", n);
-    stop = 1;
-    CHECK(bd_depth_means_mt(s, n, 2, &stop, many) == 1, "n %u: a set stop flag does not stop", n);
+    CHECK(bd_depth_means_mt(s, n, 2, stop_after, &left, many) == 0 && memcmp(one, many, nd * sizeof *one) == 0,
+          "n %u: a stop callback that never stops changes the means", n);
+    left = 0;
+    CHECK(bd_depth_means_mt(s, n, 2, stop_after, &left, many) == 1, "n %u: stopped before the first block: not 1", n);
+    left = 1;
+    CHECK(bd_depth_means_mt(s, n, 1, stop_after, &left, many) == (n > 4096 ? 1 : 0),
+          "n %u: stopped after the first block: not %d", n, n > 4096);
 }
 
 int main(void)

@@ -60,7 +60,7 @@ int main(int argc, char **argv)
     for (unsigned t = 0; same && t < 2; t++)
         for (unsigned r = 0; r < reps; r++) {
             double t0 = now();
-            if (bd_depth_means_mt(&s, n, t ? (int)threads : 1, NULL, t + r ? bd : first)) {
+            if (bd_depth_means_mt(&s, n, t ? (int)threads : 1, NULL, NULL, t + r ? bd : first)) {
                 fprintf(stderr, "normbench: out of memory\n");
                 return 1;
             }
