@@ -166,11 +166,11 @@ bin/tests/%: tests/%.c $(TESTSUP_LIB) $(COORD_LIB) $(LIB)
 
 bin/gen/%: tests/gen/%.c $(LIB)
 	@mkdir -p bin/gen
-	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm -pthread
 
 bin/tools/%: tests/tools/%.c tests/tools/pfmread.h $(LIB)
 	@mkdir -p bin/tools
-	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lm -pthread
 
 # nolockfs, a FUSE file system that refuses locks (tests/it_joblock.sh).
 bin/tools/nolockfs: tests/tools/nolockfs.c
@@ -192,7 +192,7 @@ bin/bench/packbench: tests/bench/packbench.c $(COORD_LIB) $(LIB)
 	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) -iquote coordinator -o $@ $< $(COORD_LIB) $(LIB) -Wl,--as-needed $(COORD_LIBS)
 bin/bench/%: tests/bench/%.c $(wildcard tests/bench/*.h) $(LIB)
 	@mkdir -p bin/bench
-	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) $(BENCH_LDFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm
+	$(CC) $(CSTD) $(CFLAGS) $(NO_LTO) $(CJSON_CFLAGS) $(BENCH_LDFLAGS) -o $@ $< $(LIB) $(CJSON_LIBS) -lembree3 -lm -pthread
 
 # Fuzzing: libFuzzer targets tests/fuzz/fuzz_*.c, built with clang, ASan
 # and UBSan over the common sources, each run for FUZZ_SECONDS

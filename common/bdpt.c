@@ -3,7 +3,10 @@
 
 #include "bdpt.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "bsdf.h"
 #include "camera.h"
@@ -776,26 +779,97 @@ static void no_splat(void *ctx, uint32_t x, uint32_t y, float r, float g, float 
     (void)ctx, (void)x, (void)y, (void)r, (void)g, (void)b;
 }
 
+#define NORM_BLOCK 4096u /* samples a block of bd_depth_means_mt */
+#define NORM_WAVE 1024u  /* blocks summed before they are added up (2^22 samples) */
+
+/* One bd_depth_means_mt: its samples (sample j is pixel k = j / spp of
+ * `used` spread evenly, sample index j % spp) and the wave of blocks being
+ * summed, which its threads take one at a time. */
+typedef struct {
+    const fr_scene *s;
+    uint64_t width, pixels, used, spp, total;
+    uint32_t nd;
+    uint64_t first;            /* the wave's first block */
+    uint32_t count;            /* its blocks */
+    atomic_uint next;          /* the next of them to take */
+    atomic_int failed;         /* a thread ran out of memory */
+    double *sums;              /* count * nd: each block's sums per depth */
+    bd_stop_fn stop;
+    void *ctx;
+    atomic_int stopped;        /* stop said so */
+} norm_job;
+
+static void *norm_thread(void *arg)
+{
+    norm_job *j = arg;
+    bd_work *w = bd_work_new(j->s);
+    if (!w) {
+        atomic_store(&j->failed, 1);
+        return NULL;
+    }
+    const bd_strategy all = {-1, -1, -1};
+    for (unsigned b; (b = atomic_fetch_add(&j->next, 1)) < j->count;) {
+        if (atomic_load(&j->stopped) || (j->stop && j->stop(j->ctx))) {
+            atomic_store(&j->stopped, 1);
+            break;
+        }
+        uint64_t j0 = (j->first + b) * NORM_BLOCK, j1 = j0 + NORM_BLOCK < j->total ? j0 + NORM_BLOCK : j->total;
+        for (uint64_t q = j0; q < j1; q++) {
+            uint64_t p = q / j->spp * j->pixels / j->used;
+            sample(j->s, w, &all, (uint32_t)(p % j->width), (uint32_t)(p / j->width), (uint32_t)(q % j->spp),
+                   no_splat, NULL, j->sums + (size_t)b * j->nd);
+        }
+    }
+    bd_work_free(w);
+    return NULL;
+}
+
+int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, bd_stop_fn stop, void *ctx, double *by_depth)
+{
+    norm_job j = {.s = s, .width = s->settings.width, .nd = s->settings.max_depth + 1, .stop = stop, .ctx = ctx};
+    j.pixels = j.width * s->settings.height;
+    /* Every pixel spp times, or n pixels evenly spread once each. */
+    j.spp = n > j.pixels ? (n + j.pixels - 1) / j.pixels : 1;
+    j.used = n > j.pixels ? j.pixels : (n ? n : 1);
+    j.total = j.used * j.spp;
+    uint64_t blocks = (j.total + NORM_BLOCK - 1) / NORM_BLOCK;
+    threads = threads < 1 ? 1 : threads;
+    j.sums = malloc((size_t)NORM_WAVE * j.nd * sizeof *j.sums);
+    pthread_t *tid = malloc((size_t)threads * sizeof *tid);
+    int rc = j.sums && tid ? 0 : -1;
+    atomic_init(&j.failed, 0);
+    atomic_init(&j.stopped, 0);
+    for (uint32_t d = 0; d < j.nd; d++)
+        by_depth[d] = 0.0;
+    for (j.first = 0; rc == 0 && j.first < blocks; j.first += NORM_WAVE) {
+        j.count = blocks - j.first < NORM_WAVE ? (uint32_t)(blocks - j.first) : NORM_WAVE;
+        memset(j.sums, 0, (size_t)j.count * j.nd * sizeof *j.sums);
+        atomic_init(&j.next, 0);
+        int started = 0;
+        for (int t = 1; t < threads && (uint32_t)t < j.count; t++)
+            started += pthread_create(&tid[started], NULL, norm_thread, &j) == 0;
+        norm_thread(&j);
+        for (int t = 0; t < started; t++)
+            pthread_join(tid[t], NULL);
+        if (atomic_load(&j.failed))
+            rc = -1;
+        else if (atomic_load(&j.stopped))
+            rc = 1;
+        /* In block order, whichever thread summed each block. */
+        for (uint32_t b = 0; rc == 0 && b < j.count; b++)
+            for (uint32_t d = 0; d < j.nd; d++)
+                by_depth[d] += j.sums[(size_t)b * j.nd + d];
+    }
+    for (uint32_t d = 0; rc == 0 && d < j.nd; d++)
+        by_depth[d] /= (double)j.total;
+    free(tid);
+    free(j.sums);
+    return rc;
+}
+
 int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth)
 {
-    bd_work *w = bd_work_new(s);
-    if (!w)
-        return -1;
-    const bd_strategy all = {-1, -1, -1};
-    uint64_t width = s->settings.width, pixels = width * s->settings.height;
-    /* Every pixel spp times, or n pixels evenly spread once each. */
-    uint64_t spp = n > pixels ? (n + pixels - 1) / pixels : 1, used = n > pixels ? pixels : (n ? n : 1);
-    for (uint32_t d = 0; d <= s->settings.max_depth; d++)
-        by_depth[d] = 0.0;
-    for (uint64_t k = 0; k < used; k++) {
-        uint64_t p = k * pixels / used;
-        for (uint32_t i = 0; i < spp; i++)
-            sample(s, w, &all, (uint32_t)(p % width), (uint32_t)(p / width), i, no_splat, NULL, by_depth);
-    }
-    for (uint32_t d = 0; d <= s->settings.max_depth; d++)
-        by_depth[d] /= (double)used * spp;
-    bd_work_free(w);
-    return 0;
+    return bd_depth_means_mt(s, n, 1, NULL, NULL, by_depth);
 }
 
 vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam, const bd_stream *light, float *rx,

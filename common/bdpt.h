@@ -115,6 +115,20 @@ vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam,
  * image.  -1 when out of memory. */
 int bd_depth_means(const fr_scene *s, uint32_t n, double *by_depth);
 
+/** Asked between blocks of bd_depth_means_mt, from any of its threads at
+ * once: non-zero to stop. */
+typedef int (*bd_stop_fn)(void *ctx);
+
+/** bd_depth_means on `threads` threads (below 1 counts as 1) with the
+ * same bits for any number of them: the samples, in the order above, are
+ * cut into blocks of 4096 (the boundaries a function of n alone), each
+ * block summed per depth in double from zero, and the blocks' sums added
+ * in block order.  stop(ctx) (stop NULL: never) is asked before each
+ * block; once it says stop, 1 with by_depth undefined (no partial means).
+ * -1 when out of memory.  A thread that cannot start leaves its share to
+ * the others. */
+int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, bd_stop_fn stop, void *ctx, double *by_depth);
+
 /** Render rows [y0, y1) of s->settings' size and spp with all strategies:
  * rgb (3 floats per pixel, row y0 first, width*(y1-y0)*3) receives the
  * mean of the samples' own radiance, and splat (3 sums per pixel of the

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "bdpt.h"
 #include "mlt_path.h"
@@ -286,12 +287,28 @@ int frame_lock(frame_image *im)
     return 0;
 }
 
+/* What stops a normalisation: SIGINT (stop), or --time-limit's deadline
+ * (stop_at, clock_now() time; 0 = none). */
+typedef struct {
+    volatile sig_atomic_t *stop;
+    double stop_at;
+} norm_stop;
+
+static int norm_stopped(void *ctx)
+{
+    const norm_stop *ns = ctx;
+    return *ns->stop || (ns->stop_at > 0 && clock_now() >= ns->stop_at);
+}
+
 /* Metropolis light transport's normalisation (mlt_path.h) for spec's
  * image size and samples (mlt_norm_samples of them): into norm (at least
  * PROTO_MLT_DEPTHS floats), handed to every worker by spec.  A scene
  * deeper than the command line carries leaves it to each worker (the same
- * numbers, computed per slab) and spec without it. */
-static int normalise(fr_scene *sc, job_spec *spec, float *norm, fr_error *err)
+ * numbers, computed per slab) and spec without it.  Computed on every
+ * core, the bits of a worker's own (bd_depth_means_mt), and given up
+ * between blocks when ns says: -1 with err on SIGINT or out of memory, 1
+ * at the deadline (norm and spec unchanged). */
+static int normalise(fr_scene *sc, job_spec *spec, float *norm, norm_stop *ns, fr_error *err)
 {
     sc->settings.width = spec->width;
     sc->settings.height = spec->height;
@@ -302,15 +319,20 @@ static int normalise(fr_scene *sc, job_spec *spec, float *norm, fr_error *err)
                 "normalisation (%u bidirectional samples a slab)\n", nd - 1, n);
         return 0;
     }
-    double t0 = clock_now();
-    mlt_boot bt;
-    if (mlt_bootstrap(sc, n, &bt, err))
-        return -1;
+    /* mlt_bootstrap's numbers, rounded to float as it does. */
+    double t0 = clock_now(), bd[PROTO_MLT_DEPTHS], b = 0.0;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int threads = cores < 1 ? 1 : cores > 256 ? 256 : (int)cores;
+    int rc = bd_depth_means_mt(sc, n, threads, norm_stopped, ns, bd);
+    if (rc > 0 && !*ns->stop)
+        return 1;
+    if (rc)
+        return fr_fail(err, rc > 0 ? "Metropolis normalisation: interrupted"
+                                   : "out of memory for the Metropolis normalisation");
     for (uint32_t d = 0; d < nd; d++)
-        norm[d] = (float)bt.bd[d];
-    fprintf(stderr, "franja: Metropolis normalisation: b = %.6g from %u bidirectional samples (%.1f s)\n", bt.b, n,
-            clock_now() - t0);
-    mlt_boot_free(&bt);
+        b += norm[d] = (float)bd[d];
+    fprintf(stderr, "franja: Metropolis normalisation: b = %.6g from %u bidirectional samples on %d threads "
+            "(%.1f s)\n", b, n, threads, clock_now() - t0);
     spec->mlt_norm = norm;
     spec->mlt_depths = nd;
     return 0;
@@ -326,8 +348,11 @@ int frame_normalise(frame_passes *ps, fr_error *err)
     uint32_t n = mlt_norm_samples(ps->mlt_scene);
     if (n == ps->mlt_samples)
         return 0;              /* the same samples give the same numbers */
-    if (normalise(ps->mlt_scene, &ps->spec, ps->mlt_norm, err))
-        return -1;
+    /* The first pass always ends (frame_passes), so does its normalisation. */
+    norm_stop ns = {ps->stop, ps->reached ? ps->deadline : 0};
+    int rc = normalise(ps->mlt_scene, &ps->spec, ps->mlt_norm, &ns, err);
+    if (rc)
+        return rc;
     ps->mlt_samples = n;
     return 0;
 }
@@ -427,10 +452,10 @@ int frame_open(frame_image *im)
     } else if (per_pass) {
         spec.mlt_norm = im->mlt_norm;
         spec.mlt_depths = sc.settings.max_depth + 1;
-    } else if (mlt && normalise(&sc, &spec, im->mlt_norm, &err)) {
+    } else if (mlt && normalise(&sc, &spec, im->mlt_norm, &(norm_stop){im->stop, 0}, &err)) {
         fprintf(stderr, "franja render: %s\n", err.msg);
         scn_free(&sc);
-        return 1;
+        return *im->stop ? 130 : 1;
     }
     /* Tone mapping: the scene's defaults, overridden by the command line. */
     im->tm = sc.tonemap;
@@ -462,7 +487,7 @@ int frame_open(frame_image *im)
     frame_passes *ps = &im->ps;
     *ps = (frame_passes){.a = a, .jobdir = im->jobdir, .spec = spec, .cap = spec.spp, .crop_rows = crop_rows,
                    .have = im->have, .base = im->base, .rgb = im->rgb, .scratch = NULL,
-                   .mlt_scene = keep, .mlt_norm = im->mlt_norm};
+                   .mlt_scene = keep, .mlt_norm = im->mlt_norm, .stop = im->stop};
     /* --time-limit keeps the passes of its last complete pass beside rgb. */
     if (spec.passes && a->time_limit > 0)
         im->passes = ps->passes = calloc((size_t)spec.width * spec.height * pass_channels(spec.passes),

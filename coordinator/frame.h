@@ -107,6 +107,7 @@ typedef struct {
                                   from (owned by the frame_image), else NULL */
     float *mlt_norm;           /* that normalisation, spec.mlt_norm (the frame_image's) */
     uint32_t mlt_samples;      /* the bidirectional samples it was computed from; 0 = not yet */
+    volatile sig_atomic_t *stop; /* the frame_image's: stops a normalisation (not owned) */
 } frame_passes;
 
 /** One image of a render, from its job lock to its output: the render of
@@ -160,8 +161,10 @@ int frame_next_pass(frame_passes *ps, uint32_t *spp, fr_error *err);
  * pass just planned (ps->spec.spp) into ps->mlt_norm, as a render asked
  * for its samples computes it (mlt_path.h), unless the one there was
  * computed from the same number of bidirectional samples (the same
- * numbers); nothing for another render.  -1 with err when out of
- * memory. */
+ * numbers); nothing for another render.  Computed on every core and
+ * given up between blocks: 1 when ps->deadline passes first (after the
+ * first pass; the pass is then stopped), -1 with err on SIGINT (ps->stop)
+ * or when out of memory. */
 int frame_normalise(frame_passes *ps, fr_error *err);
 
 /** The image of the pass just planned and complete into ps->rgb.  -1 with

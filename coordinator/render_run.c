@@ -395,8 +395,13 @@ int render_run(const frame_settings *a, const hosts_table *table, const char *fb
                     ps->stopped = spp;
                     break;
                 }
-                if (frame_plan(ps, spp, err) || (ps->rows_missing && frame_normalise(ps, err))) {
+                int norm = 0;
+                if (frame_plan(ps, spp, err) || (ps->rows_missing && (norm = frame_normalise(ps, err)) < 0)) {
                     rc = -1;
+                    break;
+                }
+                if (norm > 0) {
+                    ps->stopped = spp; /* the limit came during its normalisation */
                     break;
                 }
                 ps->npass++;
