@@ -113,7 +113,7 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
     scene_hooks hooks = {mesh_hook, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
                          o ? o->allow : NULL, o ? o->n_allow : 0, &budget,
                          o ? o->fbin : NULL, o ? o->timed : 0, o ? o->frame : 0.0, o ? o->fps : 0.0,
-                         o ? o->shutter : 0.0, skeleton, &keys};
+                         o ? o->shutter : 0.0, skeleton, &keys, bounds, n_bounds};
     int rc;
     if (compile_is_gltf(path))
         rc = gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
