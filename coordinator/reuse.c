@@ -180,7 +180,9 @@ static int placed_skeleton(const reuse_state *st, const char *scene, const compi
     fr_error ignored;
     if (skeleton(scene, &bo, out, stop, s, key, &ignored) < 0)
         return -1;
-    if (co->timed && shutter_keys(scene, &bo, out, stop, key) < 0) {
+    /* A glTF placed skeleton reads every mesh it does not stand in for, so
+     * its sections say all the poses around the frame would. */
+    if (co->timed && !compile_is_gltf(scene) && shutter_keys(scene, &bo, out, stop, key) < 0) {
         scn_free(s);
         return -1;
     }

@@ -20,7 +20,8 @@
  * keyed by the meshes' content alone; a glTF mesh placed by instances
  * (drawn by several nodes, or moving across the shutter) is such a mesh,
  * keyed by the file's identity, its node and whether it moves
- * (scene_hooks.h's mesh_bounds).  Anything else (a mesh that moves
+ * (scene_hooks.h's mesh_bounds; without the skeletons half a frame
+ * around, as that skeleton reads every other mesh whole).  Anything else (a mesh that moves
  * itself, a mesh of its file's materials, a glTF mesh flattened into the
  * world's triangles that moves, skinned or morphed, a section the
  * meshes add to: the lights of an emissive mesh) compiles the frame whole, and so does a file that the last full compile

@@ -8,8 +8,10 @@
 # are made of the frame before's mesh sections and a skeleton's
 # placements, and every frame's scene and image are byte for byte those
 # of the frame alone, without and with a shutter (the moving instance
-# blurred).  The box on one node, without a shutter, is flattened into the
-# world's triangles where it stands: every frame compiles whole.
+# blurred).  The box on one node is an instance when it moves across the
+# shutter, made of the frame before's too; without a shutter it is
+# flattened into the world's triangles where it stands: every frame
+# compiles whole.
 . "$(dirname "$0")/support/lib.sh"
 T=$(mktemp -d) || exit 1
 trap 'rm -rf "$T"' EXIT
@@ -44,6 +46,10 @@ for sh in 0 0.5; do
 done
 check "twin: the shutter changes frame 1's scene (the instance blurred)" \
     sh -c "! cmp -s twin-0/f.1.pfm.franja-job/scene.fbin twin-0.5/f.1.pfm.franja-job/scene.fbin"
-anim one anim.gltf 0
-check "one: a moving mesh on one node compiles every frame whole" test "$(grep -c "scene compiled" log-one)" -eq 4
+anim one-0.5 anim.gltf 0.5
+check "one (shutter 0.5): frames 1 to 3 made of the frame before's" \
+    test "$(grep -c "scene made of the frame before's" log-one-0.5)" -eq 3
+anim one-0 anim.gltf 0
+check "one (shutter 0): a mesh moving flattened compiles every frame whole" \
+    test "$(grep -c "scene compiled" log-one-0)" -eq 4
 summary
