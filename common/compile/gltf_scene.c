@@ -538,9 +538,8 @@ static int blends(const fr_builder *b, uint32_t k, const affine *frame)
  * node (builder_instance.h), unless morph weights bend it: then this node's
  * copy is placed into the world's triangles. */
 /* What places and shapes node n's mesh m, folded into the hooks' key. */
-static void mesh_key(imp *c, uint32_t n, uint32_t m, const affine *w, const morph *mw, const skinning *sk)
+static void mesh_key(uint64_t *k, uint32_t n, uint32_t m, const affine *w, const morph *mw, const skinning *sk)
 {
-    uint64_t *k = c->hooks ? c->hooks->mesh_key : NULL;
     if (!k)
         return;
     uint32_t id[4] = {n, m, mw->n, sk ? sk->n : 0};
@@ -552,11 +551,10 @@ static void mesh_key(imp *c, uint32_t n, uint32_t m, const affine *w, const morp
 }
 
 /* What a placed skeleton's stand-in (scene_hooks.h's mesh_bounds) stands
- * for, folded into the hooks' key: node n's mesh m placed by an instance
- * that moves or not, wherever that is. */
-static void placed_key(imp *c, uint32_t n, uint32_t m, int moves)
+ * for, folded into *k: node n's mesh m placed by an instance that moves
+ * or not, wherever that is. */
+static void placed_key(uint64_t *k, uint32_t n, uint32_t m, int moves)
 {
-    uint64_t *k = c->hooks->mesh_key;
     uint32_t id[4] = {n, m, (uint32_t)moves, 0x51a4du};
     if (k)
         *k = XXH3_64bits_withSeed(id, sizeof id, *k);
@@ -621,16 +619,20 @@ static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning 
     }
     /* A placed skeleton (scene_hooks.h's mesh_bounds) stands in for the
      * meshes placed by instances, keyed without their placement. */
-    int placed = c->hooks && c->hooks->skeleton && c->hooks->mesh_bounds && (c->uses[m] >= 2 || moves) &&
-                 !mw.n && !sk;
-    if (placed)
-        placed_key(c, n, m, moves);
-    else
-        mesh_key(c, n, m, w, &mw, sk);
-    /* The poses at the shutter's ends are part of what the mesh makes. */
-    if (moves && !placed && c->hooks && c->hooks->mesh_key) {
-        mesh_key(c, n, m, &c->shut[0][n], &mw, sk);
-        mesh_key(c, n, m, &c->shut[1][n], &mw, sk);
+    int instanced = (c->uses[m] >= 2 || moves) && !mw.n && !sk;
+    int placed = c->hooks && c->hooks->skeleton && c->hooks->mesh_bounds && instanced;
+    uint64_t *keys[2] = {c->hooks ? c->hooks->mesh_key : NULL, c->hooks ? c->hooks->placed_key : NULL};
+    for (int i = 0; i < 2; i++) {
+        if (i ? instanced : placed) {
+            placed_key(keys[i], n, m, moves);
+            continue;
+        }
+        mesh_key(keys[i], n, m, w, &mw, sk);
+        /* The poses at the shutter's ends are part of what the mesh makes. */
+        if (moves) {
+            mesh_key(keys[i], n, m, &c->shut[0][n], &mw, sk);
+            mesh_key(keys[i], n, m, &c->shut[1][n], &mw, sk);
+        }
     }
     if (c->hooks && c->hooks->skeleton && !c->hooks->mesh_bounds)
         return stand_in(c, err);
@@ -1210,16 +1212,19 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
  * may hold other meshes under the same nodes. */
 static void file_key(const char *path, const scene_hooks *hooks)
 {
-    uint64_t *k = hooks ? hooks->mesh_key : NULL;
     struct stat st;
     uint64_t id[5] = {0};
-    if (!k)
+    if (!hooks)
         return;
     if (stat(path, &st) == 0)
         id[0] = (uint64_t)st.st_dev, id[1] = (uint64_t)st.st_ino, id[2] = (uint64_t)st.st_size,
         id[3] = (uint64_t)st.st_mtim.tv_sec, id[4] = (uint64_t)st.st_mtim.tv_nsec;
-    *k = XXH3_64bits_withSeed(path, strlen(path) + 1, *k);
-    *k = XXH3_64bits_withSeed(id, sizeof id, *k);
+    uint64_t *keys[2] = {hooks->mesh_key, hooks->placed_key};
+    for (int i = 0; i < 2; i++)
+        if (keys[i]) {
+            *keys[i] = XXH3_64bits_withSeed(path, strlen(path) + 1, *keys[i]);
+            *keys[i] = XXH3_64bits_withSeed(id, sizeof id, *keys[i]);
+        }
 }
 
 int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *o, fr_builder *b, gltf_result *r,

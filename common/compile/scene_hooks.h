@@ -109,6 +109,10 @@ typedef struct {
      * mesh is read whole (its triangles are the world's). */
     const float *mesh_bounds;
     uint32_t n_mesh_bounds;
+    /** When not NULL: every glTF file and mesh folded into *placed_key as
+     * a skeleton with mesh_bounds folds them into *mesh_key (that key,
+     * without reading a mesh). */
+    uint64_t *placed_key;
 } scene_hooks;
 
 #endif
