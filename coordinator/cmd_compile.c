@@ -116,7 +116,7 @@ int cmd_compile(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
     compile_child_stats st;
     compile_opts co = {camera, print_warning, (void *)"franja compile", allow, n_allow, &limits, NULL, 0, 0.0,
-                       0.0, 0.0, 0, NULL, NULL, NULL, 0};
+                       0.0, 0.0, 0, NULL, NULL, NULL, 0, NULL};
     if (compile_child(in, &co, out, &stop_flag, &st, &err) < 0) {
         fprintf(stderr, "franja compile: %s\n", err.msg);
         return stop_flag ? 130 : 1;

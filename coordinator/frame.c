@@ -79,7 +79,7 @@ static int scene_binary(frame_image *im, char *path, size_t cap, fr_scene *sc, f
     /* In a child process, so that Ctrl-C stops a long compile at once. */
     compile_opts co = {a->camera, print_warning, (void *)"franja", a->allow, a->n_allow, &a->limits, NULL,
                        a->timed, a->frame, a->fps > 0 ? a->fps : GANIM_FPS, a->timed ? a->shutter : 0.0,
-                       0, NULL, NULL, NULL, 0};
+                       0, NULL, NULL, NULL, 0, NULL};
     if (im->reuse) {
         snprintf(im->patch, sizeof im->patch, "%s/scene.patch", jobdir);
         if (reuse_compile(im->reuse, a->scene, &co, path, im->patch, stop, &im->reused, err))

@@ -103,9 +103,10 @@ static int full_compile(reuse_state *st, const char *scene, const compile_opts *
 }
 
 /* The skeleton of the frame (JSON scenes) into *skel, mapped; its file
- * goes once mapped. */
+ * goes once mapped.  *key its meshes' key; *pkey (may be NULL) the key
+ * of a glTF scene's placed skeleton (compile_opts.placed_key). */
 static int skeleton(const char *scene, const compile_opts *co, const char *out, volatile sig_atomic_t *stop,
-                    fr_scene *skel, uint64_t *key, fr_error *err)
+                    fr_scene *skel, uint64_t *key, uint64_t *pkey, fr_error *err)
 {
     char path[4400];
     snprintf(path, sizeof path, "%s.skeleton", out);
@@ -117,6 +118,8 @@ static int skeleton(const char *scene, const compile_opts *co, const char *out, 
     if (compile_child(scene, &so, path, stop, &cs, err) < 0)
         return -1;
     *key = cs.mesh_key;
+    if (pkey)
+        *pkey = cs.placed_key;
     int rc = fbin_load(path, skel, err);
     unlink(path);
     return rc;
@@ -137,7 +140,7 @@ static int shutter_keys(const char *scene, const compile_opts *co, const char *o
         fr_scene s;
         uint64_t k = 0;
         fr_error ignored;
-        if (skeleton(scene, &at, out, stop, &s, &k, &ignored) < 0)
+        if (skeleton(scene, &at, out, stop, &s, &k, NULL, &ignored) < 0)
             return -1;
         scn_free(&s);
         *key = *key * 0x9e3779b97f4a7c15ull ^ k;
@@ -178,9 +181,11 @@ static int placed_skeleton(const reuse_state *st, const char *scene, const compi
     bo.mesh_bounds = st->bounds;
     bo.n_mesh_bounds = st->n_bounds;
     fr_error ignored;
-    if (skeleton(scene, &bo, out, stop, s, key, &ignored) < 0)
+    if (skeleton(scene, &bo, out, stop, s, key, NULL, &ignored) < 0)
         return -1;
-    if (co->timed && shutter_keys(scene, &bo, out, stop, key) < 0) {
+    /* A glTF placed skeleton reads every mesh it does not stand in for, so
+     * its sections say all the poses around the frame would. */
+    if (co->timed && !compile_is_gltf(scene) && shutter_keys(scene, &bo, out, stop, key) < 0) {
         scn_free(s);
         return -1;
     }
@@ -189,11 +194,14 @@ static int placed_skeleton(const reuse_state *st, const char *scene, const compi
 
 /* The frame made of the frame before's meshes placed anew
  * (reuse_placed.h) into `out`: 1 made (its skeleton into *s, key *key), 0
- * not, -1 with err on a write error. */
+ * not, -1 with err on a write error.  gkey: the key the frame's skeleton
+ * gave for a glTF scene's placed skeleton, which is not made unless it is
+ * the frame before's (it reads the meshes it does not stand in for). */
 static int placed(const reuse_state *st, const char *scene, const compile_opts *co, const char *out,
-                  volatile sig_atomic_t *stop, fr_scene *s, uint64_t *key, fr_error *err)
+                  volatile sig_atomic_t *stop, uint64_t gkey, fr_scene *s, uint64_t *key, fr_error *err)
 {
     if (!st->have || !st->placed.blob || !st->n_bounds || !files_unchanged(st->files) ||
+        (compile_is_gltf(scene) && gkey != st->placed_key) ||
         placed_skeleton(st, scene, co, out, stop, s, key) < 0)
         return 0;
     int made = *key == st->placed_key ? reuse_placed_splice(&st->full, &st->placed, s, out, err) : 0;
@@ -229,11 +237,11 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
     memset(r, 0, sizeof *r);
     double t0 = clock_now();
     fr_scene skel = {0}, now = {0}, pskel = {0};
-    uint64_t key = 0, pkey = 0;
+    uint64_t key = 0, pkey = 0, gkey = 0;
     /* A skeleton that does not compile leaves the frame to a full compile,
      * which says what is wrong. */
     fr_error ignored;
-    int have_skel = skeleton(scene, co, out, stop, &skel, &key, &ignored) == 0;
+    int have_skel = skeleton(scene, co, out, stop, &skel, &key, &gkey, &ignored) == 0;
     uint64_t key_now = key; /* the frame's own, as its full compile's */
     if (have_skel && co->timed && shutter_keys(scene, co, out, stop, &key) < 0) {
         scn_free(&skel);
@@ -248,7 +256,7 @@ int reuse_compile(reuse_state *st, const char *scene, const compile_opts *co, co
         return -1;
     }
     /* Else the meshes may be the frame before's placed elsewhere. */
-    if (!made && (made = placed(st, scene, co, out, stop, &pskel, &pkey, err)) < 0) {
+    if (!made && (made = placed(st, scene, co, out, stop, gkey, &pskel, &pkey, err)) < 0) {
         scn_free(&skel);
         return -1;
     }

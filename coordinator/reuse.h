@@ -17,8 +17,13 @@
  * only the instances of meshes moved (a rigid object placed by keyed
  * instances), the frame is made of the frame before's mesh sections and
  * the rest of a skeleton given those meshes' bounds (reuse_placed.h),
- * keyed by the meshes' content alone.  Anything else (a mesh that moves
- * itself, a mesh of its file's materials, a glTF mesh, a section the
+ * keyed by the meshes' content alone; a glTF mesh placed by instances
+ * (drawn by several nodes, or moving across the shutter) is such a mesh,
+ * keyed by the file's identity, its node and whether it moves
+ * (scene_hooks.h's mesh_bounds; without the skeletons half a frame
+ * around, as that skeleton reads every other mesh whole).  Anything else (a mesh that moves
+ * itself, a mesh of its file's materials, a glTF mesh flattened into the
+ * world's triangles that moves, skinned or morphed, a section the
  * meshes add to: the lights of an emissive mesh) compiles the frame whole, and so does a file that the last full compile
  * read and that changed since (a mesh's MTL file, a texture it names).
  * The result is byte for byte the scene a full

@@ -153,7 +153,10 @@ for sc in blur anim; do
     done
 done
 check "blur.gltf: frames 1 and 2 made of the frame before's" test "$(grep -c "scene made of" log-blur-0.5)" -eq 2
-check "anim.gltf: the moving box compiles every frame" test "$(grep -c "scene compiled" log-anim-0.5)" -eq 3
+check "anim.gltf: the moving box, sharp (flattened), compiles every frame" \
+    test "$(grep -c "scene compiled" log-anim-0)" -eq 3
+check "anim.gltf: the moving box, blurred (an instance), is made of the frame before's" \
+    test "$(grep -c "scene made of" log-anim-0.5)" -eq 2
 
 # f.000N.json places ga/morphN.gltf: the same nodes, other vertices.
 for i in 1 2; do

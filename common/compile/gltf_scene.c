@@ -21,6 +21,7 @@
 #include "compile/gltf_anim.h"
 #include "compile/gltf_doc.h"
 #include "compile/gltf_mat.h"
+#include "compile/standin.h"
 
 /* Extensions read here or in gltf_mat.c; any other one used is reported. */
 static const char *const known_extensions[] = {
@@ -94,6 +95,9 @@ typedef struct {
     unsigned char *placed;     /* with skins: which nodes of world are set (in the scene) */
     affine *shut[2];           /* with a shutter: every node's world transform at its opening and closing
                                   (gltf_motion), else NULL */
+    int stand;                 /* reading a mesh for its materials only (placed_mesh): primitive() stops
+                                  once it has made its material */
+    uint32_t stand_mat;        /* then the first primitive's material, or FR_NONE */
 } imp;
 
 /* A skin as one node uses it: its joints' matrices (joint's world
@@ -366,6 +370,11 @@ static int primitive(imp *c, uint32_t mesh, uint32_t pi, const cJSON *p, const a
     const double *uvxf = NULL;
     if (mat == FR_NONE && gmat_material(&c->mat, imat, &mat, &uvxf, err) < 0)
         return -1;
+    if (c->stand) {
+        if (c->stand_mat == FR_NONE)
+            c->stand_mat = mat;
+        return 0;
+    }
 
     /* (a skinned mesh: its first joint's orientation decides the winding) */
     double det = af_det(sk ? &sk->joint[0] : w), cof[3][3];
@@ -529,9 +538,8 @@ static int blends(const fr_builder *b, uint32_t k, const affine *frame)
  * node (builder_instance.h), unless morph weights bend it: then this node's
  * copy is placed into the world's triangles. */
 /* What places and shapes node n's mesh m, folded into the hooks' key. */
-static void mesh_key(imp *c, uint32_t n, uint32_t m, const affine *w, const morph *mw, const skinning *sk)
+static void mesh_key(uint64_t *k, uint32_t n, uint32_t m, const affine *w, const morph *mw, const skinning *sk)
 {
-    uint64_t *k = c->hooks ? c->hooks->mesh_key : NULL;
     if (!k)
         return;
     uint32_t id[4] = {n, m, mw->n, sk ? sk->n : 0};
@@ -540,6 +548,45 @@ static void mesh_key(imp *c, uint32_t n, uint32_t m, const affine *w, const morp
     *k = XXH3_64bits_withSeed(mw->w, mw->n * sizeof *mw->w, *k);
     if (sk)
         *k = XXH3_64bits_withSeed(sk->joint, sk->n * sizeof *sk->joint, *k);
+}
+
+/* What a placed skeleton's stand-in (scene_hooks.h's mesh_bounds) stands
+ * for, folded into *k: node n's mesh m placed by an instance that moves
+ * or not, wherever that is. */
+static void placed_key(uint64_t *k, uint32_t n, uint32_t m, int moves)
+{
+    uint32_t id[4] = {n, m, (uint32_t)moves, 0x51a4du};
+    if (k)
+        *k = XXH3_64bits_withSeed(id, sizeof id, *k);
+}
+
+/* A placed skeleton's builder mesh for glTF mesh m into *k: its materials
+ * made as reading it makes them (in the same order), then standin.h's
+ * triangle spanning the bounds of the full compile's mesh of the same
+ * index, of the first primitive's material. */
+static int placed_mesh(imp *c, uint32_t m, const morph *mw, uint32_t *k, fr_error *err)
+{
+    const scene_hooks *h = c->hooks;
+    uint32_t at = c->b->meshes.count;
+    char ptr[48];
+    snprintf(ptr, sizeof ptr, "/meshes/%u", m);
+    if (at >= h->n_mesh_bounds)
+        return gdoc_fail(c->d, err, ptr, "the skeleton has no bounds for its mesh %u", at);
+    affine id;
+    af_identity(&id);
+    c->stand = 1;
+    c->stand_mat = FR_NONE;
+    int rc = mesh_prims(c, m, &id, mw, NULL, err);
+    c->stand = 0;
+    if (rc < 0)
+        return -1;
+    if (c->stand_mat == FR_NONE)
+        return gdoc_fail(c->d, err, ptr, "no triangles for a stand-in");
+    fr_error e;
+    if (standin_mesh(c->b, h->mesh_bounds + 6 * (size_t)at, c->stand_mat, k, &e) < 0)
+        return gdoc_fail(c->d, err, ptr, "%s", e.msg);
+    c->r->triangles++;
+    return 0;
 }
 
 /* A skeleton's mesh: one triangle of the default material in its place. */
@@ -570,19 +617,32 @@ static int mesh(imp *c, uint32_t n, uint32_t m, const affine *w, const skinning 
                   "blurred: it is posed at the frame's time, sharp", ptr);
         moves = 0;
     }
-    mesh_key(c, n, m, w, &mw, sk);
-    /* The poses at the shutter's ends are part of what the mesh makes. */
-    if (moves && c->hooks && c->hooks->mesh_key) {
-        mesh_key(c, n, m, &c->shut[0][n], &mw, sk);
-        mesh_key(c, n, m, &c->shut[1][n], &mw, sk);
+    /* A placed skeleton (scene_hooks.h's mesh_bounds) stands in for the
+     * meshes placed by instances, keyed without their placement. */
+    int instanced = (c->uses[m] >= 2 || moves) && !mw.n && !sk;
+    int placed = c->hooks && c->hooks->skeleton && c->hooks->mesh_bounds && instanced;
+    uint64_t *keys[2] = {c->hooks ? c->hooks->mesh_key : NULL, c->hooks ? c->hooks->placed_key : NULL};
+    for (int i = 0; i < 2; i++) {
+        if (i ? instanced : placed) {
+            placed_key(keys[i], n, m, moves);
+            continue;
+        }
+        mesh_key(keys[i], n, m, w, &mw, sk);
+        /* The poses at the shutter's ends are part of what the mesh makes. */
+        if (moves) {
+            mesh_key(keys[i], n, m, &c->shut[0][n], &mw, sk);
+            mesh_key(keys[i], n, m, &c->shut[1][n], &mw, sk);
+        }
     }
-    if (c->hooks && c->hooks->skeleton)
+    if (c->hooks && c->hooks->skeleton && !c->hooks->mesh_bounds)
         return stand_in(c, err);
     const affine *w_frame = w;
     if (moves)
         w = &c->shut[0][n];
     if ((c->uses[m] < 2 && !moves) || mw.n || sk)
         return mesh_prims(c, m, w, &mw, sk, err);
+    if (c->mesh_of[m] == FR_NONE && placed && placed_mesh(c, m, &mw, &c->mesh_of[m], err) < 0)
+        return -1;
     if (c->mesh_of[m] == FR_NONE) {
         affine id;
         af_identity(&id);
@@ -1119,7 +1179,7 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
 {
     memset(r, 0, sizeof *r);
     imp c = {d, hooks, o, b, r, {0}, o->max_triangles ? o->max_triangles : GLTF_MAX_TRIANGLES, 0, -1, 0,
-             NULL, NULL, {0}, NULL, NULL, {NULL, NULL}};
+             NULL, NULL, {0}, NULL, NULL, {NULL, NULL}, 0, FR_NONE};
     gdoc_warn_extensions(d, known_extensions);
     if (o->animate) {
         if (ganim_eval(d, o->time, &c.pose, err) < 0) {
@@ -1152,16 +1212,19 @@ static int import_doc(gltf_doc *d, const scene_hooks *hooks, const gltf_options 
  * may hold other meshes under the same nodes. */
 static void file_key(const char *path, const scene_hooks *hooks)
 {
-    uint64_t *k = hooks ? hooks->mesh_key : NULL;
     struct stat st;
     uint64_t id[5] = {0};
-    if (!k)
+    if (!hooks)
         return;
     if (stat(path, &st) == 0)
         id[0] = (uint64_t)st.st_dev, id[1] = (uint64_t)st.st_ino, id[2] = (uint64_t)st.st_size,
         id[3] = (uint64_t)st.st_mtim.tv_sec, id[4] = (uint64_t)st.st_mtim.tv_nsec;
-    *k = XXH3_64bits_withSeed(path, strlen(path) + 1, *k);
-    *k = XXH3_64bits_withSeed(id, sizeof id, *k);
+    uint64_t *keys[2] = {hooks->mesh_key, hooks->placed_key};
+    for (int i = 0; i < 2; i++)
+        if (keys[i]) {
+            *keys[i] = XXH3_64bits_withSeed(path, strlen(path) + 1, *keys[i]);
+            *keys[i] = XXH3_64bits_withSeed(id, sizeof id, *keys[i]);
+        }
 }
 
 int gltf_import(const char *path, const scene_hooks *hooks, const gltf_options *o, fr_builder *b, gltf_result *r,

@@ -99,6 +99,20 @@ typedef struct {
      * mesh, world transform, morph weights, joints), into *mesh_key, in a
      * skeleton or not alike. */
     uint64_t *mesh_key;
+    /** A skeleton only: NULL, or the object-space vertex bounds (lo x y z,
+     * hi x y z) of the n_mesh_bounds meshes (builder_instance.h) of the
+     * full compile the skeleton follows, by mesh index.  A glTF mesh placed
+     * by instances (drawn by several nodes, or moving across the shutter)
+     * then stands as standin.h's triangle spanning the bounds its mesh
+     * index has, of its first primitive's material, placed as the mesh
+     * would be; its key leaves out the node's placement.  Every other glTF
+     * mesh is read whole (its triangles are the world's). */
+    const float *mesh_bounds;
+    uint32_t n_mesh_bounds;
+    /** When not NULL: every glTF file and mesh folded into *placed_key as
+     * a skeleton with mesh_bounds folds them into *mesh_key (that key,
+     * without reading a mesh). */
+    uint64_t *placed_key;
 } scene_hooks;
 
 #endif

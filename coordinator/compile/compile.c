@@ -70,7 +70,7 @@ int compile_is_gltf(const char *path)
 
 /* The compile's meshes' key, and whether they are left out (compile_opts:
  * skeleton, mesh_key); a compile runs on one thread. */
-static uint64_t keys;
+static uint64_t keys, placed_keys;
 static int skeleton;
 static const float *bounds;
 static uint32_t n_bounds;
@@ -100,7 +100,7 @@ static int mesh_hook(fr_builder *b, const cJSON *node, const char *where, const 
 
 int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_error *err)
 {
-    keys = 0;
+    keys = placed_keys = 0;
     skeleton = o && o->skeleton;
     bounds = skeleton ? o->mesh_bounds : NULL;
     n_bounds = bounds ? o->n_mesh_bounds : 0;
@@ -113,7 +113,8 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
     scene_hooks hooks = {mesh_hook, texture_load, image_load, o ? o->warn : NULL, o ? o->user : NULL,
                          o ? o->allow : NULL, o ? o->n_allow : 0, &budget,
                          o ? o->fbin : NULL, o ? o->timed : 0, o ? o->frame : 0.0, o ? o->fps : 0.0,
-                         o ? o->shutter : 0.0, skeleton, &keys};
+                         o ? o->shutter : 0.0, skeleton, &keys, bounds, n_bounds,
+                         o && o->placed_key ? &placed_keys : NULL};
     int rc;
     if (compile_is_gltf(path))
         rc = gltf_load_scene(path, &hooks, o ? o->camera : NULL, out, err);
@@ -123,6 +124,8 @@ int compile_scene(const char *path, const compile_opts *o, fr_scene *out, fr_err
         rc = json_scene_load(path, &hooks, out, err);
     if (rc == 0 && o && o->mesh_key)
         *o->mesh_key = keys;
+    if (rc == 0 && o && o->placed_key)
+        *o->placed_key = placed_keys;
     char where[4200];
     snprintf(where, sizeof where, "%s: the binary scene", path);
     if (rc == 0 && budget_take(&budget, BUDGET_FBIN, out->blob_size, where, err) < 0) {

@@ -44,8 +44,11 @@ typedef struct {
                                     of the n_mesh_bounds meshes of the full compile the skeleton follows,
                                     by mesh index: a mesh shape with instances and a material (without
                                     an interior medium) whose mesh index has bounds becomes mesh.h's mesh_stand_in_placed, and its
-                                    key leaves its instances out (what the mesh's own content reads) */
+                                    key leaves its instances out (what the mesh's own content reads); a
+                                    glTF scene's meshes placed by instances stand so too (scene_hooks.h) */
     uint32_t n_mesh_bounds;
+    uint64_t *placed_key;      /**< when not NULL, receives the key the same compile with mesh_bounds
+                                    would give a glTF scene (scene_hooks.h's placed_key) */
 } compile_opts;
 
 /** Help text for --limit (franja compile and franja render). */

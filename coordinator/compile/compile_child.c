@@ -83,6 +83,7 @@ static void child(const char *scene, const compile_opts *o, const char *file, in
         memset(&co, 0, sizeof co);
     co.fbin = file;
     co.mesh_key = &a.st.mesh_key;
+    co.placed_key = &a.st.placed_key;
     read_list reads = {NULL, 0, 0, 0};
     if (co.files)
         confine_watch(note_read, &reads);

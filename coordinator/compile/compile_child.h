@@ -47,6 +47,7 @@ typedef struct {
     unsigned instances, meshes; /**< placements of meshes, and the meshes they place */
     double seconds;         /**< compile time, without writing the file */
     uint64_t mesh_key;      /**< compile_opts.mesh_key's */
+    uint64_t placed_key;    /**< compile_opts.placed_key's */
 } compile_child_stats;
 
 /** Compiles `scene` with options o (warnings are reported by the child

@@ -14,6 +14,7 @@
 #include "compile/builder_instance.h"
 #include "compile/jsonval.h"
 #include "compile/mesh_import.h"
+#include "compile/standin.h"
 
 #define XXH_INLINE_ALL
 #include <xxhash.h>
@@ -302,20 +303,10 @@ int mesh_stand_in_placed(fr_builder *b, const cJSON *node, const char *where, co
     const cJSON *insts = cJSON_GetObjectItemCaseSensitive(node, "instances");
     if (!cJSON_IsArray(insts) || cJSON_GetArraySize(insts) == 0)
         return fr_fail(err, "%s.instances: expected a non-empty array of transforms", where);
-    vec3 corner[3] = {v3(box[0], box[1], box[2]), v3(box[3], box[4], box[5]), v3(box[0], box[4], box[5])};
-    uint32_t mesh = bld_mesh_begin(b), base = b->positions.count;
-    if (mesh == FR_NONE)
-        return fr_fail(err, "%s: out of memory", where);
-    for (int i = 0; i < 3; i++)
-        if (bld_push(&b->positions, &corner[i]) == FR_NONE)
-            return fr_fail(err, "%s: out of memory", where);
-    fr_triangle tri = {{base, base + 1, base + 2}, 0};
-    uint32_t ti = bld_push(&b->triangles, &tri);
-    fr_prim p = {FR_PRIM_TRIANGLE, ti, material, FR_NONE};
-    if (ti == FR_NONE || bld_push(&b->prims, &p) == FR_NONE)
-        return fr_fail(err, "%s: out of memory", where);
-    if (bld_mesh_end(b, mesh, err) < 0)
-        return -1;
+    uint32_t mesh;
+    fr_error e;
+    if (standin_mesh(b, box, material, &mesh, &e) < 0)
+        return fr_fail(err, "%s: %s", where, e.msg);
     return place_instances(b, insts, where, mesh, err);
 }
 

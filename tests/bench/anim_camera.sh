@@ -13,7 +13,9 @@
 # frame made of the frame before's sections: coordinator/reuse.h) and the
 # bytes it sent the host (the packed scene, or a patch: common/fpatch.h).
 # MOVE=instance keeps the camera still and keys instead the translation
-# of one of two instances of the knot (a rigid object moving).
+# of one of two instances of the knot (a rigid object moving); MOVE=gltf
+# is that scene as glTF (tests/bench/anim_gltf.py: one mesh drawn by two
+# nodes, one node's translation animated), rendered at 64x64, 1 spp.
 # Results: tests/bench/README.md, "A camera move through a large scene".
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 . "$ROOT/tests/support/fakehosts.sh"
@@ -38,10 +40,17 @@ cat >"$T/move.json" <<JSON
   "lights": [ { "type": "point", "position": [0, 4, -3], "intensity": [20, 20, 20] } ],
   "shapes": [ { "type": "mesh", "file": "knot.obj", "material": "gold"$INST } ] }
 JSON
+SCENE=$T/move.json
+SIZE=""
+if [ "${MOVE:-camera}" = gltf ]; then
+    SCENE=$T/move.gltf
+    SIZE="--size 64x64 --spp 1"
+    python3 tests/bench/anim_gltf.py "$T/knot.obj" "$SCENE" || exit 1
+fi
 machine
 times=""
 for i in 1 2 3; do
-    times="$times $(elapsed "bin/franja compile '$T/move.json' -o '$T/move.fbin'")" || exit 1
+    times="$times $(elapsed "bin/franja compile '$SCENE' -o '$T/move.fbin'")" || exit 1
 done
 echo "compile of one frame ($TRIS triangles): $times s, median $(median $times) s; .fbin $(stat -c %s "$T/move.fbin") bytes"
 fh_start a 2 2
@@ -50,7 +59,7 @@ r=1
 while [ $r -le "$RUNS" ]; do
     rm -rf "$T/out" "$FH/a/work/scenes"/*
     s=$(date +%s.%N)
-    fr render "$T/move.json" --frames 1-"$FRAMES" -o "$T/out/f.#.pfm" --hosts "$FH/hosts" 2>"$T/log" ||
+    fr render "$SCENE" $SIZE --frames 1-"$FRAMES" -o "$T/out/f.#.pfm" --hosts "$FH/hosts" 2>"$T/log" ||
         { cat "$T/log"; exit 1; }
     echo "run $r: render of $FRAMES frames over one SSH host: $(calc "$(date +%s.%N) - $s") s"
     sed "s/^/run $r: /" "$T/log" >>"$T/logs"
