@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "fmath.h"
 #include "motion.h"
 
 /* The polar decomposition m = r s of a 3x3 matrix (r a rotation, s the
@@ -121,11 +122,17 @@ int bld_instance_motion(fr_builder *b, uint32_t inst, const float close[3][4], f
     if (dot < 0.0) {
         for (int i = 0; i < 4; i++)
             m.q1[i] = -m.q1[i];
-        dot = -dot;
     }
-    double angle = acos(dot > 1.0 ? 1.0 : dot);
-    m.angle = (float)angle;
-    m.inv_sin = m.angle >= MOTION_SLERP_MIN ? (float)(1.0 / sin((double)m.angle)) : 0.0f;
+    /* The angle between the rotations, 2 atan2(|q1 - q0|, |q1 + q0|):
+     * accurate at small angles, where acos of the dot product is not, and
+     * the project's own atan2 and sine, the same bits on every machine. */
+    float dm = 0.0f, dp = 0.0f;
+    for (int i = 0; i < 4; i++) {
+        dm += (m.q1[i] - m.q0[i]) * (m.q1[i] - m.q0[i]);
+        dp += (m.q1[i] + m.q0[i]) * (m.q1[i] + m.q0[i]);
+    }
+    m.angle = 2.0f * fm_atan2f(sqrtf(dm), sqrtf(dp));
+    m.inv_sin = m.angle >= MOTION_SLERP_MIN ? 1.0f / fm_sinf(m.angle) : 0.0f;
     /* The blended stretch must stay invertible: its determinant keeps the
      * sign it has at both ends, at every sampled time. */
     double d0 = det3((const float(*)[3])m.s0);
