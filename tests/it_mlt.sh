@@ -38,8 +38,8 @@ for rows in 3 8; do
     check "$rows-row slabs over 2 SSH hosts give the same bytes" cmp -s ssh$rows.pfm one.pfm
 done
 
-# The partial image: its rows (black: all light is splatted), then the
-# splats of its chains over the whole image.
+# The partial image: its rows (the short paths' own radiance), then the
+# splats of its short paths and chains over the whole image.
 "$WORKER" --scene scene.fbin --rows 5:9 $SIZE $M -o part.pf
 check "the header counts the slab's mutations and hashes the splats" \
     sh -c "head -n 2 part.pf | grep -Eq '^# franja scene=[0-9a-f]{16} rows=5:9 spp=8 size=${W}x$H splat=$((W * 4 * 8)):[0-9a-f]{16}\$'"
