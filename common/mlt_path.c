@@ -260,11 +260,11 @@ int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, 
     return 0;
 }
 
-/* The short paths' samples per pixel (MLT_SHORT_DIV). */
+/* The short paths' samples per pixel (MLT_SHORT_MUL, MLT_SHORT_DIV). */
 static uint32_t short_spp(const fr_scene *s)
 {
-    uint32_t n = s->settings.spp / MLT_SHORT_DIV;
-    return n ? n : 1;
+    uint64_t n = (uint64_t)s->settings.spp * MLT_SHORT_MUL / MLT_SHORT_DIV;
+    return n < 1 ? 1 : n > UINT32_MAX ? UINT32_MAX : (uint32_t)n;
 }
 
 int mlt_render_rows(const fr_scene *s, const mlt_boot *given, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat,

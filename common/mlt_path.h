@@ -61,14 +61,18 @@
 
 /** Veach's split (1997, sec. 11.4): paths of at most MLT_SHORT_DEPTH
  * bounces (emission seen directly and direct lighting) are rendered by
- * bidirectional path tracing at spp / MLT_SHORT_DIV samples per pixel
- * (at least 1; bd_render_short), the chains cover only the longer ones. */
+ * bidirectional path tracing at spp * MLT_SHORT_MUL / MLT_SHORT_DIV
+ * samples per pixel (at least 1; bd_render_short), the chains cover only
+ * the longer ones.  One sample per mutation: a quarter of that left 1.4
+ * to 2.5 times more noise at equal time (tests/bench/README.md). */
 #ifndef MLT_SHORT_DEPTH
 #define MLT_SHORT_DEPTH 1
 #endif
-/** The short paths' samples per pixel: the render's spp over this, at least 1. */
+#ifndef MLT_SHORT_MUL
+#define MLT_SHORT_MUL 1u
+#endif
 #ifndef MLT_SHORT_DIV
-#define MLT_SHORT_DIV 4u
+#define MLT_SHORT_DIV 1u
 #endif
 
 /** The normalisation: b and b_d. */
@@ -112,9 +116,10 @@ int mlt_boot_long(const mlt_boot *bt, int short_depth, mlt_boot *out, fr_error *
 
 /** Render rows [y0, y1) of scene s by MLT, as franja-worker does: the
  * paths of at most MLT_SHORT_DEPTH bounces by bd_render_short of the
- * rows (at spp / MLT_SHORT_DIV samples per pixel, at least 1), the longer
- * ones by chains (mlt_boot_long): row y stands for chain y, of width * spp mutations (so a whole image has spp
- * mutations per pixel), normalised by bt (NULL: computed here, as the
+ * rows (spp * MLT_SHORT_MUL / MLT_SHORT_DIV samples per pixel), the
+ * longer ones by chains (mlt_boot_long): row y stands for chain y, of
+ * width * spp mutations (so a whole image has spp mutations per pixel),
+ * normalised by bt (NULL: computed here, as the
  * coordinator does, mlt_bootstrap of mlt_norm_samples); rgb (the rows' own
  * pixels) receives the short paths' own radiance and splat their
  * light-tracing splats and the chains' splats over the whole image
