@@ -6,7 +6,9 @@
 # whole image.  The stitched image is byte-identical for any slab height,
 # any number of worker processes, local or over fake SSH hosts; the
 # normalisation is computed once, by the coordinator, and handed to every
-# worker (one left to compute it gets the same bits); a resumed
+# worker (one left to compute it gets the same bits), which covers only
+# the paths of more than one bounce (the shorter ones are bidirectional
+# samples of each slab's rows); a resumed
 # job renders only the lost chains, to the same bytes; franja stitch adds
 # a kept job's splats; what MLT cannot do is refused with the reason.
 . "$(dirname "$0")/support/fakehosts.sh"
@@ -64,6 +66,15 @@ check "a worker's own normalisation gives the job's slab, byte for byte" cmp -s 
 ones=3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000
 "$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $ones -o ones.pf
 check "a worker uses the normalisation it is given" sh -c "test -s ones.pf && ! cmp -s ones.pf own.pf"
+# Veach's split: depths 0 and 1 are bidirectional samples of the slab's
+# rows, the chains cover only the longer paths, so b_0 and b_1 change
+# nothing, b_2 does.
+z=00000000
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $z,$z,$z,$z,$z,$z,$z,$z,$z -o z.pf
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm 3f800000,3f800000,$z,$z,$z,$z,$z,$z,$z -o z01.pf
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $z,$z,3f800000,$z,$z,$z,$z,$z,$z -o z2.pf
+check "the chains leave depths 0 and 1 to bidirectional samples" cmp -s z.pf z01.pf
+check "and render depth 2" sh -c "test -s z2.pf && ! cmp -s z.pf z2.pf"
 "$WORKER" --scene scene.fbin --rows 7:14 $SIZE $M --mlt-norm 3f800000 -o x.pf 2>e0
 check "a normalisation of the wrong number of depths is refused (status 2)" test $? -eq 2
 check "saying how many it expects" grep -q "1 values for mlt, expected 9" e0
