@@ -63,8 +63,9 @@
  * bounces (emission seen directly and direct lighting) are rendered by
  * bidirectional path tracing at spp * MLT_SHORT_MUL / MLT_SHORT_DIV
  * samples per pixel (at least 1; bd_render_short), the chains cover only
- * the longer ones.  One sample per mutation: a quarter of that left 1.4
- * to 2.5 times more noise at equal time (tests/bench/README.md). */
+ * the longer ones.  One sample per mutation: a quarter of that left 1.05
+ * to 2.6 times more noise at equal time, twice that no less
+ * (tests/bench/README.md). */
 #ifndef MLT_SHORT_DEPTH
 #define MLT_SHORT_DEPTH 1
 #endif
