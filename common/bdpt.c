@@ -727,15 +727,20 @@ static vec3 connect(const fr_scene *s, bd_work *w, int s_, int t, vert *sampled,
 static int finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 /* bd_sample, also adding each weighted contribution's luminance to
- * by_depth[its depth] when by_depth is not NULL. */
+ * by_depth[its depth] when by_depth is not NULL; below > 0 keeps only the
+ * depths under it (with st all MIS-weighted) and traces the subpaths no
+ * further than they need: a vertex's numbers and pdfs do not depend on
+ * the vertices after it, so the paths kept are the same bits. */
 static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
-                   bd_splat_fn splat, void *ctx, double *by_depth)
+                   bd_splat_fn splat, void *ctx, double *by_depth, int below)
 {
     fr_sampler cs, ls;
     smp_start(&cs, x, y, index, s->settings.seed);
     ls = cs;
     ls.dim = LIGHT_DIM;
     int maxd = (int)s->settings.max_depth;
+    if (below > 0 && below - 1 < maxd)
+        maxd = below - 1;
     rnd rc = {&cs, NULL}, rl = {&ls, NULL};
     int nc = w->ncam = camera_subpath(s, &rc, x, y, w->cam, maxd + 2, NULL, NULL, &w->time, &w->at);
     int nl = light_subpath(s, &rl, w->lgt, maxd + 1, w->time);
@@ -771,7 +776,7 @@ static vec3 sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_
 vec3 bd_sample(const fr_scene *s, bd_work *w, const bd_strategy *st, uint32_t x, uint32_t y, uint32_t index,
                bd_splat_fn splat, void *ctx)
 {
-    return sample(s, w, st, x, y, index, splat, ctx, NULL);
+    return sample(s, w, st, x, y, index, splat, ctx, NULL, 0);
 }
 
 static void no_splat(void *ctx, uint32_t x, uint32_t y, float r, float g, float b)
@@ -817,7 +822,7 @@ static void *norm_thread(void *arg)
         for (uint64_t q = j0; q < j1; q++) {
             uint64_t p = q / j->spp * j->pixels / j->used;
             sample(j->s, w, &all, (uint32_t)(p % j->width), (uint32_t)(p / j->width), (uint32_t)(q % j->spp),
-                   no_splat, NULL, j->sums + (size_t)b * j->nd);
+                   no_splat, NULL, j->sums + (size_t)b * j->nd, 0);
         }
     }
     bd_work_free(w);
@@ -903,15 +908,16 @@ vec3 bd_path(const fr_scene *s, bd_work *w, int s_, int t, const bd_stream *cam,
 typedef struct {
     uint64_t *buf;
     uint32_t width;
+    float scale;               /* the render's spp over the samples taken (1: the same bits) */
 } fixed_splats;
 
 static void add_fixed(void *ctx, uint32_t x, uint32_t y, float r, float g, float b)
 {
     fixed_splats *f = ctx;
     uint64_t *p = f->buf + ((size_t)y * f->width + x) * 3;
-    spl_add(&p[0], spl_fixed(r));
-    spl_add(&p[1], spl_fixed(g));
-    spl_add(&p[2], spl_fixed(b));
+    spl_add(&p[0], spl_fixed(r * f->scale));
+    spl_add(&p[1], spl_fixed(g * f->scale));
+    spl_add(&p[2], spl_fixed(b * f->scale));
 }
 
 /* The passes of one sample from its camera subpath cam[0..n) (passes.h;
@@ -935,8 +941,10 @@ int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint
     return bd_render_rows_passes(s, y0, y1, rgb, splat, 0, NULL, err);
 }
 
-int bd_render_rows_passes(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, uint32_t passes,
-                          float *out, fr_error *err)
+/* Rows [y0, y1) at spp samples per pixel, depths under below (0: all),
+ * splats scaled to the scene's spp (bd_render_rows_passes). */
+static int render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, int below, uint32_t spp, float *rgb,
+                       uint64_t *splat, uint32_t passes, float *out, fr_error *err)
 {
     if (passes & ~BD_PASSES)
         return fr_fail(err, "bidirectional path tracing does not fill render passes beyond the camera subpath's");
@@ -946,15 +954,15 @@ int bd_render_rows_passes(const fr_scene *s, uint32_t y0, uint32_t y1, float *rg
     if (!w)
         return fr_fail(err, "out of memory for the bidirectional subpaths");
     const bd_strategy all = {-1, -1, -1};
-    fixed_splats f = {splat, s->settings.width};
-    uint32_t width = s->settings.width, spp = s->settings.spp;
+    fixed_splats f = {splat, s->settings.width, (float)s->settings.spp / (float)spp};
+    uint32_t width = s->settings.width;
     uint32_t nch = pass_channels(passes);
     pass_sample ps;
     for (uint32_t y = y0; y < y1; y++)
         for (uint32_t x = 0; x < width; x++) {
             double acc[3] = {0, 0, 0}, pacc[PASS_MAX_ACC] = {0};
             for (uint32_t i = 0; i < spp; i++) {
-                vec3 c = bd_sample(s, w, &all, x, y, i, add_fixed, &f);
+                vec3 c = sample(s, w, &all, x, y, i, add_fixed, &f, NULL, below);
                 acc[0] += c.x; acc[1] += c.y; acc[2] += c.z;
                 if (passes) {
                     camera_passes(s, w->cam, w->ncam, &ps);
@@ -970,4 +978,16 @@ int bd_render_rows_passes(const fr_scene *s, uint32_t y0, uint32_t y1, float *rg
         }
     bd_work_free(w);
     return 0;
+}
+
+int bd_render_rows_passes(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, uint32_t passes,
+                          float *out, fr_error *err)
+{
+    return render_rows(s, y0, y1, 0, s->settings.spp, rgb, splat, passes, out, err);
+}
+
+int bd_render_short(const fr_scene *s, uint32_t y0, uint32_t y1, int below, uint32_t spp, float *rgb,
+                    uint64_t *splat, fr_error *err)
+{
+    return render_rows(s, y0, y1, below, spp ? spp : 1, rgb, splat, 0, NULL, err);
 }

@@ -138,6 +138,16 @@ int bd_depth_means_mt(const fr_scene *s, uint32_t n, int threads, bd_stop_fn sto
  * set when the scene is not supported or memory runs out. */
 int bd_render_rows(const fr_scene *s, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat, fr_error *err);
 
+/** bd_render_rows restricted to the paths of fewer than `below` bounces
+ * (below >= 1; the subpaths are traced only as far as those need), at
+ * spp samples per pixel (0: 1) whatever the scene's: rgb receives their
+ * mean, and splat their light-tracing splats scaled by the scene's spp
+ * over spp, so that the image is still rgb plus spl_resolve with the
+ * scene's spp (the short paths of Metropolis light transport,
+ * mlt_path.h).  -1 with err as bd_render_rows. */
+int bd_render_short(const fr_scene *s, uint32_t y0, uint32_t y1, int below, uint32_t spp, float *rgb,
+                    uint64_t *splat, fr_error *err);
+
 /** The render passes bidirectional path tracing fills (passes.h), from
  * each sample's camera subpath: the first hit's depth, position,
  * material_id, object_id and Cryptomatte, and albedo and normal at the

@@ -260,21 +260,47 @@ int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, 
     return 0;
 }
 
+/* The short paths' samples per pixel (MLT_SHORT_MUL, MLT_SHORT_DIV). */
+static uint32_t short_spp(const fr_scene *s)
+{
+    uint64_t n = (uint64_t)s->settings.spp * MLT_SHORT_MUL / MLT_SHORT_DIV;
+    return n < 1 ? 1 : n > UINT32_MAX ? UINT32_MAX : (uint32_t)n;
+}
+
 int mlt_render_rows(const fr_scene *s, const mlt_boot *given, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat,
                     fr_error *err)
 {
     if (mlt_supported(s, err) < 0)
         return -1;
-    memset(rgb, 0, (size_t)s->settings.width * (y1 - y0) * 3 * sizeof *rgb);
     mlt_boot own;
     if (!given && mlt_bootstrap(s, mlt_norm_samples(s), &own, err) < 0)
         return -1;
     if (given && given->nd != s->settings.max_depth + 1)
         return fr_fail(err, "the Metropolis normalisation has %u depths, the scene %u (max_depth + 1)", given->nd,
                        s->settings.max_depth + 1);
-    int rc = mlt_chains(s, given ? given : &own, y0, y1, s->settings.height,
-                        (uint64_t)s->settings.width * s->settings.spp, splat, err);
+    const mlt_boot *bt = given ? given : &own;
+    /* The short paths by bidirectional path tracing into the rows' own
+     * pixels and the splats; the chains get only the longer depths. */
+    int rc = bd_render_short(s, y0, y1, MLT_SHORT_DEPTH + 1, short_spp(s), rgb, splat, err);
+    mlt_boot long_only = {.bd = NULL};
+    if (rc == 0 && mlt_boot_long(bt, MLT_SHORT_DEPTH, &long_only, err) < 0)
+        rc = -1;
+    if (rc == 0)
+        rc = mlt_chains(s, &long_only, y0, y1, s->settings.height, (uint64_t)s->settings.width * s->settings.spp,
+                        splat, err);
+    mlt_boot_free(&long_only);
     if (!given)
         mlt_boot_free(&own);
     return rc;
+}
+
+int mlt_boot_long(const mlt_boot *bt, int short_depth, mlt_boot *out, fr_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->nd = bt->nd;
+    if (!(out->bd = calloc(bt->nd ? bt->nd : 1, sizeof *out->bd)))
+        return fr_fail(err, "out of memory for the Metropolis normalisation");
+    for (uint32_t d = 0; d < bt->nd; d++)
+        out->b += out->bd[d] = (int)d > short_depth ? bt->bd[d] : 0.0;
+    return 0;
 }

@@ -59,6 +59,23 @@
 /** Probability of a large step (Kelemen et al.'s suggestion is 0.1-0.5). */
 #define MLT_P_LARGE 0.3f
 
+/** Veach's split (1997, sec. 11.4): paths of at most MLT_SHORT_DEPTH
+ * bounces (emission seen directly and direct lighting) are rendered by
+ * bidirectional path tracing at spp * MLT_SHORT_MUL / MLT_SHORT_DIV
+ * samples per pixel (at least 1; bd_render_short), the chains cover only
+ * the longer ones.  One sample per mutation: a quarter of that left 1.05
+ * to 2.6 times more noise at equal time, twice that no less
+ * (tests/bench/README.md). */
+#ifndef MLT_SHORT_DEPTH
+#define MLT_SHORT_DEPTH 1
+#endif
+#ifndef MLT_SHORT_MUL
+#define MLT_SHORT_MUL 1u
+#endif
+#ifndef MLT_SHORT_DIV
+#define MLT_SHORT_DIV 1u
+#endif
+
 /** The normalisation: b and b_d. */
 typedef struct {
     double b;                  /**< sum over depths of the mean f: the integral of the target */
@@ -93,12 +110,21 @@ int mlt_boot_set(mlt_boot *bt, const float *bd, uint32_t nd, fr_error *err);
 int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, uint32_t n_chains, uint64_t mutations,
                uint64_t *splat, fr_error *err);
 
-/** Render rows [y0, y1) of scene s by MLT, as franja-worker does: row y
- * stands for chain y, of width * spp mutations (so a whole image has spp
- * mutations per pixel), normalised by bt (NULL: computed here, as the
+/** *out: bt with b_d = 0 for d <= short_depth (what the chains cover when
+ * bidirectional path tracing renders those depths); -1 with err when out
+ * of memory.  Free with mlt_boot_free. */
+int mlt_boot_long(const mlt_boot *bt, int short_depth, mlt_boot *out, fr_error *err);
+
+/** Render rows [y0, y1) of scene s by MLT, as franja-worker does: the
+ * paths of at most MLT_SHORT_DEPTH bounces by bd_render_short of the
+ * rows (spp * MLT_SHORT_MUL / MLT_SHORT_DIV samples per pixel), the
+ * longer ones by chains (mlt_boot_long): row y stands for chain y, of
+ * width * spp mutations (so a whole image has spp mutations per pixel),
+ * normalised by bt (NULL: computed here, as the
  * coordinator does, mlt_bootstrap of mlt_norm_samples); rgb (the rows' own
- * pixels) is zeroed and splat receives the chains' splats over the whole
- * image (bd_render_rows' contract: the image is rgb plus spl_resolve with
+ * pixels) receives the short paths' own radiance and splat their
+ * light-tracing splats and the chains' splats over the whole image
+ * (bd_render_rows' contract: the image is rgb plus spl_resolve with
  * spp).  -1 with err when unsupported, bt has another number of depths
  * than the scene, or out of memory. */
 int mlt_render_rows(const fr_scene *s, const mlt_boot *bt, uint32_t y0, uint32_t y1, float *rgb, uint64_t *splat,

@@ -6,7 +6,9 @@
 # whole image.  The stitched image is byte-identical for any slab height,
 # any number of worker processes, local or over fake SSH hosts; the
 # normalisation is computed once, by the coordinator, and handed to every
-# worker (one left to compute it gets the same bits); a resumed
+# worker (one left to compute it gets the same bits), which covers only
+# the paths of more than one bounce (the shorter ones are bidirectional
+# samples of each slab's rows); a resumed
 # job renders only the lost chains, to the same bytes; --time-limit writes
 # its last complete pass, the bytes of a render asked for its mutations,
 # as bright as the whole render; franja stitch adds a kept job's splats;
@@ -101,8 +103,8 @@ check "to 8, the passes of 1 not rendered again" sh -c "grep -q 'pass [0-9]* don
 check "the bytes of 8 at once" cmp -s tr.pfm one.pfm
 check "no slab discarded" sh -c "! grep -q discarded logtr"
 
-# The partial image: its rows (black: all light is splatted), then the
-# splats of its chains over the whole image.
+# The partial image: its rows (the short paths' own radiance), then the
+# splats of its short paths and chains over the whole image.
 "$WORKER" --scene scene.fbin --rows 5:9 $SIZE $M -o part.pf
 check "the header counts the slab's mutations and hashes the splats" \
     sh -c "head -n 2 part.pf | grep -Eq '^# franja scene=[0-9a-f]{16} rows=5:9 spp=8 size=${W}x$H splat=$((W * 4 * 8)):[0-9a-f]{16}\$'"
@@ -127,6 +129,15 @@ check "a worker's own normalisation gives the job's slab, byte for byte" cmp -s 
 ones=3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000,3f800000
 "$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $ones -o ones.pf
 check "a worker uses the normalisation it is given" sh -c "test -s ones.pf && ! cmp -s ones.pf own.pf"
+# Veach's split: depths 0 and 1 are bidirectional samples of the slab's
+# rows, the chains cover only the longer paths, so b_0 and b_1 change
+# nothing, b_2 does.
+z=00000000
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $z,$z,$z,$z,$z,$z,$z,$z,$z -o z.pf
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm 3f800000,3f800000,$z,$z,$z,$z,$z,$z,$z -o z01.pf
+"$WORKER" --scene scene.fbin --rows 0:7 $SIZE $M --mlt-norm $z,$z,3f800000,$z,$z,$z,$z,$z,$z -o z2.pf
+check "the chains leave depths 0 and 1 to bidirectional samples" cmp -s z.pf z01.pf
+check "and render depth 2" sh -c "test -s z2.pf && ! cmp -s z.pf z2.pf"
 "$WORKER" --scene scene.fbin --rows 7:14 $SIZE $M --mlt-norm 3f800000 -o x.pf 2>e0
 check "a normalisation of the wrong number of depths is refused (status 2)" test $? -eq 2
 check "saying how many it expects" grep -q "1 values for mlt, expected 9" e0
