@@ -13,6 +13,7 @@
 
 #include "bdpt.h"
 #include "check.h"
+#include "scenes.h"
 #include "compile/json_scene.h"
 
 #define MAXD 64
@@ -55,11 +56,7 @@ static void same_bits(const fr_scene *s, uint32_t n)
 int main(void)
 {
     fr_scene s;
-    fr_error err;
-    if (json_scene_load("scenes/cornell.json", NULL, &s, &err) < 0) {
-        CHECK(0, "%s", err.msg);
-        return check_done();
-    }
+    test_scene_file("scenes/cornell.json", &s);
     s.settings.width = 24;
     s.settings.height = 24;
     CHECK(s.settings.max_depth + 1 <= MAXD, "max_depth %u", s.settings.max_depth);

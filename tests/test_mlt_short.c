@@ -16,6 +16,7 @@
 
 #include "bdpt.h"
 #include "check.h"
+#include "scenes.h"
 #include "compile/json_scene.h"
 #include "mlt_path.h"
 #include "pathtrace.h"
@@ -82,10 +83,7 @@ int main(void)
 {
     fr_scene s;
     fr_error err;
-    if (json_scene_load("scenes/cornell.json", NULL, &s, &err) < 0) {
-        CHECK(0, "%s", err.msg);
-        return check_done();
-    }
+    test_scene_file("scenes/cornell.json", &s);
     s.settings.width = W;
     s.settings.height = H;
     s.settings.noise_threshold = 0.0f;

@@ -24,6 +24,17 @@ static inline void test_scene_with(const char *json, const char *file, const sce
     bld_free(&b);
 }
 
+/* Load the scene file `path` (relative to the project's root, where tests
+ * run); aborts the test on error, as test_scene_with does. */
+static inline void test_scene_file(const char *path, fr_scene *out)
+{
+    fr_error err;
+    if (json_scene_load(path, NULL, out, &err) < 0) {
+        printf("FAIL scene %s: %s\n", path, err.msg);
+        exit(1);
+    }
+}
+
 /* Parse and freeze a scene from JSON text (no asset loaders). */
 static inline void test_scene(const char *json, fr_scene *out) { test_scene_with(json, "(test)", NULL, out); }
 
