@@ -6,6 +6,7 @@
 #include "bvh.h"
 #include "file.h"
 #include "fmath.h"
+#include "le.h"
 #include "motion.h"
 #include "passes.h"
 #include "proto_limits.h"
@@ -87,10 +88,6 @@ static const section_desc sections[SEC_COUNT + 1] = {
 };
 #undef ARR
 
-static void put32(unsigned char *p, uint32_t v) { for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i)); }
-static void put64(unsigned char *p, uint64_t v) { for (int i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i)); }
-static uint32_t get32(const unsigned char *p) { uint32_t v = 0; for (int i = 3; i >= 0; i--) v = v << 8 | p[i]; return v; }
-static uint64_t get64(const unsigned char *p) { uint64_t v = 0; for (int i = 7; i >= 0; i--) v = v << 8 | p[i]; return v; }
 
 static size_t align_up(size_t x) { return (x + ALIGN - 1) & ~(size_t)(ALIGN - 1); }
 
@@ -110,11 +107,11 @@ void fbin_hash_hex(uint64_t hash, char buf[17]) { snprintf(buf, 17, "%016llx", (
 void fbin_put_header(unsigned char *head, uint64_t size)
 {
     memcpy(head, fbin_magic, 8);
-    put32(head + 8, FBIN_VERSION);
-    put32(head + 12, 0x01020304u);
-    put32(head + 16, HEADER_SIZE);
-    put32(head + 20, SEC_COUNT);
-    put64(head + 24, size);
+    le_put32(head + 8, FBIN_VERSION);
+    le_put32(head + 12, 0x01020304u);
+    le_put32(head + 16, HEADER_SIZE);
+    le_put32(head + 20, SEC_COUNT);
+    le_put64(head + 24, size);
 }
 
 /* The bytes before the first section: header (hash still zero) and
@@ -132,11 +129,11 @@ static size_t layout(const fr_scene *view, unsigned char head[HEAD_SIZE], size_t
         sec_data(view, id, &count);
         offsets[id] = off;
         unsigned char *e = head + HEADER_SIZE + (size_t)ENTRY_SIZE * (id - 1);
-        put32(e, (uint32_t)id);
-        put32(e + 4, sections[id].elem);
-        put64(e + 8, off);
-        put64(e + 16, count);
-        put64(e + 24, count * sections[id].elem);
+        le_put32(e, (uint32_t)id);
+        le_put32(e + 4, sections[id].elem);
+        le_put64(e + 8, off);
+        le_put64(e + 16, count);
+        le_put64(e + 24, count * sections[id].elem);
         off = align_up(off + count * sections[id].elem);
     }
     fbin_put_header(head, off);
@@ -167,7 +164,7 @@ int fbin_serialize(const fr_scene *view, void **blob, size_t *size, fr_error *er
         if (count)
             memcpy(p + offsets[id], data, count * sections[id].elem);
     }
-    put64(p + 32, XXH3_64bits(p + HEADER_SIZE, off - HEADER_SIZE));
+    le_put64(p + 32, XXH3_64bits(p + HEADER_SIZE, off - HEADER_SIZE));
     *blob = p;
     *size = off;
     return 0;
@@ -199,7 +196,7 @@ int fbin_write_view(const fr_scene *view, const char *path, uint64_t *hash, size
     }
     uint64_t h = XXH3_64bits_digest(st);
     XXH3_freeState(st);
-    put64(head + 32, h);
+    le_put64(head + 32, h);
     file_out o;
     if (file_out_open(path, &o, err))
         return -1;
@@ -698,30 +695,30 @@ int fbin_open_mem(void *blob, size_t size, int mapped, fr_scene *out, fr_error *
         return fr_fail(err, "header: file is %zu bytes, shorter than the %d-byte header", size, HEADER_SIZE);
     if (memcmp(p, fbin_magic, 8) != 0)
         return fr_fail(err, "byte 0: not a Franja binary scene (bad magic)");
-    if (get32(p + 8) != FBIN_VERSION)
-        return fr_fail(err, "byte 8: scene format version %u, this program reads version %d", get32(p + 8), FBIN_VERSION);
-    if (get32(p + 12) != 0x01020304u || *(const uint32_t *)"\1\0\0\0" != 1)
+    if (le_get32(p + 8) != FBIN_VERSION)
+        return fr_fail(err, "byte 8: scene format version %u, this program reads version %d", le_get32(p + 8), FBIN_VERSION);
+    if (le_get32(p + 12) != 0x01020304u || *(const uint32_t *)"\1\0\0\0" != 1)
         return fr_fail(err, "byte 12: byte order mismatch (binary scenes are little-endian)");
-    uint32_t nsec = get32(p + 20);
-    if (get32(p + 16) != HEADER_SIZE || nsec != SEC_COUNT)
-        return fr_fail(err, "byte 16: header size %u / section count %u, expected %d / %d", get32(p + 16), nsec, HEADER_SIZE, SEC_COUNT);
-    if (get64(p + 24) != size)
-        return fr_fail(err, "byte 24: header says %llu bytes, file has %zu (truncated?)", (unsigned long long)get64(p + 24), size);
+    uint32_t nsec = le_get32(p + 20);
+    if (le_get32(p + 16) != HEADER_SIZE || nsec != SEC_COUNT)
+        return fr_fail(err, "byte 16: header size %u / section count %u, expected %d / %d", le_get32(p + 16), nsec, HEADER_SIZE, SEC_COUNT);
+    if (le_get64(p + 24) != size)
+        return fr_fail(err, "byte 24: header says %llu bytes, file has %zu (truncated?)", (unsigned long long)le_get64(p + 24), size);
     if ((size_t)HEADER_SIZE + (size_t)ENTRY_SIZE * nsec > size)
         return fr_fail(err, "byte %d: section table runs past the end of the file", HEADER_SIZE);
     for (int k = 40; k < HEADER_SIZE; k++)
         if (p[k])
             return fr_fail(err, "byte %d: reserved header byte is not zero", k);
     uint64_t hash = XXH3_64bits(p + HEADER_SIZE, size - HEADER_SIZE);
-    if (hash != get64(p + 32))
+    if (hash != le_get64(p + 32))
         return fr_fail(err, "byte 32: content hash mismatch (file is corrupt)");
     /* Sections follow the table in id order without overlapping. */
     uint64_t next = HEADER_SIZE + (uint64_t)ENTRY_SIZE * nsec, offs[SEC_COUNT + 1] = {0};
     for (uint32_t k = 0; k < nsec; k++) {
         const unsigned char *e = p + HEADER_SIZE + (size_t)ENTRY_SIZE * k;
         size_t at = HEADER_SIZE + (size_t)ENTRY_SIZE * k;
-        uint32_t id = get32(e), elem = get32(e + 4);
-        uint64_t off = get64(e + 8), count = get64(e + 16), bytes = get64(e + 24);
+        uint32_t id = le_get32(e), elem = le_get32(e + 4);
+        uint64_t off = le_get64(e + 8), count = le_get64(e + 16), bytes = le_get64(e + 24);
         if (id != k + 1)
             return fr_fail(err, "byte %zu: section %u has id %u, expected %u", at, k, id, k + 1);
         const section_desc *d = &sections[id];

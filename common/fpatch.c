@@ -10,6 +10,7 @@
 
 #include "fbin.h"
 #include "file.h"
+#include "le.h"
 
 #define XXH_INLINE_ALL
 #include <xxhash.h>
@@ -22,10 +23,6 @@ _Static_assert(FPATCH_SECTIONS <= 64, "a patch's mask has 64 bits: a new mask is
 enum { SCN_HEAD = (SCN_HEADER + SCN_ENTRY * FPATCH_SECTIONS + SCN_ALIGN - 1) & ~(SCN_ALIGN - 1) };
 static const unsigned char scn_magic[8] = {0x89, 'F', 'R', 'J', 'S', 'C', 'N', '\n'};
 
-static void wr32(unsigned char *p, uint32_t v) { for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i)); }
-static void wr64(unsigned char *p, uint64_t v) { for (int i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i)); }
-static uint32_t rd32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
-static uint64_t rd64(const unsigned char *p) { return (uint64_t)rd32(p) | (uint64_t)rd32(p + 4) << 32; }
 
 int fpatch_sections(const void *blob, size_t size, fpatch_sect s[FPATCH_SECTIONS + 1], fr_error *err)
 {
@@ -33,14 +30,14 @@ int fpatch_sections(const void *blob, size_t size, fpatch_sect s[FPATCH_SECTIONS
     memset(s, 0, sizeof(fpatch_sect) * (FPATCH_SECTIONS + 1));
     if (size < SCN_HEAD || memcmp(p, scn_magic, 8))
         return fr_fail(err, "byte 0: not a binary scene");
-    if (rd32(p + 16) != SCN_HEADER || rd32(p + 20) != FPATCH_SECTIONS)
-        return fr_fail(err, "byte 16: header size %u / section count %u, expected %d / %d", rd32(p + 16),
-                       rd32(p + 20), SCN_HEADER, FPATCH_SECTIONS);
+    if (le_get32(p + 16) != SCN_HEADER || le_get32(p + 20) != FPATCH_SECTIONS)
+        return fr_fail(err, "byte 16: header size %u / section count %u, expected %d / %d", le_get32(p + 16),
+                       le_get32(p + 20), SCN_HEADER, FPATCH_SECTIONS);
     for (uint32_t k = 0; k < FPATCH_SECTIONS; k++) {
         const unsigned char *e = p + SCN_HEADER + (size_t)SCN_ENTRY * k;
-        uint32_t elem = rd32(e + 4);
-        uint64_t off = rd64(e + 8), count = rd64(e + 16);
-        if (rd32(e) != k + 1 || elem == 0 || count > 0xffffffffu || off > size || count > (size - off) / elem)
+        uint32_t elem = le_get32(e + 4);
+        uint64_t off = le_get64(e + 8), count = le_get64(e + 16);
+        if (le_get32(e) != k + 1 || elem == 0 || count > 0xffffffffu || off > size || count > (size - off) / elem)
             return fr_fail(err, "byte %zu: section %u out of bounds", (size_t)(e - p), k + 1);
         s[k + 1] = (fpatch_sect){p + off, elem, count};
     }
@@ -75,16 +72,16 @@ int fpatch_assemble(const fpatch_sect s[FPATCH_SECTIONS + 1], void **blob, size_
     for (int id = 1; id <= FPATCH_SECTIONS; id++) {
         unsigned char *e = p + SCN_HEADER + (size_t)SCN_ENTRY * (id - 1);
         size_t bytes = (size_t)(s[id].count * s[id].elem);
-        wr32(e, (uint32_t)id);
-        wr32(e + 4, s[id].elem);
-        wr64(e + 8, off[id]);
-        wr64(e + 16, s[id].count);
-        wr64(e + 24, bytes);
+        le_put32(e, (uint32_t)id);
+        le_put32(e + 4, s[id].elem);
+        le_put64(e + 8, off[id]);
+        le_put64(e + 16, s[id].count);
+        le_put64(e + 24, bytes);
         if (bytes)
             memcpy(p + off[id], s[id].data, bytes);
     }
     *hash = XXH3_64bits(p + SCN_HEADER, n - SCN_HEADER);
-    wr64(p + 32, *hash);
+    le_put64(p + 32, *hash);
     *blob = p;
     *size = n;
     return 0;
@@ -102,7 +99,7 @@ int fpatch_make(const void *base, size_t bsize, const void *res, size_t rsize, v
     fr_error e;
     if (fpatch_sections(base, bsize, b, &e) < 0 || fpatch_sections(res, rsize, r, &e) < 0)
         return fr_fail(err, "patch: %s", e.msg);
-    if (rd32((const unsigned char *)base + 8) != rd32((const unsigned char *)res + 8))
+    if (le_get32((const unsigned char *)base + 8) != le_get32((const unsigned char *)res + 8))
         return fr_fail(err, "patch: scenes of two format versions");
     uint64_t mask = 0;
     size_t n = FPATCH_HEADER;
@@ -115,21 +112,21 @@ int fpatch_make(const void *base, size_t bsize, const void *res, size_t rsize, v
     if (!p)
         return fr_fail(err, "out of memory making a patch of %zu bytes", n);
     memcpy(p, FPATCH_MAGIC, 8);
-    wr32(p + 8, FPATCH_VERSION);
-    wr32(p + 12, (uint32_t)mask);
-    wr32(p + 52, (uint32_t)(mask >> 32));
-    wr64(p + 16, rd64((const unsigned char *)base + 32));
-    wr64(p + 24, bsize);
-    wr64(p + 32, rd64((const unsigned char *)res + 32));
-    wr64(p + 40, rsize);
-    wr32(p + 48, rd32((const unsigned char *)res + 8));
+    le_put32(p + 8, FPATCH_VERSION);
+    le_put32(p + 12, (uint32_t)mask);
+    le_put32(p + 52, (uint32_t)(mask >> 32));
+    le_put64(p + 16, le_get64((const unsigned char *)base + 32));
+    le_put64(p + 24, bsize);
+    le_put64(p + 32, le_get64((const unsigned char *)res + 32));
+    le_put64(p + 40, rsize);
+    le_put32(p + 48, le_get32((const unsigned char *)res + 8));
     size_t at = FPATCH_HEADER;
     for (int id = 1; id <= FPATCH_SECTIONS; id++)
         if (mask >> (id - 1) & 1) {
             size_t bytes = (size_t)(r[id].count * r[id].elem);
-            wr32(p + at, (uint32_t)id);
-            wr32(p + at + 4, r[id].elem);
-            wr64(p + at + 8, r[id].count);
+            le_put32(p + at, (uint32_t)id);
+            le_put32(p + at + 4, r[id].elem);
+            le_put64(p + at + 8, r[id].count);
             memcpy(p + at + FPATCH_ENTRY, r[id].data, bytes);
             at += FPATCH_ENTRY + bytes;
         }
@@ -145,7 +142,7 @@ int fpatch_base(const void *patch, size_t psize, uint64_t *base, fr_error *err)
     if (psize < FPATCH_HEADER || memcmp(p, FPATCH_MAGIC, 8))
         return fr_fail(err, "byte 0: not a scene patch (bad magic or shorter than its %d-byte header)",
                        FPATCH_HEADER);
-    *base = rd64(p + 16);
+    *base = le_get64(p + 16);
     return 0;
 }
 
@@ -156,11 +153,11 @@ int fpatch_apply(const void *patch, size_t psize, const void *base, size_t bsize
     uint64_t want_base = 0;
     if (fpatch_base(patch, psize, &want_base, err) < 0)
         return -1;
-    if (rd32(p + 8) != FPATCH_VERSION)
-        return fr_fail(err, "byte 8: patch version %u, this program reads version %u", rd32(p + 8), FPATCH_VERSION);
-    if (rd32(p + 48) != FBIN_VERSION)
+    if (le_get32(p + 8) != FPATCH_VERSION)
+        return fr_fail(err, "byte 8: patch version %u, this program reads version %u", le_get32(p + 8), FPATCH_VERSION);
+    if (le_get32(p + 48) != FBIN_VERSION)
         return fr_fail(err, "byte 48: a patch of scene format version %u, this program reads version %d",
-                       rd32(p + 48), FBIN_VERSION);
+                       le_get32(p + 48), FBIN_VERSION);
     for (int k = 56; k < FPATCH_HEADER; k++)
         if (p[k])
             return fr_fail(err, "byte %d: reserved header byte is not zero", k);
@@ -168,11 +165,11 @@ int fpatch_apply(const void *patch, size_t psize, const void *base, size_t bsize
     fr_error e;
     if (fpatch_sections(base, bsize, s, &e) < 0)
         return fr_fail(err, "the base scene: %s", e.msg);
-    if (want_base != rd64(b + 32) || rd64(p + 24) != bsize)
+    if (want_base != le_get64(b + 32) || le_get64(p + 24) != bsize)
         return fr_fail(err, "byte 16: the patch is of base scene %016llx (%llu bytes), not of %016llx (%zu bytes)",
-                       (unsigned long long)want_base, (unsigned long long)rd64(p + 24),
-                       (unsigned long long)rd64(b + 32), bsize);
-    uint64_t mask = rd32(p + 12) | (uint64_t)rd32(p + 52) << 32;
+                       (unsigned long long)want_base, (unsigned long long)le_get64(p + 24),
+                       (unsigned long long)le_get64(b + 32), bsize);
+    uint64_t mask = le_get32(p + 12) | (uint64_t)le_get32(p + 52) << 32;
     if (mask >> FPATCH_SECTIONS)
         return fr_fail(err, "byte 52: the mask names a section past %d", FPATCH_SECTIONS);
     size_t at = FPATCH_HEADER;
@@ -181,8 +178,8 @@ int fpatch_apply(const void *patch, size_t psize, const void *base, size_t bsize
             continue;
         if (psize - at < FPATCH_ENTRY)
             return fr_fail(err, "byte %zu: section %u's entry runs past the end of the patch", at, id);
-        uint32_t got = rd32(p + at), elem = rd32(p + at + 4);
-        uint64_t count = rd64(p + at + 8);
+        uint32_t got = le_get32(p + at), elem = le_get32(p + at + 4);
+        uint64_t count = le_get64(p + at + 8);
         if (got != id)
             return fr_fail(err, "byte %zu: section %u where the mask says %u comes next", at, got, id);
         if (elem != s[id].elem)
@@ -197,18 +194,18 @@ int fpatch_apply(const void *patch, size_t psize, const void *base, size_t bsize
         return fr_fail(err, "byte %zu: %zu bytes after the last section", at, psize - at);
     size_t off[FPATCH_SECTIONS + 1];
     size_t n = laid_size(s, off);
-    uint64_t want = rd64(p + 40);
+    uint64_t want = le_get64(p + 40);
     if (!n || n != want)
         return fr_fail(err, "byte 40: the patch announces a scene of %llu bytes, its sections make %zu",
                        (unsigned long long)want, n);
     uint64_t hash;
     if (fpatch_assemble(s, out, osize, &hash, err) < 0)
         return -1;
-    if (hash != rd64(p + 32)) {
+    if (hash != le_get64(p + 32)) {
         free(*out);
         *out = NULL;
         return fr_fail(err, "byte 32: the rebuilt scene has hash %016llx, the patch announces %016llx",
-                       (unsigned long long)hash, (unsigned long long)rd64(p + 32));
+                       (unsigned long long)hash, (unsigned long long)le_get64(p + 32));
     }
     return 0;
 }
