@@ -526,7 +526,7 @@ static int cont_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
         return 0;
     const unsigned char *buf = (const unsigned char *)text;
     img_partial_info info;
-    float *rows;
+    float *rows = NULL;
     if (read_slab(buf, len, c->spec, y0, y1, &info, &rows, &e) == 0 && info.spp == c->spp && info.sums_offset) {
         size_t row = (size_t)c->spec->width * 3;
         double *sums = malloc((y1 - y0) * row * sizeof *sums);
@@ -539,8 +539,8 @@ static int cont_one(const char *dir, const char *name, uint32_t y0, uint32_t y1,
             }
             free(sums);
         }
-        free(rows);
     }
+    free(rows);
     free(text);
     return 0;
 }
