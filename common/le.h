@@ -1,5 +1,7 @@
-/* le.h -- little-endian integers in byte buffers (the binary scene's and
- * the scene patch's byte order, whatever the host's). */
+/** @file le.h
+ * Little-endian integers in byte buffers: the byte order of binary scenes
+ * and scene patches, whatever the host's.
+ */
 #ifndef FRANJA_LE_H
 #define FRANJA_LE_H
 
