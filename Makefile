@@ -127,7 +127,7 @@ bin/franja-worker: $(WORKER_OBJ) $(LIB)
 # "Profile feedback").  Its objects live in $(B)/pgo; a later plain `make`
 # keeps this worker until a source changes.
 PGO_SCENES = scenes/cornell.json scenes/metals.json scenes/sky-spheres.json
-pgo: bin/franja
+pgo: bin/franja $(IIO_PLUGIN)
 	rm -rf $(B)/pgo
 	$(MAKE) --no-print-directory B=$(B)/pgo PGO='-fprofile-generate -fprofile-update=atomic' bin/franja-worker
 	for f in $(PGO_SCENES); do \

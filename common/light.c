@@ -148,7 +148,9 @@ static inline float unit(float x) { return x < 0.0f ? 0.0f : x < 1.0f ? x : 0x1.
  * picks in the power table. */
 static inline float tree_share(const fr_scene *s, uint32_t nd) { return nd ? 1.0f - s->lights[nd - 1].cdf : 1.0f; }
 
-uint32_t lgt_choose(const fr_scene *s, vec3 from, vec3 nrm, float *u, float *pick)
+/* Inlined where it is called (always_inline): a path vertex's light pick
+ * then costs no call, and its number and pick stay in registers. */
+__attribute__((always_inline)) inline uint32_t lgt_choose(const fr_scene *s, vec3 from, vec3 nrm, float *u, float *pick)
 {
     if (s->n_lights == 0)
         return FR_NONE;

@@ -149,8 +149,9 @@ static vec3 escaped(const fr_scene *s, pt_strategy strategy, vec3 dir, vec3 beta
  * NULL (smp_start_shared): the same bits either way.  With ps not NULL,
  * what the sample brings to the render passes goes there too (passes.h);
  * the radiance is the same either way. */
-static vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x, uint32_t y, uint32_t index,
-                             smp_shared *shared, pass_sample *ps)
+static inline __attribute__((always_inline)) vec3 pt_sample_seeded(const fr_scene *s, pt_strategy strategy, uint32_t x,
+                                                                   uint32_t y, uint32_t index, smp_shared *shared,
+                                                                   pass_sample *ps)
 {
     fr_sampler smp;
     if (shared)
@@ -368,7 +369,9 @@ void pt_render_rows_passes(const fr_scene *s, pt_strategy strategy, uint32_t y0,
             double acc[3] = {0, 0, 0}, lsum = 0, lsum2 = 0, pacc[PASS_MAX_ACC] = {0};
             uint32_t n = 0;
             while (n < spp) {
-                vec3 c = pt_sample_seeded(s, strategy, x, y, n, &shared, ps);
+                /* Two copies of the sample: without passes, none of their tests. */
+                vec3 c = ps ? pt_sample_seeded(s, strategy, x, y, n, &shared, ps)
+                            : pt_sample_seeded(s, strategy, x, y, n, &shared, NULL);
                 if (ps)
                     pass_accumulate(pacc, passes, ps, n);
                 n++;

@@ -522,7 +522,10 @@ void trace_surface(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_sur
     surface(s, r, hit, out, 1);
 }
 
-void trace_surface_uv(const fr_scene *s, const fr_ray *r, const fr_hit *hit, fr_surface *out, int uv)
+/* Inlined where a path's hit point is made (always_inline): the hit and the
+ * surface are then the caller's locals, not memory behind a call. */
+__attribute__((always_inline)) inline void trace_surface_uv(const fr_scene *s, const fr_ray *r, const fr_hit *hit,
+                                                             fr_surface *out, int uv)
 {
     surface(s, r, hit, out, uv);
 }

@@ -10,6 +10,8 @@
 #define FRANJA_VEC_H
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 typedef struct { float x, y, z; } vec3;
 typedef struct { float u, v; } vec2;
@@ -40,7 +42,16 @@ static inline vec3 v3_vmax(vec3 a, vec3 b) {
     return v3(a.x > b.x ? a.x : b.x, a.y > b.y ? a.y : b.y, a.z > b.z ? a.z : b.z);
 }
 static inline float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }
-static inline int v3_is_zero(vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+/** All three coordinates == 0 (either sign), by their bits: a float
+ * compares equal to 0 exactly where its bits but the sign are 0. */
+static inline int v3_is_zero(vec3 a)
+{
+    uint32_t x, y, z;
+    memcpy(&x, &a.x, 4);
+    memcpy(&y, &a.y, 4);
+    memcpy(&z, &a.z, 4);
+    return ((x | y | z) & 0x7fffffffu) == 0;
+}
 /** Rec. 709 luminance of a linear RGB colour */
 static inline float v3_luma(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 

@@ -174,14 +174,22 @@ int vtx_direct_surface(const fr_scene *s, const fr_material *m, const fr_surface
     float tmax = ls->distant ? INFINITY : v3_dot(v3_sub(ls->p, shadow.o), ls->wi);
     out->weight = (ls->delta || !mis.area) ? 1.0f : vtx_power_heuristic(ls->pdf, out->scatter_pdf);
     float cosi = fabsf(v3_dot(ls->wi, sf->ns));
-    if (tmax > 0.0f)
-        out->unshadowed = v3_scale(v3_mul(beta, v3_mul(f, ls->radiance)), out->weight * cosi / ls->pdf);
-    vec3 tr = v3s(1.0f);
-    if (s->n_media && tmax > 0.0f)
-        tr = med_shadow(s, med_after(s, medium, m, sf->ng, ls->wi), &shadow, tmax, ls->prim);
-    if (!(tmax > 0.0f) || v3_is_zero(tr) || (!s->n_media && trace_occluded(s, &shadow, tmax, ls->prim)))
+    if (!(tmax > 0.0f))
         return 0;
-    out->L = v3_scale(v3_mul(beta, v3_mul(v3_mul(tr, f), ls->radiance)), out->weight * cosi / ls->pdf);
+    /* Without media the transmittance is 1 and L is the unshadowed light
+     * (1 * f is f, bit for bit): one product for both. */
+    float k = out->weight * cosi / ls->pdf;
+    out->unshadowed = v3_scale(v3_mul(beta, v3_mul(f, ls->radiance)), k);
+    if (!s->n_media) {
+        if (trace_occluded(s, &shadow, tmax, ls->prim))
+            return 0;
+        out->L = out->unshadowed;
+        return 1;
+    }
+    vec3 tr = med_shadow(s, med_after(s, medium, m, sf->ng, ls->wi), &shadow, tmax, ls->prim);
+    if (v3_is_zero(tr))
+        return 0;
+    out->L = v3_scale(v3_mul(beta, v3_mul(v3_mul(tr, f), ls->radiance)), k);
     return 1;
 }
 

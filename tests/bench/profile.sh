@@ -69,6 +69,8 @@ BEGIN {
         p = S
     else if (fn ~ /^(lgt_|vtx_direct|prim_point|aim|textured)/)
         p = L
+    else if (file == "trace.c" && fn ~ /^vtx_next/)
+        p = H                  # the hit point (trace_surface_uv), inlined there beside the walk entry
     else if (file == "trace.c")
         p = T                  # the entry points, inlined where they are called
     else if (fn ~ /^(pt_|vtx_|roulette|light_numbers|emission|escaped)/ || file == "vertex.c")
