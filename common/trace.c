@@ -172,8 +172,7 @@ static __attribute__((noinline)) int closest_base(const fr_scene *s, const fr_ra
 
 static __attribute__((noinline)) int occluded_base(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
-    fr_hit h = {0};
-    return walk_base(s, NULL, r, tmax, &h, 1, skip);
+    return walk_base(s, NULL, r, tmax, NULL, 1, skip);
 }
 
 #if TRACE_WIDE
@@ -194,8 +193,7 @@ static __attribute__((noinline)) int closest_wide(const fr_scene *s, const fr_ra
 
 static __attribute__((noinline)) int occluded_wide(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
-    fr_hit h = {0};
-    return walk_wide(s, NULL, r, tmax, &h, 1, skip);
+    return walk_wide(s, NULL, r, tmax, NULL, 1, skip);
 }
 #pragma GCC pop_options
 
@@ -218,8 +216,7 @@ static __attribute__((noinline)) int closest_v4(const fr_scene *s, const fr_ray 
 
 static __attribute__((noinline)) int occluded_v4(const fr_scene *s, const fr_ray *r, float tmax, uint32_t skip)
 {
-    fr_hit h = {0};
-    return walk_v4(s, NULL, r, tmax, &h, 1, skip);
+    return walk_v4(s, NULL, r, tmax, NULL, 1, skip);
 }
 #pragma GCC pop_options
 
