@@ -29,6 +29,7 @@ typedef struct {
     mlt_chain ch;
     uint64_t *splat;
     double scale;              /* the current chain's: b_d * n_chains / (chains of depth d) */
+    mlt_counts *counts;        /* per depth, or NULL */
 } runner;
 
 static uint64_t key(uint64_t tag, uint32_t seed, uint32_t k) { return tag << 62 ^ (uint64_t)seed << 32 ^ k; }
@@ -85,6 +86,7 @@ static int runner_open(runner *r, const fr_scene *s, uint64_t *splat, fr_error *
     r->s = s;
     r->splat = splat;
     r->scale = 0.0;
+    r->counts = NULL;
     r->w = bd_work_new(s);
     if (!r->w || mlt_init(&r->ch, dims(s), N_STREAMS, 0, MLT_P_LARGE) < 0) {
         bd_work_free(r->w);
@@ -230,7 +232,12 @@ static void run_chain(runner *r, const mlt_boot *bt, uint32_t k, uint32_t n_chai
         float a = x.f > 0.0f ? (y.f >= x.f ? 1.0f : y.f / x.f) : 1.0f;
         splat_state(r, &y, a);
         splat_state(r, &x, 1.0f - a);
-        if (mlt_uniform(&r->ch) < a) {
+        int accept = mlt_uniform(&r->ch) < a;
+        if (r->counts) {
+            r->counts[d].proposed[r->ch.large]++;
+            r->counts[d].accepted[r->ch.large] += (uint64_t)accept;
+        }
+        if (accept) {
             mlt_accept(&r->ch);
             x = y;
         } else {
@@ -241,6 +248,12 @@ static void run_chain(runner *r, const mlt_boot *bt, uint32_t k, uint32_t n_chai
 
 int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, uint32_t n_chains, uint64_t mutations,
                uint64_t *splat, fr_error *err)
+{
+    return mlt_chains_counted(s, bt, k0, k1, n_chains, mutations, splat, NULL, err);
+}
+
+int mlt_chains_counted(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, uint32_t n_chains,
+                       uint64_t mutations, uint64_t *splat, mlt_counts *counts, fr_error *err)
 {
     if (!(bt->b > 0.0))
         return 0;              /* no light reaches the camera: a black image */
@@ -253,6 +266,7 @@ int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, 
         return -1;
     }
     allocate(bt, n_chains, per_depth);
+    r.counts = counts;
     for (uint32_t k = k0; k < k1; k++)
         run_chain(&r, bt, k, n_chains, per_depth, mutations);
     runner_close(&r);

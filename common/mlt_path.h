@@ -110,6 +110,20 @@ int mlt_boot_set(mlt_boot *bt, const float *bd, uint32_t nd, fr_error *err);
 int mlt_chains(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, uint32_t n_chains, uint64_t mutations,
                uint64_t *splat, fr_error *err);
 
+/** What the mutations of one path length did (mlt_chains_counted): [0]
+ * small steps, [1] large steps. */
+typedef struct {
+    uint64_t proposed[2];
+    uint64_t accepted[2];
+} mlt_counts;
+
+/** mlt_chains, also adding to counts[d] (bt->nd entries, caller-owned;
+ * NULL: not counted) each mutation of path length d, by kind, and whether
+ * it was accepted: the same splats, bit for bit.  For measurements
+ * (tests/bench/mltstats.c). */
+int mlt_chains_counted(const fr_scene *s, const mlt_boot *bt, uint32_t k0, uint32_t k1, uint32_t n_chains,
+                       uint64_t mutations, uint64_t *splat, mlt_counts *counts, fr_error *err);
+
 /** *out: bt with b_d = 0 for d <= short_depth (what the chains cover when
  * bidirectional path tracing renders those depths); -1 with err when out
  * of memory.  Free with mlt_boot_free. */

@@ -94,6 +94,27 @@ static void scene_against_path(const char *path, uint32_t pt_spp, uint32_t mlt_s
           "%s: the normalisation handed over as floats renders other bits", path);
     mlt_boot_free(&given);
 
+    /* Counted: the same bits, every mutation counted once under its path
+     * length, with large steps about MLT_P_LARGE of them. */
+    static mlt_counts counts[64];
+    memset(counts, 0, sizeof counts);
+    memset(part, 0, (size_t)W * H * 3 * sizeof *part);
+    mlt_chains_counted(&s, &bt, 0, K, K, (uint64_t)W * mlt_spp / 4, part, counts, &err);
+    CHECK(memcmp(one, part, (size_t)W * H * 3 * sizeof *one) == 0, "%s: counted chains render other bits", path);
+    uint64_t proposed = 0, large = 0, accepted = 0;
+    for (uint32_t d = 0; d < bt.nd && d < 64; d++) {
+        proposed += counts[d].proposed[0] + counts[d].proposed[1];
+        large += counts[d].proposed[1];
+        accepted += counts[d].accepted[0] + counts[d].accepted[1];
+        CHECK(counts[d].accepted[0] <= counts[d].proposed[0] && counts[d].accepted[1] <= counts[d].proposed[1],
+              "%s: depth %u: more accepted than proposed", path, d);
+    }
+    CHECK(proposed == (uint64_t)K * W * mlt_spp / 4, "%s: %llu mutations counted of %llu", path,
+          (unsigned long long)proposed, (unsigned long long)K * W * mlt_spp / 4);
+    CHECK(fabs((double)large / (double)proposed - MLT_P_LARGE) < 0.01 && accepted > 0 && accepted < proposed,
+          "%s: large steps %g of the mutations, %llu accepted", path, (double)large / (double)proposed,
+          (unsigned long long)accepted);
+
     /* Groups [67, 96), [0, 5), [5, 67), added in that order. */
     const uint32_t cut[][2] = {{67, K}, {0, 5}, {5, 67}};
     for (int g = 0; g < 3; g++) {
