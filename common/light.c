@@ -257,6 +257,38 @@ static vec3 sun_radiance(const fr_light *l)
     return v3_scale(l->intensity, 1.0f / (FM_PI * sin2));
 }
 
+/* Below this area over the squared distance from the point to the
+ * light's centre (about its solid angle seen face-on), next-event
+ * estimation samples a rectangle or triangle light by area: area
+ * sampling's density (squared distance over the light's cosine) then varies
+ * over the light by less than about a factor of 2, which the stratified
+ * numbers of a pixel's samples integrate well already, and solid-angle
+ * sampling's cost (square roots, divisions and an arctangent or four
+ * arccosines a sample) would outweigh its lower noise.  This keeps it to
+ * points within about 3.2 times the square root of the light's area from
+ * its centre (tests/bench/README.md, "Solid-angle sampling of area
+ * lights"). */
+#define SOLID_MIN_SIZE 0.1f
+
+/* Whether rectangle or triangle light l (primitive pr) is near enough to
+ * `from` for solid-angle sampling (SOLID_MIN_SIZE): a few operations, done
+ * before anything of solid_setup. */
+static inline int solid_near(const fr_scene *s, const fr_light *l, const fr_prim *pr, vec3 from)
+{
+    vec3 c;
+    if (pr->kind == FR_PRIM_RECT) {
+        const fr_rect *q = &s->rects[pr->index];
+        c = v3_add(q->origin, v3_scale(v3_add(q->edge_u, q->edge_v), 0.5f));
+    } else if (pr->kind == FR_PRIM_TRIANGLE) {
+        const fr_triangle *t = &s->triangles[pr->index];
+        c = v3_scale(v3_add(s->positions[t->v[0]], v3_add(s->positions[t->v[1]], s->positions[t->v[2]])),
+                     1.0f / 3.0f);
+    } else {
+        return 0;
+    }
+    return l->area >= SOLID_MIN_SIZE * v3_len2(v3_sub(c, from));
+}
+
 /* A rectangle or triangle light seen from a point, set up for sampling
  * uniformly in solid angle (spherical.h). */
 typedef union {
@@ -269,7 +301,8 @@ typedef union {
  * v's solid angle in *omega; else it samples by area.  Solid angle for
  * rectangles and triangles where spherical.h's setups accept the point,
  * except from behind a one-sided emitter (which sends nothing there: the
- * cheaper area sample finds that out).  The sampler and the pdf
+ * cheaper area sample finds that out); called where solid_near holds.
+ * The sampler and the pdf
  * (pdf_picked) both decide here, from the same inputs: the same decision
  * and the same density, bit for bit. */
 static int solid_setup(const fr_scene *s, const fr_prim *pr, const fr_material *m, vec3 from, solid_view *v,
@@ -313,7 +346,7 @@ static float pdf_picked(const fr_scene *s, uint32_t light, float pick, vec3 from
     }
     solid_view v;
     float omega;
-    if (solid && solid_setup(s, pr, &s->materials[pr->material], from, &v, &omega))
+    if (solid && solid_near(s, l, pr, from) && solid_setup(s, pr, &s->materials[pr->material], from, &v, &omega))
         return pick / omega;
     vec3 d = v3_sub(p, from);
     float dist2 = v3_len2(d);
@@ -516,7 +549,7 @@ static inline __attribute__((always_inline)) int sample_chosen(const fr_scene *s
     }
     float ua, ub, omega;
     solid_view v;
-    if (solid && solid_setup(s, pr, m, from, &v, &omega)) {
+    if (solid && solid_near(s, l, pr, from) && solid_setup(s, pr, m, from, &v, &omega)) {
         /* Uniform in the solid angle the rectangle or triangle subtends:
          * its coordinates of the point that direction reaches. */
         if (pr->kind == FR_PRIM_RECT) {

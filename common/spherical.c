@@ -29,9 +29,6 @@ int spherical_rect_setup(vec3 from, vec3 origin, vec3 eu, vec3 ev, spherical_rec
     if (!(fabsf(v3_dot(x, y)) <= 1e-5f))
         return 0;
     vec3 d = v3_sub(origin, from);
-    vec3 dc = v3_add(d, v3_scale(v3_add(eu, ev), 0.5f));
-    if (!(ex * ey >= SPHERICAL_MIN_SIZE * v3_len2(dc)))
-        return 0;
     float z0 = -fabsf(v3_dot(d, v3_cross(x, y)));
     if (!(-z0 >= SPHERICAL_MIN_HEIGHT * sqrtf(ex * ey)))
         return 0;
@@ -109,10 +106,6 @@ int spherical_tri_setup(vec3 from, vec3 p0, vec3 p1, vec3 p2, spherical_tri *t)
 {
     vec3 ng = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
     vec3 fa = v3_sub(p0, from), fb = v3_sub(p1, from), fc = v3_sub(p2, from);
-    /* The area is |ng| / 2: compared squared, before its square root. */
-    float dc2 = v3_len2(v3_scale(v3_add(fa, v3_add(fb, fc)), 1.0f / 3.0f)), tau = SPHERICAL_MIN_SIZE;
-    if (!(0.25f * v3_len2(ng) >= tau * tau * dc2 * dc2))
-        return 0;
     float an = v3_len(ng);     /* twice the area */
     float h = v3_dot(fa, ng) / an;
     if (!(fabsf(h) >= SPHERICAL_MIN_HEIGHT * sqrtf(0.5f * an)))

@@ -17,12 +17,13 @@
  * a point on the arc from the second vertex to it uniform in solid angle.
  *
  * Each setup decides, from the point and the shape alone, whether the
- * sampling is worth its cost and safe; where it is not it returns 0 and the
- * caller samples by area: a shape small or far (its area over the squared
- * distance to its centre below SPHERICAL_MIN_SIZE), its solid angle below
- * SPHERICAL_MIN_SOLID_ANGLE (where rounding in the sums of angles would
- * show), the point within SPHERICAL_MIN_HEIGHT of the shape's size of its
- * plane (seen edge-on), or a parallelogram that is not a rectangle.  The solid angle it gives is
+ * sampling is safe; where it is not it returns 0 and the caller samples by
+ * area: the shape's solid angle below SPHERICAL_MIN_SOLID_ANGLE (where
+ * rounding in the sums of angles would show), the point within
+ * SPHERICAL_MIN_HEIGHT of the shape's size of its plane (seen edge-on), or
+ * a parallelogram that is not a rectangle.  Whether it is worth its cost
+ * is the caller's choice (light.c samples lights far from a point by
+ * area).  The solid angle it gives is
  * the sampler's density's inverse; the caller's pdf for a direction found
  * otherwise must run the same setup to take the same decision and the same
  * density (the same bits: + - * / sqrt and fmath.h only).
@@ -31,18 +32,6 @@
 #define FRANJA_SPHERICAL_H
 
 #include "vec.h"
-
-/** Below this area over squared distance from the point to the shape's
- * centre (about its solid angle seen face-on) the setups refuse: area
- * sampling's density (squared distance over the light's cosine) then
- * varies over the shape by less than about a factor of 2, which the
- * stratified numbers of a pixel's samples already integrate well, and the
- * solid-angle sampler's cost (a few square roots, divisions and an
- * arctangent or four arccosines a sample) would outweigh its lower noise.
- * It keeps the sampler to points within about 3.2 times the square root
- * of the shape's area from its centre (tests/bench/README.md, "Solid-angle
- * sampling of area lights"). */
-#define SPHERICAL_MIN_SIZE 0.1f
 
 /** Below this solid angle (steradians) the setups refuse: the spherical
  * rectangle's and triangle's solid angle is a sum of four or three angles
