@@ -23,10 +23,10 @@
  * SPHERICAL_MIN_HEIGHT of the shape's size of its plane (seen edge-on), or
  * a parallelogram that is not a rectangle.  Whether it is worth its cost
  * is the caller's choice (light.c samples lights far from a point by
- * area).  The solid angle it gives is
- * the sampler's density's inverse; the caller's pdf for a direction found
- * otherwise must run the same setup to take the same decision and the same
- * density (the same bits: + - * / sqrt and fmath.h only).
+ * area).  The solid angle it gives is the sampler's density's inverse; the
+ * caller's pdf for a direction found otherwise must run the same setup to
+ * take the same decision and the same density (the same bits: + - * /
+ * sqrt and fmath.h only).
  */
 #ifndef FRANJA_SPHERICAL_H
 #define FRANJA_SPHERICAL_H
@@ -34,10 +34,11 @@
 #include "vec.h"
 
 /** Below this solid angle (steradians) the setups refuse: the spherical
- * rectangle's and triangle's solid angle is a sum of four or three angles
- * less 2 pi or pi, whose rounding (about 1e-6 sr in float) would be more
- * than a thousandth of it; and so small a shape looks the same from all its
- * points within a few percent, where sampling by area is as good. */
+ * rectangle's solid angle is a sum of four angles less 2 pi, whose rounding
+ * (about 1e-6 sr in float) would be more than a thousandth of it, and the
+ * steps of Arvo's construction lose about 1e-16 / omega of their precision
+ * in double; and so small a shape looks the same from all its points
+ * within a few percent, where sampling by area is as good. */
 #define SPHERICAL_MIN_SOLID_ANGLE 1e-3f
 
 /** The setups refuse a point nearer to the shape's plane than this times
