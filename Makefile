@@ -74,7 +74,7 @@ all: bin/franja-worker bin/franja $(IIO_PLUGIN)
 # -ffp-contract=off and no fast-math keep every rounding where the source
 # puts it); the rest stays at $(OPT).
 HOT_SRC = $(addprefix common/,bsdf.c camera.c envmap.c fmath.c geom.c light.c medium.c microfacet.c motion.c \
-          pathtrace.c sampler.c texture.c trace.c vertex.c)
+          pathtrace.c sampler.c spherical.c texture.c trace.c vertex.c)
 # They also carry GCC's intermediate code beside the machine code (fat LTO
 # objects), and the two programs are linked with link-time optimisation:
 # calls from one of these modules into another (the sampler, the own

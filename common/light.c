@@ -8,6 +8,7 @@
 #include "envmap.h"
 #include "fmath.h"
 #include "lanes.h"
+#include "spherical.h"
 #include "texture.h"
 
 vec3 lgt_emitted(const fr_material *m, vec3 ng, vec3 w)
@@ -256,9 +257,84 @@ static vec3 sun_radiance(const fr_light *l)
     return v3_scale(l->intensity, 1.0f / (FM_PI * sin2));
 }
 
+/* Below this area over the squared distance from the point to the
+ * light's centre (about its solid angle seen face-on), next-event
+ * estimation samples a rectangle or triangle light by area: area
+ * sampling's density (squared distance over the light's cosine) then varies
+ * over the light by less than about a factor of 2, which the stratified
+ * numbers of a pixel's samples integrate well already, and solid-angle
+ * sampling's cost (square roots, divisions and an arctangent or four
+ * arccosines a sample) would outweigh its lower noise.  This keeps it to
+ * points within about 3.2 times the square root of the light's area from
+ * its centre (tests/bench/README.md, "Solid-angle sampling of area
+ * lights"). */
+#define SOLID_MIN_SIZE 0.1f
+
+/* Whether rectangle or triangle light l (primitive pr) is near enough to
+ * `from` for solid-angle sampling (SOLID_MIN_SIZE): a few operations, done
+ * before anything of solid_setup. */
+static inline int solid_near(const fr_scene *s, const fr_light *l, const fr_prim *pr, vec3 from)
+{
+    vec3 c;
+    if (pr->kind == FR_PRIM_RECT) {
+        const fr_rect *q = &s->rects[pr->index];
+        c = v3_add(q->origin, v3_scale(v3_add(q->edge_u, q->edge_v), 0.5f));
+    } else if (pr->kind == FR_PRIM_TRIANGLE) {
+        const fr_triangle *t = &s->triangles[pr->index];
+        c = v3_scale(v3_add(s->positions[t->v[0]], v3_add(s->positions[t->v[1]], s->positions[t->v[2]])),
+                     1.0f / 3.0f);
+    } else {
+        return 0;
+    }
+    return l->area >= SOLID_MIN_SIZE * v3_len2(v3_sub(c, from));
+}
+
+/* A rectangle or triangle light seen from a point, set up for sampling
+ * uniformly in solid angle (spherical.h). */
+typedef union {
+    spherical_rect rect;
+    spherical_tri tri;
+} solid_view;
+
+/* Whether next-event estimation from `from` samples emitting primitive pr
+ * (material m) uniformly in its solid angle, with *v set up and
+ * v's solid angle in *omega; else it samples by area.  Solid angle for
+ * rectangles and triangles where spherical.h's setups accept the point,
+ * except from behind a one-sided emitter (which sends nothing there: the
+ * cheaper area sample finds that out); called where solid_near holds.
+ * The sampler and the pdf
+ * (pdf_picked) both decide here, from the same inputs: the same decision
+ * and the same density, bit for bit. */
+static int solid_setup(const fr_scene *s, const fr_prim *pr, const fr_material *m, vec3 from, solid_view *v,
+                       float *omega)
+{
+    if (pr->kind == FR_PRIM_RECT) {
+        const fr_rect *q = &s->rects[pr->index];
+        if (!m->two_sided && !(v3_dot(v3_sub(from, q->origin), q->normal) > 0.0f))
+            return 0;
+        if (!spherical_rect_setup(from, q->origin, q->edge_u, q->edge_v, &v->rect))
+            return 0;
+        *omega = v->rect.solid;
+        return 1;
+    }
+    if (pr->kind == FR_PRIM_TRIANGLE) {
+        const fr_triangle *t = &s->triangles[pr->index];
+        vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
+        if (!m->two_sided && !(v3_dot(v3_sub(from, p0), v3_cross(v3_sub(p1, p0), v3_sub(p2, p0))) > 0.0f))
+            return 0;
+        if (!spherical_tri_setup(from, p0, p1, p2, &v->tri))
+            return 0;
+        *omega = v->tri.solid;
+        return 1;
+    }
+    return 0;
+}
+
 /* Solid-angle pdf of point p (normal n) of area light `light`, picked
- * with probability pick, from `from`. */
-static float pdf_picked(const fr_scene *s, uint32_t light, float pick, vec3 from, vec3 p, vec3 n)
+ * with probability pick, from `from`: with `solid`, the density of
+ * lgt_sample_chosen (solid_setup's choice), else of lgt_sample_table
+ * (rectangles and triangles by area). */
+static float pdf_picked(const fr_scene *s, uint32_t light, float pick, vec3 from, vec3 p, vec3 n, int solid)
 {
     const fr_light *l = &s->lights[light];
     const fr_prim *pr = &s->prims[l->prim];
@@ -268,6 +344,10 @@ static float pdf_picked(const fr_scene *s, uint32_t light, float pick, vec3 from
         if (d2 > r2 * 1.0001f)
             return pick / (2.0f * FM_PI * cone_one_minus_cos(r2, d2));
     }
+    solid_view v;
+    float omega;
+    if (solid && solid_near(s, l, pr, from) && solid_setup(s, pr, &s->materials[pr->material], from, &v, &omega))
+        return pick / omega;
     vec3 d = v3_sub(p, from);
     float dist2 = v3_len2(d);
     float cosl = fabsf(v3_dot(n, d)) / sqrtf(dist2);
@@ -278,12 +358,12 @@ static float pdf_picked(const fr_scene *s, uint32_t light, float pick, vec3 from
 
 float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 nrm, vec3 p, vec3 n)
 {
-    return pdf_picked(s, light, lgt_pick_pdf(s, light, from, nrm), from, p, n);
+    return pdf_picked(s, light, lgt_pick_pdf(s, light, from, nrm), from, p, n, 1);
 }
 
 float lgt_pdf_table(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n)
 {
-    return pdf_picked(s, light, s->lights[light].pick, from, p, n);
+    return pdf_picked(s, light, s->lights[light].pick, from, p, n, 0);
 }
 
 vec3 lgt_distant(const fr_scene *s, uint32_t light, vec3 dir, float *pdf)
@@ -358,6 +438,22 @@ static int sample_other(const fr_scene *s, const fr_light *l, float pick, vec3 f
     return !v3_is_zero(out->radiance);
 }
 
+/* The point of triangle t with barycentrics b0, b1, b2 (of p0, p1, p2),
+ * its unit geometric normal, and when err is not NULL a bound on its error
+ * per coordinate. */
+static inline __attribute__((always_inline)) void tri_point(const fr_scene *s, const fr_triangle *t, float b0,
+                                                            float b1, float b2, vec3 *p, vec3 *n, vec3 *err)
+{
+    vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
+    /* p0 b0 + p1 b1 + p2 b2 and v3_norm(v3_cross(p1 - p0, p2 - p0)),
+     * three lanes at a time in the same order (lanes.h). */
+    f4 q0 = ln_from(p0), q1 = ln_from(p1), q2 = ln_from(p2);
+    *p = ln_vec(q0 * f4_set1(b0) + q1 * f4_set1(b1) + q2 * f4_set1(b2));
+    *n = ln_vec(ln_norm(ln_cross(q1 - q0, q2 - q0)));
+    if (err)
+        geo_triangle_point(p0, p1, p2, b1, b2, err);
+}
+
 /* A point uniform by area on primitive `pr` from (u1, u2): its position,
  * unit geometric normal, the coordinates trace_surface takes, and when err
  * is not NULL a bound on the point's error per coordinate (the
@@ -384,18 +480,10 @@ static inline __attribute__((always_inline)) void prim_point(const fr_scene *s, 
         *ua = u1;
         *ub = u2;
     } else {
-        const fr_triangle *t = &s->triangles[pr->index];
-        vec3 p0 = s->positions[t->v[0]], p1 = s->positions[t->v[1]], p2 = s->positions[t->v[2]];
         float su = sqrtf(u1), b1 = u2 * su, b0 = 1.0f - su, b2 = 1.0f - b0 - b1;
-        /* p0 b0 + p1 b1 + p2 b2 and v3_norm(v3_cross(p1 - p0, p2 - p0)),
-         * three lanes at a time in the same order (lanes.h). */
-        f4 q0 = ln_from(p0), q1 = ln_from(p1), q2 = ln_from(p2);
-        *p = ln_vec(q0 * f4_set1(b0) + q1 * f4_set1(b1) + q2 * f4_set1(b2));
-        *n = ln_vec(ln_norm(ln_cross(q1 - q0, q2 - q0)));
+        tri_point(s, &s->triangles[pr->index], b0, b1, b2, p, n, err);
         *ua = b1;
         *ub = b2;
-        if (err)
-            geo_triangle_point(p0, p1, p2, *ua, *ub, err);
     }
 }
 
@@ -421,11 +509,13 @@ int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 
     return 1;
 }
 
-/* Inlined where it is called, with prim_point and textured
- * (always_inline): the light sample's vectors stay in registers instead of
- * going through the stack at each call. */
-__attribute__((always_inline)) inline int lgt_sample_chosen(const fr_scene *s, uint32_t li, float pick, vec3 from,
-                                                            float u1, float u2, fr_light_sample *out)
+/* lgt_sample_chosen, with rectangles and triangles sampled in solid angle
+ * where solid_setup says so when `solid`, else by area.  Inlined where it
+ * is called, with prim_point and textured (always_inline): the light
+ * sample's vectors stay in registers instead of going through the stack at
+ * each call. */
+static inline __attribute__((always_inline)) int sample_chosen(const fr_scene *s, uint32_t li, float pick, vec3 from,
+                                                               float u1, float u2, int solid, fr_light_sample *out)
 {
     const fr_light *l = &s->lights[li];
     out->light = li;
@@ -457,8 +547,25 @@ __attribute__((always_inline)) inline int lgt_sample_chosen(const fr_scene *s, u
             return out->pdf > 0.0f && !v3_is_zero(out->radiance);
         }
     }
+    float ua, ub, omega;
+    solid_view v;
+    if (solid && solid_near(s, l, pr, from) && solid_setup(s, pr, m, from, &v, &omega)) {
+        /* Uniform in the solid angle the rectangle or triangle subtends:
+         * its coordinates of the point that direction reaches. */
+        if (pr->kind == FR_PRIM_RECT) {
+            spherical_rect_sample(&v.rect, u1, u2, &ua, &ub);
+            prim_point(s, pr, ua, ub, &out->p, &out->n, &ua, &ub, NULL);
+        } else {
+            spherical_tri_sample(&v.tri, u1, u2, &ua, &ub);
+            tri_point(s, &s->triangles[pr->index], 1.0f - ua - ub, ua, ub, &out->p, &out->n, NULL);
+        }
+        if (!(aim(out, from) > 0.0f))
+            return 0;
+        out->pdf = pick / omega;
+        out->radiance = textured(s, m, l->prim, out->p, ua, ub, lgt_emitted(m, out->n, v3_neg(out->wi)));
+        return out->pdf > 0.0f && !v3_is_zero(out->radiance);
+    }
     /* Uniform by area (a sphere seen from inside: over its whole surface). */
-    float ua, ub;
     prim_point(s, pr, u1, u2, &out->p, &out->n, &ua, &ub, NULL);
     float d2 = aim(out, from);
     if (!(d2 > 0.0f))
@@ -471,6 +578,12 @@ __attribute__((always_inline)) inline int lgt_sample_chosen(const fr_scene *s, u
     return !v3_is_zero(out->radiance);
 }
 
+__attribute__((always_inline)) inline int lgt_sample_chosen(const fr_scene *s, uint32_t li, float pick, vec3 from,
+                                                            float u1, float u2, fr_light_sample *out)
+{
+    return sample_chosen(s, li, pick, from, u1, u2, 1, out);
+}
+
 int lgt_sample(const fr_scene *s, vec3 from, vec3 nrm, float upick, float u1, float u2, fr_light_sample *out)
 {
     float pick;
@@ -478,12 +591,21 @@ int lgt_sample(const fr_scene *s, vec3 from, vec3 nrm, float upick, float u1, fl
     return li != FR_NONE && lgt_sample_chosen(s, li, pick, from, u1, u2, out);
 }
 
+/* By area, not in solid angle: bidirectional path tracing weighs its
+ * connection to a light (s = 1) against the strategies that reach the same
+ * light vertex otherwise with that vertex's density as a light subpath's
+ * origin, the table's pick over the light's area (lgt_pdf_emit); sampling
+ * it in solid angle here would need that density changed in every
+ * strategy's weight for the sum of the weights to stay 1.  Equiangular
+ * sampling picks the same point first by area (lgt_fixed_point).  The path
+ * tracer's own next-event estimation (lgt_sample_chosen) and its MIS
+ * (lgt_pdf) are the ones that change. */
 int lgt_sample_table(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out)
 {
     if (s->n_lights == 0)
         return 0;
     uint32_t li = lgt_pick(s, upick);
-    return lgt_sample_chosen(s, li, s->lights[li].pick, from, u1, u2, out);
+    return sample_chosen(s, li, s->lights[li].pick, from, u1, u2, 0, out);
 }
 
 /* ---- rays leaving lights ------------------------------------------------ */

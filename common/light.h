@@ -14,9 +14,14 @@
  * point is known when the light is picked (paths that start on a light,
  * equiangular sampling in media) the pick is the power table's: lgt_pick,
  * lgt_sample_table, lgt_pdf_table.
- * Points are chosen uniformly by area on rectangles and triangles,
- * uniformly in the visible cone on spheres seen from outside and on a sun's
- * disk, in proportion to the map (times sin theta) on an environment.
+ * lgt_sample and lgt_sample_chosen choose directions uniformly in the
+ * solid angle that a rectangle or triangle subtends (spherical.h) where it
+ * is near enough and not seen edge-on or from behind a one-sided emitter,
+ * else points uniformly by area; lgt_sample_table always by area (the
+ * density that the strategies of bidirectional path tracing and
+ * equiangular sampling count for the point, lgt_pdf_table's); uniformly in
+ * the visible cone on spheres seen from outside and on a sun's disk, in
+ * proportion to the map (times sin theta) on an environment.
  *
  * For paths that start on a light (light tracing, bidirectional methods):
  * lgt_sample_emit starts a ray on a light with the densities of its origin
@@ -81,9 +86,12 @@ int lgt_sample(const fr_scene *s, vec3 from, vec3 nrm, float upick, float u1, fl
 int lgt_sample_chosen(const fr_scene *s, uint32_t li, float pick, vec3 from, float u1, float u2,
                       fr_light_sample *out);
 
-/** lgt_sample with the power table's pick (lgt_pick) instead of the tree's:
- * for strategies whose other densities count the table's pick (the
- * connections of bidirectional path tracing, equiangular sampling). */
+/** lgt_sample with the power table's pick (lgt_pick) instead of the tree's,
+ * and rectangles and triangles sampled by area (lgt_fixed_point's point
+ * for the same numbers): for strategies whose other densities count the
+ * table's pick and the area density (the connections of bidirectional
+ * path tracing, whose MIS weights take the light vertex's density as a
+ * light subpath's origin, lgt_pdf_emit's; equiangular sampling). */
 int lgt_sample_table(const fr_scene *s, vec3 from, float upick, float u1, float u2, fr_light_sample *out);
 
 /** The point lgt_sample picks on light `light` with (u1, u2) wherever it is
@@ -99,10 +107,13 @@ int lgt_fixed_point(const fr_scene *s, uint32_t light, float u1, float u2, vec3 
 int lgt_has_fixed_point(const fr_scene *s, uint32_t light);
 
 /** Solid-angle pdf that lgt_sample would have produced the point `p` (normal
- * `n`) of area light `light` from `from` (normal nrm there). */
+ * `n`) of area light `light` from `from` (normal nrm there): for
+ * rectangles and triangles the same choice between solid angle and area
+ * as the sampler's, from the same (from, light), and the same density. */
 float lgt_pdf(const fr_scene *s, uint32_t light, vec3 from, vec3 nrm, vec3 p, vec3 n);
 
-/** The same for lgt_sample_table (the power table's pick; no normal). */
+/** The same for lgt_sample_table (the power table's pick, points by area;
+ * no normal). */
 float lgt_pdf_table(const fr_scene *s, uint32_t light, vec3 from, vec3 p, vec3 n);
 
 /** Radiance that distant light `light` sends along -dir toward the scene

@@ -71,9 +71,12 @@ static vec3 equiangular(const fr_scene *s, uint32_t medium, const fr_ray *ray, f
     float pd = med_distance_pdf(md, beta, t), ph = med_phase(md->g, v3_dot(ray->d, ls.wi));
     /* Densities of the (distance, light point) pair, each technique's
      * pdf of the point in solid angle at x: equiangular pe * pl (the
-     * table's pick), the vertex's light sample pd * pl' (the tree's pick
-     * from x), its phase sample pd * ph. */
-    float pl_tree = ls.pdf / ls.pick * lgt_pick_pdf(s, ls.light, x, v3s(0.0f));
+     * table's pick, the point by area), the vertex's light sample pd * pl'
+     * (the tree's pick from x, and on a rectangle or triangle the density
+     * of lgt_sample_chosen, which may sample its solid angle: lgt_pdf),
+     * its phase sample pd * ph. */
+    float pl_tree = ls.prim != FR_NONE ? lgt_pdf(s, ls.light, x, v3s(0.0f), ls.p, ls.n)
+                                       : ls.pdf / ls.pick * lgt_pick_pdf(s, ls.light, x, v3s(0.0f));
     float w = ls.delta ? vtx_power_heuristic(pe * ls.pdf, pd * pl_tree)
                        : vtx_power_heuristic3(pe * ls.pdf, pd * pl_tree, mis.area ? pd * ph : 0.0f);
     vec3 f = v3_mul(v3_mul(med_transmittance(md, t), md->sigma_s), v3_mul(tr, ls.radiance));
@@ -208,8 +211,12 @@ int vtx_direct_medium(const fr_scene *s, const vtx_vertex *v, uint32_t medium, v
     float pe = 0.0f;
     if (mis.equiangular && lgt_has_fixed_point(s, ls->light))
         pe = med_equiangular_pdf(v->seg.o, v->seg.d, v->seg_tmax, ls->p, v->t);
-    /* Equiangular sampling picks its light by the power table. */
-    float pl_table = pe > 0.0f ? ls->pdf / ls->pick * s->lights[ls->light].pick : 0.0f;
+    /* Equiangular sampling picks its light by the power table, and a point
+     * of a rectangle or triangle by area (lgt_pdf_table), where this
+     * sample may have sampled its solid angle. */
+    float pl_table = pe == 0.0f          ? 0.0f
+                     : ls->prim != FR_NONE ? lgt_pdf_table(s, ls->light, v->p, ls->p, ls->n)
+                                           : ls->pdf / ls->pick * s->lights[ls->light].pick;
     if (ls->delta && pe > 0.0f)
         out->weight = vtx_power_heuristic(med_distance_pdf(md, v->seg_beta, v->t) * ls->pdf, pe * pl_table);
     else if (!ls->delta && pe > 0.0f) {
