@@ -46,7 +46,9 @@ render() {
     eval "$4=\"\$$4 $(awk '{ printf "%.2f", $1 + $2 }' "$T/cpu")\""
 }
 # cycles: one timed Cycles render of the scene; appends the wall, CPU and
-# render seconds to cy_runs, cy_cpus and cy_render.
+# render seconds to cy_runs, cy_cpus and cy_render, and the render's own CPU
+# seconds (blender's start-up left out; cycles_common.py measures them) to
+# cy_rcpus.
 cycles() {
     /usr/bin/time -f '%e %U %S' -o "$T/cy.time" blender -b --factory-startup --python tests/refs/cycles_scene.py -- \
         "$T/cornell-cy.json" "$T/cy" cy "$SPP" >"$T/blender.log" 2>&1 ||
@@ -55,6 +57,7 @@ cycles() {
     cy_runs="$cy_runs $(awk '{ print $1 }' "$T/cy.time")"
     cy_cpus="$cy_cpus $(awk '{ printf "%.2f", $2 + $3 }' "$T/cy.time")"
     cy_render="$cy_render $r"
+    cy_rcpus="$cy_rcpus $(sed -n 's/^render CPU seconds: //p' "$T/blender.log" | tail -n 1)"
 }
 have_cycles=0
 if command -v blender >/dev/null 2>&1; then
@@ -64,7 +67,7 @@ if command -v blender >/dev/null 2>&1; then
         sed 's/"width": 512/"width": '"$W"'/; s/"height": 512/"height": '"$H"'/' >"$T/cornell-cy.json"
     grep -q '"two_sided": true' "$T/cornell-cy.json" || { echo "cannot make the light two-sided for Cycles"; exit 1; }
 fi
-runs="" cpus="" bruns="" bcpus="" cy_runs="" cy_cpus="" cy_render=""
+runs="" cpus="" bruns="" bcpus="" cy_runs="" cy_cpus="" cy_render="" cy_rcpus=""
 mkdir -p "$T/base"
 for run in $(seq $RUNS); do
     render bin/franja-worker "$T" runs cpus
@@ -92,6 +95,9 @@ if [ $have_cycles = 1 ]; then
     echo "Cycles ($(blender --version 2>/dev/null | head -n 1)), same size and spp, all cores, each run after Franja's:"
     echo "  wall seconds ($RUNS runs):$cy_runs; median $cw (its own render time:$cy_render; median $cr)"
     echo "  CPU seconds of the blender process ($RUNS runs):$cy_cpus; median $cc"
+    crc=$(med $cy_rcpus)
+    echo "  CPU seconds of the render alone ($RUNS runs):$cy_rcpus; median $crc"
+    awk "BEGIN { printf \"  Franja/Cycles CPU seconds of the render alone: %.3f\\n\", $cmedian / $crc }"
     awk "BEGIN { printf \"  samples per CPU-second: %.3f M; Franja/Cycles CPU seconds %.3f, wall %.3f (against Cycles' own render time: %.3f)\\n\", $W * $H * $SPP / $cc / 1e6, $cmedian / $cc, $median / $cw, $median / $cr }"
 else
     awk "BEGIN { printf \"no blender here; Cycles 3.4 measured earlier on the same kind of machine: 14.7 s wall on 2 cores, 0.59 M samples per CPU-second; Franja/Cycles wall %.2f\\n\", $median / 14.7 }"

@@ -23,7 +23,7 @@
 #   - at equal spp (SPP): wall seconds, CPU seconds (user + system of the
 #     whole process tree: Franja's workers on `nproc` row slabs; blender
 #     with its start-up and scene building, and Cycles' own render time as
-#     it prints it) and both RMSEs;
+#     it prints it, and the CPU seconds of its render alone) and both RMSEs;
 #   - at equal time: Franja at the spp that takes it as long (wall) as
 #     Cycles' own render time at SPP, and both RMSEs;
 #   - at equal RMSE: whether Franja's clamped RMSE at SPP is at most
@@ -72,14 +72,16 @@ franja() {
     } >"$3"
 }
 
-# cycles SPP SEED OUT: "wall cpu render" in $T/time (render: Cycles' own
-# render time, from its last progress line).
+# cycles SPP SEED OUT: "wall cpu render rcpu" in $T/time (render: Cycles'
+# own render time, from its last progress line; rcpu: the CPU seconds of the
+# render alone, blender's start-up left out, as cycles_common.py prints them).
 cycles() {
     mkdir -p "$T/cy"
     /usr/bin/time -f '%e %U %S' -o "$T/rt" blender -b --factory-startup --python tests/refs/cycles_scene.py -- \
         $SCENE "$T/cy" cy "$1" "$2" >"$T/blender.log" 2>&1 || { echo "blender failed:"; tail -5 "$T/blender.log"; exit 1; }
     r=$(grep -o 'Time: *[0-9][0-9:.]*' "$T/blender.log" | tail -n 1 | sed 's/Time: *//' | awk -F: '{ print $1 * 60 + $2 }')
-    awk -v r="$r" '{ printf "%s %.2f %s\n", $1, $2 + $3, r }' "$T/rt" >"$T/time"
+    rc=$(sed -n 's/^render CPU seconds: //p' "$T/blender.log" | tail -n 1)
+    awk -v r="$r" -v rc="$rc" '{ printf "%s %.2f %s %s\n", $1, $2 + $3, r, rc }' "$T/rt" >"$T/time"
     cp "$T/cy/cy.pfm" "$3"
 }
 
@@ -113,7 +115,7 @@ if [ $have_blender = 1 ]; then
     fi
     CREF=$ref
 fi
-fw="" fc="" fr="" fk="" cw="" cc="" cr="" ck="" crt="" ew="" er="" ek="" es=""
+fw="" fc="" fr="" fk="" cw="" cc="" cr="" ck="" crt="" crc="" ew="" er="" ek="" es=""
 for seed in $(seq "$RUNS"); do
     franja "$SPP" "$seed" "$T/f.pfm"
     set -- $(cat "$T/time")
@@ -121,7 +123,7 @@ for seed in $(seq "$RUNS"); do
     [ $have_blender = 1 ] || continue
     cycles "$SPP" "$seed" "$T/c.pfm"
     set -- $(cat "$T/time")
-    cw="$cw $1" cc="$cc $2" crt="$crt $3" cr="$cr $(rmse "$T/c.pfm" "$CREF")" ck="$ck $(crmse "$T/c.pfm" "$CREF")"
+    cw="$cw $1" cc="$cc $2" crt="$crt $3" crc="$crc $4" cr="$cr $(rmse "$T/c.pfm" "$CREF")" ck="$ck $(crmse "$T/c.pfm" "$CREF")"
     # Equal time: Franja's spp scaled to Cycles' render time at SPP.
     eq=$(awk -v s="$SPP" -v tf="$(echo $fw | awk '{ print $NF }')" -v tc="$3" \
         'BEGIN { n = int(s * tc / tf + 0.5); print n < 1 ? 1 : n }')
@@ -133,15 +135,15 @@ m() { echo "$@" | median; }
 printf 'Franja at %d spp: wall%s s, CPU%s s, RMSE%s, clamped RMSE%s; medians %s s wall, %s CPU-s, RMSE %s, clamped %s\n' \
     "$SPP" "$fw" "$fc" "$fr" "$fk" "$(m $fw)" "$(m $fc)" "$(m $fr)" "$(m $fk)"
 if [ $have_blender = 1 ]; then
-    printf 'Cycles at %d spp: wall%s s (blender start-up included), CPU%s s, render%s s; RMSE%s, clamped RMSE%s; medians %s s wall, %s CPU-s, %s s render, RMSE %s, clamped %s\n' \
-        "$SPP" "$cw" "$cc" "$crt" "$cr" "$ck" "$(m $cw)" "$(m $cc)" "$(m $crt)" "$(m $cr)" "$(m $ck)"
+    printf 'Cycles at %d spp: wall%s s (blender start-up included), CPU%s s, render%s s, render CPU%s s; RMSE%s, clamped RMSE%s; medians %s s wall, %s CPU-s, %s s render, %s render CPU-s, RMSE %s, clamped %s\n' \
+        "$SPP" "$cw" "$cc" "$crt" "$crc" "$cr" "$ck" "$(m $cw)" "$(m $cc)" "$(m $crt)" "$(m $crc)" "$(m $cr)" "$(m $ck)"
     printf 'Franja at equal time (Cycles render time): spp%s, wall%s s, RMSE%s, clamped RMSE%s; medians %s spp, %s s, RMSE %s, clamped %s\n' \
         "$es" "$ew" "$er" "$ek" "$(m $es)" "$(m $ew)" "$(m $er)" "$(m $ek)"
     awk -v a="$(m $fk)" -v b="$(m $ck)" -v c="$(m $ek)" -v ra="$(m $fr)" -v rb="$(m $cr)" -v fc="$(m $fc)" -v cc="$(m $cc)" \
-        -v crt="$(m $crt)" -v cw="$(m $cw)" 'BEGIN {
+        -v crt="$(m $crt)" -v cw="$(m $cw)" -v crc="$(m $crc)" 'BEGIN {
         printf "clamped RMSE ratio Franja/Cycles: %.2f at equal spp, %.2f at equal time (RMSE: %.2f at equal spp); CPU-s ratio at equal spp %.2f (below 1: Franja better)\n", a / b, c / b, ra / rb, fc / cc
         if (a <= b)
-            printf "equal RMSE: at %s spp Franja\47s clamped RMSE is at most Cycles\47 (%.4f, %.4f): Franja spends %.2f CPU-s for it, Cycles %.1f with start-up, about %.1f for the render alone (its render time times its CPU-s per wall second)\n", "'"$SPP"'", a, b, fc, cc, crt * cc / cw
+            printf "equal RMSE: at %s spp Franja\47s clamped RMSE is at most Cycles\47 (%.4f, %.4f): Franja spends %.2f CPU-s for it, Cycles %.1f with start-up, %.1f for the render alone (measured): Franja %.2f of the render\47s CPU-s\n", "'"$SPP"'", a, b, fc, cc, crc, fc / crc
         else
             printf "equal RMSE: at %s spp Franja\47s clamped RMSE is above Cycles\47 (%.4f, %.4f): run with a higher SPP for Franja to compare CPU-s\n", "'"$SPP"'", a, b }'
 fi
