@@ -70,7 +70,7 @@ void spherical_rect_sample(const spherical_rect *r, float u1, float u2, float *s
     float omb0 = zz / (zz + r->y0 * r->y0);
     float den = sqrtf(maxf(0.0f, fu * fu - omb0));
     float xu = (fu > 0.0f ? -r->z0 : r->z0) / den;
-    xu = clampf(xu, r->x0, r->x1);      /* also a NaN of 0/0 goes to x0 */
+    xu = xu > r->x0 ? (xu < r->x1 ? xu : r->x1) : r->x0; /* a NaN (0/0) goes to x0 */
     float dd = sqrtf(xu * xu + zz);
     float h0 = r->y0 / sqrtf(dd * dd + r->y0 * r->y0), h1 = r->y1 / sqrtf(dd * dd + r->y1 * r->y1);
     float hv = h0 + u2 * (h1 - h0), omh = (1.0f - hv) * (1.0f + hv);
