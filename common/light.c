@@ -62,11 +62,9 @@ uint32_t lgt_n_distant(const fr_scene *s)
 
 /* ---- the light tree (scene.h, fr_light_node) ------------------------------ */
 
-/* cos(max(0, a - b)) and sin(max(0, a - b)) of angles a, b in [0, pi]
- * given by their sines and cosines: no inverse trigonometry (pbrt-v4's
- * bounds of the importance). */
+/* cos(max(0, a - b)) of angles a, b in [0, pi] given by their sines and
+ * cosines: no inverse trigonometry (pbrt-v4's bounds of the importance). */
 static inline float cos_sub_clamped(float sa, float ca, float sb, float cb) { return ca > cb ? 1.0f : ca * cb + sa * sb; }
-static inline float sin_sub_clamped(float sa, float ca, float sb, float cb) { return ca > cb ? 0.0f : sa * cb - ca * sb; }
 
 /* The importance node n gives point p with unit normal nrm (zero: a point
  * in a medium, which takes light from every direction): its power times a
