@@ -131,6 +131,12 @@ done
 
 # A host that fails from its sixth slab on, in the middle of the range: it
 # is dropped, the other host renders the rest, every frame in its bytes.
+# The good host starts its first slab once the bad host has started one
+# (at most 10 s later) and takes 0.15 s a slab, so that slabs are left for
+# the bad host's three failures in a row (each fails at once): had the good
+# host taken them all first (the bad one joining late on a loaded machine),
+# or won the last ones as second copies (a failed copy of a finished slab
+# does not count), the bad host would not be dropped.
 cat >failing.sh <<SH
 #!/bin/sh
 case " \$* " in *" --rows "*) ;; *) exec "$WORKER" "\$@" ;; esac
@@ -138,8 +144,18 @@ echo x >>"$FH/failcount"
 [ "\$(wc -l <"$FH/failcount")" -gt 5 ] && exit 1
 exec "$WORKER" "\$@"
 SH
-chmod +x failing.sh
-printf 'good local - 1\nbad local - 1 worker=%s/failing.sh\n' "$FH" >t_fail
+cat >slow.sh <<SH
+#!/bin/sh
+case " \$* " in
+*" --rows "*)
+    n=0
+    while [ ! -e "$FH/failcount" ] && [ \$n -lt 200 ]; do sleep 0.05; n=\$((n + 1)); done
+    sleep 0.15 ;;
+esac
+exec "$WORKER" "\$@"
+SH
+chmod +x failing.sh slow.sh
+printf 'good local - 1 worker=%s/slow.sh\nbad local - 1 worker=%s/failing.sh\n' "$FH" "$FH" >t_fail
 "$FRANJA" render 'f.####.json' --frames 1-3 -o 'fail/f.####.pfm' $SIZE --hosts t_fail --slab-rows 2 2>logf
 check "the animation with a failing host renders" test $? -eq 0
 check "the failing host is dropped" grep -q "dropping host bad: 3 failures in a row" logf
