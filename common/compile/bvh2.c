@@ -16,6 +16,7 @@ void bvh2_costs(bvh2_node *bn, uint32_t v)
         n->as_leaf = 1;
         return;
     }
+    n->kinds = bn[n->kid[0]].kinds | bn[n->kid[1]].kinds;
     const float *ca = bn[n->kid[0]].cost, *cb = bn[n->kid[1]].cost;
     float split[FR_BVH_WIDTH + 1];
     uint8_t at[FR_BVH_WIDTH + 1];
@@ -31,7 +32,7 @@ void bvh2_costs(bvh2_node *bn, uint32_t v)
         }
     }
     float as_node = area * BVH2_TRAV_COST + split[FR_BVH_WIDTH];
-    float as_leaf = n->refs <= BVH2_LEAF_MAX ? area * bvh2_blocks(n->refs) : INFINITY;
+    float as_leaf = n->refs <= BVH2_LEAF_MAX && n->kinds != (BVH2_TRIS | BVH2_SHAPES) ? area * bvh2_blocks(n->refs) : INFINITY;
     n->wide = at[FR_BVH_WIDTH];
     n->as_leaf = as_leaf <= as_node;
     n->cost[0] = slot + (n->as_leaf ? as_leaf : as_node);

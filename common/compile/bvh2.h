@@ -24,6 +24,8 @@
 #include "simd4.h"
 
 enum { BVH2_LEAF_MIN = 4, BVH2_LEAF_MAX = 16 };
+/** bvh2_node.kinds: triangles, other primitives (a leaf holds one kind). */
+enum { BVH2_TRIS = 1, BVH2_SHAPES = 2 };
 #define BVH2_TRAV_COST 1.0f
 #define BVH2_SLOT_COST 0.5f
 
@@ -65,6 +67,7 @@ typedef struct {
     uint32_t kid[2];           /**< children, or a leaf's references [kid[0], kid[1]) */
     uint32_t refs;             /**< references in the subtree */
     uint8_t is_leaf;
+    uint8_t kinds;             /**< BVH2_TRIS and BVH2_SHAPES: what the subtree holds */
     uint8_t as_leaf;           /**< as one slot: 1 a leaf, 0 a wide node */
     uint8_t wide;              /**< as a wide node: slots from kid[0] (the rest from kid[1]) */
     uint8_t pick[FR_BVH_WIDTH]; /**< pick[j-1], j >= 2: 0 = as j-1 slots, else slots from kid[0] */
