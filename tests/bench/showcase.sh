@@ -28,7 +28,11 @@
 #     Cycles' own render time at SPP, and both RMSEs;
 #   - at equal RMSE: whether Franja's clamped RMSE at SPP is at most
 #     Cycles' at SPP, and then the CPU seconds each spent for it (Franja's:
-#     an upper bound of what it needs for Cycles' RMSE).
+#     an upper bound of what it needs for Cycles' RMSE);
+#   - at equal RMSE, measured: Franja rendered again at the spp where its
+#     clamped RMSE should meet Cycles' (SPP times the square of their ratio)
+#     and a sixteenth above, and the CPU ratio at the lower of the two whose
+#     median clamped RMSE is at most Cycles'.
 # Needs blender; without it, only Franja's figures.
 cd "$(dirname "$0")/../.." || exit 1
 [ -x bin/tools/imgcmp ] || { echo "$0: bin/tools/imgcmp is missing: run make bench (it builds the tools)" >&2; exit 1; }
@@ -146,4 +150,28 @@ if [ $have_blender = 1 ]; then
             printf "equal RMSE: at %s spp Franja\47s clamped RMSE is at most Cycles\47 (%.4f, %.4f): Franja spends %.2f CPU-s for it, Cycles %.1f with start-up, %.1f for the render alone (measured): Franja %.2f of the render\47s CPU-s\n", "'"$SPP"'", a, b, fc, cc, crc, fc / crc
         else
             printf "equal RMSE: at %s spp Franja\47s clamped RMSE is above Cycles\47 (%.4f, %.4f): run with a higher SPP for Franja to compare CPU-s\n", "'"$SPP"'", a, b }'
+fi
+# Equal RMSE, measured: Franja again at the spp that 1/spp scaling says
+# matches Cycles' clamped RMSE at SPP, and one step (a sixteenth) above it,
+# with the same seeds; the lowest of them whose median clamped RMSE is at
+# most Cycles' gives the CPU ratio.  The scaling only picks the spp: each
+# figure printed is a measured one.
+if [ $have_blender = 1 ]; then
+    s0=$(awk -v a="$(m $fk)" -v b="$(m $ck)" -v s="$SPP" 'BEGIN { n = int(s * (a / b) ^ 2 + 0.5); print n < 1 ? 1 : n }')
+    found=""
+    for q in $s0 $((s0 + (s0 + 15) / 16)); do
+        qc="" qk=""
+        for seed in $(seq "$RUNS"); do
+            franja "$q" "$seed" "$T/q.pfm"
+            set -- $(cat "$T/time")
+            qc="$qc $2" qk="$qk $(crmse "$T/q.pfm" "$FREF")"
+        done
+        echo "Franja at $q spp: CPU$qc s, clamped RMSE$qk; medians $(m $qc) CPU-s, clamped $(m $qk)"
+        if [ -z "$found" ] && awk -v a="$(m $qk)" -v b="$(m $ck)" 'BEGIN { exit !(a <= b) }'; then
+            found=1
+            awk -v q="$q" -v a="$(m $qk)" -v b="$(m $ck)" -v fc="$(m $qc)" -v crc="$(m $crc)" 'BEGIN {
+                printf "equal RMSE, measured: Franja at %d spp (clamped RMSE %.4f, Cycles\47 %.4f at %s spp) takes %.2f CPU-s, Cycles\47 render alone %.2f: Franja/Cycles %.3f\n", q, a, b, "'"$SPP"'", fc, crc, fc / crc }'
+        fi
+    done
+    [ -n "$found" ] || echo "equal RMSE, measured: neither spp reached Cycles' clamped RMSE; the figure at $SPP spp above stands"
 fi
