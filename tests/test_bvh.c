@@ -271,7 +271,9 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
     /* A leaf names a primitive once (a subtree packed into one leaf may
      * hold two parts of a triangle cut by a spatial split: the builder
      * keeps one), and only its last block may have empty lanes. */
-    int twice = 0, holes = 0;
+    /* The builder keeps triangles and other primitives in separate leaves,
+     * marked mixed exactly when they hold no triangle. */
+    int twice = 0, holes = 0, kinds = 0;
     for (uint32_t j = 0; j < s.n_nodes; j++)
         for (int c = 0; c < FR_BVH_WIDTH; c++) {
             uint32_t meta = s.nodes[j].leaf[c], nb = meta & FR_BVH_LEAF_MAX;
@@ -284,12 +286,14 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
                     holes += x / 4 + 1 < nb;
                     continue;
                 }
+                kinds += (s.prims[px].kind == FR_PRIM_TRIANGLE) == !!(meta & FR_BVH_MIXED);
                 for (uint32_t y = 0; y < x; y++)
                     twice += L[y / 4].prim[y % 4] == px;
             }
         }
     CHECK(twice == 0, "%s: %d primitives twice in one leaf", name, twice);
     CHECK(holes == 0, "%s: %d empty lanes before a leaf's last block", name, holes);
+    CHECK(kinds == 0, "%s: %d lanes whose kind is not their leaf's (triangles, or mixed: other shapes)", name, kinds);
     /* Lanes in use: one per primitive, more where spatial splits put a
      * primitive in several leaves. */
     uint32_t lanes = 0;
