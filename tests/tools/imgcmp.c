@@ -2,14 +2,16 @@
  *
  *   imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y]
  *          [--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]]
- *          [--clamp-pct P]
+ *          [--clamp-pct P] [--light L]
  *
  * IMAGE is box-downsampled to the reference's size when it is an integer
  * multiple of it; with --down, both are then box-downsampled by D (which
  * must divide the reference's sides), and everything below is measured on
  * the smaller images (block sizes in their pixels).  Prints each channel's mean (image and reference) and the
  * RMSE over all channels of the pixels off the light (reference pixels with
- * a channel >= 10 are the light), and with --max-block-rel the worst
+ * a channel >= L are the light; L = 10 unless --light says otherwise: 1
+ * leaves out the lamp's edge pixels too, which a render at twice the
+ * reference's size and the reference may place differently), and with --max-block-rel the worst
  * relative difference of the mean (all channels, off the light) over the
  * N x N blocks of the reference (N = 64 by default).  With limits, prints
  * the closing "N passed, N failed" line and exits non-zero when one is
@@ -52,6 +54,12 @@ static int cmp_float(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
+/* The light's threshold (--light): a reference pixel with a channel at or
+ * above it is the light. */
+static double light_at = 10;
+
+static int is_light(const float *q) { return q[0] >= light_at || q[1] >= light_at || q[2] >= light_at; }
+
 /* RMSE off the light of a against r with every channel clamped to the
  * pct-th percentile of r's channels off the light (in *at); -1 when
  * memory runs out or nothing is off the light. */
@@ -62,7 +70,7 @@ static double clamped_rmse(const image *a, const image *r, double pct, double *a
     if (!v) return -1;
     for (size_t i = 0; i < n; i++) {
         const float *q = r->px + i * 3;
-        if (q[0] < 10 && q[1] < 10 && q[2] < 10)
+        if (!is_light(q))
             for (int ch = 0; ch < 3; ch++) v[m++] = q[ch];
     }
     if (!m) { free(v); return -1; }
@@ -72,7 +80,7 @@ static double clamped_rmse(const image *a, const image *r, double pct, double *a
     free(v);
     for (size_t i = 0; i < n; i++) {
         const float *q = r->px + i * 3, *p = a->px + i * 3;
-        if (q[0] >= 10 || q[1] >= 10 || q[2] >= 10) continue;
+        if (is_light(q)) continue;
         for (int ch = 0; ch < 3; ch++) {
             double d = fmin(p[ch], t) - fmin(q[ch], t);
             se += d * d;
@@ -90,7 +98,7 @@ int main(int argc, char **argv)
     if (argc < 3) {
         fprintf(stderr, "usage: imgcmp IMAGE.pfm REFERENCE.pfm [--max-rmse X] [--max-mean-rel Y] "
                         "[--max-block-rel Z [--block N]] [--down D] [--region X0,Y0,X1,Y1 [--mask M.pfm]] "
-                        "[--clamp-pct P]\n");
+                        "[--clamp-pct P] [--light L]\n");
         return 2;
     }
     for (int i = 3; i + 1 < argc; i += 2) {
@@ -104,6 +112,13 @@ int main(int argc, char **argv)
             clamp_pct = atof(argv[i + 1]);
             if (!(clamp_pct > 0 && clamp_pct < 100)) {
                 fprintf(stderr, "imgcmp: --clamp-pct: expected a percentile between 0 and 100\n");
+                return 2;
+            }
+        }
+        else if (!strcmp(argv[i], "--light")) {
+            light_at = atof(argv[i + 1]);
+            if (!(light_at > 0 && light_at < 1e30)) {
+                fprintf(stderr, "imgcmp: --light: expected a positive radiance\n");
                 return 2;
             }
         }
@@ -150,7 +165,7 @@ int main(int argc, char **argv)
     for (int y = 0; y < r.h; y++)
         for (int x = 0; x < r.w; x++) {
             const float *q = r.px + ((size_t)y * r.w + x) * 3;
-            int light = q[0] >= 10 || q[1] >= 10 || q[2] >= 10;
+            int light = is_light(q);
             double fx = (x + 0.5) / r.w, fy = (y + 0.5) / r.h, px_se = 0;
             int in = fx >= reg[0] && fx < reg[2] && fy >= reg[1] && fy < reg[3];
             if (in && m.px) {
