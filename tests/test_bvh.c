@@ -185,6 +185,17 @@ static void nested(fr_builder *b, int n)
     tri(b, vert(b, v3(-1, -1, 0)), vert(b, v3(-0.9f, -1, 0)), vert(b, v3(-1, -0.9f, 0)));
 }
 
+/* nested(), each triangle with a sphere beside it of its size: the
+ * deepest leaves of a tree that is as deep as the build allows would hold
+ * both kinds, which the build keeps apart with one level more. */
+static void nested_mixed(fr_builder *b, int n)
+{
+    nested(b, n);
+    float s = 1.0f;
+    for (int i = 0; i < n; i++, s *= 0.5f)
+        bld_sphere(b, v3(0.3f + 1.5f * s, 0.1f + 0.5f * s, 0.2f + 0.5f * s), 0.25f * s, 0);
+}
+
 /* Long thin triangles at random places, all along one diagonal and
  * crossing one another: the inner nodes' area, the usual stand-in for the
  * SAH, is a poor guide to the collapsed tree's cost here. */
@@ -640,6 +651,7 @@ int main(void)
         {"grid", 40, 4000},          {"sheets", 600, 4000},   {"degenerate", 300, 2000},
         {"copies", 200, 1000},       {"mixed", 800, 3000},    {"mixed soup", 1500, 3000},
         {"slivers", 2000, 4000},     {"slivers and sheets", 600, 4000}, {"nested", 120, 2000},
+        {"nested among spheres", 120, 2000},
     };
     /* Every case through every walk this processor runs (the portable one
      * everywhere; on x86-64 the AVX2 one and the AVX-512 one where the
@@ -683,6 +695,7 @@ int main(void)
             case 8: others(&b[k], 100); soup(&b[k], cases[cs].n, 0.1f); degenerate(&b[k], 50); grid(&b[k], 10); break;
             case 9: slivers(&b[k], cases[cs].n); break;
             case 11: nested(&b[k], cases[cs].n); soup(&b[k], 100, 0.1f); break;
+            case 12: nested_mixed(&b[k], cases[cs].n); soup(&b[k], 100, 0.1f); break;
             default: slivers(&b[k], cases[cs].n); sheets(&b[k], 200); copies(&b[k], 30); others(&b[k], 40); break;
             }
         }
