@@ -8,7 +8,8 @@
 # cores, so the script also splits the loss into parts that such load
 # disturbs less, each a median over the -j N runs:
 # - occupancy: the seconds the workers of accepted slabs ran (the summary's
-#   "busy s"), over N times the render's seconds: 1.0 when no slot is ever
+#   "busy s", the seventh field of its host line), over N times the
+#   render's seconds: 1.0 when no slot is ever
 #   idle (start-up before the first slab, gaps between slabs, the tail);
 # - CPU ratio: CPU seconds (user + system, franja and its workers) of -j 1
 #   over -j N: below 1.0 when N processes at once each run slower (shared
@@ -46,7 +47,7 @@ parts() {
     hz=$(getconf CLK_TCK)
     cpu=$(awk -v hz="$hz" '{ sub(/.*\) /, ""); printf "%.3f", ($14 + $15) / hz }' "$T/stat")
     occ=$(awk -v n="$1" '/ spp in [0-9.]+ s:/ { for (i = 1; i < NF; i++) if ($i == "in") t = $(i + 1) }
-        $1 == "local" { busy = $(NF - 1) } END { if (t > 0) printf "%.4f", busy / (n * t) }' "$T/log")
+        $1 == "local" { busy = $7 } END { if (t > 0) printf "%.4f", busy / (n * t) }' "$T/log")
     echo "$cpu $occ"
 }
 c1="" cn="" occs=""
