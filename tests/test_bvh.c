@@ -351,6 +351,84 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
     scn_free(&s);
 }
 
+/* Leaves that mix triangles with other shapes, which the build no longer
+ * makes but a scene file may hold (FORMAT.md): a scene's tree replaced by
+ * one node over eight mixed leaves, the primitives dealt out to them in
+ * turn, and every walk checked against brute force. */
+static void mixed_leaves(void)
+{
+    fr_builder b;
+    start(&b);
+    soup(&b, 60, 0.3f);
+    others(&b, 30);
+    fr_scene s;
+    fr_error err;
+    if (frz_scene(&b, &s, &err) < 0) {
+        CHECK(0, "mixed leaves: build failed: %s", err.msg);
+        bld_free(&b);
+        return;
+    }
+    uint32_t np = s.n_prims, per = (np + FR_BVH_WIDTH - 1) / FR_BVH_WIDTH, nb = (per + 3) / 4;
+    fr_bvh_leaf *blocks = calloc((size_t)FR_BVH_WIDTH * nb, sizeof *blocks);
+    fr_bvh_node root;
+    memset(&root, 0, sizeof root);
+    int tris = 0, shapes = 0;
+    for (int c = 0; c < FR_BVH_WIDTH; c++) {
+        for (uint32_t k = 0; k < 4 * nb; k++) {
+            uint32_t p = (uint32_t)c + FR_BVH_WIDTH * k;
+            fr_bvh_leaf *L = &blocks[(size_t)c * nb + k / 4];
+            L->prim[k % 4] = k < per && p < np ? p : FR_NONE;
+            if (L->prim[k % 4] == FR_NONE)
+                continue;
+            if (s.prims[p].kind != FR_PRIM_TRIANGLE) {
+                shapes++;
+                continue;
+            }
+            tris++;
+            const fr_triangle *t = &s.triangles[s.prims[p].index];
+            for (int v = 0; v < 3; v++) {
+                vec3 q = s.positions[t->v[v]];
+                L->v[3 * v + 0][k % 4] = q.x;
+                L->v[3 * v + 1][k % 4] = q.y;
+                L->v[3 * v + 2][k % 4] = q.z;
+            }
+        }
+        /* Boxes far larger than their leaves (a bound need not be
+         * tight): every ray visits every leaf. */
+        for (int r = 0; r < 6; r++)
+            root.box[r][c] = r < 3 ? -100.0f : 100.0f;
+        root.child[c] = (uint32_t)c * nb;
+        root.leaf[c] = nb | FR_BVH_MIXED;
+    }
+    CHECK(tris > 0 && shapes > 0, "mixed leaves: %d triangle and %d other lanes", tris, shapes);
+    s.nodes = &root;
+    s.n_nodes = 1;
+    s.leaves = blocks;
+    s.n_leaves = FR_BVH_WIDTH * nb;
+    unsigned walks = trace_walks();
+    int def = trace_walk();
+    for (int k = 0; k < TRACE_WALKS; k++) {
+        if (!(walks >> k & 1))
+            continue;
+        trace_set_walk(k);
+        int bad = 0, hits = 0;
+        for (int i = 0; i < 3000; i++) {
+            fr_ray r = make_ray(&s, i % 4);
+            fr_hit hb = {0}, ht = {0};
+            int fb = brute(&s, &r, INFINITY, FR_NONE, &hb), ft = trace_closest(&s, &r, INFINITY, &ht);
+            hits += fb;
+            bad += fb != ft || (fb && (ht.prim != hb.prim || !same_bits(ht.t, hb.t))) ||
+                   trace_occluded(&s, &r, INFINITY, FR_NONE) != fb;
+        }
+        CHECK(bad == 0, "mixed leaves (%s walk): %d of 3000 rays differ from brute force", trace_walk_name(k), bad);
+        CHECK(hits > 150, "mixed leaves (%s walk): only %d rays hit", trace_walk_name(k), hits);
+    }
+    trace_set_walk(def);
+    free(blocks);
+    scn_free(&s);
+    bld_free(&b);
+}
+
 /* Depth of the wide tree under node v (1 for v alone). */
 static int wide_depth(const fr_bvh_node *nodes, uint32_t v)
 {
@@ -706,6 +784,7 @@ int main(void)
         bld_free(&b[1]);
     }
     trace_set_walk(def);
+    mixed_leaves();
     from_surfaces();
     return check_done();
 }
