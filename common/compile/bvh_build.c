@@ -608,20 +608,7 @@ static int bin_build(build *B, const span *s, int depth, int median, uint32_t *i
     if (kinds == (BVH2_TRIS | BVH2_SHAPES)) {
         /* Triangles and other primitives in separate leaves. */
         split_kinds(B, s, &pair[0], &pair[1]);
-        uint32_t kid[2];
-        for (int c = 0; c < 2; c++)
-            if (bin_build(B, &pair[c], depth + 1, median, &kid[c]) < 0)
-                return -1;
-        bvh2_node *v = &B->bn[me];
-        v->box = s->box;
-        v->kid[0] = kid[0];
-        v->kid[1] = kid[1];
-        v->refs = n;
-        bvh2_costs(B->bn, me);
-        *index = me;
-        return 0;
-    }
-    if (n <= BVH2_LEAF_MIN) {
+    } else if (n <= BVH2_LEAF_MIN) {
         bvh2_node *v = &B->bn[me];
         v->kinds = (uint8_t)kinds;
         v->box = s->box;
@@ -632,8 +619,9 @@ static int bin_build(build *B, const span *s, int depth, int median, uint32_t *i
         bvh2_costs(B->bn, me);
         *index = me;
         return 0;
+    } else {
+        split_span(B, s, &pair[0], &pair[1], median);
     }
-    split_span(B, s, &pair[0], &pair[1], median);
     uint32_t kid[2];
     for (int c = 0; c < 2; c++)
         if (bin_build(B, &pair[c], depth + 1, median, &kid[c]) < 0)
