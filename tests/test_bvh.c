@@ -351,6 +351,18 @@ static void compare(const char *name, fr_builder *b, fr_builder *again, int rays
     scn_free(&s);
 }
 
+/* Scene s from builder b; on failure a failed check naming `what`, b
+ * freed, and -1. */
+static int freeze(fr_builder *b, fr_scene *s, const char *what)
+{
+    fr_error err;
+    if (frz_scene(b, s, &err) == 0)
+        return 0;
+    CHECK(0, "%s: build failed: %s", what, err.msg);
+    bld_free(b);
+    return -1;
+}
+
 /* Leaves that mix triangles with other shapes, which the build no longer
  * makes but a scene file may hold (FORMAT.md): a scene's tree replaced by
  * one node over eight mixed leaves, the primitives dealt out to them in
@@ -362,12 +374,8 @@ static void mixed_leaves(void)
     soup(&b, 60, 0.3f);
     others(&b, 30);
     fr_scene s;
-    fr_error err;
-    if (frz_scene(&b, &s, &err) < 0) {
-        CHECK(0, "mixed leaves: build failed: %s", err.msg);
-        bld_free(&b);
+    if (freeze(&b, &s, "mixed leaves") < 0)
         return;
-    }
     uint32_t np = s.n_prims, per = (np + FR_BVH_WIDTH - 1) / FR_BVH_WIDTH, nb = (per + 3) / 4;
     fr_bvh_leaf *blocks = calloc((size_t)FR_BVH_WIDTH * nb, sizeof *blocks);
     fr_bvh_node root;
@@ -661,12 +669,8 @@ static void from_surfaces(void)
         start(&b);
         grid(&b, 40);
         fr_scene s;
-        fr_error err;
-        if (frz_scene(&b, &s, &err) < 0) {
-            CHECK(0, "from surfaces: build failed: %s", err.msg);
-            bld_free(&b);
+        if (freeze(&b, &s, "from surfaces") < 0)
             continue;
-        }
         int rays = 6000, bad = 0, badany = 0, hits = 0, own = 0;
         for (int i = 0; i < rays; i++) {
             uint32_t p = rnd_u32() % s.n_prims;
