@@ -10,8 +10,8 @@
  * the smaller images (block sizes in their pixels).  Prints each channel's mean (image and reference) and the
  * RMSE over all channels of the pixels off the light (reference pixels with
  * a channel >= L are the light; L = 10 unless --light says otherwise: 1
- * leaves out the lamp's edge pixels too, which a render at twice the
- * reference's size and the reference may place differently), and with --max-block-rel the worst
+ * leaves out the lamp's edge pixels too, where renderers may disagree by
+ * a fraction of a pixel), and with --max-block-rel the worst
  * relative difference of the mean (all channels, off the light) over the
  * N x N blocks of the reference (N = 64 by default).  With limits, prints
  * the closing "N passed, N failed" line and exits non-zero when one is
